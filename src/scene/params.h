@@ -1,0 +1,55 @@
+/* Table-driven renderer settings: one descriptor per setting gives its JSON key, type,
+ * range, default, unit and one-line doc. The scene loader, `--set` overrides, the
+ * normalized printout, sweeps and tuning all go through these tables, so a setting is
+ * declared in exactly one place (src/scene/settings.c). */
+#ifndef GR_PARAMS_H
+#define GR_PARAMS_H
+
+#include <stddef.h>
+#include "common/status.h"
+
+typedef enum gr_param_type {
+    GR_PT_DOUBLE, /* double */
+    GR_PT_INT,    /* int */
+    GR_PT_BOOL,   /* int holding 0 or 1; JSON true/false */
+    GR_PT_RGB,    /* double[3]; JSON [r, g, b] or one number for all three */
+    GR_PT_ENUM,   /* int index into enum_names; JSON string */
+    GR_PT_U64     /* unsigned long long; JSON number (integer-valued, < 2^53) */
+} gr_param_type;
+
+enum {
+    GR_PF_MIN_EXCL = 1u << 0, /* value must be > min rather than >= min */
+    GR_PF_MAX_EXCL = 1u << 1, /* value must be < max rather than <= max */
+    GR_PF_FROM_SCENE = 1u << 2 /* default is derived from the scene (NaN until resolved) */
+};
+
+typedef struct gr_param {
+    const char *name;               /* JSON key inside the section, e.g. "K" */
+    gr_param_type type;
+    size_t offset;                  /* offset of the field in the settings struct */
+    double min, max;                /* valid range (see flags) */
+    unsigned flags;
+    double def;                     /* default; NaN with GR_PF_FROM_SCENE */
+    const char *const *enum_names;  /* GR_PT_ENUM: NULL-terminated names */
+    const char *unit;               /* "m", "1/m", "" ... */
+    const char *doc;                /* one line for docs and --help */
+} gr_param;
+
+typedef struct gr_param_table {
+    const char *section;            /* "reference" or "shafts" */
+    const gr_param *params;
+    size_t count;
+} gr_param_table;
+
+/* Finds a descriptor by key; NULL if none. */
+const gr_param *gr_param_find(const gr_param_table *t, const char *name);
+/* Fills every field of settings with its default (NaN for GR_PF_FROM_SCENE). */
+void gr_param_defaults(const gr_param_table *t, void *settings);
+/* Sets one numeric setting (channel -1 = all channels of an RGB) after range checks.
+ * Errors name "section.name" and the reason (GR_E_INPUT). */
+gr_status gr_param_set_number(const gr_param_table *t, void *settings, const char *name,
+                              int channel, double value, gr_error *err);
+/* Reads one numeric setting (channel 0..2 for RGB, ignored otherwise). */
+double gr_param_get_number(const gr_param *p, const void *settings, int channel);
+
+#endif

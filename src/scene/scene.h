@@ -1,0 +1,111 @@
+/* The scene: everything both renderers need, nothing more (docs/scene-format.md).
+ * Conventions: y is up, the water rests at y = water.rest_height_m, lengths in metres,
+ * angles in degrees in the file, radians in derived fields. Directions in the xz-plane
+ * are given by an azimuth measured from +z toward +x: (sin a, cos a). */
+#ifndef GR_SCENE_H
+#define GR_SCENE_H
+
+#include <stdint.h>
+#include "common/status.h"
+#include "scene/settings.h"
+
+#define GR_MAX_WAVES 64
+#define GR_MAX_OCCLUDERS 256
+#define GR_GRAVITY 9.81 /* m/s^2, deep-water dispersion w^2 = g k */
+
+typedef struct gr_wave {
+    double amplitude_m;       /* a_i in seed eq. 5.5.7 */
+    double wavelength_m;      /* lambda; wavenumber k = 2 pi / lambda */
+    double direction_deg;     /* travel direction, azimuth from +z toward +x */
+    double phase_rad;         /* phi_i^0 */
+    double omega_rad_s;       /* w_i; from w^2 = g k unless given */
+    /* derived */
+    double k;                 /* 2 pi / lambda (1/m) */
+    double dir[2];            /* unit (x, z) direction: (sin a, cos a) */
+} gr_wave;
+
+typedef struct gr_water {
+    double rest_height_m;     /* h0 */
+    double time_s;            /* t in eq. 5.5.7 */
+    int n_waves;
+    gr_wave waves[GR_MAX_WAVES];
+} gr_water;
+
+typedef struct gr_sun {
+    double elevation_deg;     /* (0, 90] */
+    double azimuth_deg;       /* toward the sun, from +z toward +x */
+    double irradiance[3];     /* E_sun on a plane perpendicular to the rays (W/m^2, per RGB) */
+    double angular_diameter_deg; /* default 0.53 */
+    /* derived */
+    double to_sun[3];         /* unit vector toward the sun */
+    double dir[3];            /* I: unit direction in which sunlight travels (= -to_sun) */
+} gr_sun;
+
+typedef struct gr_medium {
+    double absorption[3];     /* sigma_a (1/m) */
+    double scattering[3];     /* sigma_s (1/m) */
+    double g;                 /* Henyey-Greenstein asymmetry, (-1, 1) */
+    double ior;               /* water IOR, default 1.333 */
+    char preset[64];          /* name of the preset used, "" if none */
+    /* derived */
+    double extinction[3];     /* sigma_t = sigma_a + sigma_s */
+} gr_medium;
+
+typedef struct gr_camera {
+    double position_m[3];
+    int has_look_at;          /* 1: look_at_m given; 0: yaw/pitch given */
+    double look_at_m[3];
+    double yaw_deg, pitch_deg;/* azimuth from +z toward +x; pitch up from horizontal */
+    double fov_deg;           /* vertical field of view, (0, 180) */
+    int width, height;        /* pixels */
+    /* derived: orthonormal frame */
+    double forward[3], right[3], up[3];
+} gr_camera;
+
+typedef enum gr_occluder_type { GR_OCC_BOX = 0, GR_OCC_SPHERE = 1 } gr_occluder_type;
+
+typedef struct gr_occluder {
+    gr_occluder_type type;
+    char name[64];            /* optional label, "" if none */
+    double center_m[3];
+    double size_m[3];         /* box: full extents along its local x, y, z */
+    double yaw_deg;           /* box: rotation about +y */
+    double radius_m;          /* sphere */
+} gr_occluder;
+
+typedef struct gr_scene {
+    char name[128];
+    gr_water water;
+    gr_sun sun;
+    gr_medium medium;
+    gr_camera camera;
+    int n_occluders;
+    gr_occluder occluders[GR_MAX_OCCLUDERS];
+    int has_seabed;
+    double seabed_depth_m;    /* seabed plane at y = rest_height - depth */
+    gr_reference_settings reference;
+    gr_shafts_settings shafts;
+    /* provenance */
+    char source_path[1024];   /* file it was loaded from, "" for a string */
+    char hash[17];            /* FNV-1a 64 of the normalized JSON, hex */
+} gr_scene;
+
+/* Loads, validates and normalizes a scene file. overrides: n_overrides strings of the
+ * form "json.path=value" (e.g. "shafts.K=0.7", "medium.g=0.9", "sun.irradiance=[1,2,3]"),
+ * applied to the JSON before validation so they are checked like the file itself.
+ * Errors name the file, the JSON path and the reason; GR_E_INPUT for bad content,
+ * GR_E_IO when the file cannot be read. */
+gr_status gr_scene_load_file(const char *path, const char *const *overrides, int n_overrides,
+                             gr_scene *out, gr_error *err);
+/* Same, from a JSON string; `label` names the source in error messages. */
+gr_status gr_scene_load_string(const char *json, const char *label,
+                               const char *const *overrides, int n_overrides,
+                               gr_scene *out, gr_error *err);
+/* Normalized JSON (every default filled in, stable key order, 2-space indent).
+ * Returns a malloc'd string the caller frees; NULL on allocation failure. */
+char *gr_scene_to_json(const gr_scene *s);
+/* Recomputes derived fields (wave k/dir/omega, sun direction, extinction, camera frame)
+ * and the hash after a caller changed fields in place (e.g. a sweep). Re-validates. */
+gr_status gr_scene_refresh(gr_scene *s, gr_error *err);
+
+#endif
