@@ -1,0 +1,33 @@
+/* Headless OpenGL 4.5 core context through EGL, with no window: the EGL device platform
+ * on a GPU (EGL_EXT_platform_device), Mesa's surfaceless platform (llvmpipe) elsewhere.
+ * GL entry points: include "gl/gl.h" (core profile prototypes through libOpenGL). */
+#ifndef GR_GLCTX_H
+#define GR_GLCTX_H
+
+#include "common/status.h"
+
+typedef struct gr_gl gr_gl; /* opaque: display + context; current on the creating thread */
+
+typedef enum gr_gl_platform {
+    GR_GL_AUTO = 0,        /* device platform if a hardware device works, else surfaceless */
+    GR_GL_SURFACELESS = 1, /* EGL_PLATFORM_SURFACELESS_MESA */
+    GR_GL_DEVICE = 2       /* EGL_PLATFORM_DEVICE_EXT */
+} gr_gl_platform;
+
+typedef struct gr_gl_options {
+    gr_gl_platform platform; /* 0 = auto; env GODRAYS_GL_PLATFORM=surfaceless|device overrides */
+    int debug;               /* create a debug context and print GL debug messages */
+} gr_gl_options;
+
+/* Creates the context and makes it current. opts may be NULL. Errors (GR_E_GL) say which
+ * EGL step failed and what to install. */
+gr_status gr_gl_create(const gr_gl_options *opts, gr_gl **out, gr_error *err);
+void gr_gl_destroy(gr_gl *gl); /* accepts NULL */
+const char *gr_gl_vendor(const gr_gl *gl);
+const char *gr_gl_renderer(const gr_gl *gl);
+const char *gr_gl_version(const gr_gl *gl);
+const char *gr_gl_platform_name(const gr_gl *gl); /* "surfaceless" or "device" */
+/* Returns GR_OK, or GR_E_GL with the pending glGetError codes named after `what`. */
+gr_status gr_gl_check(const char *what, gr_error *err);
+
+#endif

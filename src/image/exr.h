@@ -1,0 +1,14 @@
+/* EXR files through OpenEXR's C API (OpenEXRCore): float channels, named, plus metadata
+ * attributes. Writes go to a temporary file renamed into place: nothing half-written. */
+#ifndef GR_EXR_H
+#define GR_EXR_H
+
+#include "image/image.h"
+
+/* Writes every channel of img as 32-bit float (ZIP compression) with meta as attributes. */
+gr_status gr_exr_write(const char *path, const gr_image *img, const gr_metadata *meta, gr_error *err);
+/* Reads every channel (converted to float) and every attribute that is a string, float,
+ * double or int into meta (meta may be NULL). *out must be destroyed by the caller. */
+gr_status gr_exr_read(const char *path, gr_image **out, gr_metadata *meta, gr_error *err);
+
+#endif

@@ -1,0 +1,52 @@
+/* Float images with named channels, and the metadata that travels with them in EXR files. */
+#ifndef GR_IMAGE_H
+#define GR_IMAGE_H
+
+#include <stddef.h>
+#include "common/status.h"
+
+#define GR_IMAGE_MAX_CHANNELS 16
+#define GR_CHANNEL_NAME_MAX 32
+
+/* Pixels are interleaved, row-major, top row first: pixel (x, y) channel c is
+ * pixels[(y * width + x) * nchannels + c]. Channel names follow EXR usage: "R", "G", "B",
+ * "A", and extra channels such as "stderr.R" or "transmittance". */
+typedef struct gr_image {
+    int width, height, nchannels;
+    char names[GR_IMAGE_MAX_CHANNELS][GR_CHANNEL_NAME_MAX];
+    float *pixels;
+} gr_image;
+
+/* Allocates a zeroed image; names may be NULL (then "R","G","B","A" for up to 4 channels,
+ * "c4", "c5", ... after). Returns NULL on bad sizes or allocation failure. */
+gr_image *gr_image_create(int width, int height, int nchannels, const char *const *names);
+void gr_image_destroy(gr_image *img); /* accepts NULL */
+/* Index of the channel called name, or -1. */
+int gr_image_channel(const gr_image *img, const char *name);
+static inline float *gr_image_pixel(gr_image *img, int x, int y)
+{
+    return img->pixels + ((size_t)y * (size_t)img->width + (size_t)x) * (size_t)img->nchannels;
+}
+
+/* Metadata: ordered key -> value pairs, each a string or a double (EXR attributes). */
+typedef enum gr_meta_type { GR_META_STRING = 0, GR_META_DOUBLE = 1, GR_META_INT = 2 } gr_meta_type;
+typedef struct gr_meta_item {
+    char key[64];
+    gr_meta_type type;
+    char *str;      /* GR_META_STRING (owned) */
+    double num;     /* GR_META_DOUBLE / GR_META_INT */
+} gr_meta_item;
+typedef struct gr_metadata {
+    int count, capacity;
+    gr_meta_item *items;
+} gr_metadata;
+
+void gr_meta_init(gr_metadata *m);
+void gr_meta_free(gr_metadata *m); /* accepts NULL; leaves m empty */
+/* Adds or replaces. Return GR_OK or GR_E_NOMEM. */
+gr_status gr_meta_set_string(gr_metadata *m, const char *key, const char *value);
+gr_status gr_meta_set_double(gr_metadata *m, const char *key, double value);
+gr_status gr_meta_set_int(gr_metadata *m, const char *key, long long value);
+const gr_meta_item *gr_meta_get(const gr_metadata *m, const char *key); /* NULL if absent */
+
+#endif

@@ -1,0 +1,29 @@
+/* OpenImageIO behind a C interface (the only C++ in the project: oiio.cpp).
+ * No exception crosses this boundary: every failure becomes a gr_status. */
+#ifndef GR_OIIO_H
+#define GR_OIIO_H
+
+#include "image/image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* OpenImageIO's version string, e.g. "2.4.7". */
+const char *gr_oiio_version(void);
+/* Reads any format OpenImageIO reads (EXR, PNG, TIFF, HDR, ...) as float, all channels,
+ * channel names as the file gives them (8-bit files are decoded to linear only if
+ * linearize is nonzero; otherwise values are code/255). */
+gr_status gr_oiio_read(const char *path, int linearize, gr_image **out, gr_error *err);
+/* Writes a display-encoded 8-bit preview (PNG, by extension): the channels rgb[0..2] of img
+ * times `exposure`, clamped to [0, 1], then sRGB-encoded (OpenImageIO writes floats to 8-bit
+ * files without encoding). Written to a temporary name and renamed into place. */
+gr_status gr_oiio_write_preview(const char *path, const gr_image *img, const int rgb[3],
+                                double exposure, gr_error *err);
+/* Writes img as-is in the format the extension names (float data where the format allows). */
+gr_status gr_oiio_write(const char *path, const gr_image *img, gr_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
