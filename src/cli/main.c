@@ -8,6 +8,8 @@
 static const gr_command commands[] = {
     {"validate", "load and check a scene, print it normalized with defaults filled in", cmd_validate},
     {"info", "print library versions and the GL renderer of a headless EGL context", cmd_info},
+    {"shafts", "render the god-ray layer with seed 000's real-time shafts (OpenGL) to EXR + PNG", cmd_shafts},
+    {"reference", "render the ground-truth god-ray layer (Embree, single scattering) to EXR + PNG", cmd_reference},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
 

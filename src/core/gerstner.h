@@ -26,4 +26,13 @@ double gr_gerstner_steepness(const gr_water *w);
 int gr_gerstner_height_at(const gr_water *w, double x, double z, double t,
                           double *height, double *rest_x0, double *rest_z0);
 
+/* gr_gerstner_height_at with an explicit cap on damped-Newton iterations (height_at uses
+ * 64) and the number of iterations taken (may be NULL). Returns 0 when the rest point maps
+ * back to (x, z) within 1e-10 m + 8 eps (|x| + |z| + sum a_i), -1 otherwise (cap reached,
+ * no progress, non-finite input, NULL water); on -1 the outputs are finite but not a
+ * solution. */
+int gr_gerstner_height_at_iter(const gr_water *w, double x, double z, double t, int max_iter,
+                               double *height, double *rest_x0, double *rest_z0,
+                               int *iterations);
+
 #endif

@@ -17,6 +17,10 @@ gr_dvec3 gr_refract_d(gr_dvec3 I, gr_dvec3 N, double eta);
  * for the cosine of the incidence angle cos_i in [0, 1] measured on the side of index n1.
  * Returns 1 on total internal reflection. */
 double gr_fresnel_exact(double cos_i, double n1, double n2);
+/* The two polarizations of gr_fresnel_exact: reflectances R_s (TE) and R_p (TM), so that
+ * gr_fresnel_exact = (R_s + R_p) / 2. Both are 1 on total internal reflection. Either output
+ * pointer may be NULL. */
+void gr_fresnel_sp(double cos_i, double n1, double n2, double *r_s, double *r_p);
 /* Seed eq. 5.5.2a: R = R0 + (1 - R0)(1 - cos)^5. */
 double gr_fresnel_schlick(double cos_i, double r0);
 /* ((n1 - n2) / (n1 + n2))^2; 0.0204 for air (1.0) to water (1.333). */

@@ -19,11 +19,20 @@ static inline gr_vec3 gr_v3_cross(gr_vec3 a, gr_vec3 b)
     return gr_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
 static inline float gr_v3_len(gr_vec3 a) { return sqrtf(gr_v3_dot(a, a)); }
-/* Unit vector along a; a zero vector stays zero (never NaN). */
+/* Unit vector along a; a zero vector stays zero (never NaN). Vectors whose squared length
+ * would underflow or overflow (components below ~1e-19 or above ~1e19) are rescaled by
+ * their largest component first, so they still come out unit length. */
 static inline gr_vec3 gr_v3_norm(gr_vec3 a)
 {
-    float l = gr_v3_len(a);
-    return l > 0.0f ? gr_v3_scale(a, 1.0f / l) : a;
+    float l2 = gr_v3_dot(a, a);
+    if (!(l2 >= 1e-30f && l2 <= 1e30f)) {
+        float m = fmaxf(fabsf(a.x), fmaxf(fabsf(a.y), fabsf(a.z)));
+        if (!(m > 0.0f) || isinf(m))
+            return a; /* zero (or non-finite) stays as it is */
+        a = gr_v3(a.x / m, a.y / m, a.z / m); /* divide: 1/m may overflow for denormal m */
+        l2 = gr_v3_dot(a, a);
+    }
+    return gr_v3_scale(a, 1.0f / sqrtf(l2));
 }
 
 static inline gr_dvec3 gr_d3(double x, double y, double z) { gr_dvec3 r = {x, y, z}; return r; }
@@ -37,10 +46,18 @@ static inline gr_dvec3 gr_d3_cross(gr_dvec3 a, gr_dvec3 b)
     return gr_d3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
 static inline double gr_d3_len(gr_dvec3 a) { return sqrt(gr_d3_dot(a, a)); }
+/* Same contract as gr_v3_norm, with the rescue for components below ~1e-150 / above ~1e150. */
 static inline gr_dvec3 gr_d3_norm(gr_dvec3 a)
 {
-    double l = gr_d3_len(a);
-    return l > 0.0 ? gr_d3_scale(a, 1.0 / l) : a;
+    double l2 = gr_d3_dot(a, a);
+    if (!(l2 >= 1e-300 && l2 <= 1e300)) {
+        double m = fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
+        if (!(m > 0.0) || isinf(m))
+            return a;
+        a = gr_d3(a.x / m, a.y / m, a.z / m);
+        l2 = gr_d3_dot(a, a);
+    }
+    return gr_d3_scale(a, 1.0 / sqrt(l2));
 }
 static inline gr_vec3 gr_d3_to_f(gr_dvec3 a) { return gr_v3((float)a.x, (float)a.y, (float)a.z); }
 static inline gr_dvec3 gr_v3_to_d(gr_vec3 a) { return gr_d3(a.x, a.y, a.z); }

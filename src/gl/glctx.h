@@ -6,7 +6,9 @@
 
 #include "common/status.h"
 
-typedef struct gr_gl gr_gl; /* opaque: display + context; current on the creating thread */
+/* Opaque: display + context, current on the creating thread. A context is used from ONE
+ * thread only (EGL binds it per thread); create, use and destroy it on that thread. */
+typedef struct gr_gl gr_gl;
 
 typedef enum gr_gl_platform {
     GR_GL_AUTO = 0,        /* device platform if a hardware device works, else surfaceless */
@@ -29,5 +31,17 @@ const char *gr_gl_version(const gr_gl *gl);
 const char *gr_gl_platform_name(const gr_gl *gl); /* "surfaceless" or "device" */
 /* Returns GR_OK, or GR_E_GL with the pending glGetError codes named after `what`. */
 gr_status gr_gl_check(const char *what, gr_error *err);
+
+/* Added by the GL module: */
+const char *gr_gl_glsl_version(const gr_gl *gl); /* GL_SHADING_LANGUAGE_VERSION */
+/* Makes gl current again on the calling thread (after another gr_gl was created there). */
+gr_status gr_gl_make_current(gr_gl *gl, gr_error *err);
+/* Context version actually obtained (4.5 asked; 4.3 or 3.3 core if the driver refused). */
+void gr_gl_context_version(const gr_gl *gl, int *major, int *minor);
+/* Compiles a vertex + fragment shader pair and links them. `name` (e.g. the shader file)
+ * prefixes errors; a compile or link failure returns GR_E_GL with the driver's log (first
+ * lines, joined on one line). *program is 0 on failure. Needs a current context. */
+gr_status gr_gl_build_program(const char *name, const char *vert_src, const char *frag_src,
+                              unsigned *program, gr_error *err);
 
 #endif

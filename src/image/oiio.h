@@ -23,6 +23,18 @@ gr_status gr_oiio_write_preview(const char *path, const gr_image *img, const int
 /* Writes img as-is in the format the extension names (float data where the format allows). */
 gr_status gr_oiio_write(const char *path, const gr_image *img, gr_error *err);
 
+/* (compare module) Maps channel `channel` of src, values in [0, 1] (clamped), through the
+ * OpenImageIO color map called `map` ("inferno", "viridis", "magma", "plasma", "turbo",
+ * "blue-red", ...) into a new 3-channel "R","G","B" image of display-encoded values in [0, 1]
+ * (write it with gr_oiio_write: no further encoding). *out must be destroyed by the caller. */
+gr_status gr_oiio_color_map(const gr_image *src, int channel, const char *map, gr_image **out, gr_error *err);
+/* (compare module) Draws one line of text into the first three channels of img, baseline at
+ * y, starting at x (align 0), centred on x (1) or ending at x (2), in color rgb and size_px
+ * pixels high; font DejaVuSans if found, else OpenImageIO's default. GR_E_RUNTIME when no
+ * font can be loaded (callers may treat labels as optional). */
+gr_status gr_oiio_render_text(gr_image *img, int x, int y, const char *text, int size_px, const float rgb[3],
+                              int align, gr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

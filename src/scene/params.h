@@ -33,6 +33,9 @@ typedef struct gr_param {
     const char *const *enum_names;  /* GR_PT_ENUM: NULL-terminated names */
     const char *unit;               /* "m", "1/m", "" ... */
     const char *doc;                /* one line for docs and --help */
+    /* GR_PF_FROM_SCENE: the scene quantity the default is taken from, e.g.
+     * "medium.extinction" or "medium.g" (resolved by the scene loader). */
+    const char *scene_source;
 } gr_param;
 
 typedef struct gr_param_table {
@@ -51,5 +54,25 @@ gr_status gr_param_set_number(const gr_param_table *t, void *settings, const cha
                               int channel, double value, gr_error *err);
 /* Reads one numeric setting (channel 0..2 for RGB, ignored otherwise). */
 double gr_param_get_number(const gr_param *p, const void *settings, int channel);
+
+/* Index of an enum value by name; -1 if p is not an enum or the name is unknown. */
+int gr_param_enum_index(const gr_param *p, const char *name);
+/* Name of enum value `index`; NULL if out of range or p is not an enum. */
+const char *gr_param_enum_name(const gr_param *p, int index);
+/* Sets an enum setting by name. Errors list the valid names (GR_E_INPUT). */
+gr_status gr_param_set_enum(const gr_param_table *t, void *settings, const char *name,
+                            const char *value, gr_error *err);
+/* Checks a value against p's type and range (integer-valued for INT/U64/ENUM, 0/1 for
+ * BOOL, finite). Returns GR_OK or GR_E_INPUT with "section.name: reason, got V". */
+gr_status gr_param_check(const gr_param_table *t, const gr_param *p, double value, int channel,
+                         gr_error *err);
+/* Checks every field of settings (NaN is accepted only for unresolved
+ * GR_PF_FROM_SCENE fields when allow_unresolved is nonzero). */
+gr_status gr_param_validate(const gr_param_table *t, const void *settings, int allow_unresolved,
+                            gr_error *err);
+/* Writes p's valid range as text, e.g. "[1, 4096]", "(0, 1)", ">= 0"; returns buf. */
+const char *gr_param_range_text(const gr_param *p, char *buf, size_t n);
+/* Shortest "%.*g" text of v (15..17 digits) that reads back as exactly v; returns buf. */
+const char *gr_format_double(double v, char *buf, size_t n);
 
 #endif

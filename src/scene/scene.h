@@ -18,7 +18,7 @@ typedef struct gr_wave {
     double wavelength_m;      /* lambda; wavenumber k = 2 pi / lambda */
     double direction_deg;     /* travel direction, azimuth from +z toward +x */
     double phase_rad;         /* phi_i^0 */
-    double omega_rad_s;       /* w_i; from w^2 = g k unless given */
+    double omega_rad_s;       /* w_i; from w^2 = g k unless given (NaN: re-derive in refresh) */
     /* derived */
     double k;                 /* 2 pi / lambda (1/m) */
     double dir[2];            /* unit (x, z) direction: (sin a, cos a) */
@@ -58,7 +58,14 @@ typedef struct gr_camera {
     double yaw_deg, pitch_deg;/* azimuth from +z toward +x; pitch up from horizontal */
     double fov_deg;           /* vertical field of view, (0, 180) */
     int width, height;        /* pixels */
-    /* derived: orthonormal frame */
+    /* derived: orthonormal frame. right = normalize(cross(forward, +y)), up = cross(right,
+     * forward) (right-handed: right x up = -forward). Image x grows along right, image y
+     * grows downward (along -up): the ray through pixel centre (px + 0.5, py + 0.5) is
+     * forward + (2 (px + 0.5) / width - 1) tan(fov/2) (width/height) right
+     *         - (2 (py + 0.5) / height - 1) tan(fov/2) up.
+     * Looking straight up or down, right = (-cos yaw, 0, sin yaw) (the limit).
+     * With look_at_m given, yaw_deg/pitch_deg are derived from forward; with yaw/pitch
+     * given, look_at_m is derived as position + forward. */
     double forward[3], right[3], up[3];
 } gr_camera;
 
@@ -105,7 +112,10 @@ gr_status gr_scene_load_string(const char *json, const char *label,
  * Returns a malloc'd string the caller frees; NULL on allocation failure. */
 char *gr_scene_to_json(const gr_scene *s);
 /* Recomputes derived fields (wave k/dir/omega, sun direction, extinction, camera frame)
- * and the hash after a caller changed fields in place (e.g. a sweep). Re-validates. */
+ * and the hash after a caller changed fields in place (e.g. a sweep). Re-validates.
+ * A wave's omega_rad_s set to NaN is re-derived from w^2 = g k, and shafts.extinction /
+ * shafts.g set to NaN are re-taken from the medium (their defaults); otherwise values
+ * loaded from a file stay as they are. Errors are prefixed with source_path if set. */
 gr_status gr_scene_refresh(gr_scene *s, gr_error *err);
 
 #endif

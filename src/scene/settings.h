@@ -16,6 +16,9 @@ typedef struct gr_reference_settings {
     int threads;                  /* 0 = all cores */
     double target_error;          /* 0 = off; else refine until rel. std. error < this */
     double transmittance_cutoff;  /* camera rays stop where exp(-tau) falls below this */
+    double max_distance_m;        /* camera rays stop here at the latest (clear water) */
+    double patch_radius_m;        /* half size of the tessellated surface patch around the
+                                     camera; beyond it the waves' mean sunlight is used */
 } gr_reference_settings;
 
 typedef enum gr_target_format { GR_TARGET_RGBA8 = 0, GR_TARGET_RGBA16F = 1 } gr_target_format;

@@ -1,0 +1,374 @@
+#include "reference/beams.h"
+
+#include <float.h>
+#include <stdbool.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/gerstner.h"
+#include "core/optics.h"
+
+/* Per grid vertex, in the sheared local frame: surface point (pu, py, pw); the beam edge
+ * through it is (pu + au (y - py), y, pw + aw (y - py)); path length (y - py) * ity. */
+typedef struct beam_vertex {
+    float pu, py, pw;
+    float au, aw;        /* Tx/Ty - shear_x, Tz/Ty - shear_z: drift per metre of height */
+    float ity;           /* 1 / T_y (< 0) */
+    float tx, ty, tz;    /* refracted direction T */
+    float ft;            /* Fresnel transmittance; < 0 marks an unusable vertex */
+} beam_vertex;
+
+struct gr_beams {
+    gr_beam_stats stats;
+    int nu, nw;              /* cells */
+    beam_vertex *v;          /* (nu + 1) * (nw + 1) */
+    float *phi;              /* per triangle: F_t |I . a| (0 = no beam) */
+    float *ytop, *dy;        /* per triangle: top of the beam, slab height */
+    uint32_t *first;         /* per triangle: first primitive (size ntri + 1) */
+    uint32_t *prim_tri;      /* per primitive: its triangle */
+    double y_min;
+    float sx, sz;            /* shear: T0x / T0y, T0z / T0y */
+    RTCScene bvh, surface;
+};
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Triangle t of cell (i, j): 0 = (v00, v10, v11), 1 = (v00, v11, v01). */
+static inline void tri_vertices(const gr_beams *b, uint32_t t, uint32_t idx[3])
+{
+    uint32_t cell = t >> 1, i = cell % (uint32_t)b->nu, j = cell / (uint32_t)b->nu;
+    uint32_t row = (uint32_t)b->nu + 1;
+    uint32_t v00 = i + j * row, v10 = v00 + 1, v01 = v00 + row, v11 = v01 + 1;
+    idx[0] = v00;
+    idx[1] = (t & 1) ? v11 : v10;
+    idx[2] = (t & 1) ? v01 : v11;
+}
+
+/* Slab k of triangle t spans [lo, hi); the top slab is open upward and the bottom one
+ * downward, so each point of the beam belongs to exactly one slab (no double counting). */
+static inline void slab_range(const gr_beams *b, uint32_t t, uint32_t k, uint32_t nslab, float *lo, float *hi)
+{
+    *hi = k == 0 ? INFINITY : b->ytop[t] - (float)k * b->dy[t];
+    *lo = k + 1 == nslab ? -INFINITY : b->ytop[t] - (float)(k + 1) * b->dy[t];
+}
+
+static void beam_bounds(const struct RTCBoundsFunctionArguments *args)
+{
+    const gr_beams *b = args->geometryUserPtr;
+    uint32_t prim = args->primID, t = b->prim_tri[prim];
+    uint32_t nslab = b->first[t + 1] - b->first[t], k = prim - b->first[t];
+    float lo, hi;
+    slab_range(b, t, k, nslab, &lo, &hi);
+    float ylo = isinf(lo) ? (float)b->y_min : lo, yhi = isinf(hi) ? b->ytop[t] : hi;
+    uint32_t idx[3];
+    tri_vertices(b, t, idx);
+    float u0 = FLT_MAX, u1 = -FLT_MAX, w0 = FLT_MAX, w1 = -FLT_MAX;
+    for (int c = 0; c < 3; c++) {
+        const beam_vertex *v = &b->v[idx[c]];
+        for (int e = 0; e < 2; e++) {
+            float y = e ? yhi : ylo;
+            float u = v->pu + v->au * (y - v->py), w = v->pw + v->aw * (y - v->py);
+            u0 = fminf(u0, u); u1 = fmaxf(u1, u);
+            w0 = fminf(w0, w); w1 = fmaxf(w1, w);
+        }
+    }
+    /* widen by a few ulps of the coordinates so float rounding in the test cannot fall outside */
+    float eu = 1e-5f * (1.0f + fmaxf(fabsf(u0), fabsf(u1))), ew = 1e-5f * (1.0f + fmaxf(fabsf(w0), fabsf(w1)));
+    float ey = 1e-5f * (1.0f + fmaxf(fabsf(ylo), fabsf(yhi)));
+    struct RTCBounds *o = args->bounds_o;
+    o->lower_x = u0 - eu; o->upper_x = u1 + eu;
+    o->lower_y = ylo - ey; o->upper_y = yhi + ey;
+    o->lower_z = w0 - ew; o->upper_z = w1 + ew;
+}
+
+/* Never traced with rays: only point queries walk this BVH. */
+static void beam_intersect(const struct RTCIntersectFunctionNArguments *args) { (void)args; }
+static void beam_occluded(const struct RTCOccludedFunctionNArguments *args) { (void)args; }
+
+typedef struct lookup_state {
+    const gr_beams *b;
+    float u, y, w;
+    gr_beam_hit *hits;
+    int n, max, overflow;
+} lookup_state;
+
+static bool beam_query(struct RTCPointQueryFunctionArguments *args)
+{
+    lookup_state *s = args->userPtr;
+    const gr_beams *b = s->b;
+    uint32_t prim = args->primID, t = b->prim_tri[prim];
+    uint32_t nslab = b->first[t + 1] - b->first[t], k = prim - b->first[t];
+    float lo, hi;
+    slab_range(b, t, k, nslab, &lo, &hi);
+    float y = s->y;
+    if (!(y >= lo && y < hi)) return false;
+    uint32_t idx[3];
+    tri_vertices(b, t, idx);
+    const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
+    /* cross-section vertices at height y, relative to vertex 0 */
+    float d0 = y - v0->py, d1 = y - v1->py, d2 = y - v2->py;
+    float x0 = v0->pu + v0->au * d0, z0 = v0->pw + v0->aw * d0;
+    float e1u = v1->pu + v1->au * d1 - x0, e1w = v1->pw + v1->aw * d1 - z0;
+    float e2u = v2->pu + v2->au * d2 - x0, e2w = v2->pw + v2->aw * d2 - z0;
+    float qu = s->u - x0, qw = s->w - z0;
+    float det = e1u * e2w - e1w * e2u; /* twice the signed area: negative past a fold */
+    if (det == 0.0f) return false;      /* a measure-zero set: the exact focus */
+    float inv = 1.0f / det;
+    float l1 = (qu * e2w - qw * e2u) * inv;
+    float l2 = (e1u * qw - e1w * qu) * inv;
+    float l0 = 1.0f - l1 - l2;
+    if (l0 < 0.0f || l1 < 0.0f || l2 < 0.0f) return false;
+    /* distance from the surface along the beam; negative above the surface (in air) */
+    float path = l0 * d0 * v0->ity + l1 * d1 * v1->ity + l2 * d2 * v2->ity;
+    if (path < 0.0f) return false;
+    if (s->n >= s->max) { s->overflow = 1; return false; }
+    gr_beam_hit *h = &s->hits[s->n++];
+    h->prim = prim;
+    h->e_h = b->phi[t] / (0.5f * fabsf(det));
+    h->path_m = path;
+    h->T = gr_v3_norm(gr_v3(l0 * v0->tx + l1 * v1->tx + l2 * v2->tx,
+                            l0 * v0->ty + l1 * v1->ty + l2 * v2->ty,
+                            l0 * v0->tz + l1 * v1->tz + l2 * v2->tz));
+    return false;
+}
+
+int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hit *hits, int max_hits, int *overflow)
+{
+    if (overflow) *overflow = 0;
+    if (!b || !b->bvh) return 0;
+    lookup_state s;
+    s.b = b;
+    s.y = p.y;
+    s.u = p.x - b->sx * p.y;
+    s.w = p.z - b->sz * p.y;
+    s.hits = hits;
+    s.n = 0;
+    s.max = max_hits;
+    s.overflow = 0;
+    struct RTCPointQuery q;
+    q.x = s.u; q.y = s.y; q.z = s.w; q.time = 0.0f; q.radius = 0.0f;
+    struct RTCPointQueryContext ctx;
+    rtcInitPointQueryContext(&ctx);
+    rtcPointQuery(b->bvh, &q, &ctx, beam_query, &s);
+    /* sort by primitive id: the sum over beams then has one order whatever the BVH */
+    for (int i = 1; i < s.n; i++) {
+        gr_beam_hit h = hits[i];
+        int j = i - 1;
+        while (j >= 0 && hits[j].prim > h.prim) { hits[j + 1] = hits[j]; j--; }
+        hits[j + 1] = h;
+    }
+    if (overflow) *overflow = s.overflow;
+    return s.n;
+}
+
+static gr_status build_surface_mesh(gr_rtc *rtc, gr_beams *b, const gr_dvec3 *pos, gr_error *err)
+{
+    RTCDevice dev = rtc->device;
+    size_t nv = (size_t)(b->nu + 1) * (size_t)(b->nw + 1), nt = 2 * (size_t)b->nu * (size_t)b->nw;
+    b->surface = rtcNewScene(dev);
+    if (!b->surface) return gr_rtc_check(rtc, "reference: surface mesh", err);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv);
+    unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt);
+    if (v && idx) {
+        for (size_t i = 0; i < nv; i++) {
+            v[3 * i] = (float)pos[i].x; v[3 * i + 1] = (float)pos[i].y; v[3 * i + 2] = (float)pos[i].z;
+        }
+        for (size_t t = 0; t < nt; t++) tri_vertices(b, (uint32_t)t, idx + 3 * t);
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(b->surface, g);
+    }
+    rtcReleaseGeometry(g);
+    rtcCommitScene(b->surface);
+    return gr_rtc_check(rtc, "reference: building the surface mesh", err);
+}
+
+/* Number of depth slabs for a beam whose corners drift by up to `drift` metres per metre
+ * of height (in sheared coordinates): about one cell of drift per slab keeps its box tight. */
+static uint32_t slab_count(double depth, double drift, double cell, double scale)
+{
+    if (!(depth > 0.0)) return 1;
+    double n = ceil(depth * drift / (cell * scale));
+    if (!(n >= 1.0)) n = 1.0;
+    if (n > 4096.0) n = 4096.0;
+    return (uint32_t)n;
+}
+
+gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err)
+{
+    *out = NULL;
+    double t_start = now_s();
+    const gr_beam_region *r = &p->region;
+    double ext_u = (r->u1 - r->u0) + 2.0 * p->pad_m, ext_w = (r->w1 - r->w0) + 2.0 * p->pad_m;
+    if (!(ext_u > 0.0 && ext_w > 0.0) || p->res < 1)
+        return gr_fail(err, GR_E_INPUT, "reference: empty lit region (%g x %g m) or surface_res %d < 1", ext_u, ext_w, p->res);
+    double h = sqrt(ext_u * ext_w) / (double)p->res;
+    double nu_d = ceil(ext_u / h) + 1.0, nw_d = ceil(ext_w / h) + 1.0;
+    if (nu_d * nw_d * 2.0 > 1.0e9)
+        return gr_fail(err, GR_E_INPUT, "reference.surface_res: %d gives %.0f x %.0f cells, too many", p->res, nu_d, nw_d);
+    gr_beams *b = calloc(1, sizeof *b);
+    if (!b) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for beams");
+    b->nu = (int)nu_d;
+    b->nw = (int)nw_d;
+    b->y_min = r->y_min;
+    b->sx = (float)p->shear_x;
+    b->sz = (float)p->shear_z;
+    size_t nv = (size_t)(b->nu + 1) * (size_t)(b->nw + 1), ntri = 2 * (size_t)b->nu * (size_t)b->nw;
+    gr_dvec3 *pos = malloc(nv * sizeof *pos);
+    b->v = malloc(nv * sizeof *b->v);
+    b->phi = malloc(ntri * sizeof *b->phi);
+    b->ytop = malloc(ntri * sizeof *b->ytop);
+    b->dy = malloc(ntri * sizeof *b->dy);
+    b->first = malloc((ntri + 1) * sizeof *b->first);
+    float *drift = malloc(ntri * sizeof *drift);
+    if (!pos || !b->v || !b->phi || !b->ytop || !b->dy || !b->first || !drift) {
+        free(pos); free(drift); gr_beams_destroy(b);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu surface vertices (reference.surface_res)", nv);
+    }
+    double start_u = r->u0 - p->pad_m - p->jitter[0] * h, start_w = r->w0 - p->pad_m - p->jitter[1] * h;
+    gr_dvec3 I = p->sun_dir;
+    double eta = 1.0 / p->ior; /* air (n = 1) to water, seed eq. 5.5.1 with eta = n1 / n2 */
+    for (int j = 0; j <= b->nw; j++) {
+        for (int i = 0; i <= b->nu; i++) {
+            size_t k = (size_t)j * (size_t)(b->nu + 1) + (size_t)i;
+            double x0 = p->origin.x + start_u + i * h, z0 = p->origin.z + start_w + j * h;
+            gr_dvec3 P = gr_gerstner_position(p->water, x0, z0, p->water->time_s);
+            gr_dvec3 n;
+            gr_gerstner_frame(p->water, x0, z0, p->water->time_s, NULL, NULL, &n);
+            pos[k] = gr_d3_sub(P, p->origin);
+            beam_vertex *v = &b->v[k];
+            double cos_i = -gr_d3_dot(I, n);
+            gr_dvec3 T = cos_i > 0.0 ? gr_refract_d(I, n, eta) : gr_d3(0, 0, 0);
+            v->py = (float)pos[k].y;
+            v->pu = (float)(pos[k].x - p->shear_x * pos[k].y);
+            v->pw = (float)(pos[k].z - p->shear_z * pos[k].y);
+            v->tx = (float)T.x; v->ty = (float)T.y; v->tz = (float)T.z;
+            /* a refracted ray that does not head down (grazing sun on a steep back slope)
+             * leaves the water again at once: such vertices carry no beam (docs/reference.md) */
+            if (!(T.y < -1e-4)) {
+                v->ft = -1.0f;
+                v->au = v->aw = 0.0f;
+                v->ity = -1.0f;
+                continue;
+            }
+            v->ft = p->fresnel ? (float)(1.0 - gr_fresnel_exact(cos_i, 1.0, p->ior)) : 1.0f;
+            v->au = (float)(T.x / T.y - p->shear_x);
+            v->aw = (float)(T.z / T.y - p->shear_z);
+            v->ity = (float)(1.0 / T.y);
+        }
+    }
+    size_t lit = 0;
+    for (size_t t = 0; t < ntri; t++) {
+        uint32_t idx[3];
+        tri_vertices(b, (uint32_t)t, idx);
+        const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
+        b->phi[t] = 0.0f;
+        b->ytop[t] = fmaxf(v0->py, fmaxf(v1->py, v2->py));
+        drift[t] = 0.0f;
+        if (v0->ft < 0.0f || v1->ft < 0.0f || v2->ft < 0.0f) continue;
+        /* the grid's triangles wind so that their area vector points down */
+        gr_dvec3 a = gr_d3_scale(gr_d3_cross(gr_d3_sub(pos[idx[1]], pos[idx[0]]), gr_d3_sub(pos[idx[2]], pos[idx[0]])), 0.5);
+        double flux = gr_d3_dot(I, a); /* sun flux through the displaced triangle per unit E_sun */
+        if (!(flux > 0.0)) continue;   /* faces away from the sun: shadowed by its own wave */
+        /* F_t averaged over the vertices: O(h^2) like the rest of the tessellation */
+        b->phi[t] = (float)(flux * (v0->ft + v1->ft + v2->ft) / 3.0);
+        float d = 0.0f;
+        const beam_vertex *vs[3] = {v0, v1, v2};
+        for (int c = 0; c < 3; c++) d = fmaxf(d, hypotf(vs[c]->au, vs[c]->aw));
+        drift[t] = d;
+        lit++;
+    }
+    /* slabs: about one cell of drift each, coarsened uniformly if over the primitive budget */
+    double scale = 1.0;
+    size_t total = 0;
+    for (int attempt = 0; attempt < 64; attempt++) {
+        total = 0;
+        for (size_t t = 0; t < ntri; t++)
+            if (b->phi[t] > 0.0f) total += slab_count(b->ytop[t] - r->y_min, drift[t], h, scale);
+        if (total <= p->max_prims || total <= lit) break;
+        scale *= 1.25 * (double)total / (double)p->max_prims;
+    }
+    if (total > p->max_prims || total >= UINT32_MAX) {
+        free(pos); free(drift); gr_beams_destroy(b);
+        return gr_fail(err, GR_E_NOMEM, "reference.surface_res: %d needs %zu beam primitives, over the budget of %zu",
+                       p->res, total, p->max_prims);
+    }
+    b->prim_tri = malloc((total ? total : 1) * sizeof *b->prim_tri);
+    if (!b->prim_tri) {
+        free(pos); free(drift); gr_beams_destroy(b);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu beam primitives", total);
+    }
+    uint32_t np = 0;
+    for (size_t t = 0; t < ntri; t++) {
+        b->first[t] = np;
+        b->dy[t] = 1.0f;
+        if (!(b->phi[t] > 0.0f)) continue;
+        double depth = b->ytop[t] - r->y_min;
+        uint32_t ns = slab_count(depth, drift[t], h, scale);
+        b->dy[t] = depth > 0.0 ? (float)(depth / ns) : 1.0f;
+        for (uint32_t k = 0; k < ns; k++) b->prim_tri[np++] = (uint32_t)t;
+    }
+    b->first[ntri] = np;
+    free(drift);
+
+    RTCDevice dev = rtc->device;
+    gr_status st = GR_OK;
+    b->bvh = rtcNewScene(dev);
+    if (b->bvh && np > 0) {
+        rtcSetSceneBuildQuality(b->bvh, RTC_BUILD_QUALITY_MEDIUM);
+        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_USER);
+        if (g) {
+            rtcSetGeometryUserPrimitiveCount(g, np);
+            rtcSetGeometryUserData(g, b);
+            rtcSetGeometryBoundsFunction(g, beam_bounds, b);
+            rtcSetGeometryIntersectFunction(g, beam_intersect);
+            rtcSetGeometryOccludedFunction(g, beam_occluded);
+            rtcCommitGeometry(g);
+            rtcAttachGeometry(b->bvh, g);
+            rtcReleaseGeometry(g);
+        }
+    }
+    if (b->bvh) rtcCommitScene(b->bvh);
+    st = gr_rtc_check(rtc, "reference: building the beam BVH", err);
+    if (st == GR_OK && p->surface_mesh) st = build_surface_mesh(rtc, b, pos, err);
+    free(pos);
+    if (st != GR_OK) {
+        gr_beams_destroy(b);
+        return st;
+    }
+    b->stats.nu = b->nu;
+    b->stats.nw = b->nw;
+    b->stats.cell_m = h;
+    b->stats.triangles = ntri;
+    b->stats.lit_triangles = lit;
+    b->stats.prims = np;
+    b->stats.bytes = nv * sizeof *b->v + ntri * (3 * sizeof(float) + sizeof(uint32_t)) + np * sizeof(uint32_t);
+    b->stats.build_s = now_s() - t_start;
+    *out = b;
+    return GR_OK;
+}
+
+const gr_beam_stats *gr_beams_stats(const gr_beams *b) { return b ? &b->stats : NULL; }
+RTCScene gr_beams_surface(const gr_beams *b) { return b ? b->surface : NULL; }
+
+void gr_beams_destroy(gr_beams *b)
+{
+    if (!b) return;
+    if (b->bvh) rtcReleaseScene(b->bvh);
+    if (b->surface) rtcReleaseScene(b->surface);
+    free(b->v);
+    free(b->phi);
+    free(b->ytop);
+    free(b->dy);
+    free(b->first);
+    free(b->prim_tri);
+    free(b);
+}

@@ -1,0 +1,68 @@
+/* Beam prisms (illumination volumes) of refracted sunlight under a Gerstner surface, for
+ * one sun direction (docs/reference.md, "Beam prisms"). The rest grid of a surface patch is
+ * displaced (seed eq. 5.5.7), the sun is refracted at every vertex with the exact Fresnel
+ * transmittance, and each surface triangle's refracted beam carries the flux
+ * F_t |I . a| (a = the displaced triangle's area vector, per unit sun irradiance). The
+ * horizontal cross-section of a beam at height y has vertices linear in y, so its area is
+ * a quadratic in y and the horizontal irradiance inside is flux / |A(y)|: flux is
+ * conserved by construction, through foci and folds.
+ *
+ * Lookups go through an Embree BVH (user geometry): one primitive per beam and depth slab,
+ * in coordinates sheared along the mean refracted direction T0 (u = x - T0x/T0y y,
+ * w = z - T0z/T0y y), where beams are nearly vertical and slabs keep tight boxes.
+ * All positions are in the local frame (world - origin), origin.y = the rest height. */
+#ifndef GR_REF_BEAMS_H
+#define GR_REF_BEAMS_H
+
+#include <stddef.h>
+#include "reference/embree_scene.h"
+
+typedef struct gr_beam_region {
+    double u0, u1, w0, w1;   /* sheared horizontal bounds of the lit volume (local, m) */
+    double y_min;            /* local height of its bottom (<= 0) */
+} gr_beam_region;
+
+typedef struct gr_beam_params {
+    const gr_water *water;
+    gr_dvec3 origin;         /* world position of the local origin; origin.y = rest height */
+    gr_dvec3 sun_dir;        /* I for this beam set: unit, I_y < 0 */
+    double ior;              /* water IOR (air = 1) */
+    int fresnel;             /* 1: exact Fresnel transmittance; 0: F_t = 1 (flux oracle) */
+    double shear_x, shear_z; /* T0x / T0y and T0z / T0y */
+    gr_beam_region region;   /* where lookups must be complete */
+    double pad_m;            /* margin of the rest patch around the region */
+    int res;                 /* patch cells = res^2 (square cells) */
+    double jitter[2];        /* grid offset in cells, each in [0, 1) */
+    size_t max_prims;        /* budget of beam-slab primitives (memory bound) */
+    int surface_mesh;        /* 1: also build the displaced surface as an Embree mesh */
+} gr_beam_params;
+
+typedef struct gr_beams gr_beams;
+
+typedef struct gr_beam_stats {
+    int nu, nw;              /* cells of the rest patch */
+    double cell_m;           /* cell size (m) */
+    size_t triangles, lit_triangles, prims;
+    size_t bytes;            /* own arrays (Embree's BVH not included) */
+    double build_s;          /* wall time of the build */
+} gr_beam_stats;
+
+gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err);
+void gr_beams_destroy(gr_beams *b); /* accepts NULL */
+const gr_beam_stats *gr_beams_stats(const gr_beams *b);
+/* The displaced surface mesh (NULL unless params.surface_mesh). */
+RTCScene gr_beams_surface(const gr_beams *b);
+
+/* One beam through a point. */
+typedef struct gr_beam_hit {
+    unsigned prim;           /* for a deterministic summation order */
+    float e_h;               /* horizontal irradiance per unit sun irradiance: F_t |I.a| / |A(y)| */
+    float path_m;            /* distance travelled in water from the surface */
+    gr_vec3 T;               /* unit refracted direction at the point (interpolated) */
+} gr_beam_hit;
+
+/* Finds every beam containing the local point p; returns how many (at most max_hits,
+ * *overflow set to 1 if more were found), sorted by primitive id. */
+int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hit *hits, int max_hits, int *overflow);
+
+#endif

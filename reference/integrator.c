@@ -1,0 +1,834 @@
+#include "reference/integrator.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#if defined(__SSE2__)
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+#endif
+
+#include "core/gerstner.h"
+#include "core/optics.h"
+#include "core/rng.h"
+#include "reference/beams.h"
+#include "reference/embree_scene.h"
+#include "reference/progress.h"
+#include "scene/settings.h"
+
+#define REF_MAX_HITS 256
+#define REF_DEFAULT_MAX_PRIMS ((size_t)16 * 1024 * 1024)
+#define REF_EXP_LIMIT 700.0 /* exp(-700) ~ 1e-304: below any image value, above denormals */
+
+/* Random numbers: counter-based (core/rng.h), one generator per (seed, stream, index), so
+ * a sample's numbers never depend on the thread that draws them. */
+typedef gr_rng ref_rng;
+static inline ref_rng rng_make(uint64_t seed, uint64_t stream, uint64_t index) { return gr_rng_make(seed, stream, index); }
+static inline double rng_u(ref_rng *r) { return gr_rng_double(r); } /* [0, 1) */
+enum { STREAM_PASS = 1, STREAM_PIXEL0 = 16 };
+
+typedef struct ref_light {
+    gr_vec3 T;        /* unit refracted direction */
+    float eperp;      /* irradiance perpendicular to T per unit E_sun, before extinction */
+    float path;       /* distance from the surface along T */
+} ref_light;
+
+struct gr_ref_renderer {
+    gr_scene scene;
+    gr_ref_options opt;
+    gr_reference_settings set;
+    gr_rtc *rtc;
+    gr_ref_geometry *geom;
+    gr_beams *beams;
+    int beams_pass;
+    int flat;
+    gr_dvec3 origin;          /* (camera x, rest height, camera z) */
+    gr_vec3 cam;              /* camera in the local frame */
+    gr_dvec3 I0, T0, e1, e2;  /* sun centre, its flat refraction, a frame around I0 */
+    double sx, sz;            /* shear T0x / T0y, T0z / T0y */
+    double sun_radius;        /* angular radius in air (rad) */
+    double cutoff_d;
+    gr_beam_region region;
+    double pad;
+    int passes_per_round, spp_pass, batches, threads;
+    double sig_t[3], sig_s[3], E[3];
+    double sig_ref;           /* min_c sigma_t: the march's importance density */
+    /* current pass */
+    gr_dvec3 Ip;
+    gr_vec3 Tp;
+    float flat_eperp;         /* F_t cos(theta_i) / cos(theta_t): Oracle 1's E_w / E_sun */
+    float mu_t;
+    double beam_build_s;
+};
+
+void gr_ref_options_default(gr_ref_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->fresnel = 1;
+    o->progress = 1;
+}
+
+static double mono_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int is_flat(const gr_water *w)
+{
+    for (int i = 0; i < w->n_waves; i++)
+        if (w->waves[i].amplitude_m != 0.0) return 0;
+    return 1;
+}
+
+static double wave_amplitude_sum(const gr_water *w)
+{
+    double a = 0.0;
+    for (int i = 0; i < w->n_waves; i++) a += fabs(w->waves[i].amplitude_m);
+    return a;
+}
+
+static gr_dvec3 cam_dir(const gr_ref_renderer *r, double ndx, double ndy)
+{
+    const gr_camera *c = &r->scene.camera;
+    gr_dvec3 f = gr_d3(c->forward[0], c->forward[1], c->forward[2]);
+    gr_dvec3 rt = gr_d3(c->right[0], c->right[1], c->right[2]);
+    gr_dvec3 up = gr_d3(c->up[0], c->up[1], c->up[2]);
+    return gr_d3_norm(gr_d3_madd(gr_d3_madd(f, rt, ndx), up, ndy));
+}
+
+static void grow(double b[4], double u, double w)
+{
+    if (u < b[0]) b[0] = u;
+    if (u > b[1]) b[1] = u;
+    if (w < b[2]) b[2] = w;
+    if (w > b[3]) b[3] = w;
+}
+
+/* Largest drift |T_xz / T_y - T0_xz / T0_y| of a refracted ray per metre of height, over
+ * every normal the waves can have: Gerstner slopes are bounded by tan = Q / sqrt(1 - Q^2)
+ * with Q = sum a_i k_i (the slope sin / (1 - Q cos) peaks at cos = Q). */
+static double max_drift(const gr_ref_renderer *r)
+{
+    double Q = gr_gerstner_steepness(&r->scene.water);
+    if (Q >= 0.999) Q = 0.999;
+    double tilt = atan(Q / sqrt(1.0 - Q * Q)) + r->sun_radius;
+    double best = 0.0;
+    for (int ia = 0; ia < 64; ia++) {
+        double az = 2.0 * GR_PI * ia / 64.0;
+        for (int it = 1; it <= 8; it++) {
+            double a = tilt * it / 8.0;
+            gr_dvec3 n = gr_d3(sin(a) * sin(az), cos(a), sin(a) * cos(az));
+            if (gr_d3_dot(r->I0, n) >= 0.0) continue;
+            gr_dvec3 T = gr_refract_d(r->I0, n, 1.0 / r->scene.medium.ior);
+            if (!(T.y < -1e-3)) return INFINITY;
+            double du = T.x / T.y - r->sx, dw = T.z / T.y - r->sz;
+            double d = sqrt(du * du + dw * dw);
+            if (d > best) best = d;
+        }
+    }
+    return best;
+}
+
+/* The lit region: sheared bounds of the visible volume (camera frustum up to each ray's
+ * end), clamped to reference.patch_radius_m around the camera. */
+static void compute_region(gr_ref_renderer *r)
+{
+    const gr_scene *s = &r->scene;
+    double A = wave_amplitude_sum(&s->water);
+    double R = s->reference.patch_radius_m;
+    double b[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
+    double ymin = 0.0;
+    gr_vec3 o = r->cam;
+    double seabed_y = s->has_seabed ? -s->seabed_depth_m : -INFINITY;
+    if (r->opt.lit_box_valid) {
+        const double *lb = r->opt.lit_box;
+        ymin = lb[4] - r->origin.y;
+        for (int i = 0; i < 8; i++) {
+            double x = ((i & 1) ? lb[1] : lb[0]) - r->origin.x, z = ((i & 2) ? lb[3] : lb[2]) - r->origin.z;
+            double y = (i & 4) ? A : ymin;
+            grow(b, x - r->sx * y, z - r->sz * y);
+        }
+    } else {
+        grow(b, o.x - r->sx * o.y, o.z - r->sz * o.y);
+        ymin = o.y;
+        const gr_camera *c = &s->camera;
+        double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), aspect = (double)c->width / (double)c->height;
+        enum { NS = 16 };
+        for (int iy = 0; iy <= NS; iy++)
+            for (int ix = 0; ix <= NS; ix++) {
+                gr_dvec3 d = cam_dir(r, (2.0 * ix / NS - 1.0) * tf * aspect, (1.0 - 2.0 * iy / NS) * tf);
+                double D = r->cutoff_d;
+                if (d.y < 0.0 && s->has_seabed) D = fmin(D, (seabed_y - o.y) / d.y);
+                if (d.y > 0.0) D = fmin(D, (A - o.y) / d.y);
+                double ex = o.x + D * d.x, ey = o.y + D * d.y, ez = o.z + D * d.z;
+                grow(b, ex - r->sx * ey, ez - r->sz * ey);
+                if (ey < ymin) ymin = ey;
+            }
+        double uc = o.x - r->sx * o.y, wc = o.z - r->sz * o.y;
+        b[0] = fmax(b[0], uc - R); b[1] = fmin(b[1], uc + R);
+        b[2] = fmax(b[2], wc - R); b[3] = fmin(b[3], wc + R);
+        ymin = fmax(ymin, o.y - R);
+    }
+    ymin = fmax(ymin, seabed_y);
+    ymin = fmin(ymin, -A) - 0.05;
+    double mu = 0.02 * fmax(b[1] - b[0], b[3] - b[2]) + 0.1;
+    r->region.u0 = b[0] - mu; r->region.u1 = b[1] + mu;
+    r->region.w0 = b[2] - mu; r->region.w1 = b[3] + mu;
+    r->region.y_min = ymin;
+    /* rest patch margin: horizontal Gerstner displacement plus the largest drift of a beam
+     * over the region's depth (rays enter the region from outside it) */
+    double pad = A + fabs(ymin) * max_drift(r) + 0.25;
+    if (!(pad <= R)) pad = R;
+    r->pad = pad;
+}
+
+gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_renderer **out, gr_error *err)
+{
+    *out = NULL;
+    gr_ref_renderer *r = calloc(1, sizeof *r);
+    if (!r) return gr_fail(err, GR_E_NOMEM, "reference: out of memory");
+    r->scene = *s;
+    if (o) r->opt = *o;
+    else gr_ref_options_default(&r->opt);
+    if (!r->opt.max_prims) r->opt.max_prims = REF_DEFAULT_MAX_PRIMS;
+    if (!r->opt.max_rounds) r->opt.max_rounds = 64;
+    r->set = s->reference;
+    r->beams_pass = -1;
+    r->flat = is_flat(&s->water) && !r->opt.force_beams;
+    const gr_reference_settings *st = &r->set;
+    if (st->batches < 2) {
+        int nb = st->batches;
+        free(r);
+        return gr_fail(err, GR_E_INPUT, "reference.batches: %d, need at least 2 for error bars", nb);
+    }
+    r->batches = st->batches;
+    int S = st->sun_samples < 1 ? 1 : st->sun_samples;
+    /* every batch gets the same number of passes: round the sun samples up */
+    r->passes_per_round = ((S + r->batches - 1) / r->batches) * r->batches;
+    /* reference.spp counts samples per pixel in each batch; a batch has P / B passes */
+    int per_batch = r->passes_per_round / r->batches;
+    r->spp_pass = (st->spp + per_batch - 1) / per_batch;
+    if (r->spp_pass < 1) r->spp_pass = 1;
+    r->threads = st->threads > 0 ? st->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (r->threads < 1) r->threads = 1;
+
+    r->origin = gr_d3(s->camera.position_m[0], s->water.rest_height_m, s->camera.position_m[2]);
+    r->cam = gr_v3(0.0f, (float)(s->camera.position_m[1] - s->water.rest_height_m), 0.0f);
+    r->I0 = gr_d3_norm(gr_d3(s->sun.dir[0], s->sun.dir[1], s->sun.dir[2]));
+    r->T0 = gr_refract_d(r->I0, gr_d3(0, 1, 0), 1.0 / s->medium.ior);
+    r->sx = r->T0.x / r->T0.y;
+    r->sz = r->T0.z / r->T0.y;
+    gr_dvec3 helper = fabs(r->I0.y) < 0.9 ? gr_d3(0, 1, 0) : gr_d3(1, 0, 0);
+    r->e1 = gr_d3_norm(gr_d3_cross(r->I0, helper));
+    r->e2 = gr_d3_cross(r->I0, r->e1);
+    r->sun_radius = 0.5 * s->sun.angular_diameter_deg * GR_PI / 180.0;
+    double smin = INFINITY;
+    for (int c = 0; c < 3; c++) {
+        r->sig_t[c] = s->medium.extinction[c];
+        r->sig_s[c] = s->medium.scattering[c];
+        r->E[c] = s->sun.irradiance[c];
+        if (r->sig_t[c] < smin) smin = r->sig_t[c];
+    }
+    r->sig_ref = smin > 0.0 ? smin : 0.0;
+    /* camera rays stop where the transmittance of the least attenuated channel falls below
+     * the cutoff, and in any case at reference.max_distance_m */
+    r->cutoff_d = st->max_distance_m;
+    if (smin > 0.0 && st->transmittance_cutoff > 0.0) r->cutoff_d = fmin(r->cutoff_d, -log(st->transmittance_cutoff) / smin);
+    compute_region(r);
+
+    gr_status rc = gr_rtc_create(r->threads, &r->rtc, err);
+    if (rc == GR_OK)
+        rc = gr_ref_geometry_create(r->rtc, s, r->origin, r->cutoff_d + fabs(r->cam.y) + 1.0, &r->geom, err);
+    if (rc != GR_OK) {
+        gr_ref_destroy(r);
+        return rc;
+    }
+    *out = r;
+    return GR_OK;
+}
+
+void gr_ref_destroy(gr_ref_renderer *r)
+{
+    if (!r) return;
+    gr_beams_destroy(r->beams);
+    gr_ref_geometry_destroy(r->geom);
+    gr_rtc_destroy(r->rtc);
+    free(r);
+}
+
+gr_dvec3 gr_ref_pass_sun_dir(const gr_ref_renderer *r, int pass)
+{
+    ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)pass);
+    int P = r->passes_per_round;
+    /* stratified in the disc's solid angle (cos r uniform in [cos R, 1]), random azimuth */
+    double u = ((pass % P) + rng_u(&g)) / P;
+    double phi = 2.0 * GR_PI * rng_u(&g);
+    double cr = 1.0 - u * (1.0 - cos(r->sun_radius)), sr = sqrt(fmax(0.0, 1.0 - cr * cr));
+    gr_dvec3 off = gr_d3_madd(gr_d3_scale(r->e1, cos(phi)), r->e2, sin(phi));
+    return gr_d3_norm(gr_d3_madd(gr_d3_scale(r->I0, cr), off, sr));
+}
+
+gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
+{
+    r->Ip = gr_ref_pass_sun_dir(r, pass);
+    ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)pass);
+    (void)rng_u(&g);
+    (void)rng_u(&g);
+    double jit[2] = {rng_u(&g), rng_u(&g)};
+    /* Oracle 1: flat refraction, E_w / E_sun = F_t cos(theta_i) / cos(theta_t) */
+    gr_dvec3 T = gr_refract_d(r->Ip, gr_d3(0, 1, 0), 1.0 / r->scene.medium.ior);
+    double cos_i = -r->Ip.y;
+    double ft = r->opt.fresnel ? 1.0 - gr_fresnel_exact(cos_i, 1.0, r->scene.medium.ior) : 1.0;
+    r->Tp = gr_d3_to_f(T);
+    r->mu_t = (float)(-T.y);
+    r->flat_eperp = (float)(ft * cos_i / -T.y);
+    if (r->flat || r->beams_pass == pass) return GR_OK;
+    gr_beams_destroy(r->beams);
+    r->beams = NULL;
+    r->beams_pass = -1;
+    gr_beam_params bp;
+    memset(&bp, 0, sizeof bp);
+    bp.water = &r->scene.water;
+    bp.origin = r->origin;
+    bp.sun_dir = r->Ip;
+    bp.ior = r->scene.medium.ior;
+    bp.fresnel = r->opt.fresnel;
+    bp.shear_x = r->sx;
+    bp.shear_z = r->sz;
+    bp.region = r->region;
+    bp.pad_m = r->pad;
+    bp.res = r->set.surface_res;
+    bp.jitter[0] = jit[0];
+    bp.jitter[1] = jit[1];
+    bp.max_prims = r->opt.max_prims;
+    bp.surface_mesh = 1;
+    gr_status st = gr_beams_build(r->rtc, &bp, &r->beams, err);
+    if (st != GR_OK) return st;
+    r->beams_pass = pass;
+    r->beam_build_s += gr_beams_stats(r->beams)->build_s;
+    return GR_OK;
+}
+
+/* Sunlight arriving at the local point x: every beam through it under waves, the closed
+ * form on flat water (and outside the lit region, where the waves' mean is used). */
+static int light_at(const gr_ref_renderer *r, gr_vec3 x, ref_light *out, gr_beam_hit *hits, int *overflow)
+{
+    if (!r->flat) {
+        double u = x.x - r->sx * x.y, w = x.z - r->sz * x.y;
+        const gr_beam_region *g = &r->region;
+        if (x.y >= g->y_min && u >= g->u0 && u <= g->u1 && w >= g->w0 && w <= g->w1) {
+            int n = gr_beams_lookup(r->beams, x, hits, REF_MAX_HITS, overflow);
+            int m = 0;
+            for (int i = 0; i < n; i++) {
+                if (!(hits[i].T.y < 0.0f)) continue;
+                out[m].T = hits[i].T;
+                out[m].eperp = hits[i].e_h / -hits[i].T.y; /* horizontal -> perpendicular to T */
+                out[m].path = hits[i].path_m;
+                m++;
+            }
+            return m;
+        }
+    }
+    float depth = -x.y;
+    if (!(depth > 0.0f)) return 0;
+    out[0].T = r->Tp;
+    out[0].eperp = r->flat_eperp;
+    out[0].path = depth / r->mu_t;
+    return 1;
+}
+
+double gr_ref_irradiance_h(const gr_ref_renderer *r, gr_dvec3 world)
+{
+    gr_beam_hit hits[REF_MAX_HITS];
+    ref_light l[REF_MAX_HITS];
+    int of = 0;
+    gr_vec3 x = gr_d3_to_f(gr_d3_sub(world, r->origin));
+    int n = light_at(r, x, l, hits, &of);
+    double e = 0.0;
+    for (int i = 0; i < n; i++) e += (double)l[i].eperp * -(double)l[i].T.y;
+    return e;
+}
+
+int gr_ref_beam_count(const gr_ref_renderer *r, gr_dvec3 world)
+{
+    if (r->flat || !r->beams) return 0;
+    gr_beam_hit hits[REF_MAX_HITS];
+    int of = 0;
+    return gr_beams_lookup(r->beams, gr_d3_to_f(gr_d3_sub(world, r->origin)), hits, REF_MAX_HITS, &of);
+}
+
+void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
+{
+    memset(info, 0, sizeof *info);
+    info->flat = r->flat;
+    info->passes_per_round = r->passes_per_round;
+    info->spp_per_pass = r->spp_pass;
+    info->cutoff_distance_m = r->cutoff_d;
+    info->region[0] = r->region.u0; info->region[1] = r->region.u1;
+    info->region[2] = r->region.w0; info->region[3] = r->region.w1;
+    info->region[4] = r->region.y_min; info->region[5] = r->pad;
+    if (r->beams) {
+        info->cell_m = gr_beams_stats(r->beams)->cell_m;
+        info->prims = gr_beams_stats(r->beams)->prims;
+    }
+}
+
+/* ---- rendering ---- */
+
+typedef struct ref_accum {
+    int W, H, B;
+    double *sum;        /* [(pixel * B + batch) * 3 + c] */
+    uint32_t *count;    /* [pixel * B + batch] */
+    double *aov;        /* [pixel * 2 + {transmittance, ray length}] */
+} ref_accum;
+
+typedef struct ref_job {
+    gr_ref_renderer *r;
+    ref_accum *acc;
+    int pass, batch;
+    atomic_int next_row;
+    atomic_int rows_done;
+    atomic_int stop;
+    /* per-thread counters, summed after the pass */
+    atomic_llong queries, shadow_rays, overflows;
+} ref_job;
+
+typedef struct ref_counters { long long queries, shadow_rays, overflows; } ref_counters;
+
+/* One camera sample: L (RGB) along the ray through the jittered pixel position. */
+static void render_sample(const gr_ref_renderer *r, int px, int py, ref_rng *g, double L[3], double *trans,
+                          double *len, ref_counters *cnt, gr_beam_hit *hits, ref_light *lights)
+{
+    const gr_camera *c = &r->scene.camera;
+    double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), aspect = (double)c->width / (double)c->height;
+    double jx = rng_u(g), jy = rng_u(g);
+    gr_dvec3 dd = cam_dir(r, (2.0 * (px + jx) / c->width - 1.0) * tf * aspect, (1.0 - 2.0 * (py + jy) / c->height) * tf);
+    gr_vec3 d = gr_d3_to_f(dd), o = r->cam;
+    L[0] = L[1] = L[2] = 0.0;
+    /* where the camera ray ends: occluder or seabed, the water surface, the cutoff */
+    float D = gr_rtc_intersect(r->geom->ends, o, d, 0.0f, (float)r->cutoff_d, NULL, NULL);
+    unsigned hit = RTC_INVALID_GEOMETRY_ID;
+    if (!r->flat) D = gr_rtc_intersect(gr_beams_surface(r->beams), o, d, 0.0f, D, &hit, NULL);
+    if (hit == RTC_INVALID_GEOMETRY_ID && d.y > 0.0f) {
+        /* flat water, or beyond the tessellated patch: the rest plane */
+        float tp = -o.y / d.y;
+        if (tp < D) D = tp;
+    }
+    if (!(D > 0.0f)) D = 0.0f;
+    *len = D;
+    *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
+    if (D == 0.0f) return;
+    int n = r->set.steps;
+    /* March density ~ exp(-lam t) on [0, D], lam = sig_ref (1 - w_y / mu_t0): the camera
+     * ray's extinction times the sunlight's extinction down to the point on flat water, so
+     * the flat-water integrand is sampled exactly in proportion (Oracle 1) and the waves
+     * only add their caustic modulation. Stratified in the density's CDF, jittered. */
+    double lam = r->sig_ref * (1.0 - (double)d.y / -r->T0.y), lD = lam * D, om, wbase;
+    if (fabs(lD) > 1e-6) {
+        om = -expm1(-lD);
+        wbase = om / (lam * n);
+    } else {
+        lam = 0.0;
+        om = 0.0;
+        wbase = (double)D / n;
+    }
+    double hg_g = r->scene.medium.g;
+    for (int k = 0; k < n; k++) {
+        double u = (k + rng_u(g)) / n;
+        double t = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
+        gr_vec3 x = gr_v3_madd(o, d, (float)t);
+        int of = 0;
+        int m = light_at(r, x, lights, hits, &of);
+        cnt->queries++;
+        cnt->overflows += of;
+        for (int i = 0; i < m; i++) {
+            const ref_light *l = &lights[i];
+            if (r->geom->shadow) {
+                cnt->shadow_rays++;
+                if (gr_rtc_occluded(r->geom->shadow, x, gr_v3_scale(l->T, -1.0f), 0.0f, l->path)) continue;
+            }
+            double ph = gr_hg_phase(-(double)gr_v3_dot(l->T, d), hg_g);
+            double base = ph * l->eperp * wbase;
+            for (int ch = 0; ch < 3; ch++) {
+                /* sun-to-point and point-to-camera extinction, divided by the march density */
+                double ex = r->sig_t[ch] * ((double)l->path + t) - lam * t;
+                if (ex < REF_EXP_LIMIT) L[ch] += r->sig_s[ch] * r->E[ch] * base * exp(-ex);
+            }
+        }
+    }
+}
+
+static void *worker(void *arg)
+{
+#if defined(__SSE2__)
+    /* flush denormals: deep, murky water must not slow down (hard case sigma_t = 20 /m) */
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#endif
+    ref_job *job = arg;
+    const gr_ref_renderer *r = job->r;
+    ref_accum *acc = job->acc;
+    gr_beam_hit *hits = malloc(REF_MAX_HITS * sizeof *hits);
+    ref_light *lights = malloc(REF_MAX_HITS * sizeof *lights);
+    ref_counters cnt = {0, 0, 0};
+    if (!hits || !lights) {
+        atomic_store(&job->stop, 2);
+        free(hits);
+        free(lights);
+        return NULL;
+    }
+    for (;;) {
+        if (atomic_load(&job->stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
+        int y = atomic_fetch_add(&job->next_row, 1);
+        if (y >= acc->H) break;
+        for (int x = 0; x < acc->W; x++) {
+            size_t pix = (size_t)y * acc->W + x;
+            double *sum = acc->sum + (pix * acc->B + job->batch) * 3;
+            for (int s = 0; s < r->spp_pass; s++) {
+                uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
+                ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
+                double L[3], tr, len;
+                render_sample(r, x, y, &g, L, &tr, &len, &cnt, hits, lights);
+                sum[0] += L[0];
+                sum[1] += L[1];
+                sum[2] += L[2];
+                acc->count[pix * acc->B + job->batch]++;
+                if (acc->aov) {
+                    acc->aov[pix * 2] += tr;
+                    acc->aov[pix * 2 + 1] += len;
+                }
+            }
+        }
+        atomic_fetch_add(&job->rows_done, 1);
+    }
+    atomic_fetch_add(&job->queries, cnt.queries);
+    atomic_fetch_add(&job->shadow_rays, cnt.shadow_rays);
+    atomic_fetch_add(&job->overflows, cnt.overflows);
+    free(hits);
+    free(lights);
+    return NULL;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double percentile(double *v, size_t n, double q)
+{
+    if (!n) return 0.0;
+    qsort(v, n, sizeof *v, cmp_double);
+    double pos = q * (double)(n - 1);
+    size_t i = (size_t)pos;
+    if (i + 1 >= n) return v[n - 1];
+    double f = pos - (double)i;
+    return v[i] * (1.0 - f) + v[i + 1] * f;
+}
+
+typedef struct ref_errors { double rel_mean, rel_p95, frac_1pct, mean, p95; } ref_errors;
+
+/* Image-level error estimates from the batch images (docs/reference.md, "Error bars"). */
+static gr_status image_errors(const ref_accum *acc, ref_errors *e)
+{
+    size_t np = (size_t)acc->W * acc->H;
+    int B = acc->B;
+    double *tmp = malloc(np * sizeof *tmp), *Mb = calloc((size_t)B, sizeof *Mb), *Qb = calloc((size_t)B, sizeof *Qb);
+    double *v = malloc(np * sizeof *v), *se = malloc(np * sizeof *se);
+    if (!tmp || !Mb || !Qb || !v || !se) {
+        free(tmp); free(Mb); free(Qb); free(v); free(se);
+        return GR_E_NOMEM;
+    }
+    int nb = 0;
+    for (int b = 0; b < B; b++) {
+        size_t k = 0;
+        double m = 0.0;
+        for (size_t p = 0; p < np; p++) {
+            uint32_t c = acc->count[p * B + b];
+            if (!c) continue;
+            const double *s = acc->sum + (p * B + b) * 3;
+            tmp[k++] = (s[0] + s[1] + s[2]) / (3.0 * c);
+            m += tmp[k - 1];
+        }
+        if (k < np) continue; /* an unfinished batch (interrupted) does not enter image errors */
+        Mb[nb] = m / (double)k;
+        Qb[nb] = percentile(tmp, k, 0.95);
+        nb++;
+    }
+    double mean = 0.0;
+    for (size_t p = 0; p < np; p++) {
+        double s = 0.0, s2 = 0.0;
+        uint32_t n = 0;
+        int kb = 0;
+        double tot = 0.0;
+        for (int b = 0; b < B; b++) {
+            uint32_t c = acc->count[p * B + b];
+            if (!c) continue;
+            const double *sm = acc->sum + (p * B + b) * 3;
+            double mb = (sm[0] + sm[1] + sm[2]) / (3.0 * c);
+            s += mb;
+            s2 += mb * mb;
+            kb++;
+            n += c;
+            tot += sm[0] + sm[1] + sm[2];
+        }
+        v[p] = n ? tot / (3.0 * n) : 0.0;
+        double mm = kb ? s / kb : 0.0;
+        se[p] = kb >= 2 ? sqrt(fmax(0.0, (s2 - kb * mm * mm) / (kb - 1)) / kb) : fabs(v[p]);
+        mean += v[p];
+    }
+    mean /= (double)np;
+    size_t ok = 0;
+    for (size_t p = 0; p < np; p++) ok += se[p] <= 0.01 * fmax(v[p], mean);
+    e->mean = mean;
+    e->frac_1pct = (double)ok / (double)np;
+    memcpy(tmp, v, np * sizeof *v);
+    e->p95 = percentile(tmp, np, 0.95);
+    if (nb >= 2) {
+        double a = 0.0, a2 = 0.0, q = 0.0, q2 = 0.0;
+        for (int b = 0; b < nb; b++) { a += Mb[b]; a2 += Mb[b] * Mb[b]; q += Qb[b]; q2 += Qb[b] * Qb[b]; }
+        a /= nb;
+        q /= nb;
+        double sdm = sqrt(fmax(0.0, (a2 - nb * a * a) / (nb - 1)) / nb);
+        double sdq = sqrt(fmax(0.0, (q2 - nb * q * q) / (nb - 1)) / nb);
+        e->rel_mean = mean > 0.0 ? sdm / mean : (sdm > 0.0 ? INFINITY : 0.0);
+        e->rel_p95 = e->p95 > 0.0 ? sdq / e->p95 : (sdq > 0.0 ? INFINITY : 0.0);
+    } else {
+        e->rel_mean = e->rel_p95 = INFINITY;
+    }
+    free(tmp); free(Mb); free(Qb); free(v); free(se);
+    return GR_OK;
+}
+
+static gr_status build_image(const gr_ref_renderer *r, const ref_accum *acc, gr_ref_result *out, gr_error *err)
+{
+    static const char *const names[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "transmittance", "ray_length"};
+    int nch = acc->aov ? 8 : 6, B = acc->B;
+    gr_image *img = gr_image_create(acc->W, acc->H, nch, names);
+    if (!img) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for a %dx%d image", acc->W, acc->H);
+    uint32_t min_n = UINT32_MAX;
+    for (int y = 0; y < acc->H; y++)
+        for (int x = 0; x < acc->W; x++) {
+            size_t p = (size_t)y * acc->W + x;
+            float *px = gr_image_pixel(img, x, y);
+            uint32_t n = 0;
+            for (int b = 0; b < B; b++) n += acc->count[p * B + b];
+            if (n < min_n) min_n = n;
+            for (int c = 0; c < 3; c++) {
+                double tot = 0.0, s = 0.0, s2 = 0.0;
+                int kb = 0;
+                for (int b = 0; b < B; b++) {
+                    uint32_t k = acc->count[p * B + b];
+                    if (!k) continue;
+                    double v = acc->sum[(p * B + b) * 3 + c];
+                    tot += v;
+                    s += v / k;
+                    s2 += (v / k) * (v / k);
+                    kb++;
+                }
+                double mean = n ? tot / n : 0.0, mm = kb ? s / kb : 0.0;
+                double se = kb >= 2 ? sqrt(fmax(0.0, (s2 - kb * mm * mm) / (kb - 1)) / kb) : fabs(mean);
+                /* nothing non-finite may reach an image */
+                px[c] = isfinite(mean) ? (float)mean : 0.0f;
+                px[3 + c] = isfinite(se) ? (float)se : 0.0f;
+            }
+            if (acc->aov) {
+                px[6] = n ? (float)(acc->aov[p * 2] / n) : 0.0f;
+                px[7] = n ? (float)(acc->aov[p * 2 + 1] / n) : 0.0f;
+            }
+        }
+    out->image = img;
+    out->spp = min_n == UINT32_MAX ? 0 : (int)min_n;
+    (void)r;
+    return GR_OK;
+}
+
+static double finite_or(double v, double alt) { return isfinite(v) ? v : alt; }
+
+static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, const ref_errors *e, double qps)
+{
+    gr_metadata *m = &out->meta;
+    gr_status st = GR_OK;
+    char key[64], buf[256];
+#define SET(call) do { if (st == GR_OK) st = (call); } while (0)
+    SET(gr_meta_set_string(m, "godrays:renderer", "reference (Embree ray-marched single scattering, beam prisms)"));
+    SET(gr_meta_set_string(m, "godrays:layer", "in-scattered radiance of refracted sunlight (single scattering)"));
+    SET(gr_meta_set_string(m, "godrays:scene", r->scene.source_path[0] ? r->scene.source_path : r->scene.name));
+    SET(gr_meta_set_string(m, "godrays:scene_hash", r->scene.hash));
+    const gr_param_table *t = &gr_reference_param_table;
+    for (size_t i = 0; i < t->count; i++) {
+        snprintf(key, sizeof key, "godrays:reference.%s", t->params[i].name);
+        double v = gr_param_get_number(&t->params[i], &r->set, 0);
+        if (t->params[i].type == GR_PT_DOUBLE) SET(gr_meta_set_double(m, key, v));
+        else SET(gr_meta_set_int(m, key, (long long)v));
+    }
+    SET(gr_meta_set_int(m, "godrays:spp", out->spp));
+    SET(gr_meta_set_int(m, "godrays:passes", out->passes));
+    SET(gr_meta_set_int(m, "godrays:passes_per_round", r->passes_per_round));
+    SET(gr_meta_set_int(m, "godrays:spp_per_pass", r->spp_pass));
+    SET(gr_meta_set_int(m, "godrays:partial", out->partial));
+    SET(gr_meta_set_int(m, "godrays:flat_water_closed_form", r->flat));
+    SET(gr_meta_set_int(m, "godrays:threads", r->threads));
+    SET(gr_meta_set_double(m, "godrays:wall_s", out->wall_s));
+    SET(gr_meta_set_double(m, "godrays:rel_stderr_mean", finite_or(e->rel_mean, -1.0)));
+    SET(gr_meta_set_double(m, "godrays:rel_stderr_p95", finite_or(e->rel_p95, -1.0)));
+    SET(gr_meta_set_double(m, "godrays:image_mean", e->mean));
+    SET(gr_meta_set_double(m, "godrays:image_p95", e->p95));
+    SET(gr_meta_set_double(m, "godrays:frac_pixels_stderr_le_1pct", e->frac_1pct));
+    SET(gr_meta_set_double(m, "godrays:cutoff_distance_m", r->cutoff_d));
+    SET(gr_meta_set_double(m, "godrays:preview_exposure", out->preview_exposure));
+    SET(gr_meta_set_double(m, "godrays:queries_per_s", qps));
+    SET(gr_meta_set_double(m, "godrays:beam_build_s", r->beam_build_s));
+    snprintf(buf, sizeof buf, "u [%.3f, %.3f] w [%.3f, %.3f] y_min %.3f pad %.3f (local sheared, m)",
+             r->region.u0, r->region.u1, r->region.w0, r->region.w1, r->region.y_min, r->pad);
+    SET(gr_meta_set_string(m, "godrays:lit_region", buf));
+    if (r->beams) {
+        const gr_beam_stats *bs = gr_beams_stats(r->beams);
+        SET(gr_meta_set_double(m, "godrays:surface_cell_m", bs->cell_m));
+        SET(gr_meta_set_int(m, "godrays:beam_prims", (long long)bs->prims));
+    }
+    SET(gr_meta_set_string(m, "godrays:error_bars",
+                           "stderr.* channels: batch-mean spread (noise only); discretization bias: docs/reference.md"));
+#undef SET
+    return st;
+}
+
+gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
+{
+    memset(out, 0, sizeof *out);
+    gr_meta_init(&out->meta);
+    double t0 = mono_s();
+    ref_accum acc;
+    acc.W = r->scene.camera.width;
+    acc.H = r->scene.camera.height;
+    acc.B = r->batches;
+    size_t np = (size_t)acc.W * acc.H;
+    acc.sum = calloc(np * acc.B * 3, sizeof *acc.sum);
+    acc.count = calloc(np * acc.B, sizeof *acc.count);
+    acc.aov = r->opt.aovs ? calloc(np * 2, sizeof *acc.aov) : NULL;
+    gr_progress *prog = gr_progress_create("reference", r->opt.progress);
+    pthread_t *th = calloc((size_t)r->threads, sizeof *th);
+    if (!acc.sum || !acc.count || (r->opt.aovs && !acc.aov) || !prog || !th) {
+        free(acc.sum); free(acc.count); free(acc.aov); free(th); gr_progress_destroy(prog);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %dx%d pixels x %d batches", acc.W, acc.H, acc.B);
+    }
+    int P = r->passes_per_round;
+    int rounds = r->set.target_error > 0.0 ? r->opt.max_rounds : 1;
+    long long queries = 0, shadows = 0, overflows = 0;
+    double march_s = 0.0;
+    gr_status st = GR_OK;
+    ref_errors e;
+    memset(&e, 0, sizeof e);
+    int pass = 0;
+    for (int round = 0; round < rounds && st == GR_OK && !out->partial; round++) {
+        for (int pp = 0; pp < P && st == GR_OK; pp++, pass++) {
+            if (r->opt.interrupt && *r->opt.interrupt) { out->partial = 1; break; }
+            st = gr_ref_prepare_pass(r, pass, err);
+            if (st != GR_OK) break;
+            ref_job job;
+            job.r = r;
+            job.acc = &acc;
+            job.pass = pass;
+            job.batch = pass % acc.B;
+            atomic_init(&job.next_row, 0);
+            atomic_init(&job.rows_done, 0);
+            atomic_init(&job.stop, 0);
+            atomic_init(&job.queries, 0);
+            atomic_init(&job.shadow_rays, 0);
+            atomic_init(&job.overflows, 0);
+            double tm = mono_s();
+            int started = 0;
+            for (int i = 0; i < r->threads; i++) {
+                if (pthread_create(&th[i], NULL, worker, &job) != 0) break;
+                started++;
+            }
+            if (!started) {
+                st = gr_fail(err, GR_E_RUNTIME, "reference: could not start worker threads (reference.threads = %d)", r->threads);
+                break;
+            }
+            for (;;) {
+                int done = atomic_load(&job.rows_done);
+                double frac = rounds > 1 ? ((double)pp + (double)done / acc.H) / P
+                                         : ((double)pass + (double)done / acc.H) / P;
+                char note[64];
+                snprintf(note, sizeof note, "pass %d/%d%s", pp + 1, P, rounds > 1 ? " (refining)" : "");
+                gr_progress_update(prog, frac, note);
+                if (done >= acc.H || atomic_load(&job.stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
+                /* short sleeps first so tiny renders (tests) do not wait on the poll */
+                double waited = mono_s() - tm;
+                struct timespec ts = {0, waited < 0.05 ? 500 * 1000 : 20 * 1000 * 1000};
+                nanosleep(&ts, NULL);
+            }
+            for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
+            march_s += mono_s() - tm;
+            queries += atomic_load(&job.queries);
+            shadows += atomic_load(&job.shadow_rays);
+            overflows += atomic_load(&job.overflows);
+            if (atomic_load(&job.stop) == 2) {
+                st = gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
+                break;
+            }
+            if (atomic_load(&job.rows_done) < acc.H) { out->partial = 1; break; }
+            out->passes++;
+        }
+        if (st != GR_OK || out->partial) break;
+        if (rounds > 1) {
+            if (image_errors(&acc, &e) != GR_OK) { st = gr_fail(err, GR_E_NOMEM, "reference: out of memory"); break; }
+            if (e.rel_mean < r->set.target_error && e.rel_p95 < r->set.target_error) break;
+        }
+    }
+    gr_progress_finish(prog);
+    gr_progress_destroy(prog);
+    free(th);
+    if (st == GR_OK && image_errors(&acc, &e) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
+    if (st == GR_OK) st = build_image(r, &acc, out, err);
+    if (st == GR_OK) {
+        out->wall_s = mono_s() - t0;
+        out->rel_se_mean = e.rel_mean;
+        out->rel_se_p95 = e.rel_p95;
+        out->frac_se_1pct = e.frac_1pct;
+        out->queries_per_s = march_s > 0.0 ? (double)queries / march_s : 0.0;
+        out->shadow_rays_per_s = march_s > 0.0 ? (double)shadows / march_s : 0.0;
+        out->beam_build_s = r->beam_build_s;
+        /* preview: the 99th percentile of the brightest channel maps to 0.8 */
+        size_t n = np;
+        double *v = malloc(n * sizeof *v);
+        out->preview_exposure = 1.0;
+        if (v) {
+            for (size_t p = 0; p < n; p++) {
+                const float *px = out->image->pixels + p * out->image->nchannels;
+                v[p] = fmax(px[0], fmax(px[1], px[2]));
+            }
+            double p99 = percentile(v, n, 0.99);
+            if (p99 > 0.0 && isfinite(p99)) out->preview_exposure = 0.8 / p99;
+            free(v);
+        }
+        if (fill_metadata(r, out, &e, out->queries_per_s) != GR_OK)
+            st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for metadata");
+        else {
+            gr_meta_set_double(&out->meta, "godrays:shadow_rays_per_s", out->shadow_rays_per_s);
+            gr_meta_set_int(&out->meta, "godrays:beam_overflows", overflows);
+        }
+    }
+    free(acc.sum);
+    free(acc.count);
+    free(acc.aov);
+    if (st != GR_OK) gr_ref_result_free(out);
+    return st;
+}
+
+void gr_ref_result_free(gr_ref_result *res)
+{
+    if (!res) return;
+    gr_image_destroy(res->image);
+    res->image = NULL;
+    gr_meta_free(&res->meta);
+}

@@ -1,0 +1,88 @@
+/* The ground truth: ray-marched single scattering of refracted sunlight (the god-ray layer),
+ * with its own error bars. Derivation and method: docs/reference.md.
+ *
+ *   L(w) = int_0^D exp(-sigma_t t) sigma_s SUM_k p(T_k . -w) E_k(x(t)) dt
+ *
+ * Camera rays end at an occluder, the seabed, the water surface seen from below, or where
+ * the camera ray's transmittance falls below reference.transmittance_cutoff. E_k comes
+ * from beam prisms (reference/beams.h) under waves and from the closed form on flat water.
+ * The sun's disc is sampled by passes: each pass has one direction inside the disc and
+ * its own jitter of the surface grid; pass p feeds batch p mod batches, and the spread of
+ * the batch means gives the per-pixel standard error. */
+#ifndef GR_REF_INTEGRATOR_H
+#define GR_REF_INTEGRATOR_H
+
+#include <signal.h>
+#include <stddef.h>
+#include "common/status.h"
+#include "core/vec.h"
+#include "image/image.h"
+#include "scene/scene.h"
+
+typedef struct gr_ref_options {
+    int fresnel;            /* 1 (default): exact Fresnel transmittance; 0: F_t = 1 */
+    int force_beams;        /* 1: use beam prisms even on flat water (tests the beam path) */
+    int aovs;               /* 1: add "transmittance" and "ray_length" channels */
+    int progress;           /* 1: progress bar on stderr (only if a tty and > 2 s) */
+    volatile sig_atomic_t *interrupt; /* set nonzero (e.g. by SIGINT) to stop at the next row */
+    size_t max_prims;       /* beam-slab primitive budget; 0 = default (16 M, about 1 GB) */
+    int max_rounds;         /* --target-error: at most this many rounds of passes; 0 = 64 */
+    /* Lit region override for irradiance probes (tests): world x/z bounds at depths down to
+     * y_min. Unused when lit_box_valid = 0 (the region then follows the camera frustum). */
+    int lit_box_valid;
+    double lit_box[5];      /* x0, x1, z0, z1, y_min (world) */
+} gr_ref_options;
+
+void gr_ref_options_default(gr_ref_options *o);
+
+typedef struct gr_ref_renderer gr_ref_renderer;
+
+gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_renderer **out, gr_error *err);
+void gr_ref_destroy(gr_ref_renderer *r); /* accepts NULL */
+
+typedef struct gr_ref_result {
+    gr_image *image;        /* R, G, B, stderr.R, stderr.G, stderr.B [, transmittance, ray_length] */
+    gr_metadata meta;       /* "godrays:*" keys: settings, samples, errors, timings */
+    int partial;            /* 1 if interrupted: fewer samples than asked */
+    int spp;                /* camera samples per pixel actually taken (pixels done last) */
+    int passes;             /* passes (sun directions) completed */
+    double wall_s;
+    double rel_se_mean;     /* relative standard error of the image mean (mean of RGB) */
+    double rel_se_p95;      /* relative standard error of the 95th-percentile pixel value */
+    double frac_se_1pct;    /* fraction of pixels whose standard error <= 1% of max(pixel, mean) */
+    double preview_exposure;/* exposure that maps the 99th percentile to 0.8 in the preview */
+    double queries_per_s;   /* beam lookups (or closed-form evaluations) per second, all threads */
+    double shadow_rays_per_s;
+    double beam_build_s;    /* total time spent building beam sets */
+} gr_ref_result;
+
+/* Renders the image; `progress_label` may be NULL. On interruption returns GR_OK with
+ * out->partial = 1 (the caller writes what is there). */
+gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err);
+void gr_ref_result_free(gr_ref_result *res); /* accepts NULL */
+
+/* ---- probes for the oracles and the second estimator ---- */
+/* Builds the beam set of pass `pass` (sun direction and grid jitter of that pass). */
+gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err);
+/* Sun direction I of a pass (unit, world). */
+gr_dvec3 gr_ref_pass_sun_dir(const gr_ref_renderer *r, int pass);
+/* Horizontal irradiance per unit sun irradiance at a world point for the prepared pass,
+ * from every beam through it: SUM_k F_t |I.a_k| / |A_k(y)|, no extinction, no shadows.
+ * On flat water without force_beams: the closed form F_t cos(theta_i). Points outside the
+ * lit region return the flat-water value too. */
+double gr_ref_irradiance_h(const gr_ref_renderer *r, gr_dvec3 world);
+/* Number of beams through the point (0 outside the lit region or on flat water). */
+int gr_ref_beam_count(const gr_ref_renderer *r, gr_dvec3 world);
+/* Surface patch, cell size, lit region and D_cut, for reports and tests. */
+typedef struct gr_ref_info {
+    int flat;               /* 1: closed-form sunlight, no beams */
+    int passes_per_round;   /* sun directions per round (sun_samples rounded up to batches) */
+    int spp_per_pass;
+    double cutoff_distance_m;
+    double region[6];       /* sheared u0, u1, w0, w1, y_min (local), pad_m */
+    double cell_m;          /* surface cell size of the last beam set (0 before one is built) */
+    size_t prims;           /* beam-slab primitives of the last beam set */
+} gr_ref_info;
+void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info);
+
+#endif

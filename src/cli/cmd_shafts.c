@@ -1,0 +1,309 @@
+/* godrays shafts: render a scene with seed 000's real-time shafts (src/realtime/shafts.h)
+ * into an EXR god-ray layer (linear float, frame resolution) plus a PNG preview. */
+#include "cli/cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "image/exr.h"
+#include "image/oiio.h"
+#include "realtime/shafts.h"
+#include "scene/scene.h"
+
+#define MAX_SETS 256
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: godrays shafts SCENE [-o OUT.exr] [options]\n"
+            "\n"
+            "Renders SCENE's god-ray layer with seed 000's real-time shafts (OpenGL through headless\n"
+            "EGL) and writes it as a linear float EXR with timings and settings in its metadata,\n"
+            "plus an sRGB PNG preview beside it (OUT.png).\n"
+            "\n"
+            "options:\n"
+            "  -o, --output FILE    EXR to write (default: shafts.exr)\n"
+            "  --set KEY=VALUE      override a scene value before validation, e.g. shafts.K=0.7,\n"
+            "                       shafts.target_format=rgba16f, medium.g=0.9 (repeatable)\n"
+            "  --shader-dir DIR     GLSL files in DIR replace the embedded ones of the same name\n"
+            "  --time T             water time t (s) of eq. 5.5.7 (default: the scene's water.time_s)\n"
+            "  --frames A:B:S       render frames A, A+S, ... up to B at time T + frame / fps; the\n"
+            "                       frame number goes into the file names (OUT.0007.exr)\n"
+            "  --fps F              frames per second for --frames (default 30)\n"
+            "  --repeat R           render each frame R times in one context; timings printed are\n"
+            "                       the median of the renders (default 1)\n"
+            "  --exposure E         preview exposure (default: auto, the 99.5th percentile maps to 1)\n"
+            "  --no-preview         do not write the PNG preview\n"
+            "  --save-target FILE   also write the shaft render target (RGBA float EXR; in an\n"
+            "                       rgba16f target, A counts the shaft surfaces blended per texel)\n"
+            "  --gl-platform P      auto, surfaceless or device (default auto)\n"
+            "  -q, --quiet          print nothing on success\n"
+            "  -h, --help           this help\n"
+            "\n"
+            "Shaft settings (scene section \"shafts\"): see docs/scene-format.md and\n"
+            "docs/realtime-shafts.md. Exit codes: 0 ok, 1 runtime/GL failure, 2 bad usage or input.\n");
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v)) return -1;
+    *out = v;
+    return 0;
+}
+
+static int parse_int(const char *s, long *out)
+{
+    char *end = NULL;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || end == s || *end) return -1;
+    *out = v;
+    return 0;
+}
+
+/* "out.exr" + frame 7 -> "out.0007.exr"; no extension -> "out.0007". */
+static void frame_path(const char *base, long frame, char *buf, size_t n)
+{
+    const char *slash = strrchr(base, '/');
+    const char *dot = strrchr(base, '.');
+    if (dot && (!slash || dot > slash) && dot != base && (!slash || dot != slash + 1))
+        snprintf(buf, n, "%.*s.%04ld%s", (int)(dot - base), base, frame, dot);
+    else
+        snprintf(buf, n, "%s.%04ld", base, frame);
+}
+
+static void preview_path(const char *exr, char *buf, size_t n)
+{
+    size_t len = strlen(exr);
+    if (len > 4 && !strcmp(exr + len - 4, ".exr"))
+        snprintf(buf, n, "%.*s.png", (int)(len - 4), exr);
+    else
+        snprintf(buf, n, "%s.png", exr);
+}
+
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+static int cmp_ll(const void *a, const void *b)
+{
+    long long x = *(const long long *)a, y = *(const long long *)b;
+    return (x > y) - (x < y);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Exposure that maps the 99.5th percentile of max(R, G, B) to 1 (1 if the image is black). */
+static double auto_exposure(const gr_image *img)
+{
+    size_t n = (size_t)img->width * (size_t)img->height;
+    float *v = malloc(n * sizeof *v);
+    if (!v) return 1.0;
+    for (size_t i = 0; i < n; i++) {
+        const float *p = img->pixels + i * (size_t)img->nchannels;
+        v[i] = fmaxf(p[0], fmaxf(p[1], p[2]));
+    }
+    qsort(v, n, sizeof *v, cmp_float);
+    double q = v[(size_t)((double)(n - 1) * 0.995)];
+    free(v);
+    return q > 0 ? 1.0 / q : 1.0;
+}
+
+/* Median of each stat over the repeats, so one warm-up outlier does not dominate. */
+static void median_stats(gr_shafts_stats *all, int n, gr_shafts_stats *out)
+{
+    *out = all[n - 1];
+    if (n < 2) return;
+    long long *tmp = malloc((size_t)n * sizeof *tmp);
+    double *dt = malloc((size_t)n * sizeof *dt);
+    if (!tmp || !dt) {
+        free(tmp);
+        free(dt);
+        return;
+    }
+    for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
+        for (int i = 0; i < n; i++) tmp[i] = all[i].gpu_ns[p];
+        qsort(tmp, (size_t)n, sizeof *tmp, cmp_ll);
+        out->gpu_ns[p] = tmp[n / 2];
+    }
+    for (int i = 0; i < n; i++) dt[i] = all[i].cpu_ms;
+    qsort(dt, (size_t)n, sizeof *dt, cmp_double);
+    out->cpu_ms = dt[n / 2];
+    free(tmp);
+    free(dt);
+}
+
+int cmd_shafts(int argc, char **argv)
+{
+    const char *cmd = "shafts";
+    const char *scene_path = NULL, *out_path = "shafts.exr", *shader_dir = NULL, *target_path = NULL;
+    const char *sets[MAX_SETS];
+    int n_sets = 0, preview = 1, quiet = 0, have_time = 0, have_frames = 0;
+    double time_s = 0.0, fps = 30.0, exposure = 0.0;
+    long f0 = 0, f1 = 0, fstep = 1, repeat = 1;
+    gr_gl_platform platform = GR_GL_AUTO;
+
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            usage(stdout);
+            return 0;
+        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+            quiet = 1;
+        } else if (!strcmp(a, "--no-preview")) {
+            preview = 0;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            if (!val) return gr_cli_usage_error(cmd, "%s needs a value", a);
+            i++;
+            if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+                out_path = val;
+            } else if (!strcmp(a, "--set")) {
+                if (n_sets >= MAX_SETS) return gr_cli_usage_error(cmd, "--set: more than %d overrides", MAX_SETS);
+                if (!strchr(val, '=')) return gr_cli_usage_error(cmd, "--set %s: expected KEY=VALUE", val);
+                sets[n_sets++] = val;
+            } else if (!strcmp(a, "--save-target")) {
+                target_path = val;
+            } else if (!strcmp(a, "--shader-dir")) {
+                shader_dir = val;
+            } else if (!strcmp(a, "--time")) {
+                if (parse_double(val, &time_s)) return gr_cli_usage_error(cmd, "--time %s: not a number", val);
+                have_time = 1;
+            } else if (!strcmp(a, "--fps")) {
+                if (parse_double(val, &fps) || !(fps > 0))
+                    return gr_cli_usage_error(cmd, "--fps %s: expected a number > 0", val);
+            } else if (!strcmp(a, "--exposure")) {
+                if (parse_double(val, &exposure) || !(exposure > 0))
+                    return gr_cli_usage_error(cmd, "--exposure %s: expected a number > 0", val);
+            } else if (!strcmp(a, "--repeat")) {
+                if (parse_int(val, &repeat) || repeat < 1 || repeat > 100000)
+                    return gr_cli_usage_error(cmd, "--repeat %s: expected an integer in [1, 100000]", val);
+            } else if (!strcmp(a, "--frames")) {
+                char extra;
+                if (sscanf(val, "%ld:%ld:%ld%c", &f0, &f1, &fstep, &extra) != 3 || fstep < 1 || f1 < f0 || f0 < 0)
+                    return gr_cli_usage_error(cmd, "--frames %s: expected START:END:STEP with 0 <= START <= END, STEP >= 1", val);
+                if ((f1 - f0) / fstep >= 100000) return gr_cli_usage_error(cmd, "--frames %s: too many frames", val);
+                have_frames = 1;
+            } else if (!strcmp(a, "--gl-platform")) {
+                if (!strcmp(val, "auto")) platform = GR_GL_AUTO;
+                else if (!strcmp(val, "surfaceless")) platform = GR_GL_SURFACELESS;
+                else if (!strcmp(val, "device")) platform = GR_GL_DEVICE;
+                else return gr_cli_usage_error(cmd, "--gl-platform %s: expected auto, surfaceless or device", val);
+            } else {
+                return gr_cli_usage_error(cmd, "unknown option %s", a);
+            }
+        } else {
+            if (scene_path) return gr_cli_usage_error(cmd, "more than one scene given (%s, %s)", scene_path, a);
+            scene_path = a;
+        }
+    }
+    if (!scene_path) return gr_cli_usage_error(cmd, "no scene file given");
+
+    gr_error err = {GR_OK, ""};
+    gr_scene *scene = malloc(sizeof *scene);
+    gr_shafts *r = NULL;
+    gr_image *img = NULL;
+    gr_shafts_stats *runs = NULL;
+    gr_metadata meta;
+    gr_meta_init(&meta);
+    int rc = 0;
+    if (!scene) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        goto fail;
+    }
+    if (gr_scene_load_file(scene_path, sets, n_sets, scene, &err) != GR_OK) goto fail;
+    /* Settings are checked before any GL work, so bad input exits 2 even without GL. */
+    if (gr_shafts_check_settings(&scene->shafts, &err) != GR_OK) goto fail;
+    double t_base = have_time ? time_s : scene->water.time_s;
+
+    gr_shafts_options opts;
+    memset(&opts, 0, sizeof opts);
+    opts.shader_dir = shader_dir;
+    opts.gl.platform = platform;
+    if (gr_shafts_create(&opts, &r, &err) != GR_OK) goto fail;
+    img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
+    runs = calloc((size_t)repeat, sizeof *runs);
+    if (!img || !runs) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory for a %dx%d image", scene->camera.width, scene->camera.height);
+        goto fail;
+    }
+    if (!have_frames) {
+        f0 = f1 = 0;
+        fstep = 1;
+    }
+    for (long fr = f0; fr <= f1; fr += fstep) {
+        char path[4096], png[4200];
+        scene->water.time_s = have_frames ? t_base + (double)fr / fps : t_base;
+        for (long k = 0; k < repeat; k++)
+            if (gr_shafts_render(r, scene, NULL, img, &runs[k], &err) != GR_OK) goto fail;
+        gr_shafts_stats stats;
+        median_stats(runs, (int)repeat, &stats);
+        if (have_frames) frame_path(out_path, fr, path, sizeof path);
+        else snprintf(path, sizeof path, "%s", out_path);
+        gr_meta_free(&meta);
+        gr_meta_init(&meta);
+        if (gr_shafts_metadata(r, scene, NULL, &stats, &meta, &err) != GR_OK) goto fail;
+        if (have_frames && gr_meta_set_int(&meta, "godrays:frame", fr) != GR_OK) {
+            gr_fail(&err, GR_E_NOMEM, "out of memory");
+            goto fail;
+        }
+        if (repeat > 1 && gr_meta_set_int(&meta, "godrays:timing_repeats", repeat) != GR_OK) {
+            gr_fail(&err, GR_E_NOMEM, "out of memory");
+            goto fail;
+        }
+        if (gr_exr_write(path, img, &meta, &err) != GR_OK) goto fail;
+        if (preview) {
+            static const int rgb[3] = {0, 1, 2};
+            preview_path(path, png, sizeof png);
+            double e = exposure > 0 ? exposure : auto_exposure(img);
+            if (gr_oiio_write_preview(png, img, rgb, e, &err) != GR_OK) goto fail;
+        }
+        if (target_path) {
+            char tpath[4096];
+            gr_image *timg = NULL;
+            if (have_frames) frame_path(target_path, fr, tpath, sizeof tpath);
+            else snprintf(tpath, sizeof tpath, "%s", target_path);
+            if (gr_shafts_read_target(r, &timg, &err) != GR_OK) goto fail;
+            gr_status tst = gr_exr_write(tpath, timg, &meta, &err);
+            gr_image_destroy(timg);
+            if (tst != GR_OK) goto fail;
+        }
+        if (!quiet) {
+            char gpu[GR_SHAFTS_NPASS][32];
+            for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
+                if (stats.gpu_ns[p] >= 0) snprintf(gpu[p], sizeof gpu[p], "%.3f", (double)stats.gpu_ns[p] * 1e-6);
+                else snprintf(gpu[p], sizeof gpu[p], "n/a");
+            }
+            double tpx = (double)stats.target_width * (double)stats.target_height;
+            printf("%s: t = %.4f s, %d shafts, target %dx%d (%s), GPU ms: shadow %s, shafts %s, final %s; "
+                   "CPU %.3f ms; fragments %lld (overdraw %.2f); vertices %lld (VS invocations %lld)\n",
+                   path, scene->water.time_s, stats.n_shafts, stats.target_width, stats.target_height,
+                   scene->shafts.target_format == GR_TARGET_RGBA16F ? "rgba16f" : "rgba8",
+                   gpu[0], gpu[1], gpu[2],
+                   stats.cpu_ms, stats.fragments, (double)stats.fragments / tpx, stats.vertices_submitted,
+                   stats.vs_invocations);
+        }
+    }
+    goto done;
+fail:
+    rc = gr_cli_report(cmd, &err);
+done:
+    gr_meta_free(&meta);
+    free(runs);
+    gr_image_destroy(img);
+    gr_shafts_destroy(r);
+    free(scene);
+    return rc;
+}

@@ -1,0 +1,445 @@
+/* Comparison metrics (see metrics.h; formulas and conventions in docs/metrics.md). */
+#include "compare/metrics.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "compare/blur.h"
+
+const double gr_metrics_blur_sigmas[GR_METRICS_NSCALES] = {1.0, 4.0, 16.0};
+
+static const double lum_w[3] = {GR_LUM_R, GR_LUM_G, GR_LUM_B};
+
+const char *gr_metric_channel_name(gr_metric_channel ch)
+{
+    switch (ch) {
+    case GR_MCH_R: return "R";
+    case GR_MCH_G: return "G";
+    case GR_MCH_B: return "B";
+    case GR_MCH_RGB: return "RGB";
+    case GR_MCH_Y: return "Y";
+    case GR_MCH_COUNT: break;
+    }
+    return "?";
+}
+
+void gr_metrics_pick_rgb(const gr_image *img, int rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0;
+    if (!img) return;
+    int r = gr_image_channel(img, "R"), g = gr_image_channel(img, "G"), b = gr_image_channel(img, "B");
+    if (r >= 0 && g >= 0 && b >= 0) {
+        rgb[0] = r, rgb[1] = g, rgb[2] = b;
+    } else if (img->nchannels >= 3) {
+        rgb[0] = 0, rgb[1] = 1, rgb[2] = 2;
+    }
+}
+
+/* Everything a metrics set needs, shared between the raw and the fitted pass. */
+typedef struct ctx {
+    const gr_image *ref, *test;
+    size_t n;                     /* pixels */
+    const unsigned char *scored;  /* per pixel */
+    long long n_scored;
+    int have_stderr;
+    int serr[3];                  /* stderr channel indices in ref */
+    double eps[GR_MCH_COUNT];     /* rel MSE epsilons (independent of the test scale) */
+    double peak_ref[GR_MCH_COUNT];
+    double ssim_c1, ssim_c2;
+    const gr_metrics_options *opt;
+} ctx;
+
+static inline double refv(const ctx *cx, size_t p, int c, const int rgb[3])
+{
+    return (double)cx->ref->pixels[p * (size_t)cx->ref->nchannels + (size_t)rgb[c]];
+}
+
+/* Per-row accumulator. */
+typedef struct acc {
+    double sr, st, sd, sad, sd2, srel, max_r, max_t, max_f;
+    long long n, nsig;
+    int mx, my, mc;
+    double m_ref, m_test;
+} acc;
+
+static void acc_add(acc *a, double r, double t, double s, int have_s, double eps, int x, int y, int c)
+{
+    const double d = t - r, f = fabs(d);
+    a->sr += r;
+    a->st += t;
+    a->sd += d;
+    a->sad += f;
+    a->sd2 += d * d;
+    a->srel += d * d / (r * r + eps);
+    if (a->n == 0 || r > a->max_r) a->max_r = r;
+    if (a->n == 0 || t > a->max_t) a->max_t = t;
+    /* Strictly greater: the first maximum in scan order wins, as in OpenImageIO's compare(). */
+    if (a->n == 0 || f > a->max_f) {
+        a->max_f = f, a->mx = x, a->my = y, a->mc = c;
+        a->m_ref = r, a->m_test = t;
+    }
+    if (have_s && f <= GR_METRICS_STDERR_Z * s) a->nsig++;
+    a->n++;
+}
+
+static void acc_finish(const acc *a, double eps, double peak_ref, gr_channel_metrics *m)
+{
+    memset(m, 0, sizeof *m);
+    m->rel_mse_eps = eps;
+    m->peak_ref = peak_ref;
+    m->n_samples = a->n;
+    m->n_not_significant = a->nsig;
+    m->max_x = m->max_y = m->max_c = -1;
+    if (a->n > 0) {
+        const double n = (double)a->n;
+        m->ref_mean = a->sr / n;
+        m->test_mean = a->st / n;
+        m->bias = a->sd / n;
+        m->mae = a->sad / n;
+        m->mse = a->sd2 / n;
+        m->rel_mse = a->srel / n;
+        m->max_abs_err = a->max_f;
+        m->max_x = a->mx, m->max_y = a->my, m->max_c = a->mc;
+        m->max_ref = a->m_ref, m->max_test = a->m_test;
+    }
+    m->rmse = sqrt(m->mse);
+    /* idiff's peak: 1, raised by any larger value of either image (OpenImageIO compare()). */
+    double pk = 1.0;
+    if (a->n > 0) {
+        if (a->max_r > pk) pk = a->max_r;
+        if (a->max_t > pk) pk = a->max_t;
+    }
+    m->peak_idiff = pk;
+    m->psnr_ref_db = m->rmse > 0.0 ? 20.0 * log10(peak_ref / m->rmse) : INFINITY;
+    m->psnr_idiff_db = m->rmse > 0.0 ? 20.0 * log10(pk / m->rmse) : INFINITY;
+}
+
+/* Reference luminance standard error: the channels' errors are correlated (the same paths
+ * carry R, G and B), so use the bound valid for any correlation, SUM w_c s_c (docs/metrics.md). */
+static double stderr_y(const ctx *cx, size_t p)
+{
+    const float *px = cx->ref->pixels + p * (size_t)cx->ref->nchannels;
+    return GR_LUM_R * fabs((double)px[cx->serr[0]]) + GR_LUM_G * fabs((double)px[cx->serr[1]]) +
+           GR_LUM_B * fabs((double)px[cx->serr[2]]);
+}
+
+static gr_status ssim_luminance(const ctx *cx, const int rr[3], const int tr[3], double scale, double *out,
+                                gr_error *err)
+{
+    const gr_image *ref = cx->ref, *test = cx->test;
+    const size_t n = cx->n;
+    const int W = ref->width, H = ref->height;
+    if (cx->n_scored == 0) {
+        *out = 1.0;
+        return GR_OK;
+    }
+    /* Weight, the five moment fields, and the five blurred moments. */
+    double *buf = calloc(n * 11, sizeof(double));
+    if (!buf) return gr_fail(err, GR_E_NOMEM, "SSIM: cannot allocate %zu pixels", n);
+    double *wt = buf, *f[5], *b[5];
+    for (int k = 0; k < 5; k++) {
+        f[k] = buf + (size_t)(1 + k) * n;
+        b[k] = buf + (size_t)(6 + k) * n;
+    }
+    /* Luminance of both images, centred on their scored means before the second moments are
+     * formed (variances are shift invariant; centring keeps E[x^2] - mu^2 from cancelling). */
+    double sr = 0.0, st = 0.0;
+    for (size_t p = 0; p < n; p++) {
+        const float *a = ref->pixels + p * (size_t)ref->nchannels;
+        const float *t = test->pixels + p * (size_t)test->nchannels;
+        f[0][p] = GR_LUM_R * a[rr[0]] + GR_LUM_G * a[rr[1]] + GR_LUM_B * a[rr[2]];
+        f[1][p] = scale * (GR_LUM_R * t[tr[0]] + GR_LUM_G * t[tr[1]] + GR_LUM_B * t[tr[2]]);
+        wt[p] = cx->scored[p] ? 1.0 : 0.0;
+        if (cx->scored[p]) sr += f[0][p], st += f[1][p];
+    }
+    const double cr = sr / (double)cx->n_scored, ct = st / (double)cx->n_scored;
+    /* The local moments of Wang et al. 2004 (eq. 14-16) as weighted Gaussian means. */
+    for (size_t p = 0; p < n; p++) {
+        const double u = f[0][p] - cr, v = f[1][p] - ct;
+        f[0][p] = u;
+        f[1][p] = v;
+        f[2][p] = u * u;
+        f[3][p] = v * v;
+        f[4][p] = u * v;
+    }
+    gr_status st2 = gr_blur_fields((const double *const *)f, 5, wt, W, H, GR_SSIM_SIGMA, GR_SSIM_RADIUS, b, NULL, err);
+    if (st2 != GR_OK) {
+        free(buf);
+        return st2;
+    }
+    double sum = 0.0;
+    for (size_t p = 0; p < n; p++) {
+        if (!cx->scored[p]) continue;
+        const double mu_u = b[0][p], mu_v = b[1][p];
+        double var_x = b[2][p] - mu_u * mu_u, var_y = b[3][p] - mu_v * mu_v;
+        const double cov = b[4][p] - mu_u * mu_v;
+        if (var_x < 0.0) var_x = 0.0; /* rounding only */
+        if (var_y < 0.0) var_y = 0.0;
+        const double mx = mu_u + cr, my = mu_v + ct;
+        /* SSIM index, Wang et al. 2004 eq. 13. */
+        const double num = (2.0 * mx * my + cx->ssim_c1) * (2.0 * cov + cx->ssim_c2);
+        const double den = (mx * mx + my * my + cx->ssim_c1) * (var_x + var_y + cx->ssim_c2);
+        sum += num / den;
+    }
+    *out = sum / (double)cx->n_scored;
+    free(buf);
+    return GR_OK;
+}
+
+/* Multi-scale RMSE: blurring is linear, so RMSE(G*t - G*r) = RMSE(G*(t - r)); the difference
+ * is blurred once per sigma, as a normalized convolution over the scored pixels. */
+static gr_status blurred_rmse(const ctx *cx, const int rr[3], const int tr[3], double scale, gr_metrics_set *set,
+                              gr_error *err)
+{
+    const gr_image *ref = cx->ref, *test = cx->test;
+    const size_t n = cx->n;
+    if (cx->n_scored == 0) return GR_OK;
+    double *buf = calloc(n * 7, sizeof(double));
+    if (!buf) return gr_fail(err, GR_E_NOMEM, "multi-scale RMSE: cannot allocate %zu pixels", n);
+    double *d[3] = {buf, buf + n, buf + 2 * n}, *o[3] = {buf + 3 * n, buf + 4 * n, buf + 5 * n};
+    double *wt = buf + 6 * n;
+    for (size_t p = 0; p < n; p++) {
+        const float *a = ref->pixels + p * (size_t)ref->nchannels;
+        const float *t = test->pixels + p * (size_t)test->nchannels;
+        wt[p] = cx->scored[p] ? 1.0 : 0.0;
+        for (int c = 0; c < 3; c++) d[c][p] = cx->scored[p] ? scale * (double)t[tr[c]] - (double)a[rr[c]] : 0.0;
+    }
+    for (int s = 0; s < GR_METRICS_NSCALES; s++) {
+        const double sigma = gr_metrics_blur_sigmas[s];
+        gr_status st = gr_blur_fields((const double *const *)d, 3, wt, ref->width, ref->height, sigma,
+                                      gr_blur_radius(sigma), o, NULL, err);
+        if (st != GR_OK) {
+            free(buf);
+            return st;
+        }
+        double s2[GR_MCH_COUNT] = {0};
+        for (size_t p = 0; p < n; p++) {
+            if (!cx->scored[p]) continue;
+            double dy = 0.0;
+            for (int c = 0; c < 3; c++) {
+                s2[c] += o[c][p] * o[c][p];
+                dy += lum_w[c] * o[c][p];
+            }
+            s2[GR_MCH_Y] += dy * dy;
+        }
+        s2[GR_MCH_RGB] = s2[0] + s2[1] + s2[2];
+        const double ns = (double)cx->n_scored;
+        for (int c = 0; c < GR_MCH_COUNT; c++)
+            set->ch[c].rmse_blur[s] = sqrt(s2[c] / (c == GR_MCH_RGB ? 3.0 * ns : ns));
+    }
+    free(buf);
+    set->have_blur = 1;
+    return GR_OK;
+}
+
+static gr_status compute_set(const ctx *cx, const int rr[3], const int tr[3], double scale, gr_metrics_set *set,
+                             gr_error *err)
+{
+    memset(set, 0, sizeof *set);
+    set->scale = scale;
+    acc a[GR_MCH_COUNT];
+    memset(a, 0, sizeof a);
+    const gr_image *ref = cx->ref, *test = cx->test;
+    const int W = ref->width;
+    for (size_t p = 0; p < cx->n; p++) {
+        if (!cx->scored[p]) continue;
+        const int x = (int)(p % (size_t)W), y = (int)(p / (size_t)W);
+        const float *rp = ref->pixels + p * (size_t)ref->nchannels;
+        const float *tp = test->pixels + p * (size_t)test->nchannels;
+        double yr = 0.0, yt = 0.0;
+        for (int c = 0; c < 3; c++) {
+            const double r = (double)rp[rr[c]], t = scale * (double)tp[tr[c]];
+            const double s = cx->have_stderr ? fabs((double)rp[cx->serr[c]]) : 0.0;
+            acc_add(&a[c], r, t, s, cx->have_stderr, cx->eps[c], x, y, -1);
+            acc_add(&a[GR_MCH_RGB], r, t, s, cx->have_stderr, cx->eps[GR_MCH_RGB], x, y, c);
+            yr += lum_w[c] * r;
+            yt += lum_w[c] * t;
+        }
+        acc_add(&a[GR_MCH_Y], yr, yt, cx->have_stderr ? stderr_y(cx, p) : 0.0, cx->have_stderr, cx->eps[GR_MCH_Y],
+                x, y, -1);
+    }
+    for (int c = 0; c < GR_MCH_COUNT; c++) acc_finish(&a[c], cx->eps[c], cx->peak_ref[c], &set->ch[c]);
+    set->ssim_y = 1.0;
+    if (!cx->opt->skip_ssim) {
+        gr_status st = ssim_luminance(cx, rr, tr, scale, &set->ssim_y, err);
+        if (st != GR_OK) return st;
+        set->have_ssim = 1;
+    }
+    if (!cx->opt->skip_blur) {
+        gr_status st = blurred_rmse(cx, rr, tr, scale, set, err);
+        if (st != GR_OK) return st;
+        set->have_blur = 1;
+    }
+    return GR_OK;
+}
+
+/* Reference stderr channels, or -1s. */
+static int find_stderr(const gr_image *ref, int serr[3])
+{
+    serr[0] = gr_image_channel(ref, "stderr.R");
+    serr[1] = gr_image_channel(ref, "stderr.G");
+    serr[2] = gr_image_channel(ref, "stderr.B");
+    return serr[0] >= 0 && serr[1] >= 0 && serr[2] >= 0;
+}
+
+static gr_status check_bound(double *bound, gr_error *err)
+{
+    if (isnan(*bound) || *bound < 0.0)
+        return gr_fail(err, GR_E_INPUT, "metrics: stderr bound %g is not a value >= 0", *bound);
+    if (*bound == 0.0) *bound = GR_METRICS_STDERR_BOUND;
+    return GR_OK;
+}
+
+gr_status gr_metrics_scored_pixels(const gr_image *ref, const gr_image *mask, double stderr_bound,
+                                   unsigned char *scored, long long *n_masked_out, long long *n_stderr_excluded,
+                                   gr_error *err)
+{
+    if (!ref || !ref->pixels || !scored) return gr_fail(err, GR_E_INPUT, "metrics: no reference image");
+    if (mask && (!mask->pixels || mask->width != ref->width || mask->height != ref->height))
+        return gr_fail(err, GR_E_INPUT, "metrics: mask is %d x %d, images are %d x %d", mask->width, mask->height,
+                       ref->width, ref->height);
+    gr_status st = check_bound(&stderr_bound, err);
+    if (st != GR_OK) return st;
+    ctx cx;
+    memset(&cx, 0, sizeof cx);
+    cx.ref = ref;
+    cx.have_stderr = find_stderr(ref, cx.serr);
+    int rr[3];
+    gr_metrics_pick_rgb(ref, rr);
+    long long nm = 0, ne = 0;
+    const size_t n = (size_t)ref->width * (size_t)ref->height;
+    for (size_t p = 0; p < n; p++) {
+        unsigned char ok = 1;
+        if (mask && mask->pixels[p * (size_t)mask->nchannels] == 0.0f) {
+            ok = 0;
+            nm++;
+        } else if (cx.have_stderr) {
+            /* Relative stderr of the reference luminance; 0/0 counts as 0 (an exact zero). */
+            double yr = 0.0;
+            for (int c = 0; c < 3; c++) yr += lum_w[c] * refv(&cx, p, c, rr);
+            const double s = stderr_y(&cx, p);
+            const double rel = s == 0.0 ? 0.0 : (yr != 0.0 ? s / fabs(yr) : INFINITY);
+            if (rel > stderr_bound) {
+                ok = 0;
+                ne++;
+            }
+        }
+        scored[p] = ok;
+    }
+    if (n_masked_out) *n_masked_out = nm;
+    if (n_stderr_excluded) *n_stderr_excluded = ne;
+    return GR_OK;
+}
+
+gr_status gr_metrics_compute(const gr_image *ref, const gr_image *test, const gr_metrics_options *opt,
+                             gr_metrics *out, gr_error *err)
+{
+    static const gr_metrics_options defaults = {0};
+    if (!out) return gr_fail(err, GR_E_INPUT, "metrics: no output");
+    memset(out, 0, sizeof *out);
+    if (!opt) opt = &defaults;
+    if (!ref || !ref->pixels) return gr_fail(err, GR_E_INPUT, "metrics: no reference image");
+    if (!test || !test->pixels) return gr_fail(err, GR_E_INPUT, "metrics: no test image");
+    if (ref->width != test->width || ref->height != test->height)
+        return gr_fail(err, GR_E_INPUT, "metrics: reference is %d x %d, test is %d x %d", ref->width, ref->height,
+                       test->width, test->height);
+    const gr_image *mask = opt->mask; /* its size is checked by gr_metrics_scored_pixels */
+    double bound = opt->stderr_bound;
+    gr_status st = check_bound(&bound, err);
+    if (st != GR_OK) return st;
+    st = gr_image_check_finite(ref, "reference", err);
+    if (st == GR_OK) st = gr_image_check_finite(test, "test", err);
+    if (st == GR_OK && mask) st = gr_image_check_finite(mask, "mask", err);
+    if (st != GR_OK) {
+        if (err) err->status = GR_E_INPUT;
+        return GR_E_INPUT;
+    }
+
+    ctx cx;
+    memset(&cx, 0, sizeof cx);
+    cx.ref = ref, cx.test = test, cx.opt = opt;
+    cx.n = (size_t)ref->width * (size_t)ref->height;
+    int rr[3], tr[3];
+    gr_metrics_pick_rgb(ref, rr);
+    gr_metrics_pick_rgb(test, tr);
+    cx.have_stderr = find_stderr(ref, cx.serr);
+
+    unsigned char *scored = malloc(cx.n);
+    if (!scored) return gr_fail(err, GR_E_NOMEM, "metrics: cannot allocate %zu pixels", cx.n);
+    cx.scored = scored;
+
+    out->width = ref->width, out->height = ref->height;
+    memcpy(out->ref_rgb, rr, sizeof rr);
+    memcpy(out->test_rgb, tr, sizeof tr);
+    out->n_pixels = (long long)cx.n;
+    out->have_stderr = cx.have_stderr;
+    out->stderr_bound = bound;
+    out->stderr_z = GR_METRICS_STDERR_Z;
+
+    /* Which pixels are scored, and the scale-independent statistics of the reference. */
+    double sabs[GR_MCH_COUNT] = {0}, pk[GR_MCH_COUNT];
+    int pk_set[GR_MCH_COUNT] = {0};
+    st = gr_metrics_scored_pixels(ref, mask, bound, scored, &out->n_masked_out, &out->n_stderr_excluded, err);
+    if (st != GR_OK) {
+        free(scored);
+        return st;
+    }
+    for (size_t p = 0; p < cx.n; p++) {
+        if (!scored[p]) continue;
+        double r[3], yr = 0.0;
+        for (int c = 0; c < 3; c++) {
+            r[c] = refv(&cx, p, c, rr);
+            yr += lum_w[c] * r[c];
+        }
+        cx.n_scored++;
+        const double v[GR_MCH_COUNT] = {r[0], r[1], r[2], 0.0, yr};
+        for (int c = 0; c < GR_MCH_COUNT; c++) {
+            if (c == GR_MCH_RGB) continue;
+            sabs[c] += fabs(v[c]);
+            if (!pk_set[c] || v[c] > pk[c]) pk[c] = v[c], pk_set[c] = 1;
+        }
+    }
+    out->n_scored = cx.n_scored;
+    sabs[GR_MCH_RGB] = sabs[0] + sabs[1] + sabs[2];
+    pk_set[GR_MCH_RGB] = pk_set[0];
+    pk[GR_MCH_RGB] = 0.0;
+    if (pk_set[0]) {
+        pk[GR_MCH_RGB] = pk[0];
+        if (pk[1] > pk[GR_MCH_RGB]) pk[GR_MCH_RGB] = pk[1];
+        if (pk[2] > pk[GR_MCH_RGB]) pk[GR_MCH_RGB] = pk[2];
+    }
+    for (int c = 0; c < GR_MCH_COUNT; c++) {
+        const double ns = (double)cx.n_scored * (c == GR_MCH_RGB ? 3.0 : 1.0);
+        const double mabs = ns > 0.0 ? sabs[c] / ns : 0.0;
+        double eps = GR_METRICS_RELMSE_K * mabs * mabs;
+        cx.eps[c] = eps > GR_METRICS_RELMSE_FLOOR ? eps : GR_METRICS_RELMSE_FLOOR;
+        /* PSNR's HDR peak: the reference's maximum; 1 when it has no positive value. */
+        cx.peak_ref[c] = pk_set[c] && pk[c] > 0.0 ? pk[c] : 1.0;
+    }
+    /* SSIM's dynamic range L: the reference luminance peak (docs/metrics.md). */
+    out->ssim_L = cx.peak_ref[GR_MCH_Y];
+    cx.ssim_c1 = (GR_SSIM_K1 * out->ssim_L) * (GR_SSIM_K1 * out->ssim_L);
+    cx.ssim_c2 = (GR_SSIM_K2 * out->ssim_L) * (GR_SSIM_K2 * out->ssim_L);
+    out->ssim_c1 = cx.ssim_c1, out->ssim_c2 = cx.ssim_c2;
+
+    st = compute_set(&cx, rr, tr, 1.0, &out->raw, err);
+    if (st == GR_OK && opt->fit_scale) {
+        /* Best scale a = <t, r> / <t, t> (least squares over the scored RGB samples). */
+        double tr_dot = 0.0, tt_dot = 0.0;
+        for (size_t p = 0; p < cx.n; p++) {
+            if (!scored[p]) continue;
+            const float *rp = ref->pixels + p * (size_t)ref->nchannels;
+            const float *tp = test->pixels + p * (size_t)test->nchannels;
+            for (int c = 0; c < 3; c++) {
+                tr_dot += (double)tp[tr[c]] * (double)rp[rr[c]];
+                tt_dot += (double)tp[tr[c]] * (double)tp[tr[c]];
+            }
+        }
+        out->have_fit = 1;
+        out->fit_defined = tt_dot > 0.0;
+        st = compute_set(&cx, rr, tr, tt_dot > 0.0 ? tr_dot / tt_dot : 1.0, &out->fit, err);
+    }
+    free(scored);
+    return st;
+}

@@ -1,0 +1,295 @@
+// OpenImageIO 2.4 behind the C interface of oiio.h: the only C++ in the project.
+// Every extern "C" body is wrapped in try/catch(...) so that no exception reaches C code.
+extern "C" {
+#include "common/status.h"
+}
+#include "image/oiio.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+namespace {
+
+// One line: OpenImageIO messages may span several lines.
+std::string one_line(std::string s)
+{
+    for (char &ch : s)
+        if (ch == '\n' || ch == '\r') ch = ' ';
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    return s.empty() ? std::string("unknown OpenImageIO error") : s;
+}
+
+gr_status fail(gr_error *err, gr_status st, const char *path, const char *what, const std::string &why)
+{
+    return gr_fail(err, st, "%s: %s: %s", path, what, one_line(why).c_str());
+}
+
+// sRGB OETF, IEC 61966-2-1 (piecewise: linear toe below 0.0031308, 1/2.4 power above).
+float srgb_encode(float v)
+{
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+// Its inverse (the sRGB EOTF as the standard writes it).
+float srgb_decode(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+std::string temp_name(const char *path)
+{
+    return std::string(path) + ".tmp-" + std::to_string(static_cast<long>(getpid()));
+}
+
+// Writes w x h x nc pixels of type `type` to a temporary file in the format that `path`'s
+// extension names, then renames it over `path`: nothing half-written is ever visible.
+gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::TypeDesc type,
+                         const void *data, gr_error *err)
+{
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) return fail(err, GR_E_INPUT, path, "no writer for this file type", OIIO::geterror());
+    const std::string tmp = temp_name(path);
+    gr_status st = GR_OK;
+    if (!out->open(tmp, spec)) {
+        st = fail(err, GR_E_IO, path, "cannot create file", out->geterror());
+    } else {
+        if (!out->write_image(type, data))
+            st = fail(err, GR_E_IO, path, "writing pixels", out->geterror());
+        if (!out->close() && st == GR_OK)
+            st = fail(err, GR_E_IO, path, "closing file", out->geterror());
+    }
+    out.reset();
+    if (st == GR_OK && std::rename(tmp.c_str(), path) != 0)
+        st = gr_fail(err, GR_E_IO, "%s: cannot rename %s into place: %s", path, tmp.c_str(), std::strerror(errno));
+    if (st != GR_OK) std::remove(tmp.c_str());
+    return st;
+}
+
+bool image_ok(const gr_image *img)
+{
+    return img && img->pixels && img->width > 0 && img->height > 0 && img->nchannels > 0 &&
+           img->nchannels <= GR_IMAGE_MAX_CHANNELS;
+}
+
+gr_status exception_status(gr_error *err, const char *path, const char *what)
+{
+    try {
+        throw;
+    } catch (const std::bad_alloc &) {
+        return gr_fail(err, GR_E_NOMEM, "%s: %s: out of memory", path ? path : "(null)", what);
+    } catch (const std::exception &e) {
+        return gr_fail(err, GR_E_RUNTIME, "%s: %s: %s", path ? path : "(null)", what, one_line(e.what()).c_str());
+    } catch (...) {
+        return gr_fail(err, GR_E_RUNTIME, "%s: %s: unknown exception", path ? path : "(null)", what);
+    }
+}
+
+} // namespace
+
+extern "C" const char *gr_oiio_version(void)
+{
+    try {
+        // The runtime library's version (not the header's), e.g. 20407 -> "2.4.7".
+        static const std::string v = [] {
+            int n = OIIO::openimageio_version();
+            return std::to_string(n / 10000) + "." + std::to_string(n / 100 % 100) + "." + std::to_string(n % 100);
+        }();
+        return v.c_str();
+    } catch (...) {
+        return "unknown";
+    }
+}
+
+extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **out, gr_error *err)
+{
+    if (out) *out = nullptr;
+    if (!path || !path[0] || !out) return gr_fail(err, GR_E_USAGE, "image read: no input path or output");
+    gr_image *img = nullptr;
+    try {
+        auto in = OIIO::ImageInput::open(path);
+        if (!in) {
+            std::string why = OIIO::geterror();
+            // A missing or unreadable file is an I/O error; anything else is bad input.
+            FILE *f = std::fopen(path, "rb");
+            if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
+            std::fclose(f);
+            return fail(err, GR_E_INPUT, path, "cannot read as an image", why);
+        }
+        const OIIO::ImageSpec &spec = in->spec();
+        if (spec.deep) return gr_fail(err, GR_E_INPUT, "%s: deep images are not supported", path);
+        if (spec.depth > 1) return gr_fail(err, GR_E_INPUT, "%s: volume images are not supported", path);
+        const int nc = spec.nchannels;
+        if (nc <= 0 || nc > GR_IMAGE_MAX_CHANNELS)
+            return gr_fail(err, GR_E_INPUT, "%s: %d channels (1 to %d supported)", path, nc, GR_IMAGE_MAX_CHANNELS);
+        static const char *const rgba[4] = {"R", "G", "B", "A"};
+        std::vector<std::string> names(static_cast<size_t>(nc));
+        std::vector<const char *> cnames(static_cast<size_t>(nc));
+        for (int c = 0; c < nc; c++) {
+            std::string n = c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[static_cast<size_t>(c)] : "";
+            if (n.empty()) n = c < 4 ? rgba[c] : "c" + std::to_string(c);
+            if (n.size() >= GR_CHANNEL_NAME_MAX)
+                return gr_fail(err, GR_E_INPUT, "%s: channel %d name '%s' is longer than %d characters", path, c, n.c_str(), GR_CHANNEL_NAME_MAX - 1);
+            names[static_cast<size_t>(c)] = n;
+        }
+        for (int c = 0; c < nc; c++) cnames[static_cast<size_t>(c)] = names[static_cast<size_t>(c)].c_str();
+        img = gr_image_create(spec.width, spec.height, nc, cnames.data());
+        if (!img) return gr_fail(err, GR_E_NOMEM, "%s: cannot allocate %d x %d x %d image", path, spec.width, spec.height, nc);
+        if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, img->pixels)) {
+            gr_status st = fail(err, GR_E_INPUT, path, "reading pixels", in->geterror());
+            gr_image_destroy(img);
+            return st;
+        }
+        in->close();
+        // Integer files hold display-encoded codes; decode to linear only on request, and
+        // never alpha (stored linear) or files that declare themselves linear.
+        const bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+        const std::string cs = spec.get_string_attribute("oiio:ColorSpace");
+        if (linearize && integer && !OIIO::Strutil::iequals(cs, "Linear")) {
+            const size_t n = static_cast<size_t>(img->width) * static_cast<size_t>(img->height);
+            for (size_t p = 0; p < n; p++)
+                for (int c = 0; c < nc; c++)
+                    if (c != spec.alpha_channel)
+                        img->pixels[p * static_cast<size_t>(nc) + static_cast<size_t>(c)] =
+                            srgb_decode(img->pixels[p * static_cast<size_t>(nc) + static_cast<size_t>(c)]);
+        }
+        gr_status st = gr_image_check_finite(img, path, err);
+        if (st != GR_OK) {
+            gr_image_destroy(img);
+            if (err) err->status = GR_E_INPUT; // a non-finite sample in a file is bad input
+            return GR_E_INPUT;
+        }
+        *out = img;
+        return GR_OK;
+    } catch (...) {
+        gr_image_destroy(img);
+        return exception_status(err, path, "reading image");
+    }
+}
+
+extern "C" gr_status gr_oiio_write_preview(const char *path, const gr_image *img, const int rgb[3],
+                                           double exposure, gr_error *err)
+{
+    if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "preview: no output path");
+    if (!image_ok(img)) return gr_fail(err, GR_E_INPUT, "%s: no image or bad image size", path);
+    if (!rgb) return gr_fail(err, GR_E_INPUT, "%s: no channels chosen for the preview", path);
+    for (int k = 0; k < 3; k++)
+        if (rgb[k] < 0 || rgb[k] >= img->nchannels)
+            return gr_fail(err, GR_E_INPUT, "%s: preview channel %d is %d, the image has %d channels", path, k, rgb[k], img->nchannels);
+    if (!std::isfinite(exposure) || exposure < 0.0)
+        return gr_fail(err, GR_E_INPUT, "%s: preview exposure %g is not a finite value >= 0", path, exposure);
+    try {
+        const size_t w = static_cast<size_t>(img->width), h = static_cast<size_t>(img->height);
+        const size_t nc = static_cast<size_t>(img->nchannels);
+        std::vector<unsigned char> codes(w * h * 3);
+        const float e = static_cast<float>(exposure);
+        for (size_t p = 0; p < w * h; p++) {
+            for (size_t k = 0; k < 3; k++) {
+                float v = img->pixels[p * nc + static_cast<size_t>(rgb[k])] * e;
+                // NaN and +-Inf have no display value: written as 0 (the renderer's bug
+                // shows as black instead of crashing the preview).
+                if (!std::isfinite(v)) v = 0.0f;
+                v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+                codes[p * 3 + k] = static_cast<unsigned char>(std::floor(srgb_encode(v) * 255.0f + 0.5f));
+            }
+        }
+        OIIO::ImageSpec spec(img->width, img->height, 3, OIIO::TypeDesc::UINT8);
+        spec.attribute("oiio:ColorSpace", "sRGB");
+        return write_via_temp(path, spec, OIIO::TypeDesc::UINT8, codes.data(), err);
+    } catch (...) {
+        return exception_status(err, path, "writing preview");
+    }
+}
+
+extern "C" gr_status gr_oiio_write(const char *path, const gr_image *img, gr_error *err)
+{
+    if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "image write: no output path");
+    if (!image_ok(img)) return gr_fail(err, GR_E_INPUT, "%s: no image or bad image size", path);
+    gr_status st = gr_image_check_finite(img, path, err);
+    if (st != GR_OK) return st;
+    try {
+        OIIO::ImageSpec spec(img->width, img->height, img->nchannels, OIIO::TypeDesc::FLOAT);
+        spec.alpha_channel = -1;
+        for (int c = 0; c < img->nchannels; c++) {
+            spec.channelnames[static_cast<size_t>(c)] = img->names[c];
+            if (std::strcmp(img->names[c], "A") == 0) spec.alpha_channel = c;
+        }
+        return write_via_temp(path, spec, OIIO::TypeDesc::FLOAT, img->pixels, err);
+    } catch (...) {
+        return exception_status(err, path, "writing image");
+    }
+}
+
+// ---- color maps and text for the comparison's difference images (compare module) ----------
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
+extern "C" gr_status gr_oiio_color_map(const gr_image *src, int channel, const char *map, gr_image **out,
+                                       gr_error *err)
+{
+    if (out) *out = nullptr;
+    if (!out || !image_ok(src)) return gr_fail(err, GR_E_INPUT, "color map: no image or bad image size");
+    if (channel < 0 || channel >= src->nchannels)
+        return gr_fail(err, GR_E_INPUT, "color map: channel %d, the image has %d", channel, src->nchannels);
+    if (!map || !map[0]) return gr_fail(err, GR_E_INPUT, "color map: no map name");
+    gr_image *res = nullptr;
+    try {
+        const size_t n = static_cast<size_t>(src->width) * static_cast<size_t>(src->height);
+        OIIO::ImageBuf in(OIIO::ImageSpec(src->width, src->height, 1, OIIO::TypeDesc::FLOAT));
+        float *v = static_cast<float *>(in.localpixels());
+        for (size_t p = 0; p < n; p++) {
+            float x = src->pixels[p * static_cast<size_t>(src->nchannels) + static_cast<size_t>(channel)];
+            v[p] = std::isfinite(x) ? (x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x)) : 0.0f;
+        }
+        OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(in, 0, map);
+        if (mapped.has_error() || mapped.nchannels() != 3)
+            return gr_fail(err, GR_E_INPUT, "color map '%s': %s", map, one_line(mapped.geterror()).c_str());
+        res = gr_image_create(src->width, src->height, 3, nullptr);
+        if (!res) return gr_fail(err, GR_E_NOMEM, "color map: cannot allocate %d x %d", src->width, src->height);
+        if (!mapped.get_pixels(OIIO::ROI(0, src->width, 0, src->height, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT,
+                               res->pixels)) {
+            gr_image_destroy(res);
+            return gr_fail(err, GR_E_RUNTIME, "color map '%s': %s", map, one_line(mapped.geterror()).c_str());
+        }
+        *out = res;
+        return GR_OK;
+    } catch (...) {
+        gr_image_destroy(res);
+        return exception_status(err, map, "color map");
+    }
+}
+
+extern "C" gr_status gr_oiio_render_text(gr_image *img, int x, int y, const char *text, int size_px,
+                                         const float rgb[3], int align, gr_error *err)
+{
+    if (!image_ok(img) || !text || !rgb || size_px <= 0)
+        return gr_fail(err, GR_E_INPUT, "text: bad image, text, color or size");
+    try {
+        OIIO::ImageSpec spec(img->width, img->height, img->nchannels, OIIO::TypeDesc::FLOAT);
+        OIIO::ImageBuf buf(spec, img->pixels); // wraps img's pixels: drawn in place
+        std::vector<float> color(static_cast<size_t>(img->nchannels), 1.0f);
+        for (int c = 0; c < 3 && c < img->nchannels; c++) color[static_cast<size_t>(c)] = rgb[c];
+        const OIIO::ImageBufAlgo::TextAlignX ax = align == 1 ? OIIO::ImageBufAlgo::TextAlignX::Center
+                                               : (align == 2 ? OIIO::ImageBufAlgo::TextAlignX::Right : OIIO::ImageBufAlgo::TextAlignX::Left);
+        OIIO::ROI roi = OIIO::get_roi(spec);
+        roi.chend = img->nchannels < 3 ? img->nchannels : 3;
+        for (const char *font : {"DejaVuSans", ""}) {
+            if (OIIO::ImageBufAlgo::render_text(buf, x, y, text, size_px, font, color, ax,
+                                                OIIO::ImageBufAlgo::TextAlignY::Baseline, 0, roi))
+                return GR_OK;
+            (void)buf.geterror(); // clear, then try the next font
+        }
+        return gr_fail(err, GR_E_RUNTIME, "text '%s': no usable font (DejaVuSans or OpenImageIO's default)", text);
+    } catch (...) {
+        return exception_status(err, text, "drawing text");
+    }
+}

@@ -1,0 +1,166 @@
+/* GLSL program loading for the real-time renderers (see shaders.h). */
+#include "realtime/shaders.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "gl/gl.h"
+#include "gl/shaders_embedded.h"
+
+static char *dup_string(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d) memcpy(d, s, n);
+    return d;
+}
+
+static gr_status read_text(const char *path, char **out, gr_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, strerror(errno));
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    if (!buf) {
+        fclose(f);
+        return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
+    }
+    for (;;) {
+        if (len + 1 >= cap) {
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
+            }
+            buf = nb;
+            cap *= 2;
+        }
+        size_t got = fread(buf + len, 1, cap - len - 1, f);
+        len += got;
+        if (got == 0) break;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        return gr_fail(err, GR_E_IO, "%s: read error", path);
+    }
+    buf[len] = '\0';
+    *out = buf;
+    return GR_OK;
+}
+
+gr_status gr_shader_check_dir(const char *dir, gr_error *err)
+{
+    struct stat st;
+    if (!dir) return GR_OK;
+    if (stat(dir, &st) != 0)
+        return gr_fail(err, GR_E_INPUT, "--shader-dir %s: %s", dir, strerror(errno));
+    if (!S_ISDIR(st.st_mode)) return gr_fail(err, GR_E_INPUT, "--shader-dir %s: not a directory", dir);
+    return GR_OK;
+}
+
+gr_status gr_shader_source(const char *dir, const char *name, char **out, int *from_dir,
+                           gr_error *err)
+{
+    *out = NULL;
+    if (from_dir) *from_dir = 0;
+    if (dir) {
+        char path[4096];
+        struct stat st;
+        int n = snprintf(path, sizeof path, "%s/%s", dir, name);
+        if (n < 0 || (size_t)n >= sizeof path)
+            return gr_fail(err, GR_E_INPUT, "--shader-dir %s: path too long", dir);
+        if (stat(path, &st) == 0) {
+            gr_status st2 = read_text(path, out, err);
+            if (st2 == GR_OK && from_dir) *from_dir = 1;
+            return st2;
+        }
+    }
+    for (const gr_embedded_shader *e = gr_embedded_shaders; e->name; e++) {
+        if (!strcmp(e->name, name)) {
+            *out = dup_string(e->source);
+            return *out ? GR_OK : gr_fail(err, GR_E_NOMEM, "%s: out of memory", name);
+        }
+    }
+    return gr_fail(err, GR_E_INPUT, "%s: no such shader (embedded or in --shader-dir)", name);
+}
+
+/* The driver's log on one line: newlines become " | ", trailing blanks dropped. */
+static void flatten_log(char *log)
+{
+    size_t n = strlen(log);
+    while (n > 0 && (log[n - 1] == '\n' || log[n - 1] == '\r' || log[n - 1] == ' ')) log[--n] = '\0';
+    for (size_t i = 0; i < n; i++)
+        if (log[i] == '\n' || log[i] == '\r' || log[i] == '\t') log[i] = ' ';
+}
+
+static gr_status compile(GLenum type, const char *name, const char *src, GLuint *out, gr_error *err)
+{
+    GLuint sh = glCreateShader(type);
+    if (!sh) return gr_fail(err, GR_E_GL, "%s: glCreateShader failed", name);
+    glShaderSource(sh, 1, &src, NULL);
+    glCompileShader(sh);
+    GLint ok = 0;
+    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[900];
+        log[0] = '\0';
+        glGetShaderInfoLog(sh, (GLsizei)sizeof log, NULL, log);
+        flatten_log(log);
+        glDeleteShader(sh);
+        return gr_fail(err, GR_E_GL, "%s: GLSL compile failed: %s", name, log[0] ? log : "(no log)");
+    }
+    *out = sh;
+    return GR_OK;
+}
+
+gr_status gr_shader_program(const char *dir, const char *vert_name, const char *frag_name,
+                            const char *const *tf_varyings, int n_tf, unsigned *program,
+                            int *n_from_dir, gr_error *err)
+{
+    char *vs_src = NULL, *fs_src = NULL;
+    int vd = 0, fd = 0;
+    GLuint vs = 0, fs = 0, prog = 0;
+    gr_status st;
+    *program = 0;
+    if ((st = gr_shader_source(dir, vert_name, &vs_src, &vd, err)) != GR_OK) goto done;
+    if ((st = gr_shader_source(dir, frag_name, &fs_src, &fd, err)) != GR_OK) goto done;
+    if (n_from_dir) *n_from_dir = vd + fd;
+    if ((st = compile(GL_VERTEX_SHADER, vert_name, vs_src, &vs, err)) != GR_OK) goto done;
+    if ((st = compile(GL_FRAGMENT_SHADER, frag_name, fs_src, &fs, err)) != GR_OK) goto done;
+    prog = glCreateProgram();
+    if (!prog) {
+        st = gr_fail(err, GR_E_GL, "%s + %s: glCreateProgram failed", vert_name, frag_name);
+        goto done;
+    }
+    glAttachShader(prog, vs);
+    glAttachShader(prog, fs);
+    if (n_tf > 0) glTransformFeedbackVaryings(prog, n_tf, (const GLchar *const *)tf_varyings, GL_INTERLEAVED_ATTRIBS);
+    glLinkProgram(prog);
+    GLint ok = 0;
+    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[900];
+        log[0] = '\0';
+        glGetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
+        flatten_log(log);
+        glDeleteProgram(prog);
+        prog = 0;
+        st = gr_fail(err, GR_E_GL, "%s + %s: GLSL link failed: %s", vert_name, frag_name,
+                     log[0] ? log : "(no log)");
+        goto done;
+    }
+    *program = prog;
+    st = GR_OK;
+done:
+    if (vs) glDeleteShader(vs);
+    if (fs) glDeleteShader(fs);
+    free(vs_src);
+    free(fs_src);
+    return st;
+}

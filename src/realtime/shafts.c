@@ -1,0 +1,991 @@
+/* Seed 000's real-time god-ray shafts as an OpenGL pipeline (see shafts.h and
+ * docs/realtime-shafts.md for every decision and its reason). */
+#include "realtime/shafts.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/optics.h"
+#include "core/shaftgeom.h"
+#include "gl/gl.h"
+#include "realtime/shaders.h"
+
+#define MAX_WAVE_GROUPS 16 /* must match shafts.vert.glsl */
+#define SPHERE_STACKS 24
+#define SPHERE_SLICES 48
+/* Projection planes of the camera; with the shafts' forced clip z (seed VS) only w matters
+ * in the shaft pass, and the final pass only uses directions. */
+#define CAM_NEAR 0.05
+#define CAM_FAR 2000.0
+
+const char *const gr_shafts_pass_names[GR_SHAFTS_NPASS] = {"shadow", "shafts", "final"};
+
+/* Uniform locations of a program built from shafts.vert.glsl (shaft pass and capture). */
+typedef struct shaft_locs {
+    GLint origin, spacing, width, length, extinction, sun_dir, eta, r0;
+    GLint view_proj, shadow_matrix, wave_groups, waves, shadow_map, shadow_bias;
+} shaft_locs;
+
+struct gr_shafts {
+    gr_gl *gl;
+    char *shader_dir;
+    int from_dir;
+    GLuint prog_shadow, prog_shafts, prog_final, prog_capture;
+    GLint loc_light_vp;
+    shaft_locs ls, lc;
+    GLint loc_inv_vp, loc_texel, loc_shafts, loc_hgg, loc_refr_sun, loc_intensity, loc_bias;
+
+    GLuint vao_grid, vbo_grid, ibo_grid;
+    int grid_N, grid_nshafts;
+    float *grid_cpu; /* 5 floats per vertex: cell.xy, corner.xy, bottom */
+
+    GLuint vao_occ, vbo_occ;
+    float *occ_cpu;
+    size_t occ_cap; /* floats */
+
+    GLuint vao_empty;
+    GLuint shadow_tex, shadow_fbo;
+    int shadow_size;
+    GLuint target_tex, target_fbo;
+    int target_w, target_h, target_fmt;
+    GLuint frame_tex, frame_fbo;
+    int frame_w, frame_h;
+
+    GLuint q_time[GR_SHAFTS_NPASS], q_samples, q_vs, q_fs;
+    int have_timer, have_pipeline_stats;
+
+    float *readback;
+    size_t readback_cap;
+    int rendered;
+};
+
+/* Everything one render needs, computed on the CPU in double. Matrices are row-major. */
+typedef struct frame_setup {
+    gr_shafts_settings s;
+    int W, H, tw, th, N, nshafts;
+    gr_dvec3 eye, P, T;
+    double S;
+    float origin_rel[3];
+    int groups;
+    float waves[MAX_WAVE_GROUPS * 5 * 4];
+    float view_proj[16], inv_view_proj[16], shadow_matrix[16], light_vp[16];
+    float shadow_bias_depth;
+    float hgg[3];
+} frame_setup;
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+/* ---- small double matrix helpers (row-major m[r * 4 + c]) ------------------------- */
+
+static void mat_mul(const double *a, const double *b, double *out)
+{
+    double t[16];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) {
+            double acc = 0.0;
+            for (int k = 0; k < 4; k++) acc += a[r * 4 + k] * b[k * 4 + c];
+            t[r * 4 + c] = acc;
+        }
+    memcpy(out, t, sizeof t);
+}
+
+/* Gauss-Jordan with partial pivoting; returns -1 if singular. */
+static int mat_inverse(const double *m, double *out)
+{
+    double a[4][8];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 8; c++) a[r][c] = c < 4 ? m[r * 4 + c] : (c - 4 == r ? 1.0 : 0.0);
+    for (int c = 0; c < 4; c++) {
+        int piv = c;
+        for (int r = c + 1; r < 4; r++)
+            if (fabs(a[r][c]) > fabs(a[piv][c])) piv = r;
+        if (fabs(a[piv][c]) < 1e-300) return -1;
+        if (piv != c)
+            for (int k = 0; k < 8; k++) {
+                double t = a[c][k];
+                a[c][k] = a[piv][k];
+                a[piv][k] = t;
+            }
+        double inv = 1.0 / a[c][c];
+        for (int k = 0; k < 8; k++) a[c][k] *= inv;
+        for (int r = 0; r < 4; r++) {
+            if (r == c) continue;
+            double f = a[r][c];
+            for (int k = 0; k < 8; k++) a[r][k] -= f * a[c][k];
+        }
+    }
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) out[r * 4 + c] = a[r][c + 4];
+    return 0;
+}
+
+static void mat_to_float(const double *m, float *out)
+{
+    for (int i = 0; i < 16; i++) out[i] = (float)m[i];
+}
+
+/* ---- settings ------------------------------------------------------------------- */
+
+gr_status gr_shafts_check_settings(const gr_shafts_settings *s, gr_error *err)
+{
+    gr_status st = gr_param_validate(&gr_shafts_param_table, s, 1, err);
+    if (st != GR_OK) return st;
+    /* Structural limits the table may not express. */
+    if (s->N < 2) return gr_fail(err, GR_E_INPUT, "shafts.N = %d: must be >= 2 (N grid vertices make (N-1)^2 shafts)", s->N);
+    if (s->N > 1024) return gr_fail(err, GR_E_INPUT, "shafts.N = %d: must be <= 1024", s->N);
+    if (!(s->K > 0)) return gr_fail(err, GR_E_INPUT, "shafts.K = %g: must be > 0", s->K);
+    if (!(s->target_scale > 0)) return gr_fail(err, GR_E_INPUT, "shafts.target_scale = %g: must be > 0", s->target_scale);
+    if (!(s->shaft_width > 0)) return gr_fail(err, GR_E_INPUT, "shafts.shaft_width = %g: must be > 0", s->shaft_width);
+    if (s->shadow_map_size < 1 || s->shadow_map_size > 16384)
+        return gr_fail(err, GR_E_INPUT, "shafts.shadow_map_size = %d: must be in [1, 16384]", s->shadow_map_size);
+    if (s->target_format != GR_TARGET_RGBA8 && s->target_format != GR_TARGET_RGBA16F)
+        return gr_fail(err, GR_E_INPUT, "shafts.target_format: invalid choice %d", s->target_format);
+    return GR_OK;
+}
+
+void gr_shafts_resolve(const gr_scene *scene, const gr_shafts_settings *s, gr_shafts_settings *out)
+{
+    *out = *s;
+    for (int c = 0; c < 3; c++)
+        if (isnan(out->extinction[c])) out->extinction[c] = scene->medium.extinction[c];
+    if (isnan(out->g)) out->g = scene->medium.g;
+}
+
+/* ---- GL resources ------------------------------------------------------------------ */
+
+static void get_shaft_locs(GLuint prog, shaft_locs *l)
+{
+    l->origin = glGetUniformLocation(prog, "u_origin");
+    l->spacing = glGetUniformLocation(prog, "u_spacing");
+    l->width = glGetUniformLocation(prog, "u_width");
+    l->length = glGetUniformLocation(prog, "u_length");
+    l->extinction = glGetUniformLocation(prog, "u_extinction");
+    l->sun_dir = glGetUniformLocation(prog, "u_sun_dir");
+    l->eta = glGetUniformLocation(prog, "u_eta");
+    l->r0 = glGetUniformLocation(prog, "u_r0");
+    l->view_proj = glGetUniformLocation(prog, "u_view_proj");
+    l->shadow_matrix = glGetUniformLocation(prog, "u_shadow_matrix");
+    l->wave_groups = glGetUniformLocation(prog, "u_wave_groups");
+    l->waves = glGetUniformLocation(prog, "u_waves");
+    l->shadow_map = glGetUniformLocation(prog, "u_shadow_map");
+    l->shadow_bias = glGetUniformLocation(prog, "u_shadow_bias");
+}
+
+static int has_extension(const char *name)
+{
+    GLint n = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+    for (GLint i = 0; i < n; i++) {
+        const char *e = (const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i);
+        if (e && !strcmp(e, name)) return 1;
+    }
+    return 0;
+}
+
+gr_status gr_shafts_create(const gr_shafts_options *opts, gr_shafts **out, gr_error *err)
+{
+    gr_shafts_options defaults;
+    gr_status st;
+    *out = NULL;
+    if (!opts) {
+        memset(&defaults, 0, sizeof defaults);
+        opts = &defaults;
+    }
+    if ((st = gr_shader_check_dir(opts->shader_dir, err)) != GR_OK) return st;
+    gr_shafts *r = calloc(1, sizeof *r);
+    if (!r) return gr_fail(err, GR_E_NOMEM, "shafts renderer: out of memory");
+    if (opts->shader_dir) {
+        size_t n = strlen(opts->shader_dir) + 1;
+        r->shader_dir = malloc(n);
+        if (!r->shader_dir) {
+            free(r);
+            return gr_fail(err, GR_E_NOMEM, "shafts renderer: out of memory");
+        }
+        memcpy(r->shader_dir, opts->shader_dir, n);
+    }
+    if ((st = gr_gl_create(&opts->gl, &r->gl, err)) != GR_OK) goto fail;
+
+    int nd = 0;
+    if ((st = gr_shader_program(r->shader_dir, "shafts_shadow.vert.glsl", "shafts_shadow.frag.glsl", NULL, 0,
+                                &r->prog_shadow, &nd, err)) != GR_OK)
+        goto fail;
+    r->from_dir += nd;
+    if ((st = gr_shader_program(r->shader_dir, "shafts.vert.glsl", "shafts.frag.glsl", NULL, 0,
+                                &r->prog_shafts, &nd, err)) != GR_OK)
+        goto fail;
+    r->from_dir += nd;
+    if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_final.frag.glsl", NULL, 0,
+                                &r->prog_final, &nd, err)) != GR_OK)
+        goto fail;
+    r->from_dir += nd;
+
+    r->loc_light_vp = glGetUniformLocation(r->prog_shadow, "u_light_view_proj");
+    get_shaft_locs(r->prog_shafts, &r->ls);
+    r->loc_inv_vp = glGetUniformLocation(r->prog_final, "u_inv_view_proj");
+    r->loc_texel = glGetUniformLocation(r->prog_final, "u_texel");
+    r->loc_shafts = glGetUniformLocation(r->prog_final, "u_shafts");
+    r->loc_hgg = glGetUniformLocation(r->prog_final, "u_hgg");
+    r->loc_refr_sun = glGetUniformLocation(r->prog_final, "u_refr_sun");
+    r->loc_intensity = glGetUniformLocation(r->prog_final, "u_intensity");
+    r->loc_bias = glGetUniformLocation(r->prog_final, "u_bias");
+
+    glGenVertexArrays(1, &r->vao_grid);
+    glGenBuffers(1, &r->vbo_grid);
+    glGenBuffers(1, &r->ibo_grid);
+    glGenVertexArrays(1, &r->vao_occ);
+    glGenBuffers(1, &r->vbo_occ);
+    glGenVertexArrays(1, &r->vao_empty);
+    glGenQueries(GR_SHAFTS_NPASS, r->q_time);
+    glGenQueries(1, &r->q_samples);
+    /* Timer queries are core since 3.3; pipeline statistics need GL 4.6 or the ARB extension. */
+    r->have_timer = 1;
+    int major = 0, minor = 0;
+    gr_gl_context_version(r->gl, &major, &minor);
+    r->have_pipeline_stats = (major > 4 || (major == 4 && minor >= 6)) ||
+                             has_extension("GL_ARB_pipeline_statistics_query");
+    if (r->have_pipeline_stats) {
+        glGenQueries(1, &r->q_vs);
+        glGenQueries(1, &r->q_fs);
+    }
+    if ((st = gr_gl_check("shafts renderer setup", err)) != GR_OK) goto fail;
+    *out = r;
+    return GR_OK;
+fail:
+    gr_shafts_destroy(r);
+    return st;
+}
+
+static void delete_tex_fbo(GLuint *tex, GLuint *fbo)
+{
+    if (*fbo) glDeleteFramebuffers(1, fbo);
+    if (*tex) glDeleteTextures(1, tex);
+    *fbo = *tex = 0;
+}
+
+void gr_shafts_destroy(gr_shafts *r)
+{
+    if (!r) return;
+    if (r->gl) {
+        gr_gl_make_current(r->gl, NULL);
+        if (r->prog_shadow) glDeleteProgram(r->prog_shadow);
+        if (r->prog_shafts) glDeleteProgram(r->prog_shafts);
+        if (r->prog_final) glDeleteProgram(r->prog_final);
+        if (r->prog_capture) glDeleteProgram(r->prog_capture);
+        if (r->vao_grid) glDeleteVertexArrays(1, &r->vao_grid);
+        if (r->vbo_grid) glDeleteBuffers(1, &r->vbo_grid);
+        if (r->ibo_grid) glDeleteBuffers(1, &r->ibo_grid);
+        if (r->vao_occ) glDeleteVertexArrays(1, &r->vao_occ);
+        if (r->vbo_occ) glDeleteBuffers(1, &r->vbo_occ);
+        if (r->vao_empty) glDeleteVertexArrays(1, &r->vao_empty);
+        if (r->q_time[0]) glDeleteQueries(GR_SHAFTS_NPASS, r->q_time);
+        if (r->q_samples) glDeleteQueries(1, &r->q_samples);
+        if (r->q_vs) glDeleteQueries(1, &r->q_vs);
+        if (r->q_fs) glDeleteQueries(1, &r->q_fs);
+        delete_tex_fbo(&r->shadow_tex, &r->shadow_fbo);
+        delete_tex_fbo(&r->target_tex, &r->target_fbo);
+        delete_tex_fbo(&r->frame_tex, &r->frame_fbo);
+        gr_gl_destroy(r->gl);
+    }
+    free(r->grid_cpu);
+    free(r->occ_cpu);
+    free(r->readback);
+    free(r->shader_dir);
+    free(r);
+}
+
+const gr_gl *gr_shafts_gl(const gr_shafts *r) { return r ? r->gl : NULL; }
+int gr_shafts_shaders_from_dir(const gr_shafts *r) { return r ? r->from_dir : 0; }
+
+/* Static shaft geometry for N grid vertices per side: (N-1)^2 separate parallelepipeds,
+ * one per grid cell, 8 vertices each; indices: all lateral faces first, then all caps, so
+ * one draw call covers "caps off" (24 per shaft) or "caps on" (36 per shaft). */
+static gr_status ensure_grid(gr_shafts *r, int N, gr_error *err)
+{
+    if (r->grid_N == N) return GR_OK;
+    int cells = N - 1;
+    int ns = cells * cells;
+    size_t nv = (size_t)ns * 8;
+    float *v = malloc(nv * 5 * sizeof *v);
+    GLuint *idx = malloc((size_t)ns * 36 * sizeof *idx);
+    if (!v || !idx) {
+        free(v);
+        free(idx);
+        return gr_fail(err, GR_E_NOMEM, "shafts.N = %d: out of memory for the shaft grid", N);
+    }
+    static const float corners[4][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {0.5f, 0.5f}, {-0.5f, 0.5f}};
+    static const int lateral[4][4] = {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    static const int cap[2][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}};
+    double half = 0.5 * (double)(N - 1);
+    GLuint *lat = idx, *caps = idx + (size_t)ns * 24;
+    for (int j = 0; j < cells; j++)
+        for (int i = 0; i < cells; i++) {
+            int sh = j * cells + i;
+            float cx = (float)((double)i + 0.5 - half), cz = (float)((double)j + 0.5 - half);
+            for (int k = 0; k < 8; k++) {
+                float *p = v + ((size_t)sh * 8 + (size_t)k) * 5;
+                p[0] = cx;
+                p[1] = cz;
+                p[2] = corners[k & 3][0];
+                p[3] = corners[k & 3][1];
+                p[4] = k >= 4 ? 1.0f : 0.0f;
+            }
+            GLuint base = (GLuint)sh * 8u;
+            for (int f = 0; f < 4; f++) {
+                const int *q = lateral[f];
+                GLuint *o = lat + (size_t)sh * 24 + (size_t)f * 6;
+                o[0] = base + (GLuint)q[0]; o[1] = base + (GLuint)q[1]; o[2] = base + (GLuint)q[2];
+                o[3] = base + (GLuint)q[0]; o[4] = base + (GLuint)q[2]; o[5] = base + (GLuint)q[3];
+            }
+            for (int f = 0; f < 2; f++) {
+                const int *q = cap[f];
+                GLuint *o = caps + (size_t)sh * 12 + (size_t)f * 6;
+                o[0] = base + (GLuint)q[0]; o[1] = base + (GLuint)q[1]; o[2] = base + (GLuint)q[2];
+                o[3] = base + (GLuint)q[0]; o[4] = base + (GLuint)q[2]; o[5] = base + (GLuint)q[3];
+            }
+        }
+    glBindVertexArray(r->vao_grid);
+    glBindBuffer(GL_ARRAY_BUFFER, r->vbo_grid);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 5 * sizeof *v), v, GL_STATIC_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->ibo_grid);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)ns * 36 * sizeof *idx), idx, GL_STATIC_DRAW);
+    GLsizei stride = (GLsizei)(5 * sizeof(float));
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, stride, (const void *)0);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, stride, (const void *)(2 * sizeof(float)));
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, stride, (const void *)(4 * sizeof(float)));
+    glBindVertexArray(0);
+    free(idx);
+    free(r->grid_cpu);
+    r->grid_cpu = v;
+    r->grid_N = N;
+    r->grid_nshafts = ns;
+    return gr_gl_check("shafts.N: uploading the shaft grid", err);
+}
+
+static gr_status make_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h, int is_depth,
+                             GLint filter, const char *what, gr_error *err)
+{
+    delete_tex_fbo(tex, fbo);
+    glGenTextures(1, tex);
+    glBindTexture(GL_TEXTURE_2D, *tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, ifmt, w, h);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    if (is_depth) {
+        /* Outside the map nothing is stored: border depth 1 = no caster = lit. */
+        static const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+        glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+    } else {
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+    if (is_depth) {
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, *tex, 0);
+        glDrawBuffer(GL_NONE);
+        glReadBuffer(GL_NONE);
+    } else {
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
+    }
+    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (fs != GL_FRAMEBUFFER_COMPLETE)
+        return gr_fail(err, GR_E_GL, "%s (%dx%d): framebuffer incomplete (0x%04x)", what, w, h, (unsigned)fs);
+    return gr_gl_check(what, err);
+}
+
+static gr_status ensure_targets(gr_shafts *r, const frame_setup *f, gr_error *err)
+{
+    gr_status st;
+    if (r->shadow_size != f->s.shadow_map_size || !r->shadow_tex) {
+        r->shadow_size = 0;
+        st = make_target(&r->shadow_tex, &r->shadow_fbo, GL_DEPTH_COMPONENT32F, f->s.shadow_map_size,
+                         f->s.shadow_map_size, 1, GL_NEAREST, "shafts.shadow_map_size: shadow map", err);
+        if (st != GR_OK) return st;
+        r->shadow_size = f->s.shadow_map_size;
+    }
+    if (r->target_w != f->tw || r->target_h != f->th || r->target_fmt != f->s.target_format || !r->target_tex) {
+        r->target_w = 0;
+        GLenum ifmt = f->s.target_format == GR_TARGET_RGBA16F ? GL_RGBA16F : GL_RGBA8;
+        st = make_target(&r->target_tex, &r->target_fbo, ifmt, f->tw, f->th, 0, GL_LINEAR,
+                         "shafts.target_scale: shaft render target", err);
+        if (st != GR_OK) return st;
+        r->target_w = f->tw;
+        r->target_h = f->th;
+        r->target_fmt = f->s.target_format;
+    }
+    if (r->frame_w != f->W || r->frame_h != f->H || !r->frame_tex) {
+        r->frame_w = 0;
+        st = make_target(&r->frame_tex, &r->frame_fbo, GL_RGBA32F, f->W, f->H, 0, GL_NEAREST,
+                         "camera.width/height: god-ray layer target", err);
+        if (st != GR_OK) return st;
+        r->frame_w = f->W;
+        r->frame_h = f->H;
+    }
+    return GR_OK;
+}
+
+/* ---- per-render setup on the CPU ----------------------------------------------------- */
+
+static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in, frame_setup *f, gr_error *err)
+{
+    memset(f, 0, sizeof *f);
+    gr_shafts_resolve(scene, in ? in : &scene->shafts, &f->s);
+    gr_status st = gr_shafts_check_settings(&f->s, err);
+    if (st != GR_OK) return st;
+    const gr_shafts_settings *s = &f->s;
+    for (int c = 0; c < 3; c++) {
+        if (!(isfinite(s->extinction[c]) && s->extinction[c] >= 0))
+            return gr_fail(err, GR_E_INPUT, "shafts.extinction[%d] = %g: must be a finite number >= 0", c, s->extinction[c]);
+    }
+    if (!(isfinite(s->g) && fabs(s->g) < 1.0))
+        return gr_fail(err, GR_E_INPUT, "shafts.g = %g: must be in (-1, 1)", s->g);
+
+    const gr_camera *cam = &scene->camera;
+    f->W = cam->width;
+    f->H = cam->height;
+    if (f->W < 1 || f->H < 1 || f->W > 16384 || f->H > 16384)
+        return gr_fail(err, GR_E_INPUT, "camera.width/height = %dx%d: must be in [1, 16384]", f->W, f->H);
+    f->tw = (int)lround((double)f->W * s->target_scale);
+    f->th = (int)lround((double)f->H * s->target_scale);
+    if (f->tw < 1) f->tw = 1;
+    if (f->th < 1) f->th = 1;
+    if (f->tw > 16384 || f->th > 16384)
+        return gr_fail(err, GR_E_INPUT, "shafts.target_scale = %g: target %dx%d is too large", s->target_scale, f->tw, f->th);
+    f->N = s->N;
+    f->nshafts = (s->N - 1) * (s->N - 1);
+
+    /* Seed eqs. 5.5.5-5.5.6: recentering point P and spacing S from the viewer's depth. */
+    const gr_water *w = &scene->water;
+    double h0 = w->rest_height_m;
+    f->eye = gr_d3(cam->position_m[0], cam->position_m[1], cam->position_m[2]);
+    double depth = h0 - f->eye.y;
+    if (!(depth > 0))
+        return gr_fail(err, GR_E_INPUT, "camera.position_m: y = %g is not below the water surface (y = %g); "
+                       "the shafts renderer needs an underwater viewer", f->eye.y, h0);
+    gr_dvec3 I = gr_d3(scene->sun.dir[0], scene->sun.dir[1], scene->sun.dir[2]);
+    double ior = scene->medium.ior;
+    f->P = gr_shafts_center(f->eye, I, h0, ior, &f->T);
+    f->S = gr_shafts_spacing(s->K, depth, cam->fov_deg * GR_PI / 180.0, s->N);
+    if (!(isfinite(f->P.x) && isfinite(f->P.z) && f->S > 0 && isfinite(f->S)))
+        return gr_fail(err, GR_E_INPUT, "sun.elevation_deg: no finite recentering point P for this sun and camera");
+    gr_dvec3 orel = gr_d3_sub(f->P, f->eye);
+    f->origin_rel[0] = (float)orel.x;
+    f->origin_rel[1] = (float)orel.y;
+    f->origin_rel[2] = (float)orel.z;
+
+    /* Wave constants, packed by groups of 4 like the seed: kx, kz, A/|k|, A, c, with
+     * c = w t - phi0 - k.P folded mod 2 pi in double (eq. 5.5.7: phase = k.X0 - w t + phi0). */
+    if (w->n_waves > MAX_WAVE_GROUPS * 4)
+        return gr_fail(err, GR_E_INPUT, "water.waves: %d waves, the shafts renderer takes at most %d",
+                       w->n_waves, MAX_WAVE_GROUPS * 4);
+    f->groups = (w->n_waves + 3) / 4;
+    double t = w->time_s;
+    double amp_sum = 0.0, steep = 0.0;
+    for (int i = 0; i < w->n_waves; i++) {
+        const gr_wave *wv = &w->waves[i];
+        int g = i / 4, lane = i % 4;
+        double kx = wv->k * wv->dir[0], kz = wv->k * wv->dir[1];
+        double c = wv->omega_rad_s * t - wv->phase_rad - (kx * f->P.x + kz * f->P.z);
+        c = fmod(c, 2.0 * GR_PI);
+        float *base = f->waves + (size_t)g * 20;
+        base[0 * 4 + lane] = (float)kx;
+        base[1 * 4 + lane] = (float)kz;
+        base[2 * 4 + lane] = wv->k > 0 ? (float)(wv->amplitude_m / wv->k) : 0.0f;
+        base[3 * 4 + lane] = (float)wv->amplitude_m;
+        base[4 * 4 + lane] = (float)c;
+        amp_sum += fabs(wv->amplitude_m);
+        steep += fabs(wv->amplitude_m) * wv->k;
+    }
+
+    /* Camera: view matrix without translation (positions are viewer-relative). */
+    double aspect = (double)f->W / (double)f->H;
+    double tf = 1.0 / tan(0.5 * cam->fov_deg * GR_PI / 180.0);
+    double view[16] = {cam->right[0], cam->right[1], cam->right[2], 0,
+                       cam->up[0], cam->up[1], cam->up[2], 0,
+                       -cam->forward[0], -cam->forward[1], -cam->forward[2], 0,
+                       0, 0, 0, 1};
+    double proj[16] = {tf / aspect, 0, 0, 0,
+                       0, tf, 0, 0,
+                       0, 0, (CAM_FAR + CAM_NEAR) / (CAM_NEAR - CAM_FAR), 2.0 * CAM_FAR * CAM_NEAR / (CAM_NEAR - CAM_FAR),
+                       0, 0, -1, 0};
+    double vp[16], ivp[16];
+    mat_mul(proj, view, vp);
+    if (mat_inverse(vp, ivp) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection matrix");
+    mat_to_float(vp, f->view_proj);
+    mat_to_float(ivp, f->inv_view_proj);
+
+    /* Shadow map: orthographic along T, centred on P (decision in docs/realtime-shafts.md).
+     * Light frame e1, e2 across the beam, e3 = T along it; depth = e3.(x - P). */
+    gr_dvec3 e3 = gr_d3_norm(f->T);
+    gr_dvec3 a = fabs(e3.x) < 0.9 ? gr_d3(1, 0, 0) : gr_d3(0, 0, 1);
+    gr_dvec3 e1 = gr_d3_norm(gr_d3_cross(e3, a));
+    gr_dvec3 e2 = gr_d3_cross(e3, e1);
+    double half_grid = 0.5 * (double)s->N * f->S * fmax(1.0, s->shaft_width);
+    double radius = sqrt(2.0) * half_grid + amp_sum + s->shaft_length_m * fmin(1.0, steep + 0.05);
+    double znear = -(radius + amp_sum + 1.0);
+    double zfar = s->shaft_length_m + radius + amp_sum + 1.0;
+    double lvp[16] = {e1.x / radius, e1.y / radius, e1.z / radius, 0,
+                      e2.x / radius, e2.y / radius, e2.z / radius, 0,
+                      2.0 * e3.x / (zfar - znear), 2.0 * e3.y / (zfar - znear), 2.0 * e3.z / (zfar - znear),
+                      -(zfar + znear) / (zfar - znear),
+                      0, 0, 0, 1};
+    mat_to_float(lvp, f->light_vp);
+    /* Viewer-relative -> P-relative, then light clip, then [0,1] texture space (GL: origin
+     * at the bottom-left, depth in [0,1]; no D3D y flip or half-texel offset). */
+    double to_p[16] = {1, 0, 0, -orel.x, 0, 1, 0, -orel.y, 0, 0, 1, -orel.z, 0, 0, 0, 1};
+    double bias[16] = {0.5, 0, 0, 0.5, 0, 0.5, 0, 0.5, 0, 0, 0.5, 0.5, 0, 0, 0, 1};
+    double sm[16];
+    mat_mul(lvp, to_p, sm);
+    mat_mul(bias, sm, sm);
+    mat_to_float(sm, f->shadow_matrix);
+    f->shadow_bias_depth = (float)(s->shadow_bias / (zfar - znear));
+
+    /* Seed's packed Mie parameters HGg = (1 - g^2, 1 + g^2, 2 g). */
+    f->hgg[0] = (float)(1.0 - s->g * s->g);
+    f->hgg[1] = (float)(1.0 + s->g * s->g);
+    f->hgg[2] = (float)(2.0 * s->g);
+    return GR_OK;
+}
+
+/* Occluder triangles relative to P (float; double math before the cast). */
+static gr_status build_occluders(gr_shafts *r, const gr_scene *scene, gr_dvec3 P, size_t *nverts, gr_error *err)
+{
+    size_t need = 0;
+    for (int i = 0; i < scene->n_occluders; i++)
+        need += scene->occluders[i].type == GR_OCC_BOX ? 36 : (size_t)SPHERE_STACKS * SPHERE_SLICES * 6;
+    need *= 3;
+    if (need > r->occ_cap) {
+        float *nb = realloc(r->occ_cpu, need * sizeof *nb);
+        if (!nb) return gr_fail(err, GR_E_NOMEM, "occluders: out of memory");
+        r->occ_cpu = nb;
+        r->occ_cap = need;
+    }
+    float *o = r->occ_cpu;
+    size_t n = 0;
+#define PUT(v) do { o[n * 3] = (float)((v).x - P.x); o[n * 3 + 1] = (float)((v).y - P.y); \
+                    o[n * 3 + 2] = (float)((v).z - P.z); n++; } while (0)
+    for (int i = 0; i < scene->n_occluders; i++) {
+        const gr_occluder *oc = &scene->occluders[i];
+        gr_dvec3 c = gr_d3(oc->center_m[0], oc->center_m[1], oc->center_m[2]);
+        if (oc->type == GR_OCC_BOX) {
+            /* Box yaw about +y, azimuth convention of scene.h (+z toward +x): local +z maps
+             * to (sin a, 0, cos a), local +x to (cos a, 0, -sin a). */
+            double ya = oc->yaw_deg * GR_PI / 180.0;
+            gr_dvec3 ax = gr_d3(cos(ya), 0, -sin(ya)), ay = gr_d3(0, 1, 0), az = gr_d3(sin(ya), 0, cos(ya));
+            gr_dvec3 corner[8];
+            for (int k = 0; k < 8; k++) {
+                double sx = (k & 1) ? 0.5 : -0.5, sy = (k & 2) ? 0.5 : -0.5, sz = (k & 4) ? 0.5 : -0.5;
+                gr_dvec3 p = gr_d3_madd(c, ax, sx * oc->size_m[0]);
+                p = gr_d3_madd(p, ay, sy * oc->size_m[1]);
+                corner[k] = gr_d3_madd(p, az, sz * oc->size_m[2]);
+            }
+            static const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                            {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+            for (int fi = 0; fi < 6; fi++) {
+                const int *q = faces[fi];
+                PUT(corner[q[0]]); PUT(corner[q[1]]); PUT(corner[q[2]]);
+                PUT(corner[q[0]]); PUT(corner[q[2]]); PUT(corner[q[3]]);
+            }
+        } else {
+            double rad = oc->radius_m;
+            for (int st = 0; st < SPHERE_STACKS; st++) {
+                double t0 = GR_PI * st / SPHERE_STACKS, t1 = GR_PI * (st + 1) / SPHERE_STACKS;
+                for (int sl = 0; sl < SPHERE_SLICES; sl++) {
+                    double p0 = 2.0 * GR_PI * sl / SPHERE_SLICES, p1 = 2.0 * GR_PI * (sl + 1) / SPHERE_SLICES;
+                    gr_dvec3 q[4] = {
+                        gr_d3_madd(c, gr_d3(sin(t0) * cos(p0), cos(t0), sin(t0) * sin(p0)), rad),
+                        gr_d3_madd(c, gr_d3(sin(t1) * cos(p0), cos(t1), sin(t1) * sin(p0)), rad),
+                        gr_d3_madd(c, gr_d3(sin(t1) * cos(p1), cos(t1), sin(t1) * sin(p1)), rad),
+                        gr_d3_madd(c, gr_d3(sin(t0) * cos(p1), cos(t0), sin(t0) * sin(p1)), rad)};
+                    PUT(q[0]); PUT(q[1]); PUT(q[2]);
+                    PUT(q[0]); PUT(q[2]); PUT(q[3]);
+                }
+            }
+        }
+    }
+#undef PUT
+    *nverts = n;
+    glBindVertexArray(r->vao_occ);
+    glBindBuffer(GL_ARRAY_BUFFER, r->vbo_occ);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(n * 3 * sizeof(float)), n ? r->occ_cpu : NULL, GL_STREAM_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, (GLsizei)(3 * sizeof(float)), (const void *)0);
+    glBindVertexArray(0);
+    return GR_OK;
+}
+
+static void set_shaft_uniforms(GLuint prog, const shaft_locs *l, const frame_setup *f, const gr_scene *scene)
+{
+    const gr_shafts_settings *s = &f->s;
+    glUseProgram(prog);
+    glUniform3fv(l->origin, 1, f->origin_rel);
+    glUniform1f(l->spacing, (float)f->S);
+    glUniform1f(l->width, (float)s->shaft_width);
+    glUniform1f(l->length, (float)s->shaft_length_m);
+    glUniform3f(l->extinction, (float)s->extinction[0], (float)s->extinction[1], (float)s->extinction[2]);
+    glUniform3f(l->sun_dir, (float)scene->sun.dir[0], (float)scene->sun.dir[1], (float)scene->sun.dir[2]);
+    glUniform1f(l->eta, (float)(1.0 / scene->medium.ior));
+    glUniform1f(l->r0, (float)gr_fresnel_r0(1.0, scene->medium.ior));
+    glUniformMatrix4fv(l->view_proj, 1, GL_TRUE, f->view_proj);
+    glUniformMatrix4fv(l->shadow_matrix, 1, GL_TRUE, f->shadow_matrix);
+    glUniform1i(l->wave_groups, f->groups);
+    if (f->groups > 0) glUniform4fv(l->waves, f->groups * 5, f->waves);
+    glUniform1i(l->shadow_map, 0);
+    glUniform1f(l->shadow_bias, f->shadow_bias_depth);
+}
+
+static long long query_result(GLuint q)
+{
+    GLuint64 v = 0;
+    glGetQueryObjectui64v(q, GL_QUERY_RESULT, &v);
+    return (long long)v;
+}
+
+gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
+                           gr_image *out, gr_shafts_stats *stats, gr_error *err)
+{
+    double t0 = now_ms();
+    frame_setup *f = malloc(sizeof *f);
+    gr_status st;
+    if (!f) return gr_fail(err, GR_E_NOMEM, "shafts: out of memory");
+    if ((st = setup_frame(scene, s, f, err)) != GR_OK) goto done;
+    int ch[3] = {gr_image_channel(out, "R"), gr_image_channel(out, "G"), gr_image_channel(out, "B")};
+    if (out->width != f->W || out->height != f->H || ch[0] < 0 || ch[1] < 0 || ch[2] < 0) {
+        st = gr_fail(err, GR_E_INPUT, "shafts: output image is %dx%d (needs %dx%d with R, G, B channels)",
+                     out->width, out->height, f->W, f->H);
+        goto done;
+    }
+    if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
+    if ((st = ensure_grid(r, f->N, err)) != GR_OK) goto done;
+    if ((st = ensure_targets(r, f, err)) != GR_OK) goto done;
+    size_t n_occ = 0;
+    if ((st = build_occluders(r, scene, f->P, &n_occ, err)) != GR_OK) goto done;
+
+    /* Pass 1: shadow map of the occluders from P along T (seed: "from the point of view of
+     * the light source P"). Depth clamp keeps casters above the near plane. */
+    glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_SHADOW]);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->shadow_fbo);
+    glViewport(0, 0, f->s.shadow_map_size, f->s.shadow_map_size);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_DEPTH_CLAMP);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    if (n_occ > 0) {
+        glUseProgram(r->prog_shadow);
+        glUniformMatrix4fv(r->loc_light_vp, 1, GL_TRUE, f->light_vp);
+        glBindVertexArray(r->vao_occ);
+        glDrawArrays(GL_TRIANGLES, 0, (GLsizei)n_occ);
+    }
+    glDisable(GL_DEPTH_CLAMP);
+    glDisable(GL_DEPTH_TEST);
+    glEndQuery(GL_TIME_ELAPSED);
+
+    /* Pass 2: shafts, additive, no depth test, no culling, into the reduced target. */
+    GLsizei n_idx = (GLsizei)(f->nshafts * (f->s.caps ? 36 : 24));
+    glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_SHAFTS]);
+    glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
+    if (r->have_pipeline_stats) {
+        glBeginQuery(GL_VERTEX_SHADER_INVOCATIONS, r->q_vs);
+        glBeginQuery(GL_FRAGMENT_SHADER_INVOCATIONS, r->q_fs);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+    glViewport(0, 0, f->tw, f->th);
+    glDisable(GL_DITHER); /* dithering would make 8-bit sums depend on the pixel position */
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r->shadow_tex);
+    glBindVertexArray(r->vao_grid);
+    glDrawElements(GL_TRIANGLES, n_idx, GL_UNSIGNED_INT, (const void *)0);
+    glDisable(GL_BLEND);
+    if (r->have_pipeline_stats) {
+        glEndQuery(GL_FRAGMENT_SHADER_INVOCATIONS);
+        glEndQuery(GL_VERTEX_SHADER_INVOCATIONS);
+    }
+    glEndQuery(GL_SAMPLES_PASSED);
+    glEndQuery(GL_TIME_ELAPSED);
+
+    /* Pass 3: full-screen pass at the frame's resolution into a float target. */
+    glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_FINAL]);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->frame_fbo);
+    glViewport(0, 0, f->W, f->H);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glUseProgram(r->prog_final);
+    glUniformMatrix4fv(r->loc_inv_vp, 1, GL_TRUE, f->inv_view_proj);
+    glUniform2f(r->loc_texel, 1.0f / (float)f->tw, 1.0f / (float)f->th);
+    glUniform1i(r->loc_shafts, 0);
+    glUniform3fv(r->loc_hgg, 1, f->hgg);
+    glUniform3f(r->loc_refr_sun, (float)f->T.x, (float)f->T.y, (float)f->T.z);
+    glUniform3f(r->loc_intensity, (float)f->s.intensity[0], (float)f->s.intensity[1], (float)f->s.intensity[2]);
+    glUniform1f(r->loc_bias, (float)f->s.bias);
+    glBindTexture(GL_TEXTURE_2D, r->target_tex);
+    glBindVertexArray(r->vao_empty);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    glEndQuery(GL_TIME_ELAPSED);
+
+    /* Read the layer back (GL rows bottom-up; gr_image top row first). */
+    size_t need = (size_t)f->W * (size_t)f->H * 4;
+    if (need > r->readback_cap) {
+        float *nb = realloc(r->readback, need * sizeof *nb);
+        if (!nb) {
+            st = gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the readback");
+            goto unbind;
+        }
+        r->readback = nb;
+        r->readback_cap = need;
+    }
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, f->W, f->H, GL_RGBA, GL_FLOAT, r->readback);
+    for (int y = 0; y < f->H; y++) {
+        const float *src = r->readback + (size_t)(f->H - 1 - y) * (size_t)f->W * 4;
+        for (int x = 0; x < f->W; x++) {
+            float *px = gr_image_pixel(out, x, y);
+            for (int c = 0; c < 3; c++) px[ch[c]] = src[(size_t)x * 4 + (size_t)c];
+        }
+    }
+    if (stats) {
+        memset(stats, 0, sizeof *stats);
+        /* Every pass ran between t0 and the synchronous readback: a GPU time longer than
+         * that wall time is a broken timer (llvmpipe's first query after context creation
+         * reads ~1e12 ns) and is reported as unavailable (-1). */
+        double wall_ns = (now_ms() - t0) * 1e6;
+        for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
+            long long ns = r->have_timer ? query_result(r->q_time[p]) : -1;
+            stats->gpu_ns[p] = (ns >= 0 && (double)ns <= wall_ns) ? ns : -1;
+        }
+        stats->fragments = query_result(r->q_samples);
+        stats->vertices_submitted = n_idx;
+        stats->vs_invocations = r->have_pipeline_stats ? query_result(r->q_vs) : -1;
+        stats->fs_invocations = r->have_pipeline_stats ? query_result(r->q_fs) : -1;
+        stats->target_width = f->tw;
+        stats->target_height = f->th;
+        stats->n_shafts = f->nshafts;
+        stats->spacing_m = f->S;
+        stats->center[0] = f->P.x; stats->center[1] = f->P.y; stats->center[2] = f->P.z;
+        stats->refr_dir[0] = f->T.x; stats->refr_dir[1] = f->T.y; stats->refr_dir[2] = f->T.z;
+    }
+    if ((st = gr_gl_check("shafts render", err)) != GR_OK) goto unbind;
+    r->rendered = 1;
+    st = gr_image_check_finite(out, "shafts layer", err);
+unbind:
+    glBindVertexArray(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glUseProgram(0);
+done:
+    if (stats && st == GR_OK) stats->cpu_ms = now_ms() - t0;
+    free(f);
+    return st;
+}
+
+gr_status gr_shafts_read_target(gr_shafts *r, gr_image **out, gr_error *err)
+{
+    *out = NULL;
+    if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "shafts: no render yet, no target to read");
+    gr_status st = gr_gl_make_current(r->gl, err);
+    if (st != GR_OK) return st;
+    gr_image *img = gr_image_create(r->target_w, r->target_h, 4, NULL);
+    float *tmp = malloc((size_t)r->target_w * (size_t)r->target_h * 4 * sizeof *tmp);
+    if (!img || !tmp) {
+        gr_image_destroy(img);
+        free(tmp);
+        return gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the target readback");
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, r->target_w, r->target_h, GL_RGBA, GL_FLOAT, tmp);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    size_t row = (size_t)r->target_w * 4;
+    for (int y = 0; y < r->target_h; y++)
+        memcpy(img->pixels + (size_t)y * row, tmp + (size_t)(r->target_h - 1 - y) * row, row * sizeof *tmp);
+    free(tmp);
+    st = gr_gl_check("shafts target readback", err);
+    if (st != GR_OK) {
+        gr_image_destroy(img);
+        return st;
+    }
+    *out = img;
+    return GR_OK;
+}
+
+gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
+                            gr_shafts_vertex **out, int *count, gr_shafts_stats *stats, gr_error *err)
+{
+    *out = NULL;
+    *count = 0;
+    frame_setup *f = malloc(sizeof *f);
+    gr_status st;
+    GLuint tfb = 0;
+    float *data = NULL;
+    if (!f) return gr_fail(err, GR_E_NOMEM, "shafts: out of memory");
+    if ((st = setup_frame(scene, s, f, err)) != GR_OK) goto done;
+    if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
+    if (!r->prog_capture) {
+        static const char *const varyings[] = {"v_world", "v_intensity"};
+        if ((st = gr_shader_program(r->shader_dir, "shafts.vert.glsl", "shafts.frag.glsl", varyings, 2,
+                                    &r->prog_capture, NULL, err)) != GR_OK)
+            goto done;
+        get_shaft_locs(r->prog_capture, &r->lc);
+    }
+    if ((st = ensure_grid(r, f->N, err)) != GR_OK) goto done;
+    if ((st = ensure_targets(r, f, err)) != GR_OK) goto done;
+    /* A surfaceless context has no default framebuffer: draw calls need a complete FBO
+     * bound even with rasterizer discard on. */
+    glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+    int nv = r->grid_nshafts * 8;
+    size_t bytes = (size_t)nv * 6 * sizeof(float);
+    glGenBuffers(1, &tfb);
+    glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, tfb);
+    glBufferData(GL_TRANSFORM_FEEDBACK_BUFFER, (GLsizeiptr)bytes, NULL, GL_STATIC_READ);
+    glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, tfb);
+    set_shaft_uniforms(r->prog_capture, &r->lc, f, scene);
+    glBindVertexArray(r->vao_grid);
+    glEnable(GL_RASTERIZER_DISCARD);
+    glBeginTransformFeedback(GL_POINTS);
+    glDrawArrays(GL_POINTS, 0, nv);
+    glEndTransformFeedback();
+    glDisable(GL_RASTERIZER_DISCARD);
+    data = malloc(bytes);
+    *out = calloc((size_t)nv, sizeof **out);
+    if (!data || !*out) {
+        free(*out);
+        *out = NULL;
+        st = gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the vertex capture");
+        goto done;
+    }
+    glGetBufferSubData(GL_TRANSFORM_FEEDBACK_BUFFER, 0, (GLsizeiptr)bytes, data);
+    for (int i = 0; i < nv; i++) {
+        gr_shafts_vertex *v = &(*out)[i];
+        const float *g = r->grid_cpu + (size_t)i * 5;
+        const float *d = data + (size_t)i * 6;
+        v->cell[0] = g[0];
+        v->cell[1] = g[1];
+        v->corner[0] = g[2];
+        v->corner[1] = g[3];
+        v->bottom = g[4] > 0.5f;
+        v->pos[0] = f->eye.x + d[0];
+        v->pos[1] = f->eye.y + d[1];
+        v->pos[2] = f->eye.z + d[2];
+        for (int c = 0; c < 3; c++) v->intensity[c] = d[3 + c];
+    }
+    *count = nv;
+    if (stats) {
+        memset(stats, 0, sizeof *stats);
+        stats->n_shafts = f->nshafts;
+        stats->spacing_m = f->S;
+        stats->center[0] = f->P.x; stats->center[1] = f->P.y; stats->center[2] = f->P.z;
+        stats->refr_dir[0] = f->T.x; stats->refr_dir[1] = f->T.y; stats->refr_dir[2] = f->T.z;
+    }
+    st = gr_gl_check("shafts vertex capture", err);
+    if (st != GR_OK) {
+        free(*out);
+        *out = NULL;
+        *count = 0;
+    }
+done:
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (tfb) {
+        glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
+        glDeleteBuffers(1, &tfb);
+    }
+    glBindVertexArray(0);
+    glUseProgram(0);
+    free(data);
+    free(f);
+    return st;
+}
+
+/* ---- metadata -------------------------------------------------------------------------- */
+
+gr_status gr_shafts_metadata(const gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
+                             const gr_shafts_stats *stats, gr_metadata *meta, gr_error *err)
+{
+    gr_shafts_settings rs;
+    char key[64], val[256];
+    gr_status st = GR_OK;
+    gr_shafts_resolve(scene, s ? s : &scene->shafts, &rs);
+#define CK(call) do { if ((st = (call)) != GR_OK) goto fail; } while (0)
+    CK(gr_meta_set_string(meta, "godrays:renderer", "shafts"));
+    CK(gr_meta_set_string(meta, "godrays:technique", "seed 000: Lanza, underwater god rays as extruded shafts"));
+    CK(gr_meta_set_string(meta, "godrays:gl_renderer", gr_gl_renderer(r->gl)));
+    CK(gr_meta_set_string(meta, "godrays:gl_version", gr_gl_version(r->gl)));
+    CK(gr_meta_set_string(meta, "godrays:gl_platform", gr_gl_platform_name(r->gl)));
+    CK(gr_meta_set_string(meta, "godrays:shaders", r->shader_dir && r->from_dir ? r->shader_dir : "embedded"));
+    CK(gr_meta_set_string(meta, "godrays:scene", scene->name));
+    CK(gr_meta_set_string(meta, "godrays:scene_hash", scene->hash));
+    CK(gr_meta_set_double(meta, "godrays:time_s", scene->water.time_s));
+    const gr_param_table *t = &gr_shafts_param_table;
+    for (size_t i = 0; i < t->count; i++) {
+        const gr_param *p = &t->params[i];
+        snprintf(key, sizeof key, "godrays:shafts.%s", p->name);
+        switch (p->type) {
+        case GR_PT_RGB:
+            snprintf(val, sizeof val, "%.9g %.9g %.9g", gr_param_get_number(p, &rs, 0), gr_param_get_number(p, &rs, 1),
+                     gr_param_get_number(p, &rs, 2));
+            CK(gr_meta_set_string(meta, key, val));
+            break;
+        case GR_PT_ENUM: {
+            int idx = (int)gr_param_get_number(p, &rs, 0);
+            CK(gr_meta_set_string(meta, key, p->enum_names && idx >= 0 ? p->enum_names[idx] : "?"));
+            break;
+        }
+        case GR_PT_INT:
+        case GR_PT_BOOL:
+        case GR_PT_U64:
+            CK(gr_meta_set_int(meta, key, (long long)gr_param_get_number(p, &rs, 0)));
+            break;
+        default:
+            CK(gr_meta_set_double(meta, key, gr_param_get_number(p, &rs, 0)));
+        }
+    }
+    if (stats) {
+        snprintf(val, sizeof val, "%.9g %.9g %.9g", stats->center[0], stats->center[1], stats->center[2]);
+        CK(gr_meta_set_string(meta, "godrays:shafts_center_m", val));
+        snprintf(val, sizeof val, "%.9g %.9g %.9g", stats->refr_dir[0], stats->refr_dir[1], stats->refr_dir[2]);
+        CK(gr_meta_set_string(meta, "godrays:shafts_refracted_sun", val));
+        CK(gr_meta_set_double(meta, "godrays:shafts_spacing_m", stats->spacing_m));
+        CK(gr_meta_set_int(meta, "godrays:shafts_count", stats->n_shafts));
+        snprintf(val, sizeof val, "%dx%d", stats->target_width, stats->target_height);
+        CK(gr_meta_set_string(meta, "godrays:shafts_target_size", val));
+        for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
+            snprintf(key, sizeof key, "godrays:gpu_ns.%s", gr_shafts_pass_names[p]);
+            CK(gr_meta_set_int(meta, key, stats->gpu_ns[p]));
+        }
+        CK(gr_meta_set_double(meta, "godrays:cpu_ms", stats->cpu_ms));
+        CK(gr_meta_set_int(meta, "godrays:fragments_blended", stats->fragments));
+        CK(gr_meta_set_double(meta, "godrays:overdraw",
+                              (double)stats->fragments / ((double)stats->target_width * (double)stats->target_height)));
+        CK(gr_meta_set_int(meta, "godrays:vertices_submitted", stats->vertices_submitted));
+        CK(gr_meta_set_int(meta, "godrays:vertex_shader_invocations", stats->vs_invocations));
+        CK(gr_meta_set_int(meta, "godrays:fragment_shader_invocations", stats->fs_invocations));
+    }
+#undef CK
+    return GR_OK;
+fail:
+    return gr_fail(err, st, "shafts metadata: cannot add an entry (%s)", gr_status_name(st));
+}

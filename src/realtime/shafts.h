@@ -1,0 +1,87 @@
+/* Seed 000's real-time underwater god-ray shafts (Lanza, ShaderX^5 ch. 5.5) as an OpenGL
+ * pipeline through a headless EGL context: (1) shadow map of the occluders from P along the
+ * refracted sun, (2) an N x N grid of extruded shafts blended additively into a reduced
+ * render target, (3) a full-screen pass (4 bilinear taps, HG phase, bias, intensity) giving
+ * the god-ray layer in linear float at the frame's resolution.
+ * The renderer keeps its context, programs and buffers alive across renders: create it
+ * once, render many parameter sets (sweeps, tuning), destroy it. Settings changes never
+ * recompile shaders; buffers are rebuilt only when N, the frame or target size changes.
+ * Decisions and their reasons: docs/realtime-shafts.md. */
+#ifndef GR_SHAFTS_H
+#define GR_SHAFTS_H
+
+#include "common/status.h"
+#include "gl/glctx.h"
+#include "image/image.h"
+#include "scene/scene.h"
+
+typedef struct gr_shafts gr_shafts; /* opaque; used from the thread that created it */
+
+typedef struct gr_shafts_options {
+    const char *shader_dir; /* NULL: embedded shaders; else files there override them */
+    gr_gl_options gl;       /* headless context options (zero = defaults) */
+} gr_shafts_options;
+
+enum { GR_SHAFTS_PASS_SHADOW = 0, GR_SHAFTS_PASS_SHAFTS = 1, GR_SHAFTS_PASS_FINAL = 2, GR_SHAFTS_NPASS = 3 };
+extern const char *const gr_shafts_pass_names[GR_SHAFTS_NPASS]; /* "shadow", "shafts", "final" */
+
+typedef struct gr_shafts_stats {
+    long long gpu_ns[GR_SHAFTS_NPASS]; /* GL_TIME_ELAPSED per pass; -1 if unavailable */
+    double cpu_ms;                     /* wall time of the render call, readback included */
+    long long fragments;               /* shaft fragments blended (GL_SAMPLES_PASSED) */
+    long long vertices_submitted;      /* indices drawn in the shaft pass */
+    long long vs_invocations;          /* shaft pass, ARB_pipeline_statistics_query; -1 if absent */
+    long long fs_invocations;          /* idem */
+    int target_width, target_height;   /* shaft render target */
+    int n_shafts;                      /* (N - 1)^2 */
+    double spacing_m;                  /* S, seed eq. 5.5.6 */
+    double center[3];                  /* P, seed eq. 5.5.5a */
+    double refr_dir[3];                /* T, seed eq. 5.5.5b */
+} gr_shafts_stats;
+
+/* One transformed shaft vertex read back by transform feedback (gr_shafts_capture). */
+typedef struct gr_shafts_vertex {
+    float cell[2];      /* grid cell centre, in cells, relative to P (x, z) */
+    float corner[2];    /* corner offset in cells (+-0.5 before the width factor) */
+    int bottom;         /* 1 for an extruded bottom vertex */
+    double pos[3];      /* world position (m), as the vertex shader computed it */
+    double intensity[3];/* per-vertex intensity exp(-c (len + |pos - E|)) (1 - Schlick) */
+} gr_shafts_vertex;
+
+/* Creates the GL context, compiles every program (a compile or link failure is GR_E_GL
+ * with the GLSL log; a bad --shader-dir is GR_E_INPUT). opts may be NULL. */
+gr_status gr_shafts_create(const gr_shafts_options *opts, gr_shafts **out, gr_error *err);
+void gr_shafts_destroy(gr_shafts *r); /* accepts NULL */
+const gr_gl *gr_shafts_gl(const gr_shafts *r);
+/* Number of the renderer's shader files that came from --shader-dir. */
+int gr_shafts_shaders_from_dir(const gr_shafts *r);
+
+/* Range checks of every setting (the table in src/scene/settings.c) plus N >= 2; the
+ * error names "shafts.KEY". NaN is accepted for scene-derived settings (extinction, g). */
+gr_status gr_shafts_check_settings(const gr_shafts_settings *s, gr_error *err);
+/* Copies s with scene-derived defaults (NaN) resolved from the scene's medium. */
+void gr_shafts_resolve(const gr_scene *scene, const gr_shafts_settings *s, gr_shafts_settings *out);
+
+/* Renders the god-ray layer of scene at scene->water.time_s with settings s (NULL: the
+ * scene's own) into out, which must be camera.width x camera.height with channels "R",
+ * "G", "B" (others are left alone). stats may be NULL. Never writes NaN or Inf. */
+gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
+                           gr_image *out, gr_shafts_stats *stats, gr_error *err);
+
+/* The shaft render target of the last render as an RGBA float image (top row first),
+ * as stored (8-bit targets read back as code / 255). *out is the caller's. */
+gr_status gr_shafts_read_target(gr_shafts *r, gr_image **out, gr_error *err);
+
+/* Runs the shaft vertex shader alone over every grid vertex (8 per shaft) with transform
+ * feedback and returns what it computed; *out is malloc'd (caller frees), *count = 8 (N-1)^2.
+ * stats (may be NULL) receives the placement (P, T, S). */
+gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
+                            gr_shafts_vertex **out, int *count, gr_shafts_stats *stats,
+                            gr_error *err);
+
+/* Adds the "godrays:*" metadata of a render: renderer, GL strings, scene name/hash, time,
+ * every setting (resolved), placement, per-pass GPU ns, CPU ms, fragments, vertices. */
+gr_status gr_shafts_metadata(const gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
+                             const gr_shafts_stats *stats, gr_metadata *meta, gr_error *err);
+
+#endif

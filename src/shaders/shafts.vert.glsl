@@ -1,0 +1,100 @@
+#version 330 core
+// Seed 000 (Lanza, "Animation and Rendering of Underwater God Rays"), shaft vertex shader,
+// ported from the seed's HLSL VS. Every deviation is listed in docs/realtime-shafts.md.
+// Positions are relative to the viewer (camera-relative rendering): the CPU subtracts the
+// viewer in double precision, so float stays exact far from the world origin.
+
+#define MAX_WAVE_GROUPS 16
+
+layout(location = 0) in vec2 a_cell;    // cell centre, in grid cells, relative to P
+layout(location = 1) in vec2 a_corner;  // corner of the shaft's cross-section, +-0.5 cell
+layout(location = 2) in float a_bottom; // 0: top vertex, 1: bottom vertex (seed: input.length > 0)
+
+uniform vec3 u_origin;        // P - viewer (m): seed `origin`, eq. 5.5.5a
+uniform float u_spacing;      // S (m): seed `spacing`, eq. 5.5.6
+uniform float u_width;        // shaft width as a fraction of the grid cell
+uniform float u_length;       // extrusion length (m) of bottom vertices
+uniform vec3 u_extinction;    // c (1/m), eq. 5.5.3: seed `extinction_c`
+uniform vec3 u_sun_dir;       // I, unit direction of travel: seed `sunDir`
+uniform float u_eta;          // 1 / ior (seed: 1./1.333)
+uniform float u_r0;           // Schlick R0 (seed: 0.0204)
+uniform mat4 u_view_proj;     // viewer-relative world -> clip
+uniform mat4 u_shadow_matrix; // viewer-relative world -> shadow-map texture space [0,1]^3
+uniform int u_wave_groups;    // number of groups of 4 waves
+// Seed layout per group of 4 waves: kx, ky, A/|k|, A, phase constant. Here "ky" is the
+// z component of the wave vector and the constant is c = w t - phi0 - k.P (mod 2 pi, in
+// double on the CPU), so phase = k.(X0 - P) - c = k.X0 - w t + phi0, eq. 5.5.7.
+uniform vec4 u_waves[MAX_WAVE_GROUPS * 5];
+
+out vec3 v_intensity;   // seed: output.intensity (read as input.outScattering by its PS)
+out vec4 v_shadow_pos;  // seed: output.shadowmapPos
+out vec3 v_world;       // viewer-relative world position (transform-feedback capture only)
+
+// Seed eq. 5.5.2a with the incidence cosine as argument (the listing declares 3 parameters
+// and calls it with 2); clamped so that pow never sees a negative base.
+float fast_fresnel(float cos_i, float r0)
+{
+    float m = 1.0 - clamp(cos_i, 0.0, 1.0);
+    float m2 = m * m;
+    return r0 + (1.0 - r0) * (m2 * m2 * m);
+}
+
+void main()
+{
+    // Scale and translate the vertex on the water surface (rest position, relative to P).
+    vec2 rest = (a_cell + a_corner * u_width) * u_spacing;
+
+    // Seed CalculateWaterNormal (eq. 5.5.8), plus the displacement of eq. 5.5.7.
+    vec3 t1 = vec3(1.0, 0.0, 0.0);
+    vec3 t2 = vec3(0.0, 0.0, 1.0);
+    vec3 disp = vec3(0.0);
+    for (int i = 0, j = 0; i < u_wave_groups; i++, j += 5) {
+        vec4 kx = u_waves[j];
+        vec4 ky = u_waves[j + 1];
+        vec4 Ainvk = u_waves[j + 2];
+        vec4 A = u_waves[j + 3];
+        vec4 wt = u_waves[j + 4];
+        vec4 phase = kx * rest.x + ky * rest.y - wt;
+        vec4 sinp = sin(phase);
+        vec4 cosp = cos(phase);
+
+        // eq. 5.5.7: X = X0 - sum a K/|K| sin(phase), y = y0 + sum a cos(phase)
+        disp.x -= dot(Ainvk, kx * sinp);
+        disp.z -= dot(Ainvk, ky * sinp);
+        disp.y += dot(A, cosp);
+
+        // Update tangent vector along x0 (eq. 5.5.8, T)
+        t1.x -= dot(Ainvk, kx * cosp * kx);
+        t1.z -= dot(Ainvk, ky * cosp * kx);
+        t1.y += dot(A, (-sinp) * kx);
+
+        // Update tangent vector along z0 (eq. 5.5.8, B)
+        t2.x -= dot(Ainvk, kx * cosp * ky);
+        t2.z -= dot(Ainvk, ky * cosp * ky);
+        t2.y += dot(A, (-sinp) * ky);
+    }
+    vec3 normal = normalize(cross(t2, t1));
+
+    // Top vertices on the Gerstner surface (eq. 5.5.7; the seed's listing leaves them flat).
+    vec3 pos = u_origin + vec3(rest.x, 0.0, rest.y) + disp;
+
+    // Extrude bottom vertices along the refracted sunlight (eq. 5.5.1, GLSL refract).
+    float len = a_bottom * u_length;
+    if (a_bottom > 0.5) {
+        vec3 refr = refract(u_sun_dir, normal, u_eta);
+        pos += refr * len;
+    }
+
+    // Transmittance (eq. 5.5.2b) and attenuation over surface->vertex->viewer (eq. 5.5.3).
+    float tr = 1.0 - fast_fresnel(dot(-u_sun_dir, normal), u_r0);
+    float total_dist = len + length(pos);
+    v_intensity = exp(-total_dist * u_extinction) * tr;
+
+    v_shadow_pos = u_shadow_matrix * vec4(pos, 1.0);
+    v_world = pos;
+
+    gl_Position = u_view_proj * vec4(pos, 1.0);
+    // Seed: force z so shafts close to the viewer are not clipped. With z = 0.01 the GL
+    // clip test -w <= z <= w keeps exactly what D3D's 0 <= z <= w keeps: w >= 0.01.
+    gl_Position.z = 0.01;
+}
