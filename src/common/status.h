@@ -4,6 +4,13 @@
 #ifndef GR_STATUS_H
 #define GR_STATUS_H
 
+#ifdef __cplusplus
+extern "C" {
+#ifdef __cplusplus
+}
+#endif
+#endif
+
 typedef enum gr_status {
     GR_OK = 0,
     GR_E_USAGE,       /* bad command line (exit 2) */
@@ -32,4 +39,7 @@ const char *gr_status_name(gr_status st);
 /* Process exit code for a status: 0 ok, 2 usage/input, 1 otherwise. */
 int gr_status_exit_code(gr_status st);
 
+#ifdef __cplusplus
+}
+#endif
 #endif
