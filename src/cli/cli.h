@@ -13,6 +13,7 @@ typedef struct gr_command {
 
 int cmd_validate(int argc, char **argv);
 int cmd_info(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
 int cmd_shafts(int argc, char **argv);
 int cmd_reference(int argc, char **argv);
 

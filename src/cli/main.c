@@ -8,6 +8,7 @@
 static const gr_command commands[] = {
     {"validate", "load and check a scene, print it normalized with defaults filled in", cmd_validate},
     {"info", "print library versions and the GL renderer of a headless EGL context", cmd_info},
+    {"compare", "error metrics between two images (any format), with mask, stderr, scale fit", cmd_compare},
     {"shafts", "render the god-ray layer with seed 000's real-time shafts (OpenGL) to EXR + PNG", cmd_shafts},
     {"reference", "render the ground-truth god-ray layer (Embree, single scattering) to EXR + PNG", cmd_reference},
 };

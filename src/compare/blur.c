@@ -42,8 +42,9 @@ gr_status gr_blur_fields(const double *const *src, int nch, const double *weight
     double *kern = malloc(sizeof(double) * (size_t)(2 * radius + 1));
     double *hor = malloc(sizeof(double) * N * (size_t)nf); /* after the horizontal pass */
     double *acc = malloc(sizeof(double) * W * (size_t)nf); /* one output row */
+    double *prow = malloc(sizeof(double) * W);             /* one premultiplied input row */
     gr_status st = GR_OK;
-    if (!kern || !hor || !acc) {
+    if (!kern || !hor || !acc || !prow) {
         st = gr_fail(err, GR_E_NOMEM, "blur: cannot allocate %zu x %zu x %d doubles", W, H, nf);
         goto done;
     }
@@ -52,27 +53,26 @@ gr_status gr_blur_fields(const double *const *src, int nch, const double *weight
     const double *g = kern + radius; /* g[i] for i in [-radius, radius] */
 
     /* Horizontal pass: taps that would fall outside the row are simply absent; the weight
-     * field carries the missing mass, so the final division renormalizes (blur.h). */
+     * field carries the missing mass, so the final division renormalizes (blur.h). Written
+     * tap by tap over a whole row (contiguous, vectorizable loops). */
     for (size_t y = 0; y < H; y++) {
-        for (size_t x = 0; x < W; x++) {
-            long lo = -(long)radius, hi = (long)radius;
-            if ((long)x + lo < 0) lo = -(long)x;
-            if ((long)x + hi > (long)W - 1) hi = (long)W - 1 - (long)x;
-            const double *wrow = weight ? weight + y * W : NULL;
-            double sw = 0.0;
-            for (long i = lo; i <= hi; i++) sw += g[i] * (wrow ? wrow[(long)x + i] : 1.0);
-            hor[(size_t)nch * N + y * W + x] = sw;
-            for (int c = 0; c < nch; c++) {
-                const double *row = src[c] + y * W;
-                double s = 0.0;
-                if (wrow) {
-                    /* A zero weight skips the sample (it may hold anything finite or not). */
-                    for (long i = lo; i <= hi; i++)
-                        if (wrow[(long)x + i] != 0.0) s += g[i] * wrow[(long)x + i] * row[(long)x + i];
-                } else {
-                    for (long i = lo; i <= hi; i++) s += g[i] * row[(long)x + i];
-                }
-                hor[(size_t)c * N + y * W + x] = s;
+        const double *wrow = weight ? weight + y * W : NULL;
+        for (int f = 0; f < nf; f++) {
+            /* The premultiplied row w x (w itself for the weight field); a zero weight drops
+             * the sample whatever it holds. */
+            if (f == nch) {
+                for (size_t x = 0; x < W; x++) prow[x] = wrow ? wrow[x] : 1.0;
+            } else {
+                const double *row = src[f] + y * W;
+                for (size_t x = 0; x < W; x++) prow[x] = !wrow ? row[x] : (wrow[x] == 0.0 ? 0.0 : wrow[x] * row[x]);
+            }
+            double *o = hor + (size_t)f * N + y * W;
+            memset(o, 0, sizeof(double) * W);
+            for (long i = -(long)radius; i <= (long)radius; i++) {
+                /* output x reads input x + i: valid for 0 <= x + i < W */
+                const long xlo = i < 0 ? -i : 0, xhi = i > 0 ? (long)W - i : (long)W;
+                const double gi = g[i];
+                for (long x = xlo; x < xhi; x++) o[x] += gi * prow[x + i];
             }
         }
     }
@@ -101,6 +101,7 @@ done:
     free(kern);
     free(hor);
     free(acc);
+    free(prow);
     return st;
 }
 

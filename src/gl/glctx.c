@@ -21,12 +21,7 @@ struct gr_gl {
     EGLContext ctx;
     const char *platform; /* "device" or "surfaceless" */
     int major, minor;
-    struct gr_gl *next;   /* live contexts, so a shared display is terminated only once */
 };
-
-/* EGL returns the same EGLDisplay for the same platform + native display, and eglTerminate
- * invalidates every context on it: only the last live gr_gl on a display terminates it. */
-static gr_gl *live_contexts = NULL;
 
 static const char *egl_error_name(EGLint e)
 {
@@ -140,19 +135,17 @@ static gr_status init_on_display(gr_gl *gl, EGLDisplay dpy, const char *platform
     return GR_OK;
 }
 
-/* Releases whatever init_on_display got, leaving gl ready for another attempt. */
+/* Releases the context, leaving gl ready for another attempt. The display is deliberately
+ * never eglTerminate'd: EGL hands every caller the same display per platform + device, so
+ * terminating it would kill other live contexts on it; and terminating Mesa's display unloads
+ * the driver, which drops llvmpipe allocations (LeakSanitizer reports them) and makes the next
+ * context pay ~7 ms to reload it. An initialized display lives until the process exits. */
 static void release(gr_gl *gl)
 {
-    if (gl->dpy != EGL_NO_DISPLAY) {
-        if (gl->ctx != EGL_NO_CONTEXT) {
-            if (eglGetCurrentContext() == gl->ctx)
-                eglMakeCurrent(gl->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-            eglDestroyContext(gl->dpy, gl->ctx);
-        }
-        int shared = 0;
-        for (const gr_gl *o = live_contexts; o; o = o->next)
-            if (o != gl && o->dpy == gl->dpy) shared = 1;
-        if (!shared) eglTerminate(gl->dpy);
+    if (gl->dpy != EGL_NO_DISPLAY && gl->ctx != EGL_NO_CONTEXT) {
+        if (eglGetCurrentContext() == gl->ctx)
+            eglMakeCurrent(gl->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        eglDestroyContext(gl->dpy, gl->ctx);
     }
     gl->dpy = EGL_NO_DISPLAY;
     gl->ctx = EGL_NO_CONTEXT;
@@ -241,8 +234,6 @@ gr_status gr_gl_create(const gr_gl_options *opts, gr_gl **out, gr_error *err)
         free(gl);
         return st;
     }
-    gl->next = live_contexts;
-    live_contexts = gl;
     *out = gl;
     return GR_OK;
 }
@@ -250,11 +241,6 @@ gr_status gr_gl_create(const gr_gl_options *opts, gr_gl **out, gr_error *err)
 void gr_gl_destroy(gr_gl *gl)
 {
     if (!gl) return;
-    for (gr_gl **p = &live_contexts; *p; p = &(*p)->next)
-        if (*p == gl) {
-            *p = gl->next;
-            break;
-        }
     release(gl);
     eglReleaseThread();
     free(gl);

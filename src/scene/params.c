@@ -195,9 +195,14 @@ gr_status gr_param_set_enum(const gr_param_table *t, void *settings, const char 
         return gr_fail(err, GR_E_INPUT, "%s.%s: unknown key", t ? t->section : "?", name ? name : "(null)");
     if (p->type != GR_PT_ENUM) return gr_fail(err, GR_E_INPUT, "%s.%s: not a named choice", t->section, name);
     int idx = gr_param_enum_index(p, value);
-    if (idx < 0)
-        return gr_fail(err, GR_E_INPUT, "%s.%s: unknown value, expected one of %s, got \"%s\"", t->section,
-                       name, gr_param_range_text(p, names, sizeof names), value ? value : "");
+    if (idx < 0) {
+        gr_fail(err, GR_E_INPUT, "%s.%s: unknown value, expected one of %s, got \"%s\"", t->section, name,
+                gr_param_range_text(p, names, sizeof names), value ? value : "");
+        /* the value is user text: keep the message on one line */
+        for (char *q = err ? err->msg : NULL; q && *q; q++)
+            if ((unsigned char)*q < 0x20 || *q == 0x7f) *q = '?';
+        return GR_E_INPUT;
+    }
     store(p, settings, -1, idx);
     return GR_OK;
 }

@@ -23,6 +23,9 @@
 #define RAD2DEG (180.0 / 3.14159265358979323846)
 #define GR_MAX_IMAGE_SIDE 16384
 #define GR_MAX_SCENE_BYTES (64u << 20)
+/* Positions beyond this are rejected: far enough for precision tests (1e5 m), near enough
+ * that sums of coordinates and squared distances stay finite and meaningful. */
+#define GR_MAX_COORD_M 1e7
 
 /* ---- medium presets -----------------------------------------------------------------
  * Only presets whose every number has a published source (docs/scene-format.md).
@@ -40,12 +43,14 @@ static const medium_preset presets[] = {
 };
 static const int n_presets = (int)(sizeof presets / sizeof presets[0]);
 
-/* Defaults of a medium given without a preset: illustrative clear ocean water
- * (docs/scene-format.md, "Default medium"): Pope & Fry pure-water absorption plus a small
- * particulate/CDOM term, particle scattering 0.035 /m at 550 nm with a 550/lambda shape
- * plus Morel's molecular term, and g = 0.9 after Petzold's mean cosine ~0.92. */
-static const double default_absorption[3] = {0.345, 0.066, 0.030};
-static const double default_scattering[3] = {0.031, 0.037, 0.047};
+/* Defaults of a medium given without a preset: clear oceanic water, illustrative
+ * (docs/scene-format.md, "Default medium"). Chlorophyll C = 0.05 mg/m^3 assumed.
+ * Absorption: Pope & Fry 1997 pure water + phytoplankton (Bricaud et al. 1998,
+ * a_ph(440) = 0.0654 C^0.728) + a like amount of CDOM, rounded: +[0.002, 0.002, 0.012].
+ * Scattering: Gordon & Morel 1983 b_p = 0.30 C^0.62 (550/lambda) + Morel 1974 seawater.
+ * g = 0.9: Petzold's particle mean cosine ~0.92 diluted by 4-7% molecular (g = 0). */
+static const double default_absorption[3] = {0.342, 0.0585, 0.0212};
+static const double default_scattering[3] = {0.041, 0.049, 0.062};
 static const double default_g = 0.9;
 
 /* ---- error context ------------------------------------------------------------------ */
@@ -64,6 +69,16 @@ static gr_status vfail(vctx *c, const char *path, const char *fmt, ...)
     va_end(ap);
     snprintf(c->path, sizeof c->path, "%s", path);
     return gr_fail(c->err, GR_E_INPUT, "%s: %s", path[0] ? path : "(root)", msg);
+}
+
+/* Messages are one line: control characters that came from the input (a key or string
+ * with an escaped newline, an override argument) are shown as '?'. */
+static gr_status one_line(gr_error *err, gr_status st)
+{
+    if (err && st != GR_OK)
+        for (char *q = err->msg; *q; q++)
+            if ((unsigned char)*q < 0x20 || *q == 0x7f) *q = '?';
+    return st;
 }
 
 static void join(char *out, size_t n, const char *parent, const char *key)
@@ -569,7 +584,7 @@ static gr_status validate_fields(vctx *c, const gr_scene *s)
     char p[96];
     gr_status st;
     const double inf = INFINITY;
-    if ((st = range(c, "water.rest_height_m", s->water.rest_height_m, -inf, inf, 0)) ||
+    if ((st = range(c, "water.rest_height_m", s->water.rest_height_m, -GR_MAX_COORD_M, GR_MAX_COORD_M, 0)) ||
         (st = range(c, "water.time_s", s->water.time_s, -inf, inf, 0)))
         return st;
     if (s->water.n_waves < 0 || s->water.n_waves > GR_MAX_WAVES)
@@ -595,9 +610,9 @@ static gr_status validate_fields(vctx *c, const gr_scene *s)
         snprintf(p, sizeof p, "sun.irradiance[%d]", k);
         if ((st = range(c, p, s->sun.irradiance[k], 0, inf, 0))) return st;
         snprintf(p, sizeof p, "medium.absorption_per_m[%d]", k);
-        if ((st = range(c, p, s->medium.absorption[k], 0, 1e4, 0))) return st;
+        if ((st = range(c, p, s->medium.absorption[k], 0, 1000, 0))) return st;
         snprintf(p, sizeof p, "medium.scattering_per_m[%d]", k);
-        if ((st = range(c, p, s->medium.scattering[k], 0, 1e4, 0))) return st;
+        if ((st = range(c, p, s->medium.scattering[k], 0, 1000, 0))) return st;
     }
     if ((st = range(c, "medium.g", s->medium.g, -1, 1, LO_X | HI_X)) ||
         (st = range(c, "medium.ior", s->medium.ior, 1, 3, 0)))
@@ -605,10 +620,10 @@ static gr_status validate_fields(vctx *c, const gr_scene *s)
     const gr_camera *cam = &s->camera;
     for (int k = 0; k < 3; k++) {
         snprintf(p, sizeof p, "camera.position_m[%d]", k);
-        if ((st = range(c, p, cam->position_m[k], -inf, inf, 0))) return st;
+        if ((st = range(c, p, cam->position_m[k], -GR_MAX_COORD_M, GR_MAX_COORD_M, 0))) return st;
         if (cam->has_look_at) {
             snprintf(p, sizeof p, "camera.look_at_m[%d]", k);
-            if ((st = range(c, p, cam->look_at_m[k], -inf, inf, 0))) return st;
+            if ((st = range(c, p, cam->look_at_m[k], -GR_MAX_COORD_M, GR_MAX_COORD_M, 0))) return st;
         }
     }
     if (!cam->has_look_at && ((st = range(c, "camera.yaw_deg", cam->yaw_deg, -inf, inf, 0)) ||
@@ -624,7 +639,7 @@ static gr_status validate_fields(vctx *c, const gr_scene *s)
         const gr_occluder *o = &s->occluders[i];
         for (int k = 0; k < 3; k++) {
             snprintf(p, sizeof p, "occluders[%d].center_m[%d]", i, k);
-            if ((st = range(c, p, o->center_m[k], -inf, inf, 0))) return st;
+            if ((st = range(c, p, o->center_m[k], -GR_MAX_COORD_M, GR_MAX_COORD_M, 0))) return st;
         }
         if (o->type == GR_OCC_BOX) {
             for (int k = 0; k < 3; k++) {
@@ -699,7 +714,8 @@ static gr_status derive(vctx *c, gr_scene *s)
         double a = w->direction_deg * DEG2RAD;
         w->dir[0] = sin(a);
         w->dir[1] = cos(a);
-        /* deep-water dispersion w^2 = g k (e.g. Tessendorf 2001, eq. 14) unless given */
+        /* deep-water dispersion of linear waves, w^2 = g k (e.g. Tessendorf 2001, "Simulating
+         * Ocean Water"), unless given */
         if (isnan(w->omega_rad_s)) w->omega_rad_s = sqrt(GR_GRAVITY * w->k);
     }
     /* sun.to_sun = (cos el sin az, sin el, cos el cos az); light travels along -to_sun */
@@ -753,6 +769,13 @@ static gr_status derive(vctx *c, gr_scene *s)
 static gr_status validate_cross(vctx *c, const gr_scene *s)
 {
     char a[40], b[40], d[40];
+    /* FROM_SCENE settings now hold scene values: they too must lie in the table's range */
+    if (gr_param_validate(&gr_reference_param_table, &s->reference, 0, c->err) ||
+        gr_param_validate(&gr_shafts_param_table, &s->shafts, 0, c->err)) {
+        size_t n = strcspn(c->err->msg, ":");
+        snprintf(c->path, sizeof c->path, "%.*s", (int)(n < sizeof c->path ? n : sizeof c->path - 1), c->err->msg);
+        return GR_E_INPUT;
+    }
     const gr_water *w = &s->water;
     double steep = gr_gerstner_steepness(w);
     if (!(steep < 1.0))
@@ -1037,7 +1060,7 @@ static gr_status finish(vctx *c, gr_scene *s)
     return GR_OK;
 }
 
-gr_status gr_scene_refresh(gr_scene *s, gr_error *err)
+static gr_status refresh_impl(gr_scene *s, gr_error *err)
 {
     gr_error local;
     vctx c = {err ? err : &local, ""};
@@ -1236,8 +1259,8 @@ static gr_status load_tree(const char *json, const char *label, const char *cons
     return st;
 }
 
-gr_status gr_scene_load_string(const char *json, const char *label, const char *const *overrides, int n_overrides,
-                               gr_scene *out, gr_error *err)
+static gr_status load_string_impl(const char *json, const char *label, const char *const *overrides,
+                                  int n_overrides, gr_scene *out, gr_error *err)
 {
     gr_error local;
     if (!err) err = &local;
@@ -1289,8 +1312,8 @@ gr_status gr_scene_load_string(const char *json, const char *label, const char *
     return gr_error_prefix(err, "%s", label);
 }
 
-gr_status gr_scene_load_file(const char *path, const char *const *overrides, int n_overrides, gr_scene *out,
-                             gr_error *err)
+static gr_status load_file_impl(const char *path, const char *const *overrides, int n_overrides, gr_scene *out,
+                                gr_error *err)
 {
     if (!path) return gr_fail(err, GR_E_RUNTIME, "gr_scene_load_file: no path");
     FILE *f = fopen(path, "rb");
@@ -1333,8 +1356,26 @@ gr_status gr_scene_load_file(const char *path, const char *const *overrides, int
         free(buf);
         return gr_fail(err, GR_E_INPUT, "%s: not a JSON text (contains a NUL byte)", path);
     }
-    gr_status st = gr_scene_load_string(buf, path, overrides, n_overrides, out, err);
+    gr_status st = load_string_impl(buf, path, overrides, n_overrides, out, err);
     free(buf);
     if (st == GR_OK) snprintf(out->source_path, sizeof out->source_path, "%s", path);
     return st;
+}
+
+/* ---- public entry points: every message leaves as one line ---------------------------- */
+gr_status gr_scene_refresh(gr_scene *s, gr_error *err)
+{
+    return one_line(err, refresh_impl(s, err));
+}
+
+gr_status gr_scene_load_string(const char *json, const char *label, const char *const *overrides, int n_overrides,
+                               gr_scene *out, gr_error *err)
+{
+    return one_line(err, load_string_impl(json, label, overrides, n_overrides, out, err));
+}
+
+gr_status gr_scene_load_file(const char *path, const char *const *overrides, int n_overrides, gr_scene *out,
+                             gr_error *err)
+{
+    return one_line(err, load_file_impl(path, overrides, n_overrides, out, err));
 }

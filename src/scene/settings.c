@@ -64,7 +64,7 @@ static const gr_param shafts_params[] = {
     {.name = "target_format", .type = GR_PT_ENUM, .offset = SH(target_format), .min = 0, .max = 1,
      .def = GR_TARGET_RGBA8, .enum_names = target_format_names, .unit = "",
      .doc = "shaft render target format (the seed uses 8 bits per channel)"},
-    {.name = "extinction", .type = GR_PT_RGB, .offset = SH(extinction), .min = 0, .max = 1000,
+    {.name = "extinction", .type = GR_PT_RGB, .offset = SH(extinction), .min = 0, .max = 10000,
      .flags = FROM, .def = NAN, .unit = "1/m", .scene_source = "medium.extinction",
      .doc = "extinction c of seed eq. 5.5.3; default: the medium's sigma_t"},
     {.name = "g", .type = GR_PT_DOUBLE, .offset = SH(g), .min = -1, .max = 1,

@@ -12,8 +12,9 @@ void main()
     vec2 p = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0);
     gl_Position = vec4(p, 0.0, 1.0);
     vec2 uv = p * 0.5 + 0.5;
-    // The seed's taps at +0 and +1 texel centre the filter half a texel off the pixel
-    // (a D3D9 pixel-centre artifact); here the four taps surround the pixel centre.
+    // The seed's taps at +0 and +1 texel are centred in D3D9, whose pixel centres sit at
+    // integer coordinates (content half a texel toward +u,+v); GL has no such offset, so
+    // the same filter is four taps at +-1/2 texel around the pixel (docs: D15).
     v_uv[0].xy = uv + vec2(-0.5, -0.5) * u_texel;
     v_uv[0].zw = uv + vec2(0.5, -0.5) * u_texel;
     v_uv[1].xy = uv + vec2(0.5, 0.5) * u_texel;

@@ -86,7 +86,7 @@ static void test_errors(void)
     EXPECT_ERR(with("{}", "camera.fov_deg=wide", NULL), "--set camera.fov_deg=wide: camera.fov_deg: must be a number");
     EXPECT_ERR(with(waves2, "water.waves[1].amplitude_m=-1", NULL), "--set water.waves[1].amplitude_m=-1: water.waves[1].amplitude_m");
     EXPECT_ERR(with(waves2, "water.waves[5].amplitude_m=0.1", NULL), "--set water.waves[5].amplitude_m=0.1: water.waves[5]: index out of range");
-    EXPECT_ERR(with("{}", "camera.fov_deg.x=1", NULL), "camera.fov_deg: not an object");
+    EXPECT_ERR(with("{\"camera\": {\"fov_deg\": 60}}", "camera.fov_deg.x=1", NULL), "camera.fov_deg: not an object");
     EXPECT_ERR(with("{\"camera\": {}}", "camera[0]=1", NULL), "camera: not an array");
     EXPECT_ERR(with("{}", "camera.fov_deg", NULL), "--set camera.fov_deg: expected json.path=value");
     EXPECT_ERR(with("{}", "=1", NULL), "expected json.path=value");

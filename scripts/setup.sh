@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Installs what godrays needs from Debian bookworm packages, and only what is missing.
+# Idempotent: a machine that has everything is left alone (no apt-get update, no install).
+# Needs root only when something is missing (exit 2 otherwise). docs/dependencies.md says
+# why each package is here.
+set -euo pipefail
+
+# ---- the package list: the one place to add a dependency -------------------------------
+# Installed with --no-install-recommends. The run-time pieces that this would otherwise drop
+# are named explicitly: libegl-mesa0 + libgl1-mesa-dri (Mesa EGL vendor + llvmpipe, what a
+# headless context runs on without a GPU) and plplot-driver-qt (PLplot's pngqt device; it is
+# only a Recommends of libplplotqt2). PLplot's svg/pdf/ps devices are in libplplot17 itself.
+GODRAYS_PACKAGES=(
+  # toolchain
+  gcc g++ cmake ninja-build pkg-config git
+  # ray tracing, images, JSON
+  libembree-dev libopenexr-dev libopenimageio-dev openimageio-tools libcjson-dev
+  # headless OpenGL through EGL (GLVND) with Mesa's software rasterizer
+  libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
+  # plots
+  libplplot-dev plplot-driver-qt
+)
+
+installed() {
+  # "install ok installed" is the only state in which a package's files are all present
+  [ "$(dpkg-query -W -f '${Status}' "$1" 2>/dev/null)" = "install ok installed" ]
+}
+
+missing=()
+for p in "${GODRAYS_PACKAGES[@]}"; do
+  installed "$p" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#GODRAYS_PACKAGES[@]} packages are installed"
+  exit 0
+fi
+
+echo "setup: missing packages: ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then
+  echo "setup: not root: run as root (or: sudo apt-get install --no-install-recommends ${missing[*]})" >&2
+  exit 2
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+echo "setup: apt-get update"
+apt-get update -q
+echo "setup: apt-get install -y --no-install-recommends ${missing[*]}"
+apt-get install -y -q --no-install-recommends "${missing[@]}"
+
+still=()
+for p in "${missing[@]}"; do
+  installed "$p" || still+=("$p")
+done
+if [ ${#still[@]} -ne 0 ]; then
+  echo "setup: still missing after install: ${still[*]}" >&2
+  exit 1
+fi
+echo "setup: installed ${#missing[@]} package(s)"

@@ -1,0 +1,21 @@
+/* The metrics as text (a table for people) and as JSON (every number, for scripts and the
+ * report). Conventions travel with the numbers: the JSON carries a "conventions" object. */
+#ifndef GR_METRICS_IO_H
+#define GR_METRICS_IO_H
+
+#include <stdio.h>
+
+#include <cjson/cJSON.h>
+
+#include "compare/metrics.h"
+
+/* A new JSON object with every field of m and the conventions used (luminance weights, rel
+ * MSE epsilon rule, PSNR peaks, SSIM constants, blur sigmas, stderr z and bound). +inf PSNR
+ * is written as null (JSON has no infinity). NULL if out of memory. */
+cJSON *gr_metrics_to_json(const gr_metrics *m);
+
+/* Prints the metrics as an aligned table (rows: metrics, columns R G B RGB Y) with the
+ * scoring counts, exclusions and conventions stated; the fitted table follows if present. */
+void gr_metrics_print_table(FILE *f, const gr_metrics *m);
+
+#endif
