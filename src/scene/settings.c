@@ -14,14 +14,14 @@
 
 #define REF(field) offsetof(gr_reference_settings, field)
 static const gr_param reference_params[] = {
-    {.name = "spp", .type = GR_PT_INT, .offset = REF(spp), .min = 1, .max = 1 << 20, .def = 4,
+    {.name = "spp", .type = GR_PT_INT, .offset = REF(spp), .min = 1, .max = 1 << 20, .def = 1,
      .unit = "", .doc = "camera samples per pixel in each batch"},
     {.name = "steps", .type = GR_PT_INT, .offset = REF(steps), .min = 1, .max = 1 << 16, .def = 64,
      .unit = "", .doc = "stratified, jittered march steps along each camera ray"},
     {.name = "surface_res", .type = GR_PT_INT, .offset = REF(surface_res), .min = 2, .max = 16384,
      .def = 256, .unit = "", .doc = "surface tessellation: cells along each axis of the lit patch"},
     {.name = "sun_samples", .type = GR_PT_INT, .offset = REF(sun_samples), .min = 1, .max = 4096,
-     .def = 4, .unit = "", .doc = "directions sampled inside the sun's disc"},
+     .def = 8, .unit = "", .doc = "directions sampled inside the sun's disc"},
     {.name = "batches", .type = GR_PT_INT, .offset = REF(batches), .min = 1, .max = 1024, .def = 8,
      .unit = "", .doc = "independent batches for the standard-error estimate"},
     {.name = "seed", .type = GR_PT_U64, .offset = REF(seed), .min = 0, .max = 9007199254740991.0,
