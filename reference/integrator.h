@@ -84,5 +84,11 @@ typedef struct gr_ref_info {
     size_t prims;           /* beam-slab primitives of the last beam set */
 } gr_ref_info;
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info);
+/* For the benchmark (reference/bench.c): the displaced surface mesh of the prepared pass
+ * (NULL on flat water), its triangle count, and the rate of bare beam lookups (1 thread)
+ * at random local points of box = {u0, u1, w0, w1, y0, y1}. */
+void *gr_ref_surface_scene_ptr(const gr_ref_renderer *r);
+long long gr_ref_surface_triangles(const gr_ref_renderer *r);
+double gr_ref_lookup_rate(const gr_ref_renderer *r, const double box[6], int n);
 
 #endif

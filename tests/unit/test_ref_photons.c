@@ -100,6 +100,7 @@ int main(void)
     int reduced = ref_reduced();
     const double bins[][3] = {{0.3, 2.1, -8.0}, {-1.7, 4.4, -8.0}, {2.6, 6.0, -8.0}, {1.0, 3.0, -20.0}};
     const int nbins = reduced ? 2 : 4;
+    const long nphot = reduced ? 300000 : 1000000;
     const double b = 0.25;
     for (int k = 0; k < nbins; k++) {
         double bx = bins[k][0], bz = bins[k][1], y = bins[k][2];
@@ -127,7 +128,7 @@ int main(void)
         gr_ref_destroy(r);
         double beam = s1 / passes, beam_se = sqrt(fmax(0.0, (s2 - passes * beam * beam) / (passes - 1)) / passes);
         double ph, ph_se;
-        photons(s, bx, bz, b, y, reduced ? 400000 : 1500000, &ph, &ph_se);
+        photons(s, bx, bz, b, y, nphot, &ph, &ph_se);
         double tol = 3.0 * sqrt(beam_se * beam_se + ph_se * ph_se);
         printf("bin (%.2f, %.2f) at y = %g m: beams %.4f +- %.4f, photons %.4f +- %.4f, difference %.4f (3 sigma %.4f)\n",
                bx, bz, y, beam, beam_se, ph, ph_se, beam - ph, tol);

@@ -1,0 +1,57 @@
+/* The ground-truth cache of `godrays run`: a reference render is slow (about 2 minutes on the
+ * default scene on 2 cores) and depends only on the scene's content and the reference
+ * settings, so it is stored as an EXR and reused while neither changes. docs/report.md.
+ *
+ * Key = "SCENEHASH-SETTINGSHASH" (16 hex digits each, FNV-1a 64):
+ *  - SCENEHASH: the normalized scene JSON (every default filled in, stable key order) without
+ *    the "name", "shafts" and "reference" sections: what the ground truth renders. A change of
+ *    the real-time settings or of the scene's label does not invalidate the reference.
+ *  - SETTINGSHASH: every reference.* setting except `threads` (the integrator gives the same
+ *    bytes for any thread count), plus the cache format and the godrays version (a new build of
+ *    the integrator may render differently).
+ * The file is CACHEDIR/reference-KEY.exr and carries the key in its "godrays:cache_key"
+ * attribute; a read checks that key, the size, the channels and that the render was complete,
+ * and treats any mismatch as a miss (with the reason). */
+#ifndef GR_CACHE_H
+#define GR_CACHE_H
+
+#include <stddef.h>
+#include "common/status.h"
+#include "image/image.h"
+#include "scene/scene.h"
+
+#define GR_CACHE_KEY_LEN 33          /* 16 + 1 + 16 hex characters */
+#define GR_CACHE_META_KEY "godrays:cache_key"
+#define GR_CACHE_FORMAT "godrays-reference-cache-1"
+
+/* FNV-1a 64 (Fowler, Noll, Vo) of n bytes, continuing from h (start: GR_FNV_BASIS). */
+#define GR_FNV_BASIS 14695981039346656037ull
+unsigned long long gr_fnv1a64(unsigned long long h, const void *data, size_t n);
+
+/* The cache key of s's ground truth into key[GR_CACHE_KEY_LEN + 1]. GR_E_NOMEM. */
+gr_status gr_cache_key(const gr_scene *s, char *key, gr_error *err);
+
+/* Chooses and creates the cache directory: $GODRAYS_CACHE if set and non-empty, else
+ * $XDG_CACHE_HOME/godrays or $HOME/.cache/godrays, else ./.godrays-cache (relative to the
+ * working directory, e.g. the build directory). The first that exists or can be created and
+ * is writable wins; $GODRAYS_CACHE, when set, is the only candidate (a user who names a
+ * directory means it): GR_E_IO naming GODRAYS_CACHE if it is unusable. */
+gr_status gr_cache_dir(char *buf, size_t n, gr_error *err);
+
+/* CACHEDIR/reference-KEY.exr into buf. GR_E_USAGE if it does not fit. */
+gr_status gr_cache_path(const char *dir, const char *key, char *buf, size_t n, gr_error *err);
+
+/* Looks the key up. On a valid entry *hit = 1, *img (caller destroys) and meta (initialized
+ * by the caller; filled with the file's attributes) hold it. A missing file, a file that does
+ * not read, or one that fails a check (key attribute, size width x height, channels R, G, B,
+ * stderr.R/G/B, godrays:partial = 0, finite samples) gives *hit = 0 and the reason in why
+ * (may be NULL); only allocation failures are errors (GR_E_NOMEM). */
+gr_status gr_cache_load(const char *dir, const char *key, int width, int height, gr_image **img,
+                        gr_metadata *meta, int *hit, char *why, size_t why_n, gr_error *err);
+
+/* Stores img with meta plus the key attribute (atomically: temporary file renamed into
+ * place, so concurrent runs never see half a file). */
+gr_status gr_cache_store(const char *dir, const char *key, const gr_image *img, const gr_metadata *meta,
+                         gr_error *err);
+
+#endif

@@ -1,0 +1,120 @@
+/* Validation 6: convergence of the ground truth on the default scene (64 x 36 pixels).
+ *  - surface resolution: renders at surface_res 32..256 with the same seed (same camera
+ *    samples, same sun directions and grid offsets in cells) against surface_res 512; the
+ *    mean relative pixel difference must fall at least 2.5x per doubling at the fine end
+ *    (O(h^2) expected for piecewise-linear beams);
+ *  - samples: the median per-pixel relative standard error must fall as spp^-1/2
+ *    (ratio 2 +- 0.5 from spp 1 to 4 per batch), the march and the disc being unbiased
+ *    (jittered stratification), so more samples only remove noise.
+ * Prints the table of docs/reference.md section 4 and, with PLplot, writes
+ * GODRAYS_TEST_OUT/ref_convergence.svg. Slow: reduced variant stops at surface_res 256. */
+#include "check.h"
+#include "test_ref_util.h"
+
+#include <math.h>
+#ifdef GR_HAVE_PLPLOT
+#include <plplot.h>
+#endif
+
+static gr_ref_result render(const char *path, int res, int spp)
+{
+    char r_[64], s_[64];
+    snprintf(r_, sizeof r_, "reference.surface_res=%d", res);
+    snprintf(s_, sizeof s_, "reference.spp=%d", spp);
+    const char *ov[] = {"camera.width=64", "camera.height=36", "reference.sun_samples=4", "reference.batches=4", r_, s_};
+    gr_scene *s = malloc(sizeof *s);
+    gr_error err = {GR_OK, ""};
+    if (!s || gr_scene_load_file(path, ov, 6, s, &err) != GR_OK) {
+        fprintf(stderr, "%s\n", err.msg);
+        exit(1);
+    }
+    gr_ref_result res_;
+    ref_render(s, NULL, &res_);
+    free(s);
+    return res_;
+}
+
+static double lum(const gr_image *im, int i)
+{
+    const float *p = im->pixels + (size_t)i * im->nchannels;
+    return (p[0] + p[1] + p[2]) / 3.0;
+}
+
+static int cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+int main(void)
+{
+    const char *src = getenv("GODRAYS_SOURCE_DIR");
+    char path[4096];
+    snprintf(path, sizeof path, "%s/data/scenes/default.json", src ? src : GR_SOURCE_DIR);
+    int reduced = ref_reduced();
+    const int resl[] = {32, 64, 128, 256};
+    int nres = 4, ref_res = reduced ? 256 : 512;
+    if (reduced) nres = 3;
+    gr_ref_result ref = render(path, ref_res, 1);
+    int np = ref.image->width * ref.image->height;
+    double mean = 0.0;
+    for (int i = 0; i < np; i++) mean += lum(ref.image, i);
+    mean /= np;
+    double err[4];
+    printf("| surface_res | cell (m) | mean abs pixel difference vs %d / image mean | ratio |\n|---|---|---|---|\n", ref_res);
+    for (int k = 0; k < nres; k++) {
+        gr_ref_result r = render(path, resl[k], 1);
+        double d = 0.0;
+        for (int i = 0; i < np; i++) d += fabs(lum(r.image, i) - lum(ref.image, i));
+        err[k] = d / np / mean;
+        const gr_meta_item *cell = gr_meta_get(&r.meta, "godrays:surface_cell_m");
+        printf("| %d | %.3f | %.3e | %s%.2f |\n", resl[k], cell ? cell->num : 0.0, err[k], k ? "" : "-", k ? err[k - 1] / err[k] : 0.0);
+        gr_ref_result_free(&r);
+    }
+    CHECK_MSG(err[nres - 2] / err[nres - 1] >= 2.5, "surface_res doubling must cut the bias >= 2.5x, got %.2f",
+              err[nres - 2] / err[nres - 1]);
+
+    /* samples: median relative standard error per pixel */
+    double med[2];
+    const int spps[2] = {1, 4};
+    for (int k = 0; k < 2; k++) {
+        gr_ref_result r = render(path, 128, spps[k]);
+        double *rel = malloc(np * sizeof *rel);
+        for (int i = 0; i < np; i++) {
+            const float *p = r.image->pixels + (size_t)i * r.image->nchannels;
+            rel[i] = (p[3] + p[4] + p[5]) / fmax(1e-30, p[0] + p[1] + p[2]);
+        }
+        qsort(rel, np, sizeof *rel, cmp);
+        med[k] = rel[np / 2];
+        printf("spp %d per batch (x4 batches): median relative standard error %.3e\n", spps[k], med[k]);
+        free(rel);
+        gr_ref_result_free(&r);
+    }
+    CHECK_MSG(med[0] / med[1] > 1.5 && med[0] / med[1] < 2.6, "4x samples must halve the error, ratio %.2f", med[0] / med[1]);
+#ifdef GR_HAVE_PLPLOT
+    const char *out = getenv("GODRAYS_TEST_OUT");
+    char png[4096];
+    snprintf(png, sizeof png, "%s/ref_convergence.svg", out ? out : ".");
+    PLFLT x[4], y[4], yr[4];
+    for (int k = 0; k < nres; k++) {
+        x[k] = log10((double)resl[k]);
+        y[k] = log10(err[k]);
+        yr[k] = log10(err[0] * pow((double)resl[0] / resl[k], 2.0));
+    }
+    plsdev("svg");
+    plsfnam(png);
+    plinit();
+    plenv(x[0] - 0.1, x[nres - 1] + 0.1, fmin(y[nres - 1], yr[nres - 1]) - 0.3, y[0] + 0.3, 0, 30);
+    pllab("surface_res (cells per side)", "mean |pixel - truth| / mean", "ground truth: bias vs surface resolution");
+    plcol0(2);
+    plline(nres, x, y);
+    plpoin(nres, x, y, 17);
+    plcol0(3);
+    plline(nres, x, yr);
+    plptex(x[1], yr[1] - 0.15, 1, 0, 0, "slope -2 (h^2)");
+    plend();
+    printf("plot: %s\n", png);
+#endif
+    gr_ref_result_free(&ref);
+    CHECK_DONE();
+}
