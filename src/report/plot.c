@@ -44,6 +44,11 @@ static int world_point(const gr_plot_spec *spec, const gr_plot_series *s, int i,
 /* World range of one axis: explicit (converted to log10 on log axes) or from the data. */
 static void axis_range(const gr_plot_spec *spec, int axis, double *lo, double *hi)
 {
+    if (axis == 0 && spec->n_categories > 0) {
+        *lo = -0.3;
+        *hi = spec->n_categories - 1 + 0.3;
+        return;
+    }
     const int logax = axis ? spec->log_y : spec->log_x;
     const double a = axis ? spec->ymin : spec->xmin, b = axis ? spec->ymax : spec->xmax;
     if (a != b) {
@@ -99,6 +104,9 @@ static gr_status check_spec(const gr_plot_spec *spec, int *w, int *h, gr_error *
             return gr_fail(err, GR_E_INPUT, "plot '%s': series %d: unknown line style %d",
                            spec->title ? spec->title : "", k, (int)s->style);
     }
+    if (spec->n_categories < 0 || spec->n_categories > 32 || (spec->n_categories > 0 && (!spec->x_categories || spec->log_x)))
+        return gr_fail(err, GR_E_INPUT, "plot '%s': %d x categories (at most 32, with labels, linear axis)",
+                       spec->title ? spec->title : "", spec->n_categories);
     const double r[2][2] = {{spec->xmin, spec->xmax}, {spec->ymin, spec->ymax}};
     const int lg[2] = {spec->log_x, spec->log_y};
     for (int a = 0; a < 2; a++) {
@@ -132,6 +140,20 @@ static void on_plabort(const char *msg)
 
 enum { PART_CONTENT = 0, PART_LEGEND = 1 };
 
+/* plslabelfunc callback: category labels at integer x, nothing elsewhere; y as PLplot would. */
+static void category_label(PLINT axis, PLFLT value, char *label, PLINT length, PLPointer data)
+{
+    const gr_plot_spec *spec = data;
+    label[0] = '\0';
+    if (axis != PL_X_AXIS) {
+        snprintf(label, (size_t)length, "%g", value);
+        return;
+    }
+    const double r = floor(value + 0.5);
+    if (fabs(value - r) > 1e-6 || r < 0 || r >= spec->n_categories) return;
+    plot_text(spec->x_categories[(int)r], label, (size_t)length);
+}
+
 /* One PLplot session on the shared buffer, shifted by (dx, dy) device pixels. */
 static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, int H, int dx, int dy, int part,
                          int legend_background)
@@ -161,7 +183,7 @@ static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, in
         plcol0(2);
         snprintf(xo, sizeof xo, "g%s", spec->log_x ? "l" : "");
         snprintf(yo, sizeof yo, "g%s", spec->log_y ? "l" : "");
-        plbox(xo, 0.0, 0, yo, 0.0, 0);
+        plbox(xo, spec->n_categories > 0 ? 1.0 : 0.0, 0, yo, 0.0, 0);
         for (int k = 0; k < spec->n_series; k++) {
             const gr_plot_series *s = &spec->series[k];
             plcol0(3 + k);
@@ -187,9 +209,17 @@ static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, in
             pllsty(1);
         }
         plcol0(1);
+        if (spec->n_categories > 0) {
+            /* custom labels at every integer, major ticks there, no minor ticks */
+            plslabelfunc(category_label, (PLPointer)spec);
+            plbox("bcnto", 1.0, 1, "", 0.0, 0);
+            plslabelfunc(NULL, NULL);
+            snprintf(yo, sizeof yo, "bcnstv%s", spec->log_y ? "l" : "");
+            plbox("", 0.0, 0, yo, 0.0, 0);
+        }
         snprintf(xo, sizeof xo, "bcnst%s", spec->log_x ? "l" : "");
         snprintf(yo, sizeof yo, "bcnstv%s", spec->log_y ? "l" : "");
-        plbox(xo, 0.0, 0, yo, 0.0, 0);
+        if (spec->n_categories == 0) plbox(xo, 0.0, 0, yo, 0.0, 0);
         char t[3][512];
         plot_text(spec->xlabel, t[0], sizeof t[0]);
         plot_text(spec->ylabel, t[1], sizeof t[1]);

@@ -38,6 +38,10 @@ typedef struct gr_plot_spec {
     double xmin, xmax, ymin, ymax;
     const gr_plot_series *series;
     int n_series;                /* 0..GR_PLOT_MAX_SERIES */
+    /* Categorical x axis (n_categories > 0, log_x = 0): x values are the indices 0..n-1 and
+     * the axis shows these labels at them (e.g. blur sigmas "none", "1", "4", "16"). */
+    const char *const *x_categories;
+    int n_categories;            /* 0..32 */
 } gr_plot_spec;
 
 /* 1 if this build can draw charts (PLplot found at configure time). */
