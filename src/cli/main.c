@@ -11,6 +11,7 @@ static const gr_command commands[] = {
     {"compare", "error metrics between two images (any format), with mask, stderr, scale fit", cmd_compare},
     {"shafts", "render the god-ray layer with seed 000's real-time shafts (OpenGL) to EXR + PNG", cmd_shafts},
     {"reference", "render the ground-truth god-ray layer (Embree, single scattering) to EXR + PNG", cmd_reference},
+    {"run", "the main job: ground truth (cached) + real-time shafts + comparison + HTML report", cmd_run},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
 

@@ -71,15 +71,17 @@ static void axis_range(const gr_plot_spec *spec, int axis, double *lo, double *h
         mn = 0.0;
         mx = 1.0;
     }
+    const double head = axis && spec->legend_headroom > 0.0 && isfinite(spec->legend_headroom)
+                            ? spec->legend_headroom : 0.0;
     if (logax) {
         *lo = floor(mn);
-        *hi = ceil(mx);
+        *hi = ceil(mx + head * (mx - mn > 1.0 ? mx - mn : 1.0));
         if (*hi <= *lo) *hi = *lo + 1.0;
     } else {
         double span = mx - mn;
         if (span <= 0.0) span = fabs(mx) > 0.0 ? fabs(mx) : 1.0;
         *lo = mn - 0.04 * span;
-        *hi = mx + 0.04 * span;
+        *hi = mx + (0.04 + head) * span;
     }
 }
 
@@ -155,8 +157,7 @@ static void category_label(PLINT axis, PLFLT value, char *label, PLINT length, P
 }
 
 /* One PLplot session on the shared buffer, shifted by (dx, dy) device pixels. */
-static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, int H, int dx, int dy, int part,
-                         int legend_background)
+static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, int H, int dx, int dy, int part)
 {
     PLINT prev = 0, strm = 0;
     plgstrm(&prev);
@@ -245,7 +246,7 @@ static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, in
         }
         if (n > 0) {
             PLFLT lw = 0, lh = 0;
-            pllegend(&lw, &lh, PL_LEGEND_BACKGROUND * (legend_background != 0) | PL_LEGEND_BOUNDING_BOX,
+            pllegend(&lw, &lh, PL_LEGEND_BOUNDING_BOX,
                      PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE, 0.02, 0.03, 0.08, 0, 1, 1, 0, 0, n,
                      opt, 0.8, 0.8, 2.0, 0.0, tcol, tp, NULL, NULL, NULL, NULL, lcol, lsty, lwid, NULL, NULL, NULL,
                      NULL);
@@ -269,7 +270,7 @@ gr_status gr_plot_render(const gr_plot_spec *spec, gr_image **out, gr_error *err
     const int W = SS * w, H = SS * h;
     unsigned char *buf = malloc((size_t)W * (size_t)H * 3);
     gr_image *img = gr_image_create(w, h, 3, NULL);
-    if (!buf || !img) {
+    if (!buf || !img) { /* (the legend buffer below is optional: without it, no legend) */
         free(buf);
         gr_image_destroy(img);
         return gr_fail(err, GR_E_NOMEM, "plot '%s': out of memory for %d x %d", spec->title ? spec->title : "", W, H);
@@ -277,11 +278,29 @@ gr_status gr_plot_render(const gr_plot_spec *spec, gr_image **out, gr_error *err
     memset(buf, 255, (size_t)W * (size_t)H * 3); /* the mem device draws over what is there */
     g_abort_msg[0] = '\0';
     plsabort(on_plabort);
-    /* Four passes shifted by one device pixel make every stroke two device pixels wide; the
-     * legend comes after all content passes, its background only in the first, so the content
-     * never draws over it and its own strokes are not erased. */
-    for (int part = PART_CONTENT; part <= PART_LEGEND; part++)
-        for (int k = 0; k < 4; k++) draw_session(spec, buf, W, H, k & 1, k >> 1, part, k == 0);
+    /* Four passes shifted by one device pixel make every stroke two device pixels wide. */
+    for (int k = 0; k < 4; k++) draw_session(spec, buf, W, H, k & 1, k >> 1, PART_CONTENT);
+    /* The legend on a white buffer of its own; the bounding box of what it drew (its frame
+     * included) is pasted over the chart, which makes it opaque without a PLplot fill. */
+    unsigned char *leg = malloc((size_t)W * (size_t)H * 3);
+    if (leg) {
+        memset(leg, 255, (size_t)W * (size_t)H * 3);
+        for (int k = 0; k < 4; k++) draw_session(spec, leg, W, H, k & 1, k >> 1, PART_LEGEND);
+        int x0 = W, x1 = -1, y0 = H, y1 = -1;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                const unsigned char *q = leg + ((size_t)y * (size_t)W + (size_t)x) * 3;
+                if (q[0] == 255 && q[1] == 255 && q[2] == 255) continue;
+                if (x < x0) x0 = x;
+                if (x > x1) x1 = x;
+                if (y < y0) y0 = y;
+                if (y > y1) y1 = y;
+            }
+        for (int y = y0; y <= y1; y++)
+            memcpy(buf + ((size_t)y * (size_t)W + (size_t)x0) * 3, leg + ((size_t)y * (size_t)W + (size_t)x0) * 3,
+                   (size_t)(x1 - x0 + 1) * 3);
+        free(leg);
+    }
     plsabort(NULL);
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++)

@@ -2,7 +2,9 @@
  * error against blur scale. PLplot's "mem" device draws into an RGB buffer of ours, so no
  * display, Qt or cairo is needed; the chart is drawn at twice the size with each pass offset
  * by one device pixel (thicker strokes) and box-filtered down (antialiasing), then written as
- * PNG through OpenImageIO. Built without PLplot (GR_HAVE_PLPLOT unset), every drawing call
+ * PNG through OpenImageIO. The legend is drawn on its own white buffer and pasted over the
+ * chart as an opaque box (PLplot's legend background needs solid fills, which the memory
+ * device lacks). Built without PLplot (GR_HAVE_PLPLOT unset), every drawing call
  * returns GR_E_RUNTIME and the report says the charts are missing. */
 #ifndef GR_PLOT_H
 #define GR_PLOT_H
@@ -36,6 +38,9 @@ typedef struct gr_plot_spec {
     /* Axis ranges in data units; xmin == xmax (e.g. both 0) takes the range of the data
      * (with a 4 % margin on linear axes, whole decades on log axes). */
     double xmin, xmax, ymin, ymax;
+    /* With the y range from the data: this fraction of it is added above the data (room for
+     * the legend, drawn opaque in the top right corner). */
+    double legend_headroom;
     const gr_plot_series *series;
     int n_series;                /* 0..GR_PLOT_MAX_SERIES */
     /* Categorical x axis (n_categories > 0, log_x = 0): x values are the indices 0..n-1 and

@@ -48,13 +48,18 @@ typedef struct gr_report_result {
  * different sizes; GR_E_IO; GR_E_NOMEM. res may be NULL. */
 gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_result *res, gr_error *err);
 
+/* Creates dir and its missing parents (GR_E_IO naming the part that failed). */
+gr_status gr_report_make_dir(const char *dir, gr_error *err);
+
 /* The summary contact sheet: the three panels (display-encoded RGB images in [0, 1], any
  * heights) side by side under their titles, and the lines of text below, on a dark background.
- * Panels wider than max_panel_w are shrunk by an integer factor. Text is optional: without a
- * usable font the sheet is drawn unlabelled and *labelled = 0. */
+ * Panels wider than max_panel_w are shrunk by an integer factor (box filter), panels narrower
+ * than min_panel_w enlarged by one (pixel replication) so that small renders stay legible; the
+ * sheet widens for long text lines. Text is optional: without a usable font the sheet is drawn
+ * unlabelled and *labelled = 0. */
 gr_status gr_report_contact_sheet(const gr_image *const panels[3], const char *const titles[3],
-                                  const char *const *lines, int n_lines, int max_panel_w, gr_image **out,
-                                  int *labelled, gr_error *err);
+                                  const char *const *lines, int n_lines, int min_panel_w, int max_panel_w,
+                                  gr_image **out, int *labelled, gr_error *err);
 
 /* Exposure mapping the q-th quantile (0..1) of max(R, G, B) of img (times scale) to `target`
  * (1 if that quantile is not > 0). */

@@ -1,0 +1,1106 @@
+/* The report of `godrays run` (see report.h; how to read it: docs/report.md). */
+#include "report/report.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
+
+#include "compare/diffmap.h"
+#include "compare/metrics_io.h"
+#include "image/oiio.h"
+#include "report/html.h"
+#include "report/plot.h"
+#include "report/profile.h"
+#include "scene/params.h"
+#include "scene/settings.h"
+
+#ifndef GR_VERSION
+#define GR_VERSION "unknown"
+#endif
+
+#define PROFILE_TARGET_BINS 60
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- small helpers -------------------------------------------------------------------- */
+
+gr_status gr_report_make_dir(const char *dir, gr_error *err)
+{
+    char buf[4096];
+    if (!dir || !dir[0]) return gr_fail(err, GR_E_USAGE, "report: no output directory");
+    if (snprintf(buf, sizeof buf, "%s", dir) >= (int)sizeof buf)
+        return gr_fail(err, GR_E_USAGE, "%s: output directory name too long", dir);
+    for (char *p = buf + 1;; p++) {
+        if (*p == '/' || *p == '\0') {
+            char saved = *p;
+            *p = '\0';
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return gr_fail(err, GR_E_IO, "%s: cannot create directory: %s", buf, strerror(errno));
+            *p = saved;
+            if (saved == '\0') break;
+        }
+    }
+    struct stat sb;
+    if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) return gr_fail(err, GR_E_IO, "%s: not a directory", dir);
+    return GR_OK;
+}
+
+static gr_status join(char *buf, size_t n, const char *dir, const char *name, gr_error *err)
+{
+    if (snprintf(buf, n, "%s/%s", dir, name) >= (int)n)
+        return gr_fail(err, GR_E_USAGE, "%s: output directory name too long", dir);
+    return GR_OK;
+}
+
+/* Writes text to path through PATH.tmp-PID renamed into place. */
+static gr_status write_text(const char *path, const char *text, gr_error *err)
+{
+    char tmp[4400];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()) >= (int)sizeof tmp)
+        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
+    int ok = fputs(text, f) >= 0;
+    ok = (fclose(f) == 0) && ok;
+    if (!ok || rename(tmp, path) != 0) {
+        const int e = errno;
+        remove(tmp);
+        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(e));
+    }
+    return GR_OK;
+}
+
+static const gr_meta_item *meta_get(const gr_metadata *m, const char *key)
+{
+    return m ? gr_meta_get(m, key) : NULL;
+}
+
+/* The number stored under key, or NaN. */
+static double meta_num(const gr_metadata *m, const char *key)
+{
+    const gr_meta_item *it = meta_get(m, key);
+    if (!it || it->type == GR_META_STRING) return NAN;
+    return it->num;
+}
+
+static const char *meta_str(const gr_metadata *m, const char *key)
+{
+    const gr_meta_item *it = meta_get(m, key);
+    return it && it->type == GR_META_STRING ? it->str : NULL;
+}
+
+/* "%.4g", with "inf" / "n/a" for non-finite values. */
+static const char *fmt(double v, char *buf, size_t n)
+{
+    if (isnan(v)) snprintf(buf, n, "n/a");
+    else if (isinf(v)) snprintf(buf, n, "%sinf", v < 0 ? "-" : "");
+    else snprintf(buf, n, "%.4g", v);
+    return buf;
+}
+
+static int cmp_float(const void *a, const void *b)
+{
+    const float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+double gr_report_exposure(const gr_image *img, double scale, double q, double target)
+{
+    if (!img || !img->pixels || !(scale > 0.0) || !isfinite(scale)) return 1.0;
+    int rgb[3];
+    gr_metrics_pick_rgb(img, rgb);
+    const size_t n = (size_t)img->width * (size_t)img->height;
+    float *v = malloc(n * sizeof *v);
+    if (!v) return 1.0;
+    for (size_t i = 0; i < n; i++) {
+        const float *p = img->pixels + i * (size_t)img->nchannels;
+        v[i] = fmaxf(p[rgb[0]], fmaxf(p[rgb[1]], p[rgb[2]]));
+    }
+    qsort(v, n, sizeof *v, cmp_float);
+    const double qq = q < 0.0 ? 0.0 : q > 1.0 ? 1.0 : q;
+    const double val = scale * (double)v[(size_t)((double)(n - 1) * qq)];
+    free(v);
+    return val > 0.0 && isfinite(target / val) ? target / val : 1.0;
+}
+
+/* sRGB transfer function (IEC 61966-2-1) of a linear value clamped to [0, 1]. */
+static float srgb_encode(double x)
+{
+    if (!(x > 0.0)) return 0.0f;
+    if (x >= 1.0) return 1.0f;
+    return (float)(x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055);
+}
+
+gr_status gr_report_display(const gr_image *img, double exposure, gr_image **out, gr_error *err)
+{
+    *out = NULL;
+    if (!img || !img->pixels) return gr_fail(err, GR_E_INPUT, "display image: no image");
+    gr_image *d = gr_image_create(img->width, img->height, 3, NULL);
+    if (!d) return gr_fail(err, GR_E_NOMEM, "display image: out of memory for %d x %d", img->width, img->height);
+    int rgb[3];
+    gr_metrics_pick_rgb(img, rgb);
+    const size_t n = (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++)
+            d->pixels[i * 3 + (size_t)c] = srgb_encode(exposure * (double)img->pixels[i * (size_t)img->nchannels + (size_t)rgb[c]]);
+    *out = d;
+    return GR_OK;
+}
+
+/* Integer resize of a 3-channel display image: k > 0 shrinks by k (box filter), k < 0
+ * enlarges by -k (pixel replication: small renders stay honest, no invented detail). */
+static gr_image *resize(const gr_image *src, int k)
+{
+    const int up = k < 0 ? -k : 1, down = k > 0 ? k : 1;
+    const int w = up * ((src->width + down - 1) / down), h = up * ((src->height + down - 1) / down);
+    gr_image *d = gr_image_create(w, h, 3, NULL);
+    if (!d) return NULL;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double s[3] = {0, 0, 0};
+            int cnt = 0;
+            for (int j = 0; j < down; j++)
+                for (int i = 0; i < down; i++) {
+                    const int sx = (x / up) * down + i, sy = (y / up) * down + j;
+                    if (sx >= src->width || sy >= src->height) continue;
+                    const float *p = src->pixels + ((size_t)sy * (size_t)src->width + (size_t)sx) * (size_t)src->nchannels;
+                    for (int c = 0; c < 3; c++) s[c] += p[c < src->nchannels ? c : 0];
+                    cnt++;
+                }
+            for (int c = 0; c < 3; c++) gr_image_pixel(d, x, y)[c] = (float)(s[c] / cnt);
+        }
+    return d;
+}
+
+gr_status gr_report_contact_sheet(const gr_image *const panels[3], const char *const titles[3],
+                                  const char *const *lines, int n_lines, int min_panel_w, int max_panel_w,
+                                  gr_image **out, int *labelled, gr_error *err)
+{
+    *out = NULL;
+    if (labelled) *labelled = 0;
+    if (n_lines < 0 || (n_lines > 0 && !lines) || min_panel_w < 1 || max_panel_w < 16 || min_panel_w > max_panel_w)
+        return gr_fail(err, GR_E_INPUT, "contact sheet: bad text lines or panel widths %d..%d", min_panel_w, max_panel_w);
+    for (int i = 0; i < 3; i++)
+        if (!panels[i] || !panels[i]->pixels || panels[i]->nchannels < 1)
+            return gr_fail(err, GR_E_INPUT, "contact sheet: panel %d missing", i);
+    enum { M = 16, TITLE_H = 32, TITLE_PX = 18, LINE_H = 24, LINE_PX = 16 };
+    gr_image *p[3] = {NULL, NULL, NULL};
+    int W = M, maxh = 0;
+    for (int i = 0; i < 3; i++) {
+        const int w = panels[i]->width;
+        int k = 1;
+        if (w > max_panel_w) k = (w + max_panel_w - 1) / max_panel_w;
+        else if (w < min_panel_w) k = -((min_panel_w + w - 1) / w);
+        if (k < 0 && -k * w > max_panel_w) k = w * 2 <= max_panel_w ? -(max_panel_w / w) : 1;
+        p[i] = resize(panels[i], k);
+        if (!p[i]) {
+            for (int j = 0; j < i; j++) gr_image_destroy(p[j]);
+            return gr_fail(err, GR_E_NOMEM, "contact sheet: out of memory");
+        }
+        W += p[i]->width + M;
+        if (p[i]->height > maxh) maxh = p[i]->height;
+    }
+    /* Wide enough for the longest text line (DejaVu Sans advances about 0.58 em per
+     * character on average; 0.6 em keeps a margin). */
+    size_t longest = 0;
+    for (int i = 0; i < n_lines; i++)
+        if (lines[i] && strlen(lines[i]) > longest) longest = strlen(lines[i]);
+    const int text_w = 2 * M + (int)(0.6 * LINE_PX * (double)longest);
+    const int extra = text_w > W ? text_w - W : 0;
+    W += extra;
+    const int H = M + TITLE_H + maxh + M + n_lines * LINE_H + M;
+    gr_image *s = gr_image_create(W, H, 3, NULL);
+    if (!s) {
+        for (int j = 0; j < 3; j++) gr_image_destroy(p[j]);
+        return gr_fail(err, GR_E_NOMEM, "contact sheet: out of memory for %d x %d", W, H);
+    }
+    static const float bg[3] = {0.11f, 0.12f, 0.14f};
+    for (size_t i = 0; i < (size_t)W * (size_t)H; i++)
+        for (int c = 0; c < 3; c++) s->pixels[i * 3 + (size_t)c] = bg[c];
+    int x0 = M + extra / 2;
+    int x_centre[3];
+    for (int i = 0; i < 3; i++) {
+        for (int y = 0; y < p[i]->height; y++)
+            memcpy(gr_image_pixel(s, x0, M + TITLE_H + y), gr_image_pixel(p[i], 0, y),
+                   (size_t)p[i]->width * 3 * sizeof(float));
+        x_centre[i] = x0 + p[i]->width / 2;
+        x0 += p[i]->width + M;
+    }
+    for (int j = 0; j < 3; j++) gr_image_destroy(p[j]);
+    /* Labels are optional: the first text that cannot be drawn (no font) stops them all. */
+    static const float fg[3] = {0.93f, 0.93f, 0.93f};
+    gr_error terr = {GR_OK, ""};
+    int ok = 1;
+    for (int i = 0; ok && i < 3; i++)
+        if (titles && titles[i])
+            ok = gr_oiio_render_text(s, x_centre[i], M + TITLE_H - 10, titles[i], TITLE_PX, fg, 1, &terr) == GR_OK;
+    for (int i = 0; ok && i < n_lines; i++)
+        if (lines[i])
+            ok = gr_oiio_render_text(s, M, M + TITLE_H + maxh + M + (i + 1) * LINE_H - 7, lines[i], LINE_PX, fg, 0,
+                                     &terr) == GR_OK;
+    if (labelled) *labelled = ok;
+    *out = s;
+    return GR_OK;
+}
+
+/* ---- charts ----------------------------------------------------------------------------- */
+
+typedef struct profiles {
+    double dir[3];
+    double max_deg;
+    gr_radial_profile ref, fit, raw;
+} profiles;
+
+static gr_status compute_profiles(const gr_report_input *in, double a, profiles *pr, gr_error *err)
+{
+    memset(pr, 0, sizeof *pr);
+    const gr_camera *cam = &in->scene->camera;
+    if (cam->width != in->ref->width || cam->height != in->ref->height)
+        return gr_fail(err, GR_E_INPUT, "report: the scene's camera is %d x %d but the images are %d x %d",
+                       cam->width, cam->height, in->ref->width, in->ref->height);
+    const size_t n = (size_t)cam->width * (size_t)cam->height;
+    float *ang = malloc(n * sizeof *ang);
+    if (!ang) return gr_fail(err, GR_E_NOMEM, "report: out of memory for the radial profile");
+    gr_profile_sun_view_dir(in->scene, pr->dir);
+    gr_profile_angles(cam, pr->dir, ang);
+    double mx = 0.0;
+    for (size_t i = 0; i < n; i++) mx = fmax(mx, ang[i]);
+    pr->max_deg = mx;
+    const double bin = gr_profile_bin_width(mx, PROFILE_TARGET_BINS);
+    const int nbins = (int)floor(mx / bin) + 1; /* the last bin holds the maximum itself */
+    gr_status st = gr_radial_profile_compute(in->ref, ang, NULL, nbins, bin, 1.0, &pr->ref, err);
+    if (st == GR_OK) st = gr_radial_profile_compute(in->test, ang, NULL, nbins, bin, a, &pr->fit, err);
+    if (st == GR_OK) st = gr_radial_profile_compute(in->test, ang, NULL, nbins, bin, 1.0, &pr->raw, err);
+    free(ang);
+    return st;
+}
+
+static void free_profiles(profiles *pr)
+{
+    gr_radial_profile_free(&pr->ref);
+    gr_radial_profile_free(&pr->fit);
+    gr_radial_profile_free(&pr->raw);
+}
+
+/* RMS over the image of the reference's luminance standard error (linear sum over channels,
+ * docs/metrics.md): the noise level the error-vs-blur chart is drawn against. NaN without
+ * stderr channels. */
+static double ref_noise_rms_y(const gr_image *ref)
+{
+    const int s[3] = {gr_image_channel(ref, "stderr.R"), gr_image_channel(ref, "stderr.G"),
+                      gr_image_channel(ref, "stderr.B")};
+    if (s[0] < 0 || s[1] < 0 || s[2] < 0) return NAN;
+    const size_t n = (size_t)ref->width * (size_t)ref->height;
+    double sum = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const float *p = ref->pixels + i * (size_t)ref->nchannels;
+        const double sy = GR_LUM_R * p[s[0]] + GR_LUM_G * p[s[1]] + GR_LUM_B * p[s[2]];
+        sum += sy * sy;
+    }
+    return sqrt(sum / (double)n);
+}
+
+static gr_status draw_charts(const char *dir, const gr_report_input *in, double a, const profiles *pr,
+                             double noise_y, int *n_charts, char *note, size_t note_n, gr_error *err)
+{
+    *n_charts = 0;
+    char path[4200], title[256], lab[2][128];
+    gr_status st;
+    const gr_metrics *m = in->metrics;
+    if (!gr_plot_available()) {
+        snprintf(note, note_n, "charts not drawn: this build has no PLplot (install libplplot-dev and rebuild)");
+        return GR_OK;
+    }
+    /* 1. Radial profile, luminance. */
+    snprintf(lab[0], sizeof lab[0], "real-time shafts x a (a = %.4g)", a);
+    const gr_plot_series prof_y[2] = {
+        {"ground truth (reference)", pr->ref.center_deg, pr->ref.mean[GR_PROFILE_Y], pr->ref.nbins, {0, 0, 0},
+         GR_PLOT_SOLID, 0},
+        {lab[0], pr->fit.center_deg, pr->fit.mean[GR_PROFILE_Y], pr->fit.nbins, {30, 100, 220}, GR_PLOT_DASHED, 1},
+    };
+    snprintf(title, sizeof title, "Radial profile of '%s': luminance vs angle from the refracted sun", in->scene->name);
+    gr_plot_spec spec = {.width = 800, .height = 450, .title = title,
+                         .xlabel = "angle between view ray and refracted sun direction (deg)",
+                         .ylabel = "mean luminance Y", .log_y = 1, .series = prof_y, .n_series = 2,
+                         .legend_headroom = 0.25};
+    if ((st = join(path, sizeof path, dir, "radial_profile.png", err)) != GR_OK) return st;
+    if ((st = gr_plot_write(path, &spec, err)) != GR_OK) return st;
+    (*n_charts)++;
+
+    /* 2. Radial profile per channel. */
+    static const unsigned char col[3][3] = {{215, 40, 40}, {30, 150, 50}, {40, 80, 220}};
+    static const char *const cn[3] = {"R", "G", "B"};
+    char labs[6][64];
+    gr_plot_series prof_c[6];
+    for (int c = 0; c < 3; c++) {
+        snprintf(labs[2 * c], sizeof labs[0], "%s reference", cn[c]);
+        snprintf(labs[2 * c + 1], sizeof labs[0], "%s shafts x a", cn[c]);
+        prof_c[2 * c] = (gr_plot_series){labs[2 * c], pr->ref.center_deg, pr->ref.mean[c], pr->ref.nbins,
+                                         {col[c][0], col[c][1], col[c][2]}, GR_PLOT_SOLID, 0};
+        prof_c[2 * c + 1] = (gr_plot_series){labs[2 * c + 1], pr->fit.center_deg, pr->fit.mean[c], pr->fit.nbins,
+                                             {col[c][0], col[c][1], col[c][2]}, GR_PLOT_DASHED, 0};
+    }
+    snprintf(title, sizeof title, "Radial profile per channel (shafts x a, a = %.4g)", a);
+    spec.title = title;
+    spec.ylabel = "mean radiance per channel";
+    spec.legend_headroom = 0.6;
+    spec.series = prof_c;
+    spec.n_series = 6;
+    if ((st = join(path, sizeof path, dir, "radial_profile_rgb.png", err)) != GR_OK) return st;
+    if ((st = gr_plot_write(path, &spec, err)) != GR_OK) return st;
+    (*n_charts)++;
+
+    /* 3. Error against blur scale: unblurred, then sigma 1, 4, 16 px. */
+    static const char *const cats[1 + GR_METRICS_NSCALES] = {"none", "1", "4", "16"};
+    double xs[1 + GR_METRICS_NSCALES], fy[1 + GR_METRICS_NSCALES], frgb[1 + GR_METRICS_NSCALES],
+        ry[1 + GR_METRICS_NSCALES], nz[1 + GR_METRICS_NSCALES];
+    const gr_metrics_set *fs = m->have_fit ? &m->fit : &m->raw;
+    xs[0] = 0;
+    fy[0] = fs->ch[GR_MCH_Y].rmse;
+    frgb[0] = fs->ch[GR_MCH_RGB].rmse;
+    ry[0] = m->raw.ch[GR_MCH_Y].rmse;
+    for (int s = 0; s < GR_METRICS_NSCALES; s++) {
+        xs[s + 1] = s + 1;
+        fy[s + 1] = fs->have_blur ? fs->ch[GR_MCH_Y].rmse_blur[s] : NAN;
+        frgb[s + 1] = fs->have_blur ? fs->ch[GR_MCH_RGB].rmse_blur[s] : NAN;
+        ry[s + 1] = m->raw.have_blur ? m->raw.ch[GR_MCH_Y].rmse_blur[s] : NAN;
+    }
+    for (int s = 0; s <= GR_METRICS_NSCALES; s++) nz[s] = noise_y;
+    snprintf(lab[0], sizeof lab[0], "Y, shafts x a (a = %.4g)", fs->scale);
+    snprintf(lab[1], sizeof lab[1], "RGB pooled, shafts x a");
+    gr_plot_series blur[4] = {
+        {lab[0], xs, fy, 1 + GR_METRICS_NSCALES, {30, 100, 220}, GR_PLOT_SOLID, 1},
+        {lab[1], xs, frgb, 1 + GR_METRICS_NSCALES, {120, 60, 170}, GR_PLOT_DASHED, 1},
+        {"Y, shafts as rendered (a = 1)", xs, ry, 1 + GR_METRICS_NSCALES, {215, 40, 40}, GR_PLOT_LONG_DASHED, 1},
+        {"reference noise (RMS std. error of Y)", xs, nz, 1 + GR_METRICS_NSCALES, {120, 120, 120}, GR_PLOT_DASHED, 0},
+    };
+    spec = (gr_plot_spec){.width = 800, .height = 450, .title = "RMSE after Gaussian blur of the difference",
+                          .xlabel = "blur sigma (px)", .ylabel = "RMSE", .log_y = 1, .series = blur,
+                          .n_series = isfinite(noise_y) && noise_y > 0 ? 4 : 3, .legend_headroom = 0.8, .x_categories = cats,
+                          .n_categories = 1 + GR_METRICS_NSCALES};
+    if ((st = join(path, sizeof path, dir, "error_vs_blur.png", err)) != GR_OK) return st;
+    if ((st = gr_plot_write(path, &spec, err)) != GR_OK) return st;
+    (*n_charts)++;
+    return GR_OK;
+}
+
+/* ---- metrics.json ------------------------------------------------------------------------- */
+
+static void jnum(cJSON *o, const char *k, double v, int *ok)
+{
+    if (!*ok) return;
+    *ok = (isfinite(v) ? cJSON_AddNumberToObject(o, k, v) : cJSON_AddNullToObject(o, k)) != NULL;
+}
+
+static void jstr(cJSON *o, const char *k, const char *v, int *ok)
+{
+    if (!*ok) return;
+    *ok = (v ? cJSON_AddStringToObject(o, k, v) : cJSON_AddNullToObject(o, k)) != NULL;
+}
+
+static cJSON *jarr(const double *v, int n)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; a && i < n; i++) {
+        cJSON *x = isfinite(v[i]) ? cJSON_CreateNumber(v[i]) : cJSON_CreateNull();
+        if (!x || !cJSON_AddItemToArray(a, x)) {
+            cJSON_Delete(x);
+            cJSON_Delete(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+static void jadd(cJSON *o, const char *k, cJSON *item, int *ok)
+{
+    if (!*ok || !item || !cJSON_AddItemToObject(o, k, item)) {
+        cJSON_Delete(item); /* not attached: ours to free (NULL is fine) */
+        *ok = 0;
+    }
+}
+
+static cJSON *meta_json(const gr_metadata *m)
+{
+    cJSON *o = cJSON_CreateObject();
+    int ok = o != NULL;
+    for (int i = 0; ok && m && i < m->count; i++) {
+        const gr_meta_item *it = &m->items[i];
+        if (it->type == GR_META_STRING) jstr(o, it->key, it->str, &ok);
+        else jnum(o, it->key, it->num, &ok);
+    }
+    if (!ok) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
+}
+
+static cJSON *profile_json(const gr_radial_profile *p, int with_se)
+{
+    static const char *const names[GR_PROFILE_NCH] = {"R", "G", "B", "Y"};
+    cJSON *o = cJSON_CreateObject();
+    int ok = o != NULL;
+    for (int c = 0; ok && c < GR_PROFILE_NCH; c++) jadd(o, names[c], jarr(p->mean[c], p->nbins), &ok);
+    if (ok && with_se && p->stderr_bound[0]) {
+        cJSON *s = cJSON_CreateObject();
+        for (int c = 0; s && c < GR_PROFILE_NCH; c++) {
+            int ok2 = 1;
+            jadd(s, names[c], jarr(p->stderr_bound[c], p->nbins), &ok2);
+            if (!ok2) {
+                cJSON_Delete(s);
+                s = NULL;
+            }
+        }
+        jadd(o, "stderr_bound_of_mean", s, &ok);
+    }
+    if (!ok) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
+}
+
+/* ---- index.html ----------------------------------------------------------------------------- */
+
+static const char *const CSS =
+    "body{font-family:DejaVu Sans,Helvetica,Arial,sans-serif;margin:0 auto;max-width:1500px;padding:0 18px 40px;"
+    "color:#1d1f23;background:#fafafa;line-height:1.4}"
+    "h1{font-size:1.6em;margin:18px 0 4px}h2{font-size:1.25em;margin-top:28px;border-bottom:1px solid #ccc}"
+    ".sub{color:#555;font-size:.92em}.box{background:#fff;border:1px solid #ddd;border-radius:6px;padding:10px 14px}"
+    ".warn{background:#fff4e0;border-color:#e5b567}"
+    ".grid{display:flex;flex-wrap:wrap;gap:14px}.grid figure{margin:0;background:#fff;border:1px solid #ddd;"
+    "border-radius:6px;padding:8px;flex:1 1 300px;max-width:680px}.grid figure.chart{flex:1 1 560px;"
+    "max-width:820px}figure img{width:100%;height:auto;display:block;image-rendering:pixelated}"
+    "figure.chart img{image-rendering:auto}figcaption{font-size:.85em;color:#444;margin-top:6px}"
+    "table{border-collapse:collapse;background:#fff;font-size:.88em;margin:6px 0}"
+    "td,th{border:1px solid #ddd;padding:3px 8px;text-align:right;vertical-align:top}"
+    "th{background:#f0f2f5}td.l,th.l{text-align:left}pre{background:#fff;border:1px solid #ddd;padding:10px;"
+    "overflow:auto;font-size:.85em;max-height:520px}details{margin:8px 0}summary{cursor:pointer;font-weight:bold}"
+    "code{background:#eef0f3;padding:0 3px}";
+
+static void html_metrics_table(gr_strbuf *b, const gr_metrics *m, const gr_metrics_set *s, const char *caption)
+{
+    char t[GR_MCH_COUNT][64];
+    gr_sb_puts(b, "<table><caption class=\"sub\">");
+    gr_sb_html(b, caption);
+    gr_sb_puts(b, "</caption><tr><th class=\"l\">metric</th>");
+    for (int c = 0; c < GR_MCH_COUNT; c++) gr_sb_printf(b, "<th>%s</th>", gr_metric_channel_name((gr_metric_channel)c));
+    gr_sb_puts(b, "</tr>\n");
+#define ROW(label, expr)                                                                   \
+    do {                                                                                   \
+        gr_sb_puts(b, "<tr><td class=\"l\">");                                             \
+        gr_sb_html(b, label);                                                              \
+        gr_sb_puts(b, "</td>");                                                            \
+        for (int c = 0; c < GR_MCH_COUNT; c++) {                                           \
+            const gr_channel_metrics *cm = &s->ch[c];                                      \
+            gr_sb_printf(b, "<td>%s</td>", fmt((expr), t[c], sizeof t[c]));               \
+        }                                                                                  \
+        gr_sb_puts(b, "</tr>\n");                                                          \
+    } while (0)
+    ROW("mean reference", cm->ref_mean);
+    ROW("mean test (x scale)", cm->test_mean);
+    ROW("bias: mean(a t - r)", cm->bias);
+    ROW("MAE", cm->mae);
+    ROW("RMSE", cm->rmse);
+    ROW("RMSE / mean reference", cm->ref_mean != 0.0 ? cm->rmse / fabs(cm->ref_mean) : NAN);
+    ROW("relative MSE", cm->rel_mse);
+    ROW("  its epsilon", cm->rel_mse_eps);
+    ROW("PSNR (dB), peak = reference max", cm->psnr_ref_db);
+    ROW("  reference max", cm->peak_ref);
+    ROW("PSNR (dB), idiff peak", cm->psnr_idiff_db);
+    ROW("max |a t - r|", cm->max_abs_err);
+    for (int k = 0; k < GR_METRICS_NSCALES && s->have_blur; k++) {
+        char label[64];
+        snprintf(label, sizeof label, "RMSE after blur, sigma %g px", gr_metrics_blur_sigmas[k]);
+        ROW(label, cm->rmse_blur[k]);
+    }
+    if (m->have_stderr)
+        ROW("not significant (|d| <= 2 stderr), %",
+            cm->n_samples > 0 ? 100.0 * (double)cm->n_not_significant / (double)cm->n_samples : NAN);
+#undef ROW
+    gr_sb_puts(b, "<tr><td class=\"l\">max error at (x, y)</td>");
+    for (int c = 0; c < GR_MCH_COUNT; c++) {
+        const gr_channel_metrics *cm = &s->ch[c];
+        if (cm->max_x < 0) gr_sb_puts(b, "<td>n/a</td>");
+        else if (cm->max_c >= 0) gr_sb_printf(b, "<td>%d, %d, %c</td>", cm->max_x, cm->max_y, "RGB"[cm->max_c]);
+        else gr_sb_printf(b, "<td>%d, %d</td>", cm->max_x, cm->max_y);
+    }
+    gr_sb_puts(b, "</tr>\n<tr><td class=\"l\">SSIM (luminance)</td>");
+    gr_sb_printf(b, "<td colspan=\"%d\">%s</td></tr>\n</table>\n", GR_MCH_COUNT,
+                 s->have_ssim ? fmt(s->ssim_y, t[0], sizeof t[0]) : "not computed");
+}
+
+static void html_settings_table(gr_strbuf *b, const gr_param_table *t, const void *settings)
+{
+    gr_sb_puts(b, "<table><tr><th class=\"l\">setting</th><th>value</th><th class=\"l\">unit</th>"
+                  "<th class=\"l\">range</th><th class=\"l\">meaning</th></tr>\n");
+    for (size_t i = 0; i < t->count; i++) {
+        const gr_param *p = &t->params[i];
+        char v[128], tmp[3][40], range[64];
+        if (p->type == GR_PT_ENUM) {
+            const char *nm = gr_param_enum_name(p, (int)gr_param_get_number(p, settings, 0));
+            snprintf(v, sizeof v, "%s", nm ? nm : "?");
+        } else if (p->type == GR_PT_BOOL) {
+            snprintf(v, sizeof v, "%s", gr_param_get_number(p, settings, 0) != 0.0 ? "true" : "false");
+        } else if (p->type == GR_PT_U64) {
+            snprintf(v, sizeof v, "%llu", *(const unsigned long long *)((const char *)settings + p->offset));
+        } else if (p->type == GR_PT_RGB) {
+            /* 6 digits for people; the exact values are in the scene JSON below */
+            for (int c = 0; c < 3; c++) snprintf(tmp[c], sizeof tmp[c], "%.6g", gr_param_get_number(p, settings, c));
+            snprintf(v, sizeof v, "%s, %s, %s", tmp[0], tmp[1], tmp[2]);
+        } else {
+            snprintf(v, sizeof v, "%.6g", gr_param_get_number(p, settings, 0));
+        }
+        gr_sb_puts(b, "<tr><td class=\"l\"><code>");
+        gr_sb_htmlf(b, "%s.%s", t->section, p->name);
+        gr_sb_puts(b, "</code></td><td>");
+        if (isnan(gr_param_get_number(p, settings, 0)) && (p->flags & GR_PF_FROM_SCENE))
+            gr_sb_htmlf(b, "from %s", p->scene_source ? p->scene_source : "the scene");
+        else
+            gr_sb_html(b, v);
+        gr_sb_puts(b, "</td><td class=\"l\">");
+        gr_sb_html(b, p->unit);
+        gr_sb_puts(b, "</td><td class=\"l\">");
+        gr_sb_html(b, gr_param_range_text(p, range, sizeof range));
+        gr_sb_puts(b, "</td><td class=\"l\">");
+        gr_sb_html(b, p->doc);
+        gr_sb_puts(b, "</td></tr>\n");
+    }
+    gr_sb_puts(b, "</table>\n");
+}
+
+static void html_meta_table(gr_strbuf *b, const gr_metadata *m)
+{
+    if (!m || m->count == 0) {
+        gr_sb_puts(b, "<p class=\"sub\">(no metadata)</p>\n");
+        return;
+    }
+    gr_sb_puts(b, "<table><tr><th class=\"l\">attribute</th><th class=\"l\">value</th></tr>\n");
+    for (int i = 0; i < m->count; i++) {
+        const gr_meta_item *it = &m->items[i];
+        char v[64];
+        gr_sb_puts(b, "<tr><td class=\"l\"><code>");
+        gr_sb_html(b, it->key);
+        gr_sb_puts(b, "</code></td><td class=\"l\">");
+        if (it->type == GR_META_STRING) gr_sb_html(b, it->str);
+        else gr_sb_html(b, gr_format_double(it->num, v, sizeof v));
+        gr_sb_puts(b, "</td></tr>\n");
+    }
+    gr_sb_puts(b, "</table>\n");
+}
+
+/* One "name | value" row; value from metadata (number) or "n/a". */
+static void kv_row(gr_strbuf *b, const char *name, const char *value)
+{
+    gr_sb_puts(b, "<tr><td class=\"l\">");
+    gr_sb_html(b, name);
+    gr_sb_puts(b, "</td><td>");
+    gr_sb_html(b, value);
+    gr_sb_puts(b, "</td></tr>\n");
+}
+
+static void kv_num(gr_strbuf *b, const char *name, double v, double factor, const char *unit)
+{
+    char t[64], u[96];
+    if (isnan(v)) snprintf(u, sizeof u, "n/a");
+    else snprintf(u, sizeof u, "%s%s%s", fmt(v * factor, t, sizeof t), unit && unit[0] ? " " : "", unit ? unit : "");
+    kv_row(b, name, u);
+}
+
+static void html_figure(gr_strbuf *b, const char *file, const gr_image *img, const char *alt, const char *caption)
+{
+    /* Renders are shown pixel for pixel when enlarged (no invented detail); charts smoothly. */
+    gr_sb_puts(b, img ? "<figure><img src=\"" : "<figure class=\"chart\"><img src=\"");
+    gr_sb_html(b, file);
+    gr_sb_puts(b, "\" alt=\"");
+    gr_sb_html(b, alt);
+    gr_sb_puts(b, "\"");
+    if (img) gr_sb_printf(b, " width=\"%d\" height=\"%d\"", img->width, img->height);
+    gr_sb_puts(b, "><figcaption>");
+    gr_sb_html(b, caption);
+    gr_sb_puts(b, "</figcaption></figure>\n");
+}
+
+/* ---- the writer ----------------------------------------------------------------------------- */
+
+typedef struct ctx {
+    const char *dir;
+    const gr_report_input *in;
+    double a, exposure, exposure_raw, noise_y;
+    gr_image *disp_ref, *disp_fit, *disp_raw, *diff_signed, *diff_abs;
+    gr_diffmap_info info_signed, info_abs;
+    profiles pr;
+    int have_profiles;
+    int charts;
+    char chart_note[512];
+    int labelled;
+    char lines[5][512];
+} ctx;
+
+static void summary_lines(ctx *c)
+{
+    const gr_report_input *in = c->in;
+    const gr_metrics *m = in->metrics;
+    const gr_metrics_set *fs = m->have_fit ? &m->fit : &m->raw;
+    const gr_channel_metrics *y = &fs->ch[GR_MCH_Y];
+    char t[8][48];
+    snprintf(c->lines[0], sizeof c->lines[0], "scene '%s' (hash %s), %d x %d; godrays %s", in->scene->name,
+             in->scene->hash, in->ref->width, in->ref->height, GR_VERSION);
+    const double wall = meta_num(in->ref_meta, "godrays:wall_s");
+    snprintf(c->lines[1], sizeof c->lines[1],
+             "reference: %s s render%s, %s spp, rel. std. error of the image mean %s %%",
+             fmt(wall, t[0], sizeof t[0]), in->ref_cached ? " (read from the cache)" : "",
+             fmt(meta_num(in->ref_meta, "godrays:spp"), t[1], sizeof t[1]),
+             fmt(100.0 * meta_num(in->ref_meta, "godrays:rel_stderr_mean"), t[2], sizeof t[2]));
+    double gpu = 0.0;
+    int any = 0;
+    static const char *const passes[3] = {"godrays:gpu_ns.shadow", "godrays:gpu_ns.shafts", "godrays:gpu_ns.final"};
+    for (int p = 0; p < 3; p++) {
+        const double v = meta_num(in->test_meta, passes[p]);
+        if (v >= 0) {
+            gpu += v * 1e-6;
+            any = 1;
+        }
+    }
+    snprintf(c->lines[2], sizeof c->lines[2], "real-time shafts: GPU %s ms (timed passes), CPU %s ms, %s shafts, %s fragments",
+             any ? fmt(gpu, t[0], sizeof t[0]) : "n/a", fmt(meta_num(in->test_meta, "godrays:cpu_ms"), t[1], sizeof t[1]),
+             fmt(meta_num(in->test_meta, "godrays:shafts_count"), t[2], sizeof t[2]),
+             fmt(meta_num(in->test_meta, "godrays:fragments_blended"), t[3], sizeof t[3]));
+    snprintf(c->lines[3], sizeof c->lines[3],
+             "best scale a = %s; luminance after fit: RMSE %s (%s of the mean), bias %s, SSIM %s, RMSE at sigma 16 px %s",
+             fmt(fs->scale, t[0], sizeof t[0]), fmt(y->rmse, t[1], sizeof t[1]),
+             y->ref_mean != 0 ? fmt(y->rmse / fabs(y->ref_mean), t[2], sizeof t[2]) : "n/a",
+             fmt(y->bias, t[3], sizeof t[3]), fs->have_ssim ? fmt(fs->ssim_y, t[4], sizeof t[4]) : "n/a",
+             fs->have_blur ? fmt(y->rmse_blur[GR_METRICS_NSCALES - 1], t[5], sizeof t[5]) : "n/a");
+    snprintf(c->lines[4], sizeof c->lines[4],
+             "scored pixels %lld of %lld; not scored: %lld (reference rel. std. error > %s)", m->n_scored,
+             m->n_pixels, m->n_stderr_excluded, fmt(m->stderr_bound, t[0], sizeof t[0]));
+}
+
+static gr_status build_json(ctx *c, char **text, gr_error *err)
+{
+    const gr_report_input *in = c->in;
+    cJSON *root = gr_metrics_to_json(in->metrics);
+    int ok = root != NULL;
+    jstr(root, "godrays_version", GR_VERSION, &ok);
+    jstr(root, "command_line", in->command_line, &ok);
+    /* the scene as the renderers saw it: normalized, every default filled in */
+    char *sj = gr_scene_to_json(in->scene);
+    cJSON *scene = sj ? cJSON_Parse(sj) : NULL;
+    free(sj);
+    jadd(root, "scene", scene, &ok);
+    jstr(root, "scene_hash", in->scene->hash, &ok);
+    jstr(root, "scene_path", in->scene->source_path, &ok);
+
+    cJSON *ref = cJSON_CreateObject();
+    jadd(root, "reference", ref, &ok);
+    if (ok) {
+        jstr(ref, "file", in->ref_exr, &ok);
+        jnum(ref, "seconds_this_run", in->ref_seconds >= 0 ? in->ref_seconds : NAN, &ok);
+        if (ok) ok = cJSON_AddBoolToObject(ref, "from_cache", in->ref_cached) != NULL;
+        jstr(ref, "cache_file", in->ref_cache_path, &ok);
+        jstr(ref, "cache_note", in->ref_cache_note, &ok);
+        jnum(ref, "noise_rms_stderr_y", c->noise_y, &ok);
+        jadd(ref, "metadata", meta_json(in->ref_meta), &ok);
+    }
+    cJSON *test = cJSON_CreateObject();
+    jadd(root, "test", test, &ok);
+    if (ok) {
+        jstr(test, "file", in->test_exr, &ok);
+        jnum(test, "seconds_this_run", in->shafts_seconds >= 0 ? in->shafts_seconds : NAN, &ok);
+        jadd(test, "metadata", meta_json(in->test_meta), &ok);
+    }
+    cJSON *pv = cJSON_CreateObject();
+    jadd(root, "previews", pv, &ok);
+    jnum(pv, "exposure", c->exposure, &ok);
+    jstr(pv, "exposure_rule", "reference 99th percentile of max(R, G, B) -> 0.8, then sRGB", &ok);
+    jnum(pv, "shafts_scale", c->a, &ok);
+    jnum(pv, "shafts_raw_exposure", c->exposure_raw, &ok);
+
+    cJSON *dj = cJSON_CreateObject();
+    jadd(root, "difference_images", dj, &ok);
+    for (int k = 0; ok && k < 2; k++) {
+        const gr_diffmap_info *info = k ? &c->info_signed : &c->info_abs;
+        cJSON *one = cJSON_CreateObject();
+        jadd(dj, k ? "diff_signed.png" : "diff.png", one, &ok);
+        jstr(one, "quantity", k ? "scale * Y(test) - Y(ref)" : "|scale * Y(test) - Y(ref)|", &ok);
+        jnum(one, "scale", c->a, &ok);
+        jstr(one, "color_map", info->map, &ok);
+        jnum(one, "min", info->vmin, &ok);
+        jnum(one, "max", info->vmax, &ok);
+        jnum(one, "unscored_pixels_gray", (double)info->n_unscored, &ok);
+    }
+
+    if (c->have_profiles) {
+        cJSON *rp = cJSON_CreateObject();
+        jadd(root, "radial_profile", rp, &ok);
+        jadd(rp, "refracted_sun_view_dir", jarr(c->pr.dir, 3), &ok);
+        jstr(rp, "angle", "between each pixel's central ray and -T0 (sun refracted by the flat surface)", &ok);
+        jnum(rp, "bin_deg", c->pr.ref.bin_deg, &ok);
+        jnum(rp, "max_angle_deg", c->pr.max_deg, &ok);
+        jadd(rp, "angle_deg", jarr(c->pr.ref.center_deg, c->pr.ref.nbins), &ok);
+        if (ok) {
+            cJSON *cnt = cJSON_CreateArray();
+            for (int i = 0; cnt && i < c->pr.ref.nbins; i++) {
+                cJSON *x = cJSON_CreateNumber((double)c->pr.ref.count[i]);
+                if (!x || !cJSON_AddItemToArray(cnt, x)) {
+                    cJSON_Delete(x);
+                    cJSON_Delete(cnt);
+                    cnt = NULL;
+                }
+            }
+            jadd(rp, "pixels", cnt, &ok);
+        }
+        jadd(rp, "reference", profile_json(&c->pr.ref, 1), &ok);
+        jadd(rp, "test_fitted", profile_json(&c->pr.fit, 0), &ok);
+        jadd(rp, "test_raw", profile_json(&c->pr.raw, 0), &ok);
+    }
+    {
+        const gr_metrics *m = in->metrics;
+        const gr_metrics_set *fs = m->have_fit ? &m->fit : &m->raw;
+        double sig[1 + GR_METRICS_NSCALES], fy[1 + GR_METRICS_NSCALES], ry[1 + GR_METRICS_NSCALES];
+        sig[0] = 0;
+        fy[0] = fs->ch[GR_MCH_Y].rmse;
+        ry[0] = m->raw.ch[GR_MCH_Y].rmse;
+        for (int s = 0; s < GR_METRICS_NSCALES; s++) {
+            sig[s + 1] = gr_metrics_blur_sigmas[s];
+            fy[s + 1] = fs->have_blur ? fs->ch[GR_MCH_Y].rmse_blur[s] : NAN;
+            ry[s + 1] = m->raw.have_blur ? m->raw.ch[GR_MCH_Y].rmse_blur[s] : NAN;
+        }
+        cJSON *eb = cJSON_CreateObject();
+        jadd(root, "error_vs_blur", eb, &ok);
+        jadd(eb, "sigma_px", jarr(sig, 1 + GR_METRICS_NSCALES), &ok);
+        jadd(eb, "rmse_y_fitted", jarr(fy, 1 + GR_METRICS_NSCALES), &ok);
+        jadd(eb, "rmse_y_raw", jarr(ry, 1 + GR_METRICS_NSCALES), &ok);
+        jnum(eb, "reference_noise_rms_stderr_y", c->noise_y, &ok);
+    }
+    cJSON *ch = cJSON_CreateObject();
+    jadd(root, "charts", ch, &ok);
+    jnum(ch, "drawn", c->charts, &ok);
+    jstr(ch, "note", c->chart_note[0] ? c->chart_note : NULL, &ok);
+    cJSON *tm = cJSON_CreateObject();
+    jadd(root, "timings_s", tm, &ok);
+    jnum(tm, "reference", in->ref_seconds >= 0 ? in->ref_seconds : NAN, &ok);
+    jnum(tm, "shafts", in->shafts_seconds >= 0 ? in->shafts_seconds : NAN, &ok);
+    jnum(tm, "compare", in->compare_seconds >= 0 ? in->compare_seconds : NAN, &ok);
+    if (ok) {
+        cJSON *sl = cJSON_CreateArray();
+        for (int i = 0; sl && i < 5; i++) {
+            cJSON *x = cJSON_CreateString(c->lines[i]);
+            if (!x || !cJSON_AddItemToArray(sl, x)) {
+                cJSON_Delete(x);
+                cJSON_Delete(sl);
+                sl = NULL;
+            }
+        }
+        jadd(root, "summary", sl, &ok);
+    }
+    *text = ok ? cJSON_Print(root) : NULL;
+    cJSON_Delete(root);
+    if (!*text) return gr_fail(err, GR_E_NOMEM, "%s/metrics.json: out of memory building the JSON", c->dir);
+    return GR_OK;
+}
+
+static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
+{
+    const gr_report_input *in = c->in;
+    const gr_metrics *m = in->metrics;
+    const gr_scene *s = in->scene;
+    char t[8][64];
+    gr_sb_puts(b, "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+                  "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>");
+    gr_sb_htmlf(b, "godrays report: %s", s->name);
+    gr_sb_printf(b, "</title>\n<style>%s</style>\n</head>\n<body>\n<h1>", CSS);
+    gr_sb_htmlf(b, "God rays: ground truth vs real-time shafts, scene '%s'", s->name);
+    gr_sb_puts(b, "</h1>\n<p class=\"sub\">");
+    {
+        char when[64] = "";
+        time_t now = time(NULL);
+        struct tm tmv;
+        if (gmtime_r(&now, &tmv)) strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", &tmv);
+        gr_sb_htmlf(b, "scene file %s, hash %s, %d x %d pixels; written by godrays %s on %s",
+                    s->source_path[0] ? s->source_path : "(string)", s->hash, in->ref->width, in->ref->height,
+                    GR_VERSION, when);
+    }
+    if (in->command_line) {
+        gr_sb_puts(b, "<br>command: <code>");
+        gr_sb_html(b, in->command_line);
+        gr_sb_puts(b, "</code>");
+    }
+    gr_sb_puts(b, "</p>\n<div class=\"box\">\n");
+    for (int i = 0; i < 5; i++) {
+        gr_sb_html(b, c->lines[i]);
+        gr_sb_puts(b, "<br>\n");
+    }
+    gr_sb_puts(b, "</div>\n");
+    /* Warnings a reader must not miss. */
+    if (m->n_stderr_excluded > 0 || m->n_masked_out > 0 || !m->have_stderr || in->ref_cache_note ||
+        meta_num(in->ref_meta, "godrays:partial") > 0) {
+        gr_sb_puts(b, "<div class=\"box warn\">\n");
+        if (m->n_stderr_excluded > 0)
+            gr_sb_htmlf(b, "%lld pixels NOT SCORED: the reference's relative standard error of luminance exceeds %g "
+                           "there (drawn mid gray in the difference images).",
+                        m->n_stderr_excluded, m->stderr_bound);
+        if (!m->have_stderr) gr_sb_html(b, " The reference carries no standard-error channels: no significance test.");
+        if (meta_num(in->ref_meta, "godrays:partial") > 0)
+            gr_sb_html(b, " The reference is a PARTIAL (interrupted) render.");
+        if (in->ref_cache_note) {
+            gr_sb_puts(b, " Cache: ");
+            gr_sb_html(b, in->ref_cache_note);
+        }
+        gr_sb_puts(b, "\n</div>\n");
+    }
+
+    /* Images */
+    char cap[1024];
+    gr_sb_puts(b, "<h2>Images</h2>\n<div class=\"grid\">\n");
+    snprintf(cap, sizeof cap,
+             "Ground truth (Embree single scattering), exposure %s (its 99th percentile -> 0.8), sRGB.%s",
+             fmt(c->exposure, t[0], sizeof t[0]), in->ref_cached ? " Read from the cache." : "");
+    html_figure(b, "reference.png", c->disp_ref, "reference (ground truth)", cap);
+    snprintf(cap, sizeof cap,
+             "Real-time shafts (seed 000) times the best scale a = %s, same exposure as the reference: the "
+             "technique's intensity is an arbitrary factor, so shapes are compared at the best-fitting level.",
+             fmt(c->a, t[0], sizeof t[0]));
+    html_figure(b, "shafts.png", c->disp_fit, "real-time shafts times a", cap);
+    snprintf(cap, sizeof cap,
+             "Signed luminance difference a Y(test) - Y(ref), OpenImageIO map '%s' on [%s, %s]: blue = real-time "
+             "too dark, red = too bright; gray = not scored.",
+             c->info_signed.map, fmt(c->info_signed.vmin, t[0], sizeof t[0]), fmt(c->info_signed.vmax, t[1], sizeof t[1]));
+    html_figure(b, "diff_signed.png", c->diff_signed, "signed difference with colorbar", cap);
+    snprintf(cap, sizeof cap, "Absolute luminance difference |a Y(test) - Y(ref)|, map '%s' on [%s, %s] (99th percentile).",
+             c->info_abs.map, fmt(c->info_abs.vmin, t[0], sizeof t[0]), fmt(c->info_abs.vmax, t[1], sizeof t[1]));
+    html_figure(b, "diff.png", c->diff_abs, "absolute difference with colorbar", cap);
+    snprintf(cap, sizeof cap, "Real-time shafts as rendered (a = 1), own exposure %s.", fmt(c->exposure_raw, t[0], sizeof t[0]));
+    html_figure(b, "shafts_raw.png", c->disp_raw, "real-time shafts as rendered", cap);
+    gr_sb_puts(b, "</div>\n<p class=\"sub\">The same three panels with the key numbers: "
+                  "<a href=\"summary.png\">summary.png</a>; every number: <a href=\"metrics.json\">metrics.json</a>");
+    if (in->ref_exr && in->test_exr) {
+        gr_sb_puts(b, "; the linear images: <a href=\"");
+        gr_sb_html(b, in->ref_exr);
+        gr_sb_puts(b, "\">");
+        gr_sb_html(b, in->ref_exr);
+        gr_sb_puts(b, "</a>, <a href=\"");
+        gr_sb_html(b, in->test_exr);
+        gr_sb_puts(b, "\">");
+        gr_sb_html(b, in->test_exr);
+        gr_sb_puts(b, "</a>");
+    }
+    gr_sb_puts(b, ".</p>\n");
+
+    /* Metrics */
+    gr_sb_puts(b, "<h2>Metrics</h2>\n<p class=\"sub\">");
+    gr_sb_htmlf(b, "%lld of %lld pixels scored (%lld masked out, %lld not scored because the reference's relative "
+                   "standard error of luminance exceeds %s). Y = 0.2126 R + 0.7152 G + 0.0722 B; RGB pools the "
+                   "three channels as OpenImageIO idiff does. Formulas and conventions: docs/metrics.md.",
+                m->n_scored, m->n_pixels, m->n_masked_out, m->n_stderr_excluded, fmt(m->stderr_bound, t[0], sizeof t[0]));
+    gr_sb_puts(b, "</p>\n");
+    if (m->have_fit) {
+        char capt[160];
+        snprintf(capt, sizeof capt, "After the best scale fit: test x a, a = <t, r> / <t, t> = %.6g%s", m->fit.scale,
+                 m->fit_defined ? "" : " (undefined: test is black; a = 1)");
+        html_metrics_table(b, m, &m->fit, capt);
+    }
+    html_metrics_table(b, m, &m->raw, "As rendered (a = 1): the real-time technique's own, arbitrary, intensity scale");
+    gr_sb_htmlf(b, "SSIM: Wang et al. 2004 on luminance, L = %.4g (reference luminance peak), C1 = %.3g, C2 = %.3g.",
+                m->ssim_L, m->ssim_c1, m->ssim_c2);
+
+    /* Charts */
+    gr_sb_puts(b, "\n<h2>Charts</h2>\n");
+    if (c->charts > 0) {
+        gr_sb_puts(b, "<div class=\"grid\">\n");
+        html_figure(b, "radial_profile.png", NULL, "radial profile, luminance",
+                    "Mean luminance against the angle between each pixel's ray and the direction in which the "
+                    "refracted sun is seen (log scale). Both renderers on one chart; the real-time one times a.");
+        html_figure(b, "radial_profile_rgb.png", NULL, "radial profile per channel",
+                    "The same per RGB channel: solid = reference, dashed = real-time x a.");
+        html_figure(b, "error_vs_blur.png", NULL, "error against blur scale",
+                    "RMSE of the difference after a Gaussian blur of sigma 1, 4, 16 px: where it falls with blur, "
+                    "the large-scale light distribution is right even if shafts do not line up. The gray line is "
+                    "the reference's own noise (RMS standard error), below which differences mean nothing.");
+        gr_sb_puts(b, "</div>\n");
+    }
+    if (c->chart_note[0]) {
+        gr_sb_puts(b, "<p class=\"box warn\">");
+        gr_sb_html(b, c->chart_note);
+        gr_sb_puts(b, "</p>\n");
+    }
+
+    /* Timings */
+    gr_sb_puts(b, "<h2>Timings and counters</h2>\n<div class=\"grid\">\n<div>\n<table><caption class=\"sub\">"
+                  "ground truth (reference/)</caption>\n");
+    const gr_metadata *rm = in->ref_meta, *tmeta = in->test_meta;
+    kv_row(b, "source", in->ref_cached ? "cache" : "rendered in this run");
+    kv_num(b, "time in this run", in->ref_seconds >= 0 ? in->ref_seconds : NAN, 1.0, "s");
+    kv_num(b, "render wall time", meta_num(rm, "godrays:wall_s"), 1.0, "s");
+    kv_num(b, "threads", meta_num(rm, "godrays:threads"), 1.0, "");
+    kv_num(b, "camera samples per pixel", meta_num(rm, "godrays:spp"), 1.0, "");
+    kv_num(b, "passes (sun directions)", meta_num(rm, "godrays:passes"), 1.0, "");
+    kv_num(b, "rel. std. error of the image mean", meta_num(rm, "godrays:rel_stderr_mean"), 100.0, "%");
+    kv_num(b, "rel. std. error of the p95 pixel", meta_num(rm, "godrays:rel_stderr_p95"), 100.0, "%");
+    kv_num(b, "pixels with std. error <= 1%", meta_num(rm, "godrays:frac_pixels_stderr_le_1pct"), 100.0, "%");
+    kv_num(b, "RMS std. error of Y (noise)", c->noise_y, 1.0, "");
+    kv_num(b, "beam lookups per second", meta_num(rm, "godrays:queries_per_s"), 1.0, "");
+    kv_num(b, "beam build time", meta_num(rm, "godrays:beam_build_s"), 1.0, "s");
+    kv_num(b, "beam primitives", meta_num(rm, "godrays:beam_prims"), 1.0, "");
+    if (in->ref_cache_path) kv_row(b, "cache file", in->ref_cache_path);
+    gr_sb_puts(b, "</table>\n</div>\n<div>\n<table><caption class=\"sub\">real-time shafts (src/realtime/)</caption>\n");
+    kv_num(b, "time in this run (context, render, readback)", in->shafts_seconds >= 0 ? in->shafts_seconds : NAN, 1.0, "s");
+    static const char *const pass_keys[3] = {"godrays:gpu_ns.shadow", "godrays:gpu_ns.shafts", "godrays:gpu_ns.final"};
+    static const char *const pass_names[3] = {"GPU time, shadow pass", "GPU time, shaft pass", "GPU time, final pass"};
+    for (int p = 0; p < 3; p++) {
+        const double v = meta_num(tmeta, pass_keys[p]);
+        kv_num(b, pass_names[p], v >= 0 ? v : NAN, 1e-6, "ms");
+    }
+    kv_num(b, "CPU time of the render call", meta_num(tmeta, "godrays:cpu_ms"), 1.0, "ms");
+    kv_num(b, "shafts", meta_num(tmeta, "godrays:shafts_count"), 1.0, "");
+    kv_num(b, "vertices submitted", meta_num(tmeta, "godrays:vertices_submitted"), 1.0, "");
+    kv_num(b, "vertex shader invocations", meta_num(tmeta, "godrays:vertex_shader_invocations"), 1.0, "");
+    kv_num(b, "fragment shader invocations", meta_num(tmeta, "godrays:fragment_shader_invocations"), 1.0, "");
+    kv_num(b, "fragments blended", meta_num(tmeta, "godrays:fragments_blended"), 1.0, "");
+    kv_num(b, "overdraw (fragments / target texel)", meta_num(tmeta, "godrays:overdraw"), 1.0, "");
+    const char *ts = meta_str(tmeta, "godrays:shafts_target_size");
+    kv_row(b, "shaft render target", ts ? ts : "n/a");
+    const char *gl = meta_str(tmeta, "godrays:gl_renderer");
+    kv_row(b, "GL renderer", gl ? gl : "n/a");
+    kv_num(b, "comparison (metrics) time", in->compare_seconds >= 0 ? in->compare_seconds : NAN, 1.0, "s");
+    gr_sb_puts(b, "</table>\n</div>\n</div>\n<p class=\"sub\">GPU times are GL_TIME_ELAPSED queries (n/a where the "
+                  "driver has no timer for a pass); on a machine without a GPU they measure Mesa's llvmpipe.</p>\n");
+
+    /* Scene and settings */
+    gr_sb_puts(b, "<h2>Scene and settings</h2>\n");
+    gr_sb_puts(b, "<h3>Ground-truth settings</h3>\n");
+    html_settings_table(b, &gr_reference_param_table, &s->reference);
+    gr_sb_puts(b, "<h3>Real-time shaft settings</h3>\n");
+    html_settings_table(b, &gr_shafts_param_table, &s->shafts);
+    gr_sb_puts(b, "<details><summary>The scene, normalized (every default filled in)</summary>\n<pre>");
+    char *sj = gr_scene_to_json(s);
+    if (!sj) return gr_fail(err, GR_E_NOMEM, "%s/index.html: out of memory printing the scene", c->dir);
+    gr_sb_html(b, sj);
+    free(sj);
+    gr_sb_puts(b, "</pre></details>\n");
+    gr_sb_puts(b, "<details><summary>Reference EXR metadata</summary>\n");
+    html_meta_table(b, rm);
+    gr_sb_puts(b, "</details>\n<details><summary>Real-time EXR metadata</summary>\n");
+    html_meta_table(b, tmeta);
+    gr_sb_puts(b, "</details>\n<p class=\"sub\">How to read this report: docs/report.md in the godrays sources.</p>\n"
+                  "</body>\n</html>\n");
+    return gr_sb_status(b, "index.html", err);
+}
+
+static gr_status check_input(const gr_report_input *in, gr_error *err)
+{
+    if (!in || !in->scene || !in->ref || !in->test || !in->metrics || !in->ref->pixels || !in->test->pixels)
+        return gr_fail(err, GR_E_INPUT, "report: missing scene, images or metrics");
+    if (in->ref->width != in->test->width || in->ref->height != in->test->height)
+        return gr_fail(err, GR_E_INPUT, "report: reference is %d x %d, test is %d x %d", in->ref->width,
+                       in->ref->height, in->test->width, in->test->height);
+    if (in->metrics->width != in->ref->width || in->metrics->height != in->ref->height)
+        return gr_fail(err, GR_E_INPUT, "report: the metrics are for %d x %d images, not %d x %d", in->metrics->width,
+                       in->metrics->height, in->ref->width, in->ref->height);
+    return GR_OK;
+}
+
+gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_result *res, gr_error *err)
+{
+    const double t0 = now_s();
+    gr_status st = check_input(in, err);
+    if (st != GR_OK) return st;
+    ctx c;
+    memset(&c, 0, sizeof c);
+    c.dir = dir;
+    c.in = in;
+    const gr_metrics *m = in->metrics;
+    c.a = m->have_fit && m->fit_defined ? m->fit.scale : 1.0;
+    c.exposure = gr_report_exposure(in->ref, 1.0, 0.99, 0.8);
+    c.exposure_raw = gr_report_exposure(in->test, 1.0, 0.99, 0.8);
+    c.noise_y = ref_noise_rms_y(in->ref);
+    gr_image *sheet = NULL;
+    char *json = NULL;
+    gr_strbuf html;
+    gr_sb_init(&html);
+    char path[4200];
+
+    /* Everything that can fail for lack of memory or bad input is computed first. */
+    if ((st = gr_report_make_dir(dir, err)) != GR_OK) goto done;
+    if ((st = gr_report_display(in->ref, c.exposure, &c.disp_ref, err)) != GR_OK) goto done;
+    if ((st = gr_report_display(in->test, c.exposure * c.a, &c.disp_fit, err)) != GR_OK) goto done;
+    if ((st = gr_report_display(in->test, c.exposure_raw, &c.disp_raw, err)) != GR_OK) goto done;
+    for (int k = 0; k < 2; k++) {
+        gr_diffmap_options dopt = {.kind = k ? GR_DIFFMAP_SIGNED : GR_DIFFMAP_ABS, .scale = c.a, .mask = NULL,
+                                   .stderr_bound = m->stderr_bound};
+        st = gr_diffmap_create(in->ref, in->test, &dopt, k ? &c.diff_signed : &c.diff_abs,
+                               k ? &c.info_signed : &c.info_abs, err);
+        if (st != GR_OK) goto done;
+    }
+    if ((st = compute_profiles(in, c.a, &c.pr, err)) != GR_OK) goto done;
+    c.have_profiles = 1;
+    summary_lines(&c);
+
+    /* Files: images first, the pages that link them last. */
+    static const char *const names[5] = {"reference.png", "shafts.png", "shafts_raw.png", "diff_signed.png", "diff.png"};
+    const gr_image *imgs[5] = {c.disp_ref, c.disp_fit, c.disp_raw, c.diff_signed, c.diff_abs};
+    for (int i = 0; i < 5; i++) {
+        if ((st = join(path, sizeof path, dir, names[i], err)) != GR_OK) goto done;
+        if ((st = gr_oiio_write(path, imgs[i], err)) != GR_OK) goto done;
+    }
+    {
+        char t0s[32];
+        char title[3][128];
+        snprintf(title[0], sizeof title[0], "ground truth (reference)");
+        snprintf(title[1], sizeof title[1], "real-time shafts x %s", fmt(c.a, t0s, sizeof t0s));
+        snprintf(title[2], sizeof title[2], "a Y(test) - Y(ref)  (blue: too dark)");
+        const gr_image *panels[3] = {c.disp_ref, c.disp_fit, c.diff_signed};
+        const char *const titles[3] = {title[0], title[1], title[2]};
+        const char *lines[5];
+        for (int i = 0; i < 5; i++) lines[i] = c.lines[i];
+        if ((st = gr_report_contact_sheet(panels, titles, lines, 5, 360, 800, &sheet, &c.labelled, err)) != GR_OK) goto done;
+        if ((st = join(path, sizeof path, dir, "summary.png", err)) != GR_OK) goto done;
+        if ((st = gr_oiio_write(path, sheet, err)) != GR_OK) goto done;
+    }
+    /* A chart PLplot could not draw is reported in the page, not fatal: the rest of the report
+     * stands on its own. Running out of memory or disk is. */
+    st = draw_charts(dir, in, c.a, &c.pr, c.noise_y, &c.charts, c.chart_note, sizeof c.chart_note, err);
+    if (st == GR_E_RUNTIME) {
+        snprintf(c.chart_note, sizeof c.chart_note, "charts incomplete (%d drawn): %.400s", c.charts, err->msg);
+        st = GR_OK;
+    }
+    if (st != GR_OK) goto done;
+    if ((st = build_json(&c, &json, err)) != GR_OK) goto done;
+    if ((st = join(path, sizeof path, dir, "metrics.json", err)) != GR_OK) goto done;
+    if ((st = write_text(path, json, err)) != GR_OK) goto done;
+    if ((st = build_html(&c, &html, err)) != GR_OK) goto done;
+    if ((st = join(path, sizeof path, dir, "index.html", err)) != GR_OK) goto done;
+    if ((st = write_text(path, gr_sb_str(&html), err)) != GR_OK) goto done;
+    if (res) {
+        res->exposure = c.exposure;
+        res->fit_scale = c.a;
+        res->charts = c.charts;
+        res->labelled = c.labelled;
+        res->seconds = now_s() - t0;
+    }
+done:
+    gr_sb_free(&html);
+    cJSON_free(json);
+    gr_image_destroy(sheet);
+    gr_image_destroy(c.disp_raw);
+    gr_image_destroy(c.disp_ref);
+    gr_image_destroy(c.disp_fit);
+    gr_image_destroy(c.diff_signed);
+    gr_image_destroy(c.diff_abs);
+    free_profiles(&c.pr);
+    return st;
+}

@@ -1,0 +1,80 @@
+/* The Embree layer of the ground truth: errors reported by Embree arrive as one-line
+ * gr_errors (GR_E_EMBREE, the operation named); ray ends against a box (rotated by yaw) and
+ * a sphere match their analytic distances; a scene 1e5 m from the origin gives the same
+ * distances (local frame); bad settings are refused with the setting named. */
+#include "check.h"
+#include "test_ref_util.h"
+
+#include <math.h>
+#include <string.h>
+#include "reference/embree_scene.h"
+
+static void distances(double off)
+{
+    gr_scene *s = ref_scene(
+        "{\"water\":{\"waves\":[]},\"camera\":{\"position_m\":[%.17g,-10,%.17g]},"
+        "\"occluders\":[{\"type\":\"box\",\"center_m\":[%.17g,-5,%.17g],\"size_m\":[2,2,4],\"yaw_deg\":90},"
+        "{\"type\":\"sphere\",\"center_m\":[%.17g,-10,%.17g],\"radius_m\":1.5}],\"seabed\":{\"depth_m\":30}}",
+        off, off, off, off + 10.0, off + 8.0, off);
+    gr_rtc *rtc = NULL;
+    gr_ref_geometry *g = NULL;
+    gr_error err = {GR_OK, ""};
+    CHECK_OK(gr_rtc_create(1, &rtc, &err), err);
+    gr_dvec3 origin = gr_d3(off, 0.0, off);
+    CHECK_OK(gr_ref_geometry_create(rtc, s, origin, 100.0, &g, &err), err);
+    if (g) {
+        /* box at local (0, -5, 10), extents 2 x 2 x 4 turned by 90 deg: x half 2, z half 1 */
+        float t = gr_rtc_intersect(g->ends, gr_v3(0, -5, 0), gr_v3(0, 0, 1), 0.0f, 1e3f, NULL, NULL);
+        CHECK_NEAR(t, 9.0, 1e-4);
+        t = gr_rtc_intersect(g->ends, gr_v3(-5, -5, 10), gr_v3(1, 0, 0), 0.0f, 1e3f, NULL, NULL);
+        CHECK_NEAR(t, 3.0, 1e-4);
+        /* sphere at local (8, -10, 0), r 1.5 */
+        t = gr_rtc_intersect(g->ends, gr_v3(0, -10, 0), gr_v3(1, 0, 0), 0.0f, 1e3f, NULL, NULL);
+        CHECK_NEAR(t, 6.5, 1e-4);
+        /* seabed at y = -30 */
+        t = gr_rtc_intersect(g->ends, gr_v3(0, -10, 0), gr_v3(0, -1, 0), 0.0f, 1e3f, NULL, NULL);
+        CHECK_NEAR(t, 20.0, 1e-4);
+        CHECK(gr_rtc_occluded(g->shadow, gr_v3(0, -10, 0), gr_v3(1, 0, 0), 0.0f, 7.0f) == 1);
+        CHECK(gr_rtc_occluded(g->shadow, gr_v3(0, -10, 0), gr_v3(1, 0, 0), 0.0f, 6.0f) == 0);
+        CHECK(gr_rtc_occluded(g->shadow, gr_v3(0, -10, 0), gr_v3(0, -1, 0), 0.0f, 100.0f) == 0); /* seabed is no caster */
+    }
+    gr_ref_geometry_destroy(g);
+    gr_rtc_destroy(rtc);
+    free(s);
+}
+
+int main(void)
+{
+    distances(0.0);
+    distances(1e5);
+
+    gr_rtc *rtc = NULL;
+    gr_error err = {GR_OK, ""};
+    CHECK_OK(gr_rtc_create(0, &rtc, &err), err);
+    if (rtc) {
+        CHECK(gr_rtc_check(rtc, "nothing", &err) == GR_OK);
+        /* an invalid operation: a user primitive count on a triangle mesh */
+        RTCGeometry geo = rtcNewGeometry(rtc->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetGeometryUserPrimitiveCount(geo, 3);
+        rtcReleaseGeometry(geo);
+        gr_status st = gr_rtc_check(rtc, "test op", &err);
+        CHECK(st == GR_E_EMBREE);
+        CHECK_MSG(strstr(err.msg, "test op: Embree error") != NULL && !strchr(err.msg, '\n'), "message: %s", err.msg);
+        CHECK(gr_rtc_check(rtc, "again", &err) == GR_OK); /* cleared */
+    }
+    gr_rtc_destroy(rtc);
+    gr_rtc_destroy(NULL);
+    gr_ref_geometry_destroy(NULL);
+    gr_ref_destroy(NULL);
+    gr_ref_result_free(NULL);
+
+    gr_scene *s = ref_scene("{\"water\":{\"waves\":[]},\"reference\":{\"batches\":1}}");
+    gr_ref_renderer *r = NULL;
+    gr_ref_options o;
+    gr_ref_options_default(&o);
+    CHECK(gr_ref_create(s, &o, &r, &err) == GR_E_INPUT);
+    CHECK_MSG(strstr(err.msg, "reference.batches") != NULL, "message: %s", err.msg);
+    CHECK(r == NULL);
+    free(s);
+    CHECK_DONE();
+}
