@@ -26,6 +26,13 @@ struct gr_beams {
     int nu, nw;              /* cells */
     beam_vertex *v;          /* (nu + 1) * (nw + 1) */
     float *phi;              /* per triangle: F_t |I . a| (0 = no beam) */
+    /* sun-disc kernel (NULL without it), per triangle: M = R J (2x2, row-major: shift in u,
+     * w per unit depth for a unit offset in the disc frame), and ybar = the mean height of
+     * the triangle's surface vertices, from which the depth d = ybar - y is measured */
+    float *kern, *ybar;
+    double kc[GR_BEAM_KERNEL_N][2]; /* the unit kernel polygon (area pi) */
+    double kc_area;          /* its area by the shoelace formula (pi up to rounding) */
+    double kc_rho, kc_rin;   /* its circumradius and inradius */
     float *ytop, *dy;        /* per triangle: top of the beam, slab height */
     uint32_t *first;         /* per triangle: first primitive (size ntri + 1) */
     uint32_t *prim_tri;      /* per primitive: its triangle */
@@ -39,6 +46,93 @@ static double now_s(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- the sun-disc kernel ----
+ * The disc of directions is approximated by a regular 16-gon of the same area (radius
+ * rho = sqrt(pi / (N/2 sin(2 pi / N))), 1.3 % beyond the unit circle), so that the
+ * normalized kernel keeps the disc's mean squared radius to 0.1 % and conserves flux
+ * exactly (it is normalized by its own area). */
+double gr_beam_kernel_radius(void)
+{
+    const double n = GR_BEAM_KERNEL_N;
+    return sqrt(GR_PI / (0.5 * n * sin(2.0 * GR_PI / n)));
+}
+
+static double polygon_area(const double (*v)[2], int n)
+{
+    double a = 0.0;
+    for (int i = 0, j = n - 1; i < n; j = i++) a += v[j][0] * v[i][1] - v[i][0] * v[j][1];
+    return 0.5 * a;
+}
+
+static void kernel_polygon(double kc[GR_BEAM_KERNEL_N][2])
+{
+    double rho = gr_beam_kernel_radius();
+    for (int j = 0; j < GR_BEAM_KERNEL_N; j++) {
+        double t = 2.0 * GR_PI * j / GR_BEAM_KERNEL_N;
+        kc[j][0] = rho * cos(t);
+        kc[j][1] = rho * sin(t);
+    }
+}
+
+/* Sutherland-Hodgman: the convex polygon kc clipped by the half-planes a_i + b_i . c >= 0
+ * whose bit is set in `mask`; returns the clipped area (each clip adds at most one vertex). */
+static double clip_area(const double (*kc)[2], int n, const double a[3], const double b[6], unsigned mask)
+{
+    double buf[2][GR_BEAM_KERNEL_N + 4][2];
+    int cur = 0, m = n;
+    memcpy(buf[0], kc, (size_t)n * sizeof kc[0]);
+    for (int i = 0; i < 3; i++) {
+        if (!(mask >> i & 1u)) continue;
+        const double (*in)[2] = (const double (*)[2])buf[cur];
+        double (*out)[2] = buf[cur ^ 1];
+        int k = 0;
+        for (int j = 0; j < m; j++) {
+            const double *p = in[j], *q = in[j + 1 < m ? j + 1 : 0];
+            double fp = a[i] + b[2 * i] * p[0] + b[2 * i + 1] * p[1];
+            double fq = a[i] + b[2 * i] * q[0] + b[2 * i + 1] * q[1];
+            if (fp >= 0.0) { out[k][0] = p[0]; out[k][1] = p[1]; k++; }
+            if ((fp >= 0.0) != (fq >= 0.0)) {
+                double t = fp / (fp - fq);
+                out[k][0] = p[0] + t * (q[0] - p[0]);
+                out[k][1] = p[1] + t * (q[1] - p[1]);
+                k++;
+            }
+        }
+        m = k;
+        cur ^= 1;
+        if (m < 3) return 0.0;
+    }
+    return fabs(polygon_area((const double (*)[2])buf[cur], m));
+}
+
+double gr_beam_kernel_coverage(const double a[3], const double b[6])
+{
+    double kc[GR_BEAM_KERNEL_N][2];
+    kernel_polygon(kc);
+    return clip_area((const double (*)[2])kc, GR_BEAM_KERNEL_N, a, b, 7u) / polygon_area((const double (*)[2])kc, GR_BEAM_KERNEL_N);
+}
+
+/* Jacobian of the refracted ray's horizontal slope (T_x / T_y, T_z / T_y) with respect to
+ * the sun direction's angular offset along e1 and e2 (rad), for the surface normal n:
+ * central differences of Snell's law in double (step 1e-5 rad: truncation ~1e-10,
+ * rounding ~1e-11 relative). J is row-major: {du/de1, du/de2, dw/de1, dw/de2}. */
+static void slope_jacobian(gr_dvec3 I, gr_dvec3 n, double eta, gr_dvec3 e1, gr_dvec3 e2, double J[4])
+{
+    const double eps = 1e-5;
+    const gr_dvec3 e[2] = {e1, e2};
+    for (int k = 0; k < 2; k++) {
+        double s[2][2];
+        for (int sg = 0; sg < 2; sg++) {
+            gr_dvec3 Id = gr_d3_norm(gr_d3_madd(I, e[k], sg ? -eps : eps));
+            gr_dvec3 T = gr_refract_d(Id, n, eta);
+            s[sg][0] = T.x / T.y;
+            s[sg][1] = T.z / T.y;
+        }
+        J[k] = (s[0][0] - s[1][0]) / (2.0 * eps);
+        J[2 + k] = (s[0][1] - s[1][1]) / (2.0 * eps);
+    }
 }
 
 /* Triangle t of cell (i, j): 0 = (v00, v10, v11), 1 = (v00, v11, v01). */
@@ -78,6 +172,17 @@ static void beam_bounds(const struct RTCBoundsFunctionArguments *args)
             float u = v->pu + v->au * (y - v->py), w = v->pw + v->aw * (y - v->py);
             u0 = fminf(u0, u); u1 = fmaxf(u1, u);
             w0 = fminf(w0, w); w1 = fmaxf(w1, w);
+        }
+    }
+    if (b->kern) {
+        /* the disc kernel reaches d J disc around the cross-section, d up to ybar - ylo */
+        const float *M = b->kern + 4 * (size_t)t;
+        float dmax = b->ybar[t] - ylo;
+        if (dmax > 0.0f) {
+            float rho = (float)b->kc_rho * 1.0001f;
+            float ku = dmax * rho * hypotf(M[0], M[1]), kw = dmax * rho * hypotf(M[2], M[3]);
+            u0 -= ku; u1 += ku;
+            w0 -= kw; w1 += kw;
         }
     }
     /* widen by a few ulps of the coordinates so float rounding in the test cannot fall outside */
@@ -120,19 +225,85 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
     float e2u = v2->pu + v2->au * d2 - x0, e2w = v2->pw + v2->aw * d2 - z0;
     float qu = s->u - x0, qw = s->w - z0;
     float det = e1u * e2w - e1w * e2u; /* twice the signed area: negative past a fold */
-    if (det == 0.0f) return false;      /* a measure-zero set: the exact focus */
-    float inv = 1.0f / det;
-    float l1 = (qu * e2w - qw * e2u) * inv;
-    float l2 = (e1u * qw - e1w * qu) * inv;
-    float l0 = 1.0f - l1 - l2;
-    if (l0 < 0.0f || l1 < 0.0f || l2 < 0.0f) return false;
+    /* barycentric coordinates times det (edge functions): f1, f2 of vertices 1, 2 */
+    float f1 = qu * e2w - qw * e2u, f2 = e1u * qw - e1w * qu, f0 = det - f1 - f2;
+    float e_h;
+    float dd = b->kern ? b->ybar[t] - y : 0.0f; /* depth below the beam's top: the kernel's scale */
+    if (!(dd > 0.0f)) {
+        /* a point sun (or the top of the beam): the point-in-triangle test */
+        if (det == 0.0f) return false; /* a measure-zero set: the exact focus */
+        float inv = 1.0f / det;
+        if (f0 * inv < 0.0f || f1 * inv < 0.0f || f2 * inv < 0.0f) return false;
+        e_h = b->phi[t] / (0.5f * fabsf(det));
+    } else {
+        /* Disc average (docs/reference.md, "The sun's disc"): the fraction of the kernel
+         * K = dd M polygon centred at p that lies inside the cross-section. In the kernel's
+         * unit coordinates c (x = p + dd M c) edge i is the half-plane a_i + b_i . c >= 0 with
+         * a_i = sign(det) f_i and b_i = sign(det) dd M^T grad(f_i). */
+        const float *M = b->kern + 4 * (size_t)t;
+        float sg = det < 0.0f ? -1.0f : 1.0f;
+        float g[3][2] = {{-(e2w - e1w), e2u - e1u}, {e2w, -e2u}, {-e1w, e1u}}; /* grad f_i in (u, w) */
+        float fa[3] = {f0, f1, f2};
+        double a[3], bb[6];
+        int inside = 1;
+        float rho = (float)b->kc_rho;
+        for (int i = 0; i < 3; i++) {
+            float bx = sg * dd * (M[0] * g[i][0] + M[2] * g[i][1]);
+            float by = sg * dd * (M[1] * g[i][0] + M[3] * g[i][1]);
+            float ai = sg * fa[i], ext = rho * hypotf(bx, by);
+            if (ai < -ext) return false;     /* the kernel lies wholly outside edge i */
+            if (ai < ext) inside = 0;
+            a[i] = ai;
+            bb[2 * i] = bx;
+            bb[2 * i + 1] = by;
+        }
+        float detM = M[0] * M[3] - M[1] * M[2];
+        float areaK = dd * dd * fabsf(detM) * (float)b->kc_area; /* the kernel's area (m^2) */
+        if (inside) {
+            /* the kernel lies wholly inside the cross-section: the beam's own irradiance */
+            if (det == 0.0f) return false;
+            e_h = b->phi[t] / (0.5f * fabsf(det));
+        } else {
+            /* the cross-section wholly inside the kernel (near a focus): flux / area(K).
+             * Its vertices in kernel units: c = M^-1 (V - p) / dd; inside the inradius. */
+            int tri_in = detM != 0.0f;
+            if (tri_in) {
+                float im = 1.0f / (detM * dd), rin2 = (float)(b->kc_rin * b->kc_rin);
+                float vx[3] = {-qu, e1u - qu, e2u - qu}, vz[3] = {-qw, e1w - qw, e2w - qw};
+                for (int i = 0; i < 3 && tri_in; i++) {
+                    float cx = (M[3] * vx[i] - M[1] * vz[i]) * im, cz = (M[0] * vz[i] - M[2] * vx[i]) * im;
+                    tri_in = cx * cx + cz * cz <= rin2;
+                }
+            }
+            if (tri_in) {
+                e_h = b->phi[t] / areaK;
+            } else {
+                if (det == 0.0f) return false;
+                double frac = clip_area((const double (*)[2])b->kc, GR_BEAM_KERNEL_N, a, bb, 7u) / b->kc_area;
+                if (!(frac > 0.0)) return false;
+                /* exact: flux area(tri n K) / (|A| area(K)) <= flux / area(K); the bound only
+                 * guards the rounding of a nearly collapsed cross-section */
+                e_h = (float)fmin((double)b->phi[t] * frac / (0.5 * fabs((double)det)), (double)b->phi[t] / areaK);
+            }
+        }
+    }
+    /* T and the path length at the nearest point of the cross-section (clamped barycentrics) */
+    float l0 = 1.0f / 3.0f, l1 = l0, l2 = l0;
+    if (det != 0.0f) {
+        float inv = 1.0f / det;
+        l0 = fmaxf(f0 * inv, 0.0f); l1 = fmaxf(f1 * inv, 0.0f); l2 = fmaxf(f2 * inv, 0.0f);
+        float sum = l0 + l1 + l2;
+        if (sum > 0.0f) { l0 /= sum; l1 /= sum; l2 /= sum; }
+        else l0 = l1 = l2 = 1.0f / 3.0f;
+    }
     /* distance from the surface along the beam; negative above the surface (in air) */
     float path = l0 * d0 * v0->ity + l1 * d1 * v1->ity + l2 * d2 * v2->ity;
     if (path < 0.0f) return false;
+    if (!(e_h > 0.0f)) return false;
     if (s->n >= s->max) { s->overflow = 1; return false; }
     gr_beam_hit *h = &s->hits[s->n++];
     h->prim = prim;
-    h->e_h = b->phi[t] / (0.5f * fabsf(det));
+    h->e_h = e_h;
     h->path_m = path;
     h->T = gr_v3_norm(gr_v3(l0 * v0->tx + l1 * v1->tx + l2 * v2->tx,
                             l0 * v0->ty + l1 * v1->ty + l2 * v2->ty,
@@ -229,8 +400,20 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->dy = malloc(ntri * sizeof *b->dy);
     b->first = malloc((ntri + 1) * sizeof *b->first);
     float *drift = malloc(ntri * sizeof *drift);
-    if (!pos || !b->v || !b->phi || !b->ytop || !b->dy || !b->first || !drift) {
-        free(pos); free(drift); gr_beams_destroy(b);
+    int disc = p->disc_radius > 0.0;
+    float *jv = NULL; /* per vertex: the slope Jacobian J (4 floats) */
+    if (disc) {
+        jv = malloc(nv * 4 * sizeof *jv);
+        b->kern = malloc(ntri * 4 * sizeof *b->kern);
+        b->ybar = malloc(ntri * sizeof *b->ybar);
+        kernel_polygon(b->kc);
+        b->kc_area = polygon_area((const double (*)[2])b->kc, GR_BEAM_KERNEL_N);
+        b->kc_rho = gr_beam_kernel_radius();
+        b->kc_rin = b->kc_rho * cos(GR_PI / GR_BEAM_KERNEL_N);
+    }
+    if (!pos || !b->v || !b->phi || !b->ytop || !b->dy || !b->first || !drift ||
+        (disc && (!jv || !b->kern || !b->ybar))) {
+        free(pos); free(drift); free(jv); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu surface vertices (reference.surface_res)", nv);
     }
     double start_u = r->u0 - p->pad_m - p->jitter[0] * h, start_w = r->w0 - p->pad_m - p->jitter[1] * h;
@@ -260,6 +443,11 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
                 continue;
             }
             v->ft = p->fresnel ? (float)(1.0 - gr_fresnel_exact(cos_i, 1.0, p->ior)) : 1.0f;
+            if (disc) {
+                double J[4];
+                slope_jacobian(I, n, eta, p->disc_e1, p->disc_e2, J);
+                for (int c = 0; c < 4; c++) jv[4 * k + (size_t)c] = (float)J[c];
+            }
             v->au = (float)(T.x / T.y - p->shear_x);
             v->aw = (float)(T.z / T.y - p->shear_z);
             v->ity = (float)(1.0 / T.y);
@@ -272,6 +460,10 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
         b->phi[t] = 0.0f;
         b->ytop[t] = fmaxf(v0->py, fmaxf(v1->py, v2->py));
+        if (disc) {
+            memset(b->kern + 4 * t, 0, 4 * sizeof *b->kern);
+            b->ybar[t] = b->ytop[t];
+        }
         drift[t] = 0.0f;
         if (v0->ft < 0.0f || v1->ft < 0.0f || v2->ft < 0.0f) continue;
         /* the grid's triangles wind so that their area vector points down */
@@ -280,6 +472,15 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         if (!(flux > 0.0)) continue;   /* faces away from the sun: shadowed by its own wave */
         /* F_t averaged over the vertices: O(h^2) like the rest of the tessellation */
         b->phi[t] = (float)(flux * (v0->ft + v1->ft + v2->ft) / 3.0);
+        if (disc) {
+            /* the beam's kernel: the disc radius times its vertices' mean Jacobian (first
+             * order: the cross-section moves rigidly with the sun direction) */
+            for (int c = 0; c < 4; c++)
+                b->kern[4 * t + (size_t)c] = (float)(p->disc_radius * (jv[4 * (size_t)idx[0] + (size_t)c] +
+                                                                     jv[4 * (size_t)idx[1] + (size_t)c] +
+                                                                     jv[4 * (size_t)idx[2] + (size_t)c]) / 3.0);
+            b->ybar[t] = (v0->py + v1->py + v2->py) / 3.0f;
+        }
         float d = 0.0f;
         const beam_vertex *vs[3] = {v0, v1, v2};
         for (int c = 0; c < 3; c++) d = fmaxf(d, hypotf(vs[c]->au, vs[c]->aw));
@@ -297,13 +498,13 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         scale *= 1.25 * (double)total / (double)p->max_prims;
     }
     if (total > p->max_prims || total >= UINT32_MAX) {
-        free(pos); free(drift); gr_beams_destroy(b);
+        free(pos); free(drift); free(jv); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference.surface_res: %d needs %zu beam primitives, over the budget of %zu",
                        p->res, total, p->max_prims);
     }
     b->prim_tri = malloc((total ? total : 1) * sizeof *b->prim_tri);
     if (!b->prim_tri) {
-        free(pos); free(drift); gr_beams_destroy(b);
+        free(pos); free(drift); free(jv); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu beam primitives", total);
     }
     uint32_t np = 0;
@@ -318,6 +519,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     }
     b->first[ntri] = np;
     free(drift);
+    free(jv);
 
     RTCDevice dev = rtc->device;
     gr_status st = GR_OK;
@@ -350,7 +552,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->stats.triangles = ntri;
     b->stats.lit_triangles = lit;
     b->stats.prims = np;
-    b->stats.bytes = nv * sizeof *b->v + ntri * (3 * sizeof(float) + sizeof(uint32_t)) + np * sizeof(uint32_t);
+    b->stats.bytes = nv * sizeof *b->v + ntri * ((disc ? 8 : 3) * sizeof(float) + sizeof(uint32_t)) + np * sizeof(uint32_t);
     b->stats.build_s = now_s() - t_start;
     *out = b;
     return GR_OK;
@@ -366,6 +568,8 @@ void gr_beams_destroy(gr_beams *b)
     if (b->surface) rtcReleaseScene(b->surface);
     free(b->v);
     free(b->phi);
+    free(b->kern);
+    free(b->ybar);
     free(b->ytop);
     free(b->dy);
     free(b->first);

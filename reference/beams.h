@@ -7,6 +7,14 @@
  * a quadratic in y and the horizontal irradiance inside is flux / |A(y)|: flux is
  * conserved by construction, through foci and folds.
  *
+ * The sun's disc (docs/reference.md, "The sun's disc: analytic convolution"): a direction
+ * delta (angular offset from the pass's central direction, in the disc frame e1, e2) moves
+ * the beam's cross-section at depth d rigidly, to first order, by d J delta, J the Jacobian
+ * of the refracted ray's horizontal slope T_xz / T_y with respect to delta (per beam: the
+ * mean of its vertices' J). Averaged over the disc, the horizontal irradiance at p is
+ *   E(p) = flux * area(triangle(y) n (p - K(y))) / (|A(y)| area(K(y))),  K = d J disc,
+ * computed exactly with K approximated by an equal-area 16-gon (convex clipping).
+ *
  * Lookups go through an Embree BVH (user geometry): one primitive per beam and depth slab,
  * in coordinates sheared along the mean refracted direction T0 (u = x - T0x/T0y y,
  * w = z - T0z/T0y y), where beams are nearly vertical and slabs keep tight boxes.
@@ -34,6 +42,11 @@ typedef struct gr_beam_params {
     int res;                 /* patch cells = res^2 (square cells) */
     double jitter[2];        /* grid offset in cells, each in [0, 1) */
     size_t max_prims;        /* budget of beam-slab primitives (memory bound) */
+    /* Sun-disc convolution: disc_radius = the disc's angular radius in air (rad), 0 = none
+     * (a point sun, or the disc sampled by passes instead); e1, e2: unit vectors spanning
+     * the disc, perpendicular to sun_dir. */
+    double disc_radius;
+    gr_dvec3 disc_e1, disc_e2;
     int surface_mesh;        /* 1: also build the displaced surface as an Embree mesh */
 } gr_beam_params;
 
@@ -61,8 +74,18 @@ typedef struct gr_beam_hit {
     gr_vec3 T;               /* unit refracted direction at the point (interpolated) */
 } gr_beam_hit;
 
-/* Finds every beam containing the local point p; returns how many (at most max_hits,
- * *overflow set to 1 if more were found), sorted by primitive id. */
+/* Finds every beam containing the local point p (with the disc convolution: every beam
+ * whose disc-blurred footprint reaches p, e_h being the disc average); returns how many
+ * (at most max_hits, *overflow set to 1 if more were found), sorted by primitive id. */
 int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hit *hits, int max_hits, int *overflow);
+
+/* The disc kernel's polygon (exposed for tests): GR_BEAM_KERNEL_N vertices on a circle of
+ * radius gr_beam_kernel_radius(), whose area is exactly pi (the unit disc's). */
+#define GR_BEAM_KERNEL_N 16
+double gr_beam_kernel_radius(void);
+/* Area of the convex polygon (unit kernel polygon) intersected with the three half-planes
+ * a_i + b_i . c >= 0 (i = 0..2), divided by the polygon's area: the fraction of the kernel
+ * that lies inside a triangle. b is {b0x, b0y, b1x, b1y, b2x, b2y}. */
+double gr_beam_kernel_coverage(const double a[3], const double b[6]);
 
 #endif

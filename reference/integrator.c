@@ -53,6 +53,7 @@ struct gr_ref_renderer {
     gr_dvec3 I0, T0, e1, e2;  /* sun centre, its flat refraction, a frame around I0 */
     double sx, sz;            /* shear T0x / T0y, T0z / T0y */
     double sun_radius;        /* angular radius in air (rad) */
+    int convolve;             /* 1: the disc by the analytic convolution, passes use I0 */
     double cutoff_d;
     gr_beam_region region;
     double pad;
@@ -230,6 +231,7 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
     r->e1 = gr_d3_norm(gr_d3_cross(r->I0, helper));
     r->e2 = gr_d3_cross(r->I0, r->e1);
     r->sun_radius = 0.5 * s->sun.angular_diameter_deg * GR_PI / 180.0;
+    r->convolve = st->sun_disc == GR_SUN_DISC_CONVOLVE && r->sun_radius > 0.0;
     double smin = INFINITY;
     for (int c = 0; c < 3; c++) {
         r->sig_t[c] = s->medium.extinction[c];
@@ -266,6 +268,9 @@ void gr_ref_destroy(gr_ref_renderer *r)
 
 gr_dvec3 gr_ref_pass_sun_dir(const gr_ref_renderer *r, int pass)
 {
+    /* the convolution averages the disc analytically around its centre (docs/reference.md):
+     * sampling directions as well would count the disc twice */
+    if (r->convolve) return r->I0;
     ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)pass);
     /* Stratified in the disc's solid angle (cos r uniform in [cos R, 1]), random azimuth.
      * The strata are those of one batch: batch b = pass mod B takes the passes b, b + B, ...
@@ -288,6 +293,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     (void)rng_u(&g);
     (void)rng_u(&g);
     double jit[2] = {rng_u(&g), rng_u(&g)};
+    if (r->opt.fixed_grid) jit[0] = jit[1] = 0.5;
     /* Oracle 1: flat refraction, E_w / E_sun = F_t cos(theta_i) / cos(theta_t) */
     gr_dvec3 T = gr_refract_d(r->Ip, gr_d3(0, 1, 0), 1.0 / r->scene.medium.ior);
     double cos_i = -r->Ip.y;
@@ -315,6 +321,11 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     bp.jitter[1] = jit[1];
     bp.max_prims = r->opt.max_prims;
     bp.surface_mesh = 1;
+    if (r->convolve) {
+        bp.disc_radius = r->sun_radius;
+        bp.disc_e1 = r->e1;
+        bp.disc_e2 = r->e2;
+    }
     gr_status st = gr_beams_build(r->rtc, &bp, &r->beams, err);
     if (st != GR_OK) return st;
     r->beams_pass = pass;

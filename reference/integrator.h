@@ -6,9 +6,11 @@
  * Camera rays end at an occluder, the seabed, the water surface seen from below, or where
  * the camera ray's transmittance falls below reference.transmittance_cutoff. E_k comes
  * from beam prisms (reference/beams.h) under waves and from the closed form on flat water.
- * The sun's disc is sampled by passes: each pass has one direction inside the disc and
- * its own jitter of the surface grid; pass p feeds batch p mod batches, and the spread of
- * the batch means gives the per-pixel standard error. */
+ * The sun's disc is averaged analytically (reference.sun_disc = "convolve": each beam's
+ * footprint convolved with the disc's image, reference/beams.h) or sampled, one direction
+ * per pass ("sample"). Each pass has its own jitter of the surface grid; pass p feeds
+ * batch p mod batches, and the spread of the batch means gives the per-pixel standard
+ * error. */
 #ifndef GR_REF_INTEGRATOR_H
 #define GR_REF_INTEGRATOR_H
 
@@ -27,6 +29,8 @@ typedef struct gr_ref_options {
     volatile sig_atomic_t *interrupt; /* set nonzero (e.g. by SIGINT) to stop at the next row */
     size_t max_prims;       /* beam-slab primitive budget; 0 = default (16 M, about 1 GB) */
     int max_rounds;         /* --target-error: at most this many rounds of passes; 0 = 64 */
+    int fixed_grid;         /* 1: every pass uses the grid offset (0.5, 0.5) cells (tests: the
+                               sun-disc treatments then differ only in the disc) */
     /* Lit region override for irradiance probes (tests): world x/z bounds at depths down to
      * y_min. Unused when lit_box_valid = 0 (the region then follows the camera frustum). */
     int lit_box_valid;
@@ -64,7 +68,7 @@ void gr_ref_result_free(gr_ref_result *res); /* accepts NULL */
 /* ---- probes for the oracles and the second estimator ---- */
 /* Builds the beam set of pass `pass` (sun direction and grid jitter of that pass). */
 gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err);
-/* Sun direction I of a pass (unit, world). */
+/* Sun direction I of a pass (unit, world): the disc's centre when the disc is convolved. */
 gr_dvec3 gr_ref_pass_sun_dir(const gr_ref_renderer *r, int pass);
 /* Horizontal irradiance per unit sun irradiance at a world point for the prepared pass,
  * from every beam through it: SUM_k F_t |I.a_k| / |A_k(y)|, no extinction, no shadows.

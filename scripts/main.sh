@@ -11,7 +11,7 @@ JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j "$JOBS"
 
-# ---- the main job (later issues replace this line with `build/godrays run "$SCENE"`) ----
-build/godrays validate "$SCENE"
+# ---- the main job: ground truth (cached after the first run) + real-time shafts + report ----
+build/godrays run "$SCENE"
 
 build/godrays info

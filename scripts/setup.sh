@@ -19,6 +19,8 @@ GODRAYS_PACKAGES=(
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   # plots
   libplplot-dev plplot-driver-qt
+  # headless browser for the report's test (tests/cli/test_report_browser.sh)
+  chromium
 )
 
 installed() {

@@ -12,6 +12,8 @@ static const gr_command commands[] = {
     {"shafts", "render the god-ray layer with seed 000's real-time shafts (OpenGL) to EXR + PNG", cmd_shafts},
     {"reference", "render the ground-truth god-ray layer (Embree, single scattering) to EXR + PNG", cmd_reference},
     {"run", "the main job: ground truth (cached) + real-time shafts + comparison + HTML report", cmd_run},
+    {"tune", "find the shafts settings that minimize the error over frames and views (Nelder-Mead)", cmd_tune},
+    {"sweep", "error surface of the shafts over a grid of one or two settings (CSV, JSON, heat map)", cmd_sweep},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
 

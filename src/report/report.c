@@ -482,7 +482,7 @@ static const char *const CSS =
     ".sub{color:#555;font-size:.92em}.box{background:#fff;border:1px solid #ddd;border-radius:6px;padding:10px 14px}"
     ".warn{background:#fff4e0;border-color:#e5b567}"
     ".grid{display:flex;flex-wrap:wrap;gap:14px}.grid figure{margin:0;background:#fff;border:1px solid #ddd;"
-    "border-radius:6px;padding:8px;flex:1 1 300px;max-width:680px}.grid figure.chart{flex:1 1 560px;"
+    "border-radius:6px;padding:8px;flex:1 1 250px;max-width:520px}.grid figure.chart{flex:1 1 560px;"
     "max-width:820px}figure img{width:100%;height:auto;display:block;image-rendering:pixelated}"
     "figure.chart img{image-rendering:auto}figcaption{font-size:.85em;color:#444;margin-top:6px}"
     "table{border-collapse:collapse;background:#fff;font-size:.88em;margin:6px 0}"
@@ -908,13 +908,16 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
                    "three channels as OpenImageIO idiff does. Formulas and conventions: docs/metrics.md.",
                 m->n_scored, m->n_pixels, m->n_masked_out, m->n_stderr_excluded, fmt(m->stderr_bound, t[0], sizeof t[0]));
     gr_sb_puts(b, "</p>\n");
+    gr_sb_puts(b, "<div class=\"grid\">\n<div>\n");
     if (m->have_fit) {
         char capt[160];
         snprintf(capt, sizeof capt, "After the best scale fit: test x a, a = <t, r> / <t, t> = %.6g%s", m->fit.scale,
                  m->fit_defined ? "" : " (undefined: test is black; a = 1)");
         html_metrics_table(b, m, &m->fit, capt);
+        gr_sb_puts(b, "</div>\n<div>\n");
     }
     html_metrics_table(b, m, &m->raw, "As rendered (a = 1): the real-time technique's own, arbitrary, intensity scale");
+    gr_sb_puts(b, "</div>\n</div>\n");
     gr_sb_htmlf(b, "SSIM: Wang et al. 2004 on luminance, L = %.4g (reference luminance peak), C1 = %.3g, C2 = %.3g.",
                 m->ssim_L, m->ssim_c1, m->ssim_c2);
 

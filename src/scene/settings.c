@@ -12,6 +12,8 @@
 #define HI_X GR_PF_MAX_EXCL
 #define FROM GR_PF_FROM_SCENE
 
+static const char *const sun_disc_names[] = {"convolve", "sample", NULL};
+
 #define REF(field) offsetof(gr_reference_settings, field)
 static const gr_param reference_params[] = {
     {.name = "spp", .type = GR_PT_INT, .offset = REF(spp), .min = 1, .max = 1 << 20, .def = 1,
@@ -21,7 +23,7 @@ static const gr_param reference_params[] = {
     {.name = "surface_res", .type = GR_PT_INT, .offset = REF(surface_res), .min = 2, .max = 16384,
      .def = 256, .unit = "", .doc = "surface tessellation: cells along each axis of the lit patch"},
     {.name = "sun_samples", .type = GR_PT_INT, .offset = REF(sun_samples), .min = 1, .max = 4096,
-     .def = 8, .unit = "", .doc = "directions sampled inside the sun's disc"},
+     .def = 8, .unit = "", .doc = "passes per round: surface-grid offsets (and sun directions with sun_disc = sample)"},
     {.name = "batches", .type = GR_PT_INT, .offset = REF(batches), .min = 1, .max = 1024, .def = 8,
      .unit = "", .doc = "independent batches for the standard-error estimate"},
     {.name = "seed", .type = GR_PT_U64, .offset = REF(seed), .min = 0, .max = 9007199254740991.0,
@@ -40,6 +42,9 @@ static const gr_param reference_params[] = {
     {.name = "patch_radius_m", .type = GR_PT_DOUBLE, .offset = REF(patch_radius_m), .min = 0,
      .max = 1e5, .flags = LO_X, .def = 60, .unit = "m",
      .doc = "half size of the tessellated surface patch around the camera; beyond it the waves' mean sunlight"},
+    {.name = "sun_disc", .type = GR_PT_ENUM, .offset = REF(sun_disc), .min = 0, .max = 1,
+     .def = GR_SUN_DISC_CONVOLVE, .enum_names = sun_disc_names, .unit = "",
+     .doc = "sun-disc average: analytic convolution of each beam's footprint, or one sampled direction per pass"},
 };
 #undef REF
 

@@ -10,7 +10,7 @@ typedef struct gr_reference_settings {
     int spp;                      /* camera samples per pixel (per batch group, see batches) */
     int steps;                    /* stratified, jittered march steps along each camera ray */
     int surface_res;              /* surface tessellation: cells along each axis of the lit patch */
-    int sun_samples;              /* directions sampled inside the sun's disc */
+    int sun_samples;              /* passes per round (grid offsets; sun directions if sampled) */
     int batches;                  /* independent batches for the standard-error estimate */
     unsigned long long seed;      /* RNG seed: same seed, same bytes, any thread count */
     int threads;                  /* 0 = all cores */
@@ -19,7 +19,12 @@ typedef struct gr_reference_settings {
     double max_distance_m;        /* camera rays stop here at the latest (clear water) */
     double patch_radius_m;        /* half size of the tessellated surface patch around the
                                      camera; beyond it the waves' mean sunlight is used */
+    int sun_disc;                 /* gr_sun_disc_mode: how the sun's disc is averaged */
 } gr_reference_settings;
+
+/* reference.sun_disc: the disc average by the analytic convolution of each beam's footprint
+ * (default), or by sampling one direction per pass (brute force, for checks). */
+typedef enum gr_sun_disc_mode { GR_SUN_DISC_CONVOLVE = 0, GR_SUN_DISC_SAMPLE = 1 } gr_sun_disc_mode;
 
 typedef enum gr_target_format { GR_TARGET_RGBA8 = 0, GR_TARGET_RGBA16F = 1 } gr_target_format;
 

@@ -1,0 +1,277 @@
+/* godrays sweep SCENE --param shafts.K=0.4:1.2:16 [--param ...]: the shafts' error surface over
+ * a grid of one or two settings against the cached ground truth (src/tune/sweep.h). */
+#include "cli/cli.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
+
+#include "image/oiio.h"
+#include "report/report.h"
+#include "tune/cliopts.h"
+#include "tune/sweep.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: godrays sweep SCENE --param shafts.KEY=LO:HI:COUNT [--param ...] [options]\n"
+            "\n"
+            "Renders the real-time shafts over a grid of one or two settings (COUNT values from LO to\n"
+            "HI inclusive per axis; the grid is COUNT1 x COUNT2 renders per frame and view), scores\n"
+            "each render against the ground truth (rendered once and cached), and writes into DIR:\n"
+            "sweep.csv (every point), sweep.json (grid, minimum, timings, snippet), sweep.png (heat\n"
+            "map with the minimum marked; a line chart for one axis), reference.png and best.png.\n"
+            "RGB settings (shafts.extinction, shafts.intensity) are swept as a SCALE on the scene's\n"
+            "value (shafts.extinction=1 is the medium's sigma_t). Integer settings (shafts.N) take\n"
+            "integer values; booleans and choices are set with --set. docs/tuning.md.\n"
+            "\n"
+            "options:\n"
+            "  --param SPEC         a sweep axis shafts.KEY=LO:HI:COUNT (one or two)\n"
+            "%s"
+            "  -h, --help           this help\n"
+            "\n"
+            "Exit codes: 0 ok, 1 runtime failure, 2 bad usage, bad parameter spec or bad scene.\n",
+            gr_tune_cli_help);
+}
+
+typedef struct progress_ctx {
+    int on;
+} progress_ctx;
+
+static void progress(void *user, int done, int total)
+{
+    const progress_ctx *p = user;
+    if (!p->on) return;
+    if (done == total || done % 8 == 0) {
+        fprintf(stderr, "\rgodrays sweep: %d/%d grid points", done, total);
+        if (done == total) fputc('\n', stderr);
+    }
+}
+
+static cJSON *num_array(const double *v, int n)
+{
+    return cJSON_CreateDoubleArray(v, n);
+}
+
+/* sweep.json: everything a script needs to redraw or re-check the sweep. */
+static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, const gr_sweep_result *r,
+                        const char *snippet)
+{
+    cJSON *root = cJSON_CreateObject();
+    if (!root) return NULL;
+    cJSON_AddStringToObject(root, "scene", s->base->name);
+    cJSON_AddStringToObject(root, "scene_file", s->base->source_path);
+    cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
+    cJSON_AddStringToObject(root, "channel", "Y");
+    cJSON_AddBoolToObject(root, "fit_scale", p->fit);
+    cJSON_AddNumberToObject(root, "width", s->base->camera.width);
+    cJSON_AddNumberToObject(root, "height", s->base->camera.height);
+    cJSON *axes = cJSON_AddArrayToObject(root, "axes");
+    for (int k = 0; axes && k < p->n_params; k++) {
+        cJSON *a = cJSON_CreateObject();
+        if (!a) break;
+        cJSON_AddStringToObject(a, "key", p->params[k].key);
+        cJSON_AddStringToObject(a, "meaning", p->params[k].kind == GR_TK_RGB_SCALE ? "scale on the scene's RGB value"
+                                                                                  : "setting value");
+        cJSON_AddNumberToObject(a, "lo", p->params[k].lo);
+        cJSON_AddNumberToObject(a, "hi", p->params[k].hi);
+        cJSON_AddNumberToObject(a, "count", p->params[k].count);
+        cJSON_AddItemToObject(a, "values", num_array(k == 0 ? r->xs : r->ys, k == 0 ? r->nx : r->ny));
+        cJSON_AddItemToArray(axes, a);
+    }
+    cJSON *cases = cJSON_AddArrayToObject(root, "cases");
+    for (int i = 0; cases && i < s->n_cases; i++) {
+        cJSON *c = cJSON_CreateObject();
+        if (!c) break;
+        cJSON_AddStringToObject(c, "label", s->labels[i]);
+        cJSON_AddNumberToObject(c, "time_s", s->cases[i].water.time_s);
+        cJSON_AddNumberToObject(c, "yaw_deg", s->cases[i].camera.yaw_deg);
+        cJSON_AddNumberToObject(c, "pitch_deg", s->cases[i].camera.pitch_deg);
+        cJSON_AddBoolToObject(c, "ground_truth_cached", s->truth[i].cached);
+        cJSON_AddNumberToObject(c, "ground_truth_seconds", s->truth[i].seconds);
+        cJSON_AddItemToArray(cases, c);
+    }
+    /* error[iy][ix] */
+    cJSON *grid = cJSON_AddArrayToObject(root, "error");
+    for (int j = 0; grid && j < r->ny; j++) cJSON_AddItemToArray(grid, num_array(r->err + (size_t)j * r->nx, r->nx));
+    cJSON *best = cJSON_AddObjectToObject(root, "minimum");
+    if (best) {
+        int bx = r->best % r->nx, by = r->best / r->nx;
+        cJSON_AddNumberToObject(best, p->params[0].key, r->xs[bx]);
+        if (p->n_params > 1) cJSON_AddNumberToObject(best, p->params[1].key, r->ys[by]);
+        cJSON_AddNumberToObject(best, "error", r->err[r->best]);
+        cJSON_AddNumberToObject(best, "scale", r->scale[r->best]);
+        cJSON_AddItemToObject(best, "per_case", num_array(r->case_err + (size_t)r->best * r->n_cases, r->n_cases));
+        cJSON *snip = snippet ? cJSON_Parse(snippet) : NULL;
+        if (snip) cJSON_AddItemToObject(best, "snippet", snip);
+    }
+    cJSON *t = cJSON_AddObjectToObject(root, "timing");
+    if (t) {
+        cJSON_AddNumberToObject(t, "renders", (double)p->renders);
+        cJSON_AddNumberToObject(t, "sweep_wall_s", r->wall_s);
+        cJSON_AddNumberToObject(t, "render_readback_s", p->render_s);
+        cJSON_AddNumberToObject(t, "metrics_s", p->metrics_s);
+        cJSON_AddNumberToObject(t, "other_s", r->wall_s - p->render_s - p->metrics_s);
+        cJSON_AddNumberToObject(t, "ms_per_render", p->renders ? 1e3 * r->wall_s / (double)p->renders : 0.0);
+        cJSON_AddNumberToObject(t, "gl_pass_timers_ms", p->gpu_timed ? p->gpu_ms_sum : -1.0);
+        cJSON_AddStringToObject(t, "gl_renderer", gr_gl_renderer(gr_shafts_gl(p->renderer)));
+        cJSON_AddNumberToObject(t, "ground_truth_s", s->truth_seconds);
+    }
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    return text;
+}
+
+/* reference.png and best.png of case 0 at the same exposure (best x its fitted scale). */
+static gr_status write_images(const char *dir, gr_tune_problem *p, const double *x, gr_error *err)
+{
+    char path[4300];
+    gr_shafts_settings s;
+    gr_status st = gr_tune_settings_at(p, x, &s, err);
+    if (st != GR_OK) return st;
+    gr_metrics m;
+    gr_image *img = gr_image_create(p->scratch->width, p->scratch->height, 3, NULL);
+    if (!img) return gr_fail(err, GR_E_NOMEM, "out of memory");
+    st = gr_tune_render_case(p, 0, &s, img, &m, err);
+    if (st == GR_OK) {
+        double e = gr_report_exposure(p->refs[0], 1.0, 0.99, 0.8);
+        static const int rgb[3] = {0, 1, 2};
+        int rr[3];
+        gr_metrics_pick_rgb(p->refs[0], rr);
+        snprintf(path, sizeof path, "%s/reference.png", dir);
+        st = gr_oiio_write_preview(path, p->refs[0], rr, e, err);
+        if (st == GR_OK) {
+            snprintf(path, sizeof path, "%s/best.png", dir);
+            st = gr_oiio_write_preview(path, img, rgb, e * (p->fit ? m.fit.scale : 1.0), err);
+        }
+    }
+    gr_image_destroy(img);
+    return st;
+}
+
+int cmd_sweep(int argc, char **argv)
+{
+    const char *cmd = "sweep";
+    gr_tune_cli c;
+    gr_tune_cli_init(&c);
+    gr_tune_param params[2];
+    int n_params = 0;
+    gr_error err = {GR_OK, ""};
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            usage(stdout);
+            return 0;
+        }
+        if (!strcmp(a, "--param")) {
+            if (i + 1 >= argc) return gr_cli_usage_error(cmd, "--param needs a value");
+            if (n_params >= 2) return gr_cli_usage_error(cmd, "--param %s: at most two axes", argv[i + 1]);
+            if (gr_tune_param_parse_sweep("--param", argv[++i], &params[n_params], &err) != GR_OK)
+                return gr_cli_report(cmd, &err);
+            for (int k = 0; k < n_params; k++)
+                if (!strcmp(params[k].key, params[n_params].key))
+                    return gr_cli_usage_error(cmd, "--param %s: %s swept twice", argv[i], params[k].key);
+            n_params++;
+            continue;
+        }
+        int r = gr_tune_cli_option(&c, argc, argv, &i, &err);
+        if (r < 0) return gr_cli_report(cmd, &err);
+        if (r > 0) continue;
+        if (a[0] == '-' && a[1] != '\0') return gr_cli_usage_error(cmd, "unknown option %s", a);
+        if (c.so.scene_path) return gr_cli_usage_error(cmd, "more than one scene given (%s, %s)", c.so.scene_path, a);
+        c.so.scene_path = a;
+    }
+    if (!c.so.scene_path) return gr_cli_usage_error(cmd, "no scene file given");
+    if (n_params == 0) return gr_cli_usage_error(cmd, "no --param given (e.g. --param shafts.K=0.4:1.2:16)");
+    if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    if (c.fit < 0) {
+        c.fit = 1;
+        for (int k = 0; k < n_params; k++)
+            if (!strcmp(params[k].p->name, "intensity")) c.fit = 0;
+    }
+    c.so.progress_label = "godrays sweep";
+
+    gr_tune_session s;
+    gr_tune_problem *p = calloc(1, sizeof *p);
+    gr_sweep_result r;
+    memset(&r, 0, sizeof r);
+    char dirbuf[4096], path[4300];
+    char *json = NULL, *snippet = NULL;
+    int rc = 0;
+    if (!p) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        memset(&s, 0, sizeof s);
+        goto fail;
+    }
+    if (gr_tune_session_open(&c.so, &s, &err) != GR_OK) goto fail;
+    gr_tune_session_problem(&s, p);
+    p->n_params = n_params;
+    memcpy(p->params, params, sizeof params);
+    p->metric = c.metric;
+    p->fit = c.fit;
+    if (gr_tune_problem_init(p, &err) != GR_OK) goto fail;
+    /* every grid value must be a valid setting before the first render */
+    for (int k = 0; k < n_params; k++) {
+        gr_shafts_settings t = p->base;
+        for (int e = 0; e < 2; e++)
+            if (gr_tune_param_apply(&params[k], &p->base, e ? params[k].hi : params[k].lo, &t, &err) != GR_OK) {
+                err.status = GR_E_USAGE;
+                gr_error_prefix(&err, "--param %s", params[k].key);
+                goto fail;
+            }
+    }
+    const char *outdir = c.outdir;
+    if (!outdir) {
+        gr_tune_default_dir(s.base->name, "sweep", dirbuf, sizeof dirbuf);
+        outdir = dirbuf;
+    }
+    if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
+
+    progress_ctx pc = {!c.quiet && isatty(2)};
+    if (gr_sweep_run(p, &r, progress, &pc, &err) != GR_OK) goto fail;
+    int bx = r.best % r.nx, by = r.best / r.nx;
+    double xbest[2] = {r.xs[bx], r.ys[by]};
+    snippet = gr_tune_snippet(p, xbest, p->fit ? r.scale[r.best] : 0.0);
+    json = sweep_json(&s, p, &r, snippet);
+    if (!snippet || !json) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
+        goto fail;
+    }
+    const char *labels[GR_TUNE_MAX_CASES];
+    for (int i = 0; i < s.n_cases; i++) labels[i] = s.labels[i];
+    snprintf(path, sizeof path, "%s/sweep.csv", outdir);
+    if (gr_sweep_write_csv(path, p, &r, labels, &err) != GR_OK) goto fail;
+    snprintf(path, sizeof path, "%s/sweep.json", outdir);
+    if (gr_tune_write_text(path, json, &err) != GR_OK) goto fail;
+    int drawn = 0;
+    snprintf(path, sizeof path, "%s/sweep.png", outdir);
+    if (gr_sweep_write_plot(path, p, &r, &drawn, &err) != GR_OK) goto fail;
+    if (write_images(outdir, p, xbest, &err) != GR_OK) goto fail;
+
+    printf("scene '%s' (%d x %d), %d case(s), metric %s of Y%s\n", s.base->name, s.base->camera.width,
+           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "");
+    printf("minimum %.6g at %s = %.6g", r.err[r.best], p->params[0].key, xbest[0]);
+    if (n_params > 1) printf(", %s = %.6g", p->params[1].key, xbest[1]);
+    printf(" (fitted scale %.4g)\n", r.scale[r.best]);
+    printf("%lld renders in %.2f s (%.1f ms each: render + readback %.2f s, metrics %.2f s, other %.2f s; %s)\n",
+           p->renders, r.wall_s, p->renders ? 1e3 * r.wall_s / (double)p->renders : 0.0, p->render_s, p->metrics_s,
+           r.wall_s - p->render_s - p->metrics_s, gr_gl_renderer(gr_shafts_gl(p->renderer)));
+    printf("ground truth: %.1f s (%s)\n", s.truth_seconds, s.truth[0].cached ? "from the cache" : "rendered");
+    printf("best settings for the scene:\n%s\n", snippet);
+    printf("written: %s/sweep.csv, sweep.json, %s, reference.png, best.png\n", outdir,
+           drawn ? "sweep.png" : "(no sweep.png: charts need PLplot)");
+    goto done;
+fail:
+    rc = gr_cli_report(cmd, &err);
+done:
+    free(json);
+    free(snippet);
+    gr_sweep_result_free(&r);
+    if (p) gr_tune_problem_free(p);
+    free(p);
+    gr_tune_session_close(&s);
+    return rc;
+}

@@ -1,0 +1,418 @@
+/* godrays tune SCENE --params shafts.extinction,shafts.K[,...]: the shafts settings that
+ * minimize the error against the ground truth over frames and views, found by bounded
+ * Nelder-Mead with restarts (src/tune/optimize.h). */
+#include "cli/cli.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
+
+#include "image/oiio.h"
+#include "report/report.h"
+#include "tune/cliopts.h"
+#include "tune/optimize.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: godrays tune SCENE --params shafts.KEY[,shafts.KEY...] [options]\n"
+            "\n"
+            "Finds the shafts settings that minimize the error against the ground truth (rendered\n"
+            "once per frame and view, cached), averaged over the frames (--frames/--times) and views\n"
+            "(--view), with bounded Nelder-Mead restarted from several starting points spread over\n"
+            "the bounds (the scene's own settings are the first). Prints the best settings as a\n"
+            "snippet for the scene's \"shafts\" section and the error before and after per frame and\n"
+            "view; writes DIR/tune.json, DIR/trace.csv (every evaluation), DIR/compare.png\n"
+            "(reference | before | after) and per-case reference/before/after PNGs.\n"
+            "RGB settings (extinction, intensity) are tuned as a SCALE on the scene's value.\n"
+            "docs/tuning.md.\n"
+            "\n"
+            "options:\n"
+            "  --params LIST        comma-separated shafts settings to tune (at most %d)\n"
+            "  --bounds KEY=LO:HI   box of one parameter (repeatable; default: docs/tuning.md table)\n"
+            "  --start KEY=V        first starting point of a parameter (repeatable; default: the\n"
+            "                       scene's value, clamped into the box)\n"
+            "  --starts N           starting points (default 4, at most %d)\n"
+            "  --max-evals N        objective evaluations per start (default 60 + 40 x parameters)\n"
+            "%s"
+            "  -h, --help           this help\n"
+            "\n"
+            "Exit codes: 0 ok, 1 runtime failure, 2 bad usage, bad parameter spec or bad scene.\n",
+            GR_TUNE_MAX_PARAMS, GR_OPT_MAX_STARTS, gr_tune_cli_help);
+}
+
+/* The objective, recording every evaluation into trace.csv. */
+typedef struct traced {
+    gr_tune_problem *p;
+    FILE *trace;
+    int n;
+    int progress;
+} traced;
+
+static gr_status traced_objective(void *user, const double *x, double *f, gr_error *err)
+{
+    traced *t = user;
+    gr_status st = gr_tune_evaluate(t->p, x, f, NULL, NULL, err);
+    if (st != GR_OK) return st;
+    t->n++;
+    if (t->trace) {
+        fprintf(t->trace, "%d", t->n);
+        for (int k = 0; k < t->p->n_params; k++) fprintf(t->trace, ",%.9g", x[k]);
+        fprintf(t->trace, ",%.9g\n", *f);
+    }
+    if (t->progress && t->n % 10 == 0) fprintf(stderr, "\rgodrays tune: %d evaluations", t->n);
+    return GR_OK;
+}
+
+static int parse_kv(const char *spec, char *key, size_t kn, double *v)
+{
+    const char *eq = strchr(spec, '=');
+    if (!eq || (size_t)(eq - spec) >= kn) return -1;
+    memcpy(key, spec, (size_t)(eq - spec));
+    key[eq - spec] = '\0';
+    char *end = NULL;
+    *v = strtod(eq + 1, &end);
+    if (end == eq + 1 || *end || !isfinite(*v)) return -1;
+    return 0;
+}
+
+static int parse_count(const char *s, int lo, int hi, int *out)
+{
+    char *end = NULL;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || v < lo || v > hi) return -1;
+    *out = (int)v;
+    return 0;
+}
+
+/* Per-case before/after images and the contact sheet of case 0. */
+static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune_problem *p, const double *xb,
+                              const double *xa, gr_error *err)
+{
+    gr_shafts_settings sb, sa;
+    gr_status st = gr_tune_settings_at(p, xb, &sb, err);
+    if (st == GR_OK) st = gr_tune_settings_at(p, xa, &sa, err);
+    if (st != GR_OK) return st;
+    int W = p->scratch->width, H = p->scratch->height;
+    gr_image *ib = gr_image_create(W, H, 3, NULL), *ia = gr_image_create(W, H, 3, NULL);
+    gr_image *disp[3] = {NULL, NULL, NULL}, *sheet = NULL;
+    char path[4300];
+    if (!ib || !ia) st = gr_fail(err, GR_E_NOMEM, "out of memory");
+    for (int i = 0; st == GR_OK && i < s->n_cases; i++) {
+        gr_metrics mb, ma;
+        if ((st = gr_tune_render_case(p, i, &sb, ib, &mb, err)) != GR_OK) break;
+        if ((st = gr_tune_render_case(p, i, &sa, ia, &ma, err)) != GR_OK) break;
+        double e = gr_report_exposure(p->refs[i], 1.0, 0.99, 0.8);
+        double ab = p->fit ? mb.fit.scale : 1.0, aa = p->fit ? ma.fit.scale : 1.0;
+        int rr[3];
+        static const int rgb[3] = {0, 1, 2};
+        gr_metrics_pick_rgb(p->refs[i], rr);
+        snprintf(path, sizeof path, "%s/reference_%02d.png", dir, i);
+        if ((st = gr_oiio_write_preview(path, p->refs[i], rr, e, err)) != GR_OK) break;
+        snprintf(path, sizeof path, "%s/before_%02d.png", dir, i);
+        if ((st = gr_oiio_write_preview(path, ib, rgb, e * ab, err)) != GR_OK) break;
+        snprintf(path, sizeof path, "%s/after_%02d.png", dir, i);
+        if ((st = gr_oiio_write_preview(path, ia, rgb, e * aa, err)) != GR_OK) break;
+        if (i == 0) {
+            if ((st = gr_report_display(p->refs[0], e, &disp[0], err)) != GR_OK) break;
+            if ((st = gr_report_display(ib, e * ab, &disp[1], err)) != GR_OK) break;
+            if ((st = gr_report_display(ia, e * aa, &disp[2], err)) != GR_OK) break;
+            char l0[256], l1[256], l2[160];
+            const char *metric = gr_tune_metric_name(p->metric);
+            snprintf(l0, sizeof l0, "%s (%s): %s of Y%s", s->labels[0], s->base->name, metric,
+                     p->fit ? " after the best scale fit" : "");
+            snprintf(l1, sizeof l1, "before: %.5g    after: %.5g    (%.1f %% lower)",
+                     gr_tune_metric_value(p->fit ? &mb.fit : &mb.raw, p->metric),
+                     gr_tune_metric_value(p->fit ? &ma.fit : &ma.raw, p->metric),
+                     100.0 * (1.0 - gr_tune_metric_value(p->fit ? &ma.fit : &ma.raw, p->metric) /
+                                        fmax(1e-300, gr_tune_metric_value(p->fit ? &mb.fit : &mb.raw, p->metric))));
+            snprintf(l2, sizeof l2, "shafts shown x their fitted scale (%.3g, %.3g), same exposure as the reference", ab,
+                     aa);
+            const char *lines[3] = {l0, l1, l2};
+            const char *titles[3] = {"ground truth", "shafts before", "shafts after tuning"};
+            int labelled = 0;
+            const gr_image *panels[3] = {disp[0], disp[1], disp[2]};
+            if ((st = gr_report_contact_sheet(panels, titles, lines, 3, 320, 640, &sheet, &labelled, err)) != GR_OK)
+                break;
+            snprintf(path, sizeof path, "%s/compare.png", dir);
+            if ((st = gr_oiio_write(path, sheet, err)) != GR_OK) break;
+        }
+    }
+    for (int k = 0; k < 3; k++) gr_image_destroy(disp[k]);
+    gr_image_destroy(sheet);
+    gr_image_destroy(ib);
+    gr_image_destroy(ia);
+    return st;
+}
+
+int cmd_tune(int argc, char **argv)
+{
+    const char *cmd = "tune";
+    gr_tune_cli c;
+    gr_tune_cli_init(&c);
+    gr_tune_param params[GR_TUNE_MAX_PARAMS];
+    int n_params = 0, n_starts = 4, max_evals = 0;
+    const char *bounds[32], *starts[32];
+    int n_bounds = 0, n_start_specs = 0;
+    gr_error err = {GR_OK, ""};
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            usage(stdout);
+            return 0;
+        }
+        if (!strcmp(a, "--params") || !strcmp(a, "--bounds") || !strcmp(a, "--start") || !strcmp(a, "--starts") ||
+            !strcmp(a, "--max-evals")) {
+            if (i + 1 >= argc) return gr_cli_usage_error(cmd, "%s needs a value", a);
+            const char *v = argv[++i];
+            if (!strcmp(a, "--params")) {
+                if (n_params) return gr_cli_usage_error(cmd, "--params given twice");
+                if (gr_tune_param_parse_list(a, v, params, GR_TUNE_MAX_PARAMS, &n_params, &err) != GR_OK)
+                    return gr_cli_report(cmd, &err);
+            } else if (!strcmp(a, "--bounds")) {
+                if (n_bounds >= 32) return gr_cli_usage_error(cmd, "--bounds: too many");
+                bounds[n_bounds++] = v;
+            } else if (!strcmp(a, "--start")) {
+                if (n_start_specs >= 32) return gr_cli_usage_error(cmd, "--start: too many");
+                starts[n_start_specs++] = v;
+            } else if (!strcmp(a, "--starts")) {
+                if (parse_count(v, 1, GR_OPT_MAX_STARTS, &n_starts))
+                    return gr_cli_usage_error(cmd, "--starts %s: expected an integer in [1, %d]", v, GR_OPT_MAX_STARTS);
+            } else {
+                if (parse_count(v, 4, 1000000, &max_evals))
+                    return gr_cli_usage_error(cmd, "--max-evals %s: expected an integer >= 4", v);
+            }
+            continue;
+        }
+        int r = gr_tune_cli_option(&c, argc, argv, &i, &err);
+        if (r < 0) return gr_cli_report(cmd, &err);
+        if (r > 0) continue;
+        if (a[0] == '-' && a[1] != '\0') return gr_cli_usage_error(cmd, "unknown option %s", a);
+        if (c.so.scene_path) return gr_cli_usage_error(cmd, "more than one scene given (%s, %s)", c.so.scene_path, a);
+        c.so.scene_path = a;
+    }
+    if (!c.so.scene_path) return gr_cli_usage_error(cmd, "no scene file given");
+    if (!n_params) return gr_cli_usage_error(cmd, "no --params given (e.g. --params shafts.extinction,shafts.K)");
+    for (int b = 0; b < n_bounds; b++)
+        if (gr_tune_param_parse_bounds("--bounds", bounds[b], params, n_params, &err) != GR_OK)
+            return gr_cli_report(cmd, &err);
+    for (int k = 0; k < n_params; k++)
+        if (!(params[k].lo < params[k].hi))
+            return gr_cli_usage_error(cmd, "--params %s: no default bounds; give --bounds %s=LO:HI", params[k].key,
+                                      params[k].key);
+    double x0[GR_TUNE_MAX_PARAMS];
+    int have_x0[GR_TUNE_MAX_PARAMS] = {0};
+    for (int b = 0; b < n_start_specs; b++) {
+        char key[64];
+        double v;
+        if (parse_kv(starts[b], key, sizeof key, &v))
+            return gr_cli_usage_error(cmd, "--start %s: expected shafts.KEY=VALUE", starts[b]);
+        int idx = -1;
+        for (int k = 0; k < n_params; k++)
+            if (!strcmp(params[k].key, key)) idx = k;
+        if (idx < 0) return gr_cli_usage_error(cmd, "--start %s: %s is not among the --params", starts[b], key);
+        x0[idx] = v;
+        have_x0[idx] = 1;
+    }
+    if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    if (c.fit < 0) {
+        c.fit = 1;
+        for (int k = 0; k < n_params; k++)
+            if (!strcmp(params[k].p->name, "intensity")) c.fit = 0;
+    }
+    c.so.progress_label = "godrays tune";
+
+    gr_tune_session s;
+    memset(&s, 0, sizeof s);
+    gr_tune_problem *p = calloc(1, sizeof *p);
+    char dirbuf[4096], path[4300];
+    char *json = NULL, *snippet = NULL;
+    FILE *trace = NULL;
+    cJSON *root = NULL;
+    int rc = 0;
+    if (!p) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        goto fail;
+    }
+    if (gr_tune_session_open(&c.so, &s, &err) != GR_OK) goto fail;
+    gr_tune_session_problem(&s, p);
+    p->n_params = n_params;
+    memcpy(p->params, params, sizeof params);
+    p->metric = c.metric;
+    p->fit = c.fit;
+    if (gr_tune_problem_init(p, &err) != GR_OK) goto fail;
+    double lo[GR_TUNE_MAX_PARAMS], hi[GR_TUNE_MAX_PARAMS], xb[GR_TUNE_MAX_PARAMS];
+    for (int k = 0; k < n_params; k++) {
+        lo[k] = params[k].lo;
+        hi[k] = params[k].hi;
+        xb[k] = gr_tune_param_current(&params[k], &p->base, &p->base); /* the scene's own value */
+        if (!have_x0[k]) x0[k] = fmin(hi[k], fmax(lo[k], xb[k]));
+        gr_shafts_settings t = p->base;
+        for (int e = 0; e < 2; e++)
+            if (gr_tune_param_apply(&params[k], &p->base, e ? hi[k] : lo[k], &t, &err) != GR_OK) {
+                err.status = GR_E_USAGE;
+                gr_error_prefix(&err, "bounds of %s", params[k].key);
+                goto fail;
+            }
+    }
+    const char *outdir = c.outdir;
+    if (!outdir) {
+        gr_tune_default_dir(s.base->name, "tune", dirbuf, sizeof dirbuf);
+        outdir = dirbuf;
+    }
+    if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
+    snprintf(path, sizeof path, "%s/trace.csv", outdir);
+    trace = fopen(path, "w");
+    if (!trace) {
+        gr_fail(&err, GR_E_IO, "%s: cannot create", path);
+        goto fail;
+    }
+    fprintf(trace, "eval");
+    for (int k = 0; k < n_params; k++) fprintf(trace, ",%s", params[k].key);
+    fprintf(trace, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
+
+    double before[GR_TUNE_MAX_CASES], after[GR_TUNE_MAX_CASES], sc_b[GR_TUNE_MAX_CASES], sc_a[GR_TUNE_MAX_CASES];
+    double fb = 0, fa = 0;
+    if (gr_tune_evaluate(p, xb, &fb, before, sc_b, &err) != GR_OK) goto fail;
+    traced t = {.p = p, .trace = trace, .progress = !c.quiet && isatty(2)};
+    gr_opt_options oo = {.n_starts = n_starts, .x0 = x0, .max_evals = max_evals};
+    gr_opt_result res;
+    double t_opt = (double)p->renders, render_s0 = p->render_s, metrics_s0 = p->metrics_s;
+    if (gr_opt_minimize(n_params, lo, hi, traced_objective, &t, &oo, &res, &err) != GR_OK) goto fail;
+    if (t.progress) fprintf(stderr, "\rgodrays tune: %d evaluations\n", t.n);
+    fclose(trace);
+    trace = NULL;
+    if (gr_tune_evaluate(p, res.x, &fa, after, sc_a, &err) != GR_OK) goto fail;
+    double scale_mean = 0.0;
+    for (int i = 0; i < s.n_cases; i++) scale_mean += sc_a[i] / s.n_cases;
+    snippet = gr_tune_snippet(p, res.x, p->fit ? scale_mean : 0.0);
+    if (!snippet) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        goto fail;
+    }
+    /* Agreement of the starts: the spread (fraction of each box side) of the results of the
+     * starts that reached the best value within 2 %. */
+    double spread[GR_TUNE_MAX_PARAMS] = {0};
+    int agreeing = 0;
+    for (int j = 0; j < res.n_starts; j++) {
+        if (!(res.starts[j].f <= res.f * 1.02 + 1e-300)) continue;
+        agreeing++;
+        for (int k = 0; k < n_params; k++)
+            spread[k] = fmax(spread[k], fabs(res.starts[j].x[k] - res.x[k]) / (hi[k] - lo[k]));
+    }
+    if (write_images(outdir, &s, p, xb, res.x, &err) != GR_OK) goto fail;
+
+    root = cJSON_CreateObject();
+    if (root) {
+        cJSON_AddStringToObject(root, "scene", s.base->name);
+        cJSON_AddStringToObject(root, "scene_file", s.base->source_path);
+        cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
+        cJSON_AddStringToObject(root, "channel", "Y");
+        cJSON_AddBoolToObject(root, "fit_scale", p->fit);
+        cJSON_AddNumberToObject(root, "width", s.base->camera.width);
+        cJSON_AddNumberToObject(root, "height", s.base->camera.height);
+        cJSON *pa = cJSON_AddArrayToObject(root, "params");
+        for (int k = 0; pa && k < n_params; k++) {
+            cJSON *o = cJSON_CreateObject();
+            if (!o) break;
+            cJSON_AddStringToObject(o, "key", params[k].key);
+            cJSON_AddStringToObject(o, "meaning", params[k].kind == GR_TK_RGB_SCALE ? "scale on the scene's RGB value"
+                                                                                    : "setting value");
+            cJSON_AddNumberToObject(o, "lo", lo[k]);
+            cJSON_AddNumberToObject(o, "hi", hi[k]);
+            cJSON_AddNumberToObject(o, "before", xb[k]);
+            cJSON_AddNumberToObject(o, "after", res.x[k]);
+            cJSON_AddNumberToObject(o, "start_spread_fraction", spread[k]);
+            cJSON_AddItemToArray(pa, o);
+        }
+        cJSON *st = cJSON_AddArrayToObject(root, "starts");
+        for (int j = 0; st && j < res.n_starts; j++) {
+            cJSON *o = cJSON_CreateObject();
+            if (!o) break;
+            cJSON_AddItemToObject(o, "x0", cJSON_CreateDoubleArray(res.starts[j].x0, n_params));
+            cJSON_AddItemToObject(o, "x", cJSON_CreateDoubleArray(res.starts[j].x, n_params));
+            cJSON_AddNumberToObject(o, "f", res.starts[j].f);
+            cJSON_AddNumberToObject(o, "evals", res.starts[j].evals);
+            cJSON_AddBoolToObject(o, "converged", res.starts[j].converged);
+            cJSON_AddItemToArray(st, o);
+        }
+        cJSON *cs = cJSON_AddArrayToObject(root, "cases");
+        for (int i = 0; cs && i < s.n_cases; i++) {
+            cJSON *o = cJSON_CreateObject();
+            if (!o) break;
+            cJSON_AddStringToObject(o, "label", s.labels[i]);
+            cJSON_AddNumberToObject(o, "time_s", s.cases[i].water.time_s);
+            cJSON_AddNumberToObject(o, "yaw_deg", s.cases[i].camera.yaw_deg);
+            cJSON_AddNumberToObject(o, "pitch_deg", s.cases[i].camera.pitch_deg);
+            cJSON_AddNumberToObject(o, "before", before[i]);
+            cJSON_AddNumberToObject(o, "after", after[i]);
+            cJSON_AddNumberToObject(o, "scale_before", sc_b[i]);
+            cJSON_AddNumberToObject(o, "scale_after", sc_a[i]);
+            cJSON_AddBoolToObject(o, "ground_truth_cached", s.truth[i].cached);
+            cJSON_AddItemToArray(cs, o);
+        }
+        cJSON_AddNumberToObject(root, "before", fb);
+        cJSON_AddNumberToObject(root, "after", fa);
+        cJSON_AddNumberToObject(root, "evaluations", res.evals);
+        cJSON_AddNumberToObject(root, "starts_agreeing", agreeing);
+        cJSON *sn = cJSON_Parse(snippet);
+        if (sn) cJSON_AddItemToObject(root, "snippet", sn);
+        cJSON *tm = cJSON_AddObjectToObject(root, "timing");
+        if (tm) {
+            cJSON_AddNumberToObject(tm, "renders", (double)p->renders - t_opt);
+            cJSON_AddNumberToObject(tm, "render_readback_s", p->render_s - render_s0);
+            cJSON_AddNumberToObject(tm, "metrics_s", p->metrics_s - metrics_s0);
+            cJSON_AddNumberToObject(tm, "ground_truth_s", s.truth_seconds);
+            cJSON_AddStringToObject(tm, "gl_renderer", gr_gl_renderer(gr_shafts_gl(p->renderer)));
+        }
+        json = cJSON_Print(root);
+    }
+    if (!json) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
+        goto fail;
+    }
+    snprintf(path, sizeof path, "%s/tune.json", outdir);
+    if (gr_tune_write_text(path, json, &err) != GR_OK) goto fail;
+
+    printf("scene '%s' (%d x %d), %d case(s), metric %s of Y%s\n", s.base->name, s.base->camera.width,
+           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "");
+    printf("%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
+    for (int k = 0; k < n_params; k++)
+        printf("%-28s %12.5g %12.5g    [%g, %g]%s\n", params[k].key, xb[k], res.x[k], lo[k], hi[k],
+               params[k].kind == GR_TK_RGB_SCALE ? " (scale)" : "");
+    printf("starts:\n");
+    for (int j = 0; j < res.n_starts; j++) {
+        printf("  %d: from (", j);
+        for (int k = 0; k < n_params; k++) printf("%s%.4g", k ? ", " : "", res.starts[j].x0[k]);
+        printf(") to (");
+        for (int k = 0; k < n_params; k++) printf("%s%.5g", k ? ", " : "", res.starts[j].x[k]);
+        printf(") error %.6g, %d evaluations%s\n", res.starts[j].f, res.starts[j].evals,
+               res.starts[j].converged ? "" : " (budget reached)");
+    }
+    printf("%d of %d starts reached the best value within 2 %%; their spread:", agreeing, res.n_starts);
+    for (int k = 0; k < n_params; k++) printf(" %s %.2f %%", params[k].key, 100.0 * spread[k]);
+    printf(" of the box\n");
+    printf("error per case (%s):        before        after\n", gr_tune_metric_name(p->metric));
+    for (int i = 0; i < s.n_cases; i++) printf("  %-24s %12.6g %12.6g\n", s.labels[i], before[i], after[i]);
+    printf("  %-24s %12.6g %12.6g (%.1f %% lower)\n", "mean", fb, fa, fb > 0 ? 100.0 * (1.0 - fa / fb) : 0.0);
+    printf("%d evaluations (%lld renders) in %.1f s; ground truth %.1f s\n", res.evals, p->renders,
+           p->render_s + p->metrics_s, s.truth_seconds);
+    printf("best settings for the scene:\n%s\n", snippet);
+    printf("written: %s/tune.json, trace.csv, compare.png, reference_NN.png, before_NN.png, after_NN.png\n", outdir);
+    goto done;
+fail:
+    rc = gr_cli_report(cmd, &err);
+done:
+    if (trace) fclose(trace);
+    cJSON_Delete(root);
+    free(json);
+    free(snippet);
+    if (p) gr_tune_problem_free(p);
+    free(p);
+    gr_tune_session_close(&s);
+    return rc;
+}

@@ -1,0 +1,130 @@
+/* Shared options of sweep and tune (cliopts.h). */
+#include "tune/cliopts.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char gr_tune_cli_help[] =
+    "  -o, --output DIR     report folder (default: out/SCENE_NAME/COMMAND)\n"
+    "  --metric M           rmse (default), relmse, ssim (scored as 1 - SSIM) or msrmse (mean RMSE\n"
+    "                       after blurs at 1, 4, 16 px); all on luminance Y\n"
+    "  --fit / --no-fit     score the shafts after the best scale fit a = <t,r>/<t,t> (default:\n"
+    "                       on, unless shafts.intensity is a parameter)\n"
+    "  --set KEY=VALUE      override a scene value before validation (repeatable), e.g.\n"
+    "                       reference.spp=2 or shafts.N=15\n"
+    "  --size WxH           image size (camera.width/height)\n"
+    "  --frames A:B:S       frames A, A+S, ..., B of the animated waves at water.time_s + frame/fps\n"
+    "  --fps F              frames per second for --frames (default 30)\n"
+    "  --times T1,T2,...    water times (s) instead of --frames\n"
+    "  --view YAW,PITCH     an extra camera view (degrees, the scene camera's position and fov;\n"
+    "                       repeatable; the scene's own view is always included)\n"
+    "  --no-cache           render the ground truths even if cached, and do not store them\n"
+    "  --gl-platform P      auto, surfaceless or device\n"
+    "  -q, --quiet          no progress messages\n";
+
+void gr_tune_cli_init(gr_tune_cli *c)
+{
+    memset(c, 0, sizeof *c);
+    c->metric = GR_TM_RMSE;
+    c->fit = -1;
+    c->fps = 30.0;
+    c->so.use_cache = 1;
+    c->so.progress = 1;
+    c->so.sets = c->sets;
+}
+
+static int needs_value(const char *a)
+{
+    static const char *const with_value[] = {"-o", "--output", "--metric", "--set", "--size", "--frames", "--fps",
+                                             "--times", "--view", "--gl-platform"};
+    for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
+        if (!strcmp(a, with_value[k])) return 1;
+    return 0;
+}
+
+int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *err)
+{
+    const char *a = argv[*i];
+    if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+        c->quiet = 1;
+        return 1;
+    }
+    if (!strcmp(a, "--no-cache")) {
+        c->so.use_cache = 0;
+        return 1;
+    }
+    if (!strcmp(a, "--fit") || !strcmp(a, "--no-fit")) {
+        c->fit = !strcmp(a, "--fit");
+        return 1;
+    }
+    if (!needs_value(a)) return 0;
+    if (*i + 1 >= argc) {
+        gr_fail(err, GR_E_USAGE, "%s needs a value", a);
+        return -1;
+    }
+    const char *v = argv[++*i];
+    gr_status st = GR_OK;
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+        if (!v[0]) st = gr_fail(err, GR_E_USAGE, "%s: empty directory name", a);
+        c->outdir = v;
+    } else if (!strcmp(a, "--metric")) {
+        st = gr_tune_metric_parse(a, v, &c->metric, err);
+    } else if (!strcmp(a, "--set")) {
+        if (c->so.n_sets >= GR_TUNE_MAX_SETS) st = gr_fail(err, GR_E_USAGE, "--set: more than %d overrides", GR_TUNE_MAX_SETS);
+        else if (!strchr(v, '=')) st = gr_fail(err, GR_E_USAGE, "--set %s: expected KEY=VALUE", v);
+        else c->sets[c->so.n_sets++] = v;
+    } else if (!strcmp(a, "--size")) {
+        int w = 0, h = 0;
+        char extra;
+        if (sscanf(v, "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1) {
+            st = gr_fail(err, GR_E_USAGE, "--size %s: expected WxH, e.g. 640x360", v);
+        } else {
+            snprintf(c->size_sets[0], sizeof c->size_sets[0], "camera.width=%d", w);
+            snprintf(c->size_sets[1], sizeof c->size_sets[1], "camera.height=%d", h);
+            c->sets[c->so.n_sets++] = c->size_sets[0];
+            c->sets[c->so.n_sets++] = c->size_sets[1];
+        }
+    } else if (!strcmp(a, "--frames")) {
+        c->frames_spec = v;
+    } else if (!strcmp(a, "--times")) {
+        c->times_spec = v;
+    } else if (!strcmp(a, "--fps")) {
+        char *end = NULL;
+        errno = 0;
+        double f = strtod(v, &end);
+        if (errno || end == v || *end || !isfinite(f) || !(f > 0))
+            st = gr_fail(err, GR_E_USAGE, "--fps %s: expected a number > 0", v);
+        c->fps = f;
+    } else if (!strcmp(a, "--view")) {
+        if (c->so.n_views >= GR_TUNE_MAX_VIEWS)
+            st = gr_fail(err, GR_E_USAGE, "--view: more than %d extra views", GR_TUNE_MAX_VIEWS);
+        else if ((st = gr_tune_parse_view(a, v, &c->so.views[c->so.n_views], err)) == GR_OK)
+            c->so.n_views++;
+    } else if (!strcmp(a, "--gl-platform")) {
+        if (!strcmp(v, "auto")) c->so.gl_platform = GR_GL_AUTO;
+        else if (!strcmp(v, "surfaceless")) c->so.gl_platform = GR_GL_SURFACELESS;
+        else if (!strcmp(v, "device")) c->so.gl_platform = GR_GL_DEVICE;
+        else st = gr_fail(err, GR_E_USAGE, "--gl-platform %s: expected auto, surfaceless or device", v);
+    }
+    return st == GR_OK ? 1 : -1;
+}
+
+gr_status gr_tune_cli_finish(gr_tune_cli *c, gr_error *err)
+{
+    gr_status st;
+    if (c->frames_spec && c->times_spec) return gr_fail(err, GR_E_USAGE, "--frames and --times: give one of them");
+    if (c->frames_spec) {
+        st = gr_tune_parse_frames("--frames", c->frames_spec, c->fps, c->so.times, GR_TUNE_MAX_TIMES, &c->so.n_times, err);
+        if (st != GR_OK) return st;
+        c->so.times_relative = 1;
+    }
+    if (c->times_spec) {
+        st = gr_tune_parse_times("--times", c->times_spec, c->so.times, GR_TUNE_MAX_TIMES, &c->so.n_times, err);
+        if (st != GR_OK) return st;
+    }
+    c->so.progress = !c->quiet;
+    return GR_OK;
+}

@@ -1,0 +1,221 @@
+/* Shafts-vs-ground-truth error as a function of settings (objective.h). */
+#include "tune/objective.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <cjson/cJSON.h>
+
+static const char *const metric_names[GR_TM_COUNT] = {"rmse", "relmse", "ssim", "msrmse"};
+
+gr_status gr_tune_metric_parse(const char *flag, const char *s, gr_tune_metric *m, gr_error *err)
+{
+    for (int i = 0; i < GR_TM_COUNT; i++) {
+        if (!strcmp(s, metric_names[i])) {
+            *m = (gr_tune_metric)i;
+            return GR_OK;
+        }
+    }
+    return gr_fail(err, GR_E_USAGE, "%s %s: unknown metric (expected rmse, relmse, ssim or msrmse)", flag, s);
+}
+
+const char *gr_tune_metric_name(gr_tune_metric m)
+{
+    return (m >= 0 && m < GR_TM_COUNT) ? metric_names[m] : "?";
+}
+
+double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m)
+{
+    const gr_channel_metrics *y = &set->ch[GR_MCH_Y];
+    double v;
+    switch (m) {
+    case GR_TM_RELMSE: v = y->rel_mse; break;
+    case GR_TM_SSIM: v = 1.0 - set->ssim_y; break;
+    case GR_TM_MSRMSE:
+        v = 0.0;
+        for (int k = 0; k < GR_METRICS_NSCALES; k++) v += y->rmse_blur[k];
+        v /= GR_METRICS_NSCALES;
+        break;
+    default: v = y->rmse; break;
+    }
+    return isfinite(v) ? v : 1e300;
+}
+
+gr_status gr_tune_make_case(const gr_scene *base, double time_s, const gr_tune_view *view, gr_scene *out,
+                            gr_error *err)
+{
+    if (out != base) memcpy(out, base, sizeof *out);
+    out->water.time_s = time_s;
+    if (view) {
+        out->camera.has_look_at = 0;
+        out->camera.yaw_deg = view->yaw_deg;
+        out->camera.pitch_deg = view->pitch_deg;
+    }
+    gr_status st = gr_scene_refresh(out, err);
+    if (st != GR_OK && view)
+        gr_error_prefix(err, "--view %g,%g", view->yaw_deg, view->pitch_deg);
+    return st;
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
+{
+    p->scratch = NULL;
+    if (p->n_cases < 1 || p->n_cases > GR_TUNE_MAX_CASES)
+        return gr_fail(err, GR_E_INPUT, "tuning: %d cases (1..%d)", p->n_cases, GR_TUNE_MAX_CASES);
+    if (p->n_params < 0 || p->n_params > GR_TUNE_MAX_PARAMS)
+        return gr_fail(err, GR_E_INPUT, "tuning: %d parameters (0..%d)", p->n_params, GR_TUNE_MAX_PARAMS);
+    const gr_camera *c0 = &p->scenes[0]->camera;
+    for (int i = 0; i < p->n_cases; i++) {
+        const gr_camera *c = &p->scenes[i]->camera;
+        if (c->width != c0->width || c->height != c0->height)
+            return gr_fail(err, GR_E_INPUT, "tuning: case %d is %dx%d, case 0 is %dx%d", i, c->width, c->height,
+                           c0->width, c0->height);
+        if (!p->refs[i] || p->refs[i]->width != c->width || p->refs[i]->height != c->height)
+            return gr_fail(err, GR_E_INPUT, "tuning: the ground truth of case %d is not %dx%d", i, c->width, c->height);
+    }
+    gr_shafts_settings r;
+    gr_shafts_resolve(p->scenes[0], &p->base, &r);
+    p->base = r;
+    p->scratch = gr_image_create(c0->width, c0->height, 3, NULL);
+    if (!p->scratch) return gr_fail(err, GR_E_NOMEM, "tuning: out of memory for a %dx%d frame", c0->width, c0->height);
+    p->renders = 0;
+    p->render_s = p->metrics_s = p->shafts_cpu_ms_sum = p->gpu_ms_sum = 0.0;
+    p->gpu_timed = 0;
+    return GR_OK;
+}
+
+void gr_tune_problem_free(gr_tune_problem *p)
+{
+    if (!p) return;
+    gr_image_destroy(p->scratch);
+    p->scratch = NULL;
+}
+
+gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, gr_shafts_settings *out, gr_error *err)
+{
+    *out = p->base;
+    for (int k = 0; k < p->n_params; k++) {
+        gr_status st = gr_tune_param_apply(&p->params[k], &p->base, x[k], out, err);
+        if (st != GR_OK) return st;
+    }
+    return GR_OK;
+}
+
+/* One render + metrics; opt chooses which metrics are computed. */
+static gr_status render_score(gr_tune_problem *p, int i, const gr_shafts_settings *s, gr_image *out,
+                              const gr_metrics_options *opt, gr_metrics *m, gr_error *err)
+{
+    gr_shafts_stats stats;
+    double t0 = now_s();
+    gr_status st = gr_shafts_render(p->renderer, p->scenes[i], s, out, &stats, err);
+    double t1 = now_s();
+    p->render_s += t1 - t0;
+    if (st != GR_OK) return st;
+    p->renders++;
+    p->shafts_cpu_ms_sum += stats.cpu_ms;
+    for (int k = 0; k < GR_SHAFTS_NPASS; k++) {
+        if (stats.gpu_ns[k] >= 0) {
+            p->gpu_ms_sum += (double)stats.gpu_ns[k] * 1e-6;
+            p->gpu_timed = 1;
+        }
+    }
+    st = gr_metrics_compute(p->refs[i], out, opt, m, err);
+    p->metrics_s += now_s() - t1;
+    return st;
+}
+
+gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, double *per_case, double *scale,
+                           gr_error *err)
+{
+    gr_shafts_settings s;
+    gr_status st = gr_tune_settings_at(p, x, &s, err);
+    if (st != GR_OK) return st;
+    /* Only what the metric needs: the pointwise pass is cheap, SSIM and blurs are not. */
+    gr_metrics_options opt = {0};
+    opt.stderr_bound = p->stderr_bound;
+    opt.fit_scale = p->fit;
+    opt.skip_ssim = p->metric != GR_TM_SSIM;
+    opt.skip_blur = p->metric != GR_TM_MSRMSE;
+    double sum = 0.0;
+    for (int i = 0; i < p->n_cases; i++) {
+        gr_metrics m;
+        if ((st = render_score(p, i, &s, p->scratch, &opt, &m, err)) != GR_OK) return st;
+        const gr_metrics_set *set = p->fit ? &m.fit : &m.raw;
+        double v = gr_tune_metric_value(set, p->metric);
+        sum += v;
+        if (per_case) per_case[i] = v;
+        if (scale) scale[i] = p->fit ? m.fit.scale : 1.0;
+    }
+    *mean = sum / (double)p->n_cases;
+    return GR_OK;
+}
+
+gr_status gr_tune_render_case(gr_tune_problem *p, int i, const gr_shafts_settings *s, gr_image *out, gr_metrics *m,
+                              gr_error *err)
+{
+    if (i < 0 || i >= p->n_cases) return gr_fail(err, GR_E_INPUT, "tuning: no case %d", i);
+    gr_metrics_options opt = {0};
+    opt.stderr_bound = p->stderr_bound;
+    opt.fit_scale = 1;
+    gr_metrics local;
+    return render_score(p, i, s, out, &opt, m ? m : &local, err);
+}
+
+gr_status gr_tune_objective(void *user, const double *x, double *f, gr_error *err)
+{
+    return gr_tune_evaluate((gr_tune_problem *)user, x, f, NULL, NULL, err);
+}
+
+static double round_sig(double v, int digits)
+{
+    if (v == 0.0 || !isfinite(v)) return v;
+    char buf[64];
+    snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return strtod(buf, NULL);
+}
+
+static int add_rgb(cJSON *o, const char *name, const double *rgb)
+{
+    double r[3] = {round_sig(rgb[0], 5), round_sig(rgb[1], 5), round_sig(rgb[2], 5)};
+    cJSON *a = cJSON_CreateDoubleArray(r, 3);
+    return a && cJSON_AddItemToObject(o, name, a);
+}
+
+char *gr_tune_snippet(const gr_tune_problem *p, const double *x, double scale)
+{
+    gr_shafts_settings s;
+    gr_error e;
+    if (gr_tune_settings_at(p, x, &s, &e) != GR_OK) return NULL;
+    cJSON *root = cJSON_CreateObject();
+    cJSON *sh = root ? cJSON_AddObjectToObject(root, "shafts") : NULL;
+    int ok = sh != NULL, has_intensity = 0;
+    for (int k = 0; ok && k < p->n_params; k++) {
+        const gr_tune_param *tp = &p->params[k];
+        if (!strcmp(tp->p->name, "intensity")) has_intensity = 1;
+        if (tp->kind == GR_TK_RGB_SCALE) {
+            const double *rgb = (const double *)((const char *)&s + tp->p->offset);
+            ok = add_rgb(sh, tp->p->name, rgb);
+        } else {
+            double v = gr_param_get_number(tp->p, &s, 0);
+            ok = cJSON_AddNumberToObject(sh, tp->p->name, tp->kind == GR_TK_INT ? v : round_sig(v, 5)) != NULL;
+        }
+    }
+    if (ok && !has_intensity && scale > 0 && scale != 1.0) {
+        double in[3];
+        for (int c = 0; c < 3; c++) in[c] = s.intensity[c] * scale;
+        ok = add_rgb(sh, "intensity", in);
+    }
+    char *text = ok ? cJSON_Print(root) : NULL;
+    cJSON_Delete(root);
+    return text;
+}

@@ -1,0 +1,92 @@
+/* The error of the real-time shafts against ground truth images, as a function of a few
+ * shafts settings: what `godrays sweep` tabulates and `godrays tune` minimizes. One GL
+ * renderer (context, programs, buffers) serves every evaluation; each case is one frame
+ * (water time) and camera view with its own ground truth. docs/tuning.md. */
+#ifndef GR_TUNE_OBJECTIVE_H
+#define GR_TUNE_OBJECTIVE_H
+
+#include "common/status.h"
+#include "compare/metrics.h"
+#include "image/image.h"
+#include "realtime/shafts.h"
+#include "scene/scene.h"
+#include "tune/paramspec.h"
+
+#define GR_TUNE_MAX_CASES 64
+
+typedef enum gr_tune_metric {
+    GR_TM_RMSE = 0,   /* RMSE of luminance Y */
+    GR_TM_RELMSE = 1, /* relative MSE of Y (docs/metrics.md) */
+    GR_TM_SSIM = 2,   /* 1 - SSIM of Y (so that lower is better, 0 = identical) */
+    GR_TM_MSRMSE = 3, /* mean of the RMSEs of Y after blurs at sigma 1, 4, 16 px */
+    GR_TM_COUNT
+} gr_tune_metric;
+
+/* "rmse", "relmse", "ssim", "msrmse". GR_E_USAGE naming flag for anything else. */
+gr_status gr_tune_metric_parse(const char *flag, const char *s, gr_tune_metric *m, gr_error *err);
+const char *gr_tune_metric_name(gr_tune_metric m);
+/* The metric's value from a computed set (raw or fit): lower is better, always finite. */
+double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m);
+
+/* A camera view for tuning beyond the scene's own: same position and fov, other direction. */
+typedef struct gr_tune_view {
+    double yaw_deg, pitch_deg;
+} gr_tune_view;
+
+/* Copies base into out with the water time set to time_s and, if view is not NULL, the
+ * camera turned to (yaw, pitch) (a look_at camera becomes a yaw/pitch one); re-validated
+ * through gr_scene_refresh (errors name the view). */
+gr_status gr_tune_make_case(const gr_scene *base, double time_s, const gr_tune_view *view, gr_scene *out,
+                            gr_error *err);
+
+typedef struct gr_tune_problem {
+    gr_shafts *renderer;                /* created by the caller, reused for every render */
+    int n_cases;                        /* 1..GR_TUNE_MAX_CASES */
+    const gr_scene *scenes[GR_TUNE_MAX_CASES];
+    const gr_image *refs[GR_TUNE_MAX_CASES]; /* ground truth per case (R, G, B [, stderr]) */
+    gr_shafts_settings base;            /* settings the parameters modify (resolved on init) */
+    int n_params;
+    gr_tune_param params[GR_TUNE_MAX_PARAMS];
+    gr_tune_metric metric;
+    int fit;                            /* score the test after the best scale fit */
+    double stderr_bound;                /* passed to the metrics (0: default) */
+    /* filled by gr_tune_problem_init */
+    gr_image *scratch;                  /* one frame (R, G, B) */
+    /* accounting since init */
+    long long renders;
+    double render_s, metrics_s;         /* wall time in gr_shafts_render / gr_metrics_compute */
+    double shafts_cpu_ms_sum;           /* sum of the renderer's own cpu_ms */
+    double gpu_ms_sum;                  /* sum of per-pass GPU times (-1 entries skipped) */
+    int gpu_timed;                      /* 1 if any GPU time was available */
+} gr_tune_problem;
+
+/* Resolves base (scene-derived defaults from case 0) and allocates the scratch frame. The
+ * caller fills renderer, cases, base, params, metric, fit first. GR_E_INPUT if the cases
+ * differ in size from their references; GR_E_NOMEM. */
+gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err);
+void gr_tune_problem_free(gr_tune_problem *p); /* frees what init allocated; accepts NULL */
+
+/* The settings for parameter values x[0..n_params). */
+gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, gr_shafts_settings *out, gr_error *err);
+
+/* Renders every case at x and scores it: *mean = mean over the cases of the metric;
+ * per_case[i] (may be NULL) = each case's value, scale[i] (may be NULL) = the fitted scale
+ * (1 without fit). */
+gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, double *per_case, double *scale,
+                           gr_error *err);
+
+/* Renders case i at settings s into out (frame-sized, R, G, B) and computes all metrics
+ * (SSIM and blurs included) into m (may be NULL). */
+gr_status gr_tune_render_case(gr_tune_problem *p, int i, const gr_shafts_settings *s, gr_image *out, gr_metrics *m,
+                              gr_error *err);
+
+/* The settings at x as a snippet ready to paste into the scene: {"shafts": {KEY: value, ...}}
+ * with every parameter (RGB settings as [r, g, b] = base x scale) rounded to 5 significant
+ * digits; with scale > 0 and != 1 (the fitted scale) also "intensity" = base intensity x scale,
+ * unless intensity is a parameter. malloc'd text (caller frees); NULL on failure. */
+char *gr_tune_snippet(const gr_tune_problem *p, const double *x, double scale);
+
+/* The objective for gr_opt_minimize: user = gr_tune_problem. */
+gr_status gr_tune_objective(void *user, const double *x, double *f, gr_error *err);
+
+#endif

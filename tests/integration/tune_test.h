@@ -1,0 +1,52 @@
+/* Helpers shared by tests/integration/test_tune_*.c (header-only). */
+#ifndef GR_TUNE_TEST_H
+#define GR_TUNE_TEST_H
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "realtime/shafts.h"
+#include "scene/scene.h"
+#include "tune/objective.h"
+
+/* The default scene (data/scenes/default.json) at w x h plus overrides; exits on failure. */
+static inline gr_scene *tune_test_default_scene(int w, int h, const char *const *extra, int n_extra)
+{
+    const char *src = getenv("GODRAYS_SOURCE_DIR");
+    char path[4096], sw[64], sh[64];
+    snprintf(path, sizeof path, "%s/data/scenes/default.json", src ? src : GR_SOURCE_DIR);
+    snprintf(sw, sizeof sw, "camera.width=%d", w);
+    snprintf(sh, sizeof sh, "camera.height=%d", h);
+    const char *sets[18] = {sw, sh};
+    int n = 2;
+    for (int i = 0; i < n_extra && n < 18; i++) sets[n++] = extra[i];
+    gr_scene *s = malloc(sizeof *s);
+    gr_error err;
+    if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
+        fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
+        exit(1);
+    }
+    return s;
+}
+
+static inline gr_shafts *tune_test_renderer(void)
+{
+    gr_error err;
+    gr_shafts *r = NULL;
+    if (gr_shafts_create(NULL, &r, &err) != GR_OK) {
+        fprintf(stderr, "cannot create the shafts renderer: %s\n", err.msg);
+        exit(1);
+    }
+    return r;
+}
+
+/* 1 if GODRAYS_TEST_REDUCED is set to a non-empty value other than "0" */
+static inline int tune_test_reduced(void)
+{
+    const char *v = getenv("GODRAYS_TEST_REDUCED");
+    return v && v[0] && strcmp(v, "0") != 0;
+}
+
+#endif
