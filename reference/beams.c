@@ -245,21 +245,21 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
         float g[3][2] = {{-(e2w - e1w), e2u - e1u}, {e2w, -e2u}, {-e1w, e1u}}; /* grad f_i in (u, w) */
         float fa[3] = {f0, f1, f2};
         double a[3], bb[6];
-        int inside = 1;
+        unsigned cut = 0; /* edges that cross the kernel */
         float rho = (float)b->kc_rho;
         for (int i = 0; i < 3; i++) {
             float bx = sg * dd * (M[0] * g[i][0] + M[2] * g[i][1]);
             float by = sg * dd * (M[1] * g[i][0] + M[3] * g[i][1]);
-            float ai = sg * fa[i], ext = rho * hypotf(bx, by);
+            float ai = sg * fa[i], ext = rho * sqrtf(bx * bx + by * by);
             if (ai < -ext) return false;     /* the kernel lies wholly outside edge i */
-            if (ai < ext) inside = 0;
+            if (ai < ext) cut |= 1u << i;
             a[i] = ai;
             bb[2 * i] = bx;
             bb[2 * i + 1] = by;
         }
         float detM = M[0] * M[3] - M[1] * M[2];
         float areaK = dd * dd * fabsf(detM) * (float)b->kc_area; /* the kernel's area (m^2) */
-        if (inside) {
+        if (!cut) {
             /* the kernel lies wholly inside the cross-section: the beam's own irradiance */
             if (det == 0.0f) return false;
             e_h = b->phi[t] / (0.5f * fabsf(det));
@@ -279,7 +279,7 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
                 e_h = b->phi[t] / areaK;
             } else {
                 if (det == 0.0f) return false;
-                double frac = clip_area((const double (*)[2])b->kc, GR_BEAM_KERNEL_N, a, bb, 7u) / b->kc_area;
+                double frac = clip_area((const double (*)[2])b->kc, GR_BEAM_KERNEL_N, a, bb, cut) / b->kc_area;
                 if (!(frac > 0.0)) return false;
                 /* exact: flux area(tri n K) / (|A| area(K)) <= flux / area(K); the bound only
                  * guards the rounding of a nearly collapsed cross-section */

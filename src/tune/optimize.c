@@ -34,7 +34,7 @@ static int lattice_mult(int d, int m)
         a = cand;
         if (found++ == d) break;
     }
-    return a % (m > 1 ? m : 1) ? a : 1;
+    return m > 1 ? a : 1;
 }
 
 void gr_opt_lattice_point(int n, int j, int m, double *u)

@@ -1,0 +1,318 @@
+/* godrays pareto SCENE: speed against error of both renderers (src/tune/pareto.h): the ground
+ * truth at increasing quality against a high-quality one, and the real-time shafts over
+ * settings that trade speed for quality (N, target scale, 8-bit vs 16F). */
+#include "cli/cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "compare/metrics.h"
+#include "realtime/shafts.h"
+#include "report/report.h"
+#include "tune/pareto.h"
+#include "tune/session.h"
+#include "tune/truth.h"
+
+#define MAX_SETS 256
+#define MAX_POINTS 64
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: godrays pareto SCENE [-o DIR] [options]\n"
+            "\n"
+            "Speed against error. Renders a high-quality ground truth (4x the default sun directions,\n"
+            "2x the march steps, 1.5x the surface resolution, another seed; cached), then\n"
+            "  - the ground truth at increasing quality (q0..q4: sun directions, batches, steps,\n"
+            "    surface resolution; each timed, never cached), error against the high-quality one;\n"
+            "  - the real-time shafts for N in {6, 11, 21}, target scale in {0.25, 0.5, 1} and\n"
+            "    rgba8/rgba16f targets (median time of --repeat renders in one context), error after\n"
+            "    the best scale fit.\n"
+            "Error = RMSE of luminance Y / mean Y of the high-quality ground truth. Shafts time is\n"
+            "the wall time of a render with readback (llvmpipe without a GPU); GL pass timers are\n"
+            "listed too. Writes DIR/pareto.csv and DIR/pareto.png (both families and their Pareto\n"
+            "fronts). docs/tuning.md.\n"
+            "\n"
+            "options:\n"
+            "  -o, --output DIR   folder (default: out/SCENE_NAME/pareto)\n"
+            "  --size WxH         image size (default 320x180: the high-quality ground truth costs\n"
+            "                     about 8x a default-quality one)\n"
+            "  --set KEY=VALUE    override a scene value (repeatable)\n"
+            "  --quick            fewer points (q0..q2, N in {6, 11}, scale 0.5 and 1), for tests\n"
+            "  --repeat R         shafts renders per setting; time = median (default 5)\n"
+            "  --no-cache         render the high-quality ground truth even if cached\n"
+            "  --gl-platform P    auto, surfaceless or device\n"
+            "  -q, --quiet        no progress messages\n"
+            "  -h, --help         this help\n"
+            "\n"
+            "Exit codes: 0 ok, 1 runtime failure, 2 bad usage or bad scene.\n");
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Relative RMSE of Y: RMSE / mean reference Y (0 mean: the RMSE itself). */
+static double rel_rmse(const gr_metrics_set *set)
+{
+    const gr_channel_metrics *y = &set->ch[GR_MCH_Y];
+    return y->ref_mean > 0 ? y->rmse / y->ref_mean : y->rmse;
+}
+
+/* Reference quality ladder (docs/tuning.md): each level about twice the work of the one before. */
+typedef struct ref_level {
+    const char *name;
+    int sun_samples, batches, steps, surface_res, spp;
+} ref_level;
+static const ref_level levels[] = {
+    {"q0", 1, 1, 16, 64, 1},  {"q1", 2, 2, 32, 128, 1},  {"q2", 4, 4, 48, 192, 1},
+    {"q3 (default)", 8, 8, 64, 256, 1}, {"q4", 16, 8, 96, 256, 1},
+};
+static const ref_level hq = {"hq", 32, 8, 128, 384, 1};
+
+static void set_level(gr_scene *s, const ref_level *l)
+{
+    s->reference.sun_samples = l->sun_samples;
+    s->reference.batches = l->batches;
+    s->reference.steps = l->steps;
+    s->reference.surface_res = l->surface_res;
+    s->reference.spp = l->spp;
+}
+
+int cmd_pareto(int argc, char **argv)
+{
+    const char *cmd = "pareto";
+    const char *scene_path = NULL, *outdir = NULL;
+    const char *sets[MAX_SETS + 2];
+    char size_set[2][48];
+    int n_sets = 0, quiet = 0, quick = 0, use_cache = 1, have_size = 0;
+    long repeat = 5;
+    gr_gl_platform platform = GR_GL_AUTO;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            usage(stdout);
+            return 0;
+        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+            quiet = 1;
+        } else if (!strcmp(a, "--quick")) {
+            quick = 1;
+        } else if (!strcmp(a, "--no-cache")) {
+            use_cache = 0;
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--set") || !strcmp(a, "--size") ||
+                   !strcmp(a, "--repeat") || !strcmp(a, "--gl-platform")) {
+            if (i + 1 >= argc) return gr_cli_usage_error(cmd, "%s needs a value", a);
+            const char *v = argv[++i];
+            if (!strcmp(a, "--set")) {
+                if (n_sets >= MAX_SETS) return gr_cli_usage_error(cmd, "--set: more than %d overrides", MAX_SETS);
+                if (!strchr(v, '=')) return gr_cli_usage_error(cmd, "--set %s: expected KEY=VALUE", v);
+                sets[n_sets++] = v;
+            } else if (!strcmp(a, "--size")) {
+                int w = 0, h = 0;
+                char extra;
+                if (sscanf(v, "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1)
+                    return gr_cli_usage_error(cmd, "--size %s: expected WxH, e.g. 320x180", v);
+                snprintf(size_set[0], sizeof size_set[0], "camera.width=%d", w);
+                snprintf(size_set[1], sizeof size_set[1], "camera.height=%d", h);
+                have_size = 1;
+            } else if (!strcmp(a, "--repeat")) {
+                char *end = NULL;
+                errno = 0;
+                repeat = strtol(v, &end, 10);
+                if (errno || end == v || *end || repeat < 1 || repeat > 1000)
+                    return gr_cli_usage_error(cmd, "--repeat %s: expected an integer in [1, 1000]", v);
+            } else if (!strcmp(a, "--gl-platform")) {
+                if (!strcmp(v, "auto")) platform = GR_GL_AUTO;
+                else if (!strcmp(v, "surfaceless")) platform = GR_GL_SURFACELESS;
+                else if (!strcmp(v, "device")) platform = GR_GL_DEVICE;
+                else return gr_cli_usage_error(cmd, "--gl-platform %s: expected auto, surfaceless or device", v);
+            } else {
+                if (!v[0]) return gr_cli_usage_error(cmd, "%s: empty directory name", a);
+                outdir = v;
+            }
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return gr_cli_usage_error(cmd, "unknown option %s", a);
+        } else {
+            if (scene_path) return gr_cli_usage_error(cmd, "more than one scene given (%s, %s)", scene_path, a);
+            scene_path = a;
+        }
+    }
+    if (!scene_path) return gr_cli_usage_error(cmd, "no scene file given");
+    if (!have_size) {
+        snprintf(size_set[0], sizeof size_set[0], "camera.width=320");
+        snprintf(size_set[1], sizeof size_set[1], "camera.height=180");
+    }
+    sets[n_sets++] = size_set[0];
+    sets[n_sets++] = size_set[1];
+
+    gr_error err = {GR_OK, ""};
+    gr_scene *scene = malloc(sizeof *scene), *work = malloc(sizeof *work);
+    gr_image *truth = NULL, *img = NULL;
+    gr_shafts *r = NULL;
+    gr_pareto_point *pts = calloc(MAX_POINTS, sizeof *pts);
+    int n = 0, rc = 0;
+    char dirbuf[4096], path[4300];
+    if (!scene || !work || !pts) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        goto fail;
+    }
+    if (gr_scene_load_file(scene_path, sets, n_sets, scene, &err) != GR_OK) goto fail;
+    if (gr_shafts_check_settings(&scene->shafts, &err) != GR_OK) goto fail;
+    if (!outdir) {
+        gr_tune_default_dir(scene->name, "pareto", dirbuf, sizeof dirbuf);
+        outdir = dirbuf;
+    }
+    gr_shafts_options so;
+    memset(&so, 0, sizeof so);
+    so.gl.platform = platform;
+    if (gr_shafts_create(&so, &r, &err) != GR_OK) goto fail;
+
+    /* the high-quality ground truth, with its own seed so that no ladder level shares its
+     * random numbers (a shared seed would make the lower levels look better than they are) */
+    memcpy(work, scene, sizeof *work);
+    set_level(work, &hq);
+    work->reference.seed = scene->reference.seed + 7919;
+    if (gr_scene_refresh(work, &err) != GR_OK) goto fail;
+    if (!quiet) fprintf(stderr, "godrays pareto: high-quality ground truth (%d x %d)...\n", work->camera.width,
+                        work->camera.height);
+    gr_truth_info ti;
+    if (gr_truth_get(work, use_cache, !quiet, &truth, &ti, &err) != GR_OK) goto fail;
+    if (!quiet && ti.cached) fprintf(stderr, "godrays pareto:   from the cache %s\n", ti.path);
+
+    gr_metrics_options mo = {0};
+    mo.skip_ssim = 1;
+    mo.skip_blur = 1;
+    gr_metrics m;
+    /* ground truth ladder */
+    int n_levels = quick ? 3 : (int)(sizeof levels / sizeof levels[0]);
+    for (int l = 0; l < n_levels; l++) {
+        memcpy(work, scene, sizeof *work);
+        set_level(work, &levels[l]);
+        if (gr_scene_refresh(work, &err) != GR_OK) goto fail;
+        if (!quiet) fprintf(stderr, "godrays pareto: ground truth %s...\n", levels[l].name);
+        gr_image *ri = NULL;
+        double secs = 0;
+        if (gr_truth_render(work, !quiet, &ri, &secs, &err) != GR_OK) goto fail;
+        /* no stderr exclusion: the HQ image is the reference, its own noise is tiny */
+        gr_metrics_options ro = mo;
+        ro.stderr_bound = INFINITY;
+        gr_status st = gr_metrics_compute(truth, ri, &ro, &m, &err);
+        gr_image_destroy(ri);
+        if (st != GR_OK) goto fail;
+        gr_pareto_point *p = &pts[n++];
+        p->family = GR_PARETO_REFERENCE;
+        snprintf(p->label, sizeof p->label, "%s", levels[l].name);
+        snprintf(p->settings, sizeof p->settings, "sun_samples=%d;batches=%d;steps=%d;surface_res=%d;spp=%d",
+                 levels[l].sun_samples, levels[l].batches, levels[l].steps, levels[l].surface_res, levels[l].spp);
+        p->time_s = secs;
+        p->gpu_s = -1;
+        p->error = rel_rmse(&m.raw);
+    }
+
+    /* shafts over settings that trade speed for quality */
+    static const int Ns[] = {6, 11, 21};
+    static const double scales[] = {0.25, 0.5, 1.0};
+    img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
+    double *times = malloc((size_t)repeat * sizeof *times), *gpus = malloc((size_t)repeat * sizeof *gpus);
+    if (!img || !times || !gpus) {
+        free(times);
+        free(gpus);
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        goto fail;
+    }
+    int gpu_any = 0;
+    const int n_N = quick ? 2 : 3;
+    for (int in = 0; in < n_N; in++)
+        for (int is = quick ? 1 : 0; is < 3; is++)
+            for (int fmt = 0; fmt < 2; fmt++) {
+                gr_shafts_settings s = scene->shafts;
+                s.N = Ns[in];
+                s.target_scale = scales[is];
+                s.target_format = fmt ? GR_TARGET_RGBA16F : GR_TARGET_RGBA8;
+                gr_shafts_stats stats;
+                /* warm-up render: buffers rebuilt for a new N or target size, shader JIT */
+                gr_status st = gr_shafts_render(r, scene, &s, img, &stats, &err);
+                for (long k = 0; st == GR_OK && k < repeat; k++) {
+                    st = gr_shafts_render(r, scene, &s, img, &stats, &err);
+                    times[k] = stats.cpu_ms * 1e-3;
+                    double g = 0;
+                    int ok = 1;
+                    for (int q = 0; q < GR_SHAFTS_NPASS; q++) {
+                        if (stats.gpu_ns[q] < 0) ok = 0;
+                        else g += (double)stats.gpu_ns[q] * 1e-9;
+                    }
+                    gpus[k] = ok ? g : -1;
+                }
+                if (st == GR_OK) {
+                    gr_metrics_options fo = mo;
+                    fo.fit_scale = 1;
+                    fo.stderr_bound = INFINITY;
+                    st = gr_metrics_compute(truth, img, &fo, &m, &err);
+                }
+                if (st != GR_OK) {
+                    free(times);
+                    free(gpus);
+                    goto fail;
+                }
+                qsort(times, (size_t)repeat, sizeof *times, cmp_double);
+                qsort(gpus, (size_t)repeat, sizeof *gpus, cmp_double);
+                gr_pareto_point *p = &pts[n++];
+                p->family = GR_PARETO_SHAFTS;
+                snprintf(p->label, sizeof p->label, "N=%d scale=%g %s", s.N, s.target_scale, fmt ? "rgba16f" : "rgba8");
+                snprintf(p->settings, sizeof p->settings, "N=%d;target_scale=%g;target_format=%s", s.N, s.target_scale,
+                         fmt ? "rgba16f" : "rgba8");
+                p->time_s = times[repeat / 2];
+                p->gpu_s = gpus[repeat / 2];
+                if (p->gpu_s >= 0) gpu_any = 1;
+                p->error = rel_rmse(&m.fit);
+                if (!quiet) fprintf(stderr, "godrays pareto: shafts %s: %.2f ms, error %.4g\n", p->label,
+                                    1e3 * p->time_s, p->error);
+            }
+    free(times);
+    free(gpus);
+    gr_pareto_mark_fronts(pts, n);
+
+    const char *glr = gr_gl_renderer(gr_shafts_gl(r));
+    int is_llvmpipe = glr && strstr(glr, "llvmpipe") != NULL;
+    char tlabel[128], title[256];
+    snprintf(tlabel, sizeof tlabel, "%s wall time", is_llvmpipe ? "llvmpipe" : "GPU frame");
+    snprintf(title, sizeof title, "speed vs error, scene '%s' %dx%d (shafts on %s)", scene->name, scene->camera.width,
+             scene->camera.height, is_llvmpipe ? "llvmpipe, no GPU" : glr);
+    if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
+    snprintf(path, sizeof path, "%s/pareto.csv", outdir);
+    if (gr_pareto_write_csv(path, pts, n, &err) != GR_OK) goto fail;
+    int drawn = 0;
+    snprintf(path, sizeof path, "%s/pareto.png", outdir);
+    if (gr_pareto_write_plot(path, pts, n, title, tlabel, &drawn, &err) != GR_OK) goto fail;
+
+    printf("scene '%s' (%d x %d); high-quality ground truth %.1f s (%s); shafts on %s\n", scene->name,
+           scene->camera.width, scene->camera.height, ti.seconds, ti.cached ? "from the cache" : "rendered", glr);
+    printf("%-10s %-34s %12s %12s %12s %6s\n", "family", "setting", "time ms", "GL timers ms", "rel. RMSE Y", "front");
+    for (int i = 0; i < n; i++) {
+        char g[32];
+        if (pts[i].gpu_s >= 0) snprintf(g, sizeof g, "%.3f", 1e3 * pts[i].gpu_s);
+        else snprintf(g, sizeof g, "n/a");
+        printf("%-10s %-34s %12.2f %12s %12.4g %6s\n", pts[i].family ? "shafts" : "reference", pts[i].label,
+               1e3 * pts[i].time_s, g, pts[i].error, pts[i].on_front ? "*" : "");
+    }
+    printf("GL pass timers %s; shaft times are %s\n", gpu_any ? "available" : "unavailable",
+           is_llvmpipe ? "llvmpipe (CPU) wall times" : "wall times on the GPU");
+    printf("written: %s/pareto.csv%s\n", outdir, drawn ? ", pareto.png" : " (no plot: charts need PLplot)");
+    goto done;
+fail:
+    rc = gr_cli_report(cmd, &err);
+done:
+    gr_image_destroy(img);
+    gr_image_destroy(truth);
+    gr_shafts_destroy(r);
+    free(pts);
+    free(work);
+    free(scene);
+    return rc;
+}

@@ -1,0 +1,124 @@
+/* Pareto fronts and the speed/error outputs (pareto.h). */
+#include "tune/pareto.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "report/plot.h"
+
+void gr_pareto_front(int n, const double *cost, const double *err, int *on_front)
+{
+    for (int i = 0; i < n; i++) {
+        on_front[i] = isfinite(cost[i]) && isfinite(err[i]);
+        for (int j = 0; j < n && on_front[i]; j++) {
+            if (j == i || !isfinite(cost[j]) || !isfinite(err[j])) continue;
+            if (cost[j] <= cost[i] && err[j] <= err[i] && (cost[j] < cost[i] || err[j] < err[i])) on_front[i] = 0;
+        }
+    }
+}
+
+void gr_pareto_mark_fronts(gr_pareto_point *pts, int n)
+{
+    double *c = malloc((size_t)(n > 0 ? n : 1) * sizeof *c), *e = malloc((size_t)(n > 0 ? n : 1) * sizeof *e);
+    int *f = malloc((size_t)(n > 0 ? n : 1) * sizeof *f), *idx = malloc((size_t)(n > 0 ? n : 1) * sizeof *idx);
+    if (!c || !e || !f || !idx) {
+        for (int i = 0; i < n; i++) pts[i].on_front = 0;
+    } else {
+        for (int fam = 0; fam < 2; fam++) {
+            int m = 0;
+            for (int i = 0; i < n; i++)
+                if (pts[i].family == fam) {
+                    c[m] = pts[i].time_s;
+                    e[m] = pts[i].error;
+                    idx[m++] = i;
+                }
+            gr_pareto_front(m, c, e, f);
+            for (int k = 0; k < m; k++) pts[idx[k]].on_front = f[k];
+        }
+    }
+    free(c);
+    free(e);
+    free(f);
+    free(idx);
+}
+
+gr_status gr_pareto_write_csv(const char *path, const gr_pareto_point *pts, int n, gr_error *err)
+{
+    char tmp[4200];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
+        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
+    fprintf(f, "family,label,settings,time_s,gpu_s,error,on_front\n");
+    for (int i = 0; i < n; i++)
+        fprintf(f, "%s,%s,%s,%.6g,%.6g,%.6g,%d\n", pts[i].family == GR_PARETO_REFERENCE ? "reference" : "shafts",
+                pts[i].label, pts[i].settings, pts[i].time_s, pts[i].gpu_s, pts[i].error, pts[i].on_front);
+    int bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, path) != 0) {
+        remove(tmp);
+        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
+    }
+    return GR_OK;
+}
+
+/* The points of one family as isolated markers (a NaN between points breaks the line, per
+ * gr_plot_series), and its front sorted by time as a line. */
+static int family_series(const gr_pareto_point *pts, int n, int fam, double *px, double *py, double *fx, double *fy,
+                         int *nf)
+{
+    int m = 0;
+    *nf = 0;
+    for (int i = 0; i < n; i++) {
+        if (pts[i].family != fam) continue;
+        px[m] = pts[i].time_s;
+        py[m++] = pts[i].error;
+        px[m] = NAN;
+        py[m++] = NAN;
+        if (pts[i].on_front) {
+            int k = (*nf)++;
+            while (k > 0 && fx[k - 1] > pts[i].time_s) {
+                fx[k] = fx[k - 1];
+                fy[k] = fy[k - 1];
+                k--;
+            }
+            fx[k] = pts[i].time_s;
+            fy[k] = pts[i].error;
+        }
+    }
+    return m;
+}
+
+gr_status gr_pareto_write_plot(const char *path, const gr_pareto_point *pts, int n, const char *title,
+                               const char *time_label, int *drawn, gr_error *err)
+{
+    *drawn = 0;
+    if (!gr_plot_available()) return GR_OK;
+    size_t cap = (size_t)(2 * n + 2);
+    double *buf = malloc(cap * 8 * sizeof *buf);
+    if (!buf) return gr_fail(err, GR_E_NOMEM, "pareto plot: out of memory");
+    double *rx = buf, *ry = rx + cap, *rfx = ry + cap, *rfy = rfx + cap;
+    double *sx = rfy + cap, *sy = sx + cap, *sfx = sy + cap, *sfy = sfx + cap;
+    int nrf = 0, nsf = 0;
+    int nr = family_series(pts, n, GR_PARETO_REFERENCE, rx, ry, rfx, rfy, &nrf);
+    int ns = family_series(pts, n, GR_PARETO_SHAFTS, sx, sy, sfx, sfy, &nsf);
+    char slabel[160];
+    snprintf(slabel, sizeof slabel, "real-time shafts (%s)", time_label ? time_label : "wall time");
+    gr_plot_series s[4] = {
+        {.label = "ground truth at lower quality", .x = rx, .y = ry, .n = nr, .rgb = {214, 39, 40}, .markers = 1},
+        {.label = "", .x = rfx, .y = rfy, .n = nrf, .rgb = {214, 39, 40}, .style = GR_PLOT_DASHED},
+        {.label = slabel, .x = sx, .y = sy, .n = ns, .rgb = {31, 119, 180}, .markers = 1},
+        {.label = "Pareto fronts (dashed)", .x = sfx, .y = sfy, .n = nsf, .rgb = {31, 119, 180},
+         .style = GR_PLOT_DASHED},
+    };
+    gr_plot_spec spec = {.width = 900, .height = 560, .title = title, .xlabel = "time per frame (s)",
+                         .ylabel = "relative RMSE of Y vs high-quality ground truth", .log_x = 1, .log_y = 1,
+                         .series = s, .n_series = 4, .legend_headroom = 0.0};
+    gr_status st = gr_plot_write(path, &spec, err);
+    free(buf);
+    if (st == GR_OK) *drawn = 1;
+    return st;
+}

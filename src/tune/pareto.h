@@ -1,0 +1,36 @@
+/* Speed against error (`godrays pareto`): points (time, error) of the two renderers, their
+ * Pareto fronts (the points no other point of the same family beats in both time and error),
+ * the CSV and the log-log plot with both families and their fronts. docs/tuning.md. */
+#ifndef GR_TUNE_PARETO_H
+#define GR_TUNE_PARETO_H
+
+#include "common/status.h"
+
+enum { GR_PARETO_REFERENCE = 0, GR_PARETO_SHAFTS = 1 };
+
+typedef struct gr_pareto_point {
+    int family;              /* GR_PARETO_REFERENCE or GR_PARETO_SHAFTS */
+    char label[96];          /* e.g. "N=11 scale=0.5 rgba8" or "q3 (default)" */
+    char settings[256];      /* the settings as KEY=VALUE;... for the CSV */
+    double time_s;           /* wall time per frame (reference: whole render) */
+    double gpu_s;            /* shafts: summed GL pass timers per frame; -1 unknown */
+    double error;            /* relative RMSE of Y against the high-quality reference */
+    int on_front;            /* set by gr_pareto_mark_fronts */
+} gr_pareto_point;
+
+/* on_front[i] = 1 iff no j with cost[j] <= cost[i] and err[j] <= err[i], one strictly
+ * (non-finite points are never on the front and never dominate). O(n^2). */
+void gr_pareto_front(int n, const double *cost, const double *err, int *on_front);
+
+/* Marks each point's on_front within its own family. */
+void gr_pareto_mark_fronts(gr_pareto_point *pts, int n);
+
+/* pareto.csv: family,label,settings,time_s,gpu_s,error,on_front. */
+gr_status gr_pareto_write_csv(const char *path, const gr_pareto_point *pts, int n, gr_error *err);
+
+/* The plot (PLplot, log-log): both families as markers, their fronts as lines. time_label
+ * names the shafts' timing ("llvmpipe wall time" / "GPU time"). *drawn = 0 without PLplot. */
+gr_status gr_pareto_write_plot(const char *path, const gr_pareto_point *pts, int n, const char *title,
+                               const char *time_label, int *drawn, gr_error *err);
+
+#endif

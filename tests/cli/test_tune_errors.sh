@@ -1,0 +1,65 @@
+#!/bin/sh
+# `godrays sweep` and `godrays tune` with bad parameter specs or options: exit 2, exactly one
+# stderr line that names the flag and the reason, nothing on stdout, nothing rendered
+# (these are all rejected before any GL or ground-truth work).
+bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+cat >"$dir/s.json" <<'JSON'
+{"name": "small", "water": {"waves": [{"amplitude_m": 0.1, "wavelength_m": 8, "direction_deg": 30}]},
+ "sun": {"elevation_deg": 60, "azimuth_deg": 30},
+ "medium": {"absorption_per_m": [0.3, 0.06, 0.03], "scattering_per_m": 0.03, "g": 0.8},
+ "camera": {"position_m": [0, -8, 0], "yaw_deg": 30, "pitch_deg": 60, "fov_deg": 60, "width": 32, "height": 18}}
+JSON
+fail=0
+expect() {
+  want=$1; text=$2; shift 2
+  "$bin" "$@" >"$dir/out" 2>"$dir/err"
+  rc=$?
+  lines=$(wc -l <"$dir/err")
+  if [ "$rc" -ne "$want" ] || [ "$lines" -ne 1 ] || ! grep -qF -- "$text" "$dir/err" || [ -s "$dir/out" ]; then
+    echo "FAIL: $*: exit $rc (want $want), $lines stderr line(s) (want 1 containing '$text'):"
+    cat "$dir/err"; fail=1
+  else
+    echo "ok: $*: $(cat "$dir/err")"
+  fi
+}
+s="$dir/s.json"
+o="$dir/o"
+# sweep: unknown key, empty range, non-numeric, bad count, enum/bool, malformed
+expect 2 "--param shafts.nope: unknown shafts setting" sweep "$s" -o "$o" --param shafts.nope=0:1:4
+expect 2 "unknown parameter" sweep "$s" -o "$o" --param medium.g=0:1:4
+expect 2 "empty range" sweep "$s" -o "$o" --param shafts.K=1.2:0.4:16
+expect 2 "empty range" sweep "$s" -o "$o" --param shafts.K=0.5:0.5:4
+expect 2 "LO and HI must be finite numbers" sweep "$s" -o "$o" --param shafts.K=abc:1:4
+expect 2 "COUNT must be an integer" sweep "$s" -o "$o" --param shafts.K=0.4:1.2:x
+expect 2 "COUNT must be in" sweep "$s" -o "$o" --param shafts.K=0.4:1.2:0
+expect 2 "not a numeric setting" sweep "$s" -o "$o" --param shafts.target_format=0:1:2
+expect 2 "not a numeric setting" sweep "$s" -o "$o" --param shafts.caps=0:1:2
+expect 2 "expected shafts.KEY=LO:HI:COUNT" sweep "$s" -o "$o" --param shafts.K
+expect 2 "shafts.K" sweep "$s" -o "$o" --param shafts.K=-1:1:3
+expect 2 "at most two axes" sweep "$s" -o "$o" --param shafts.K=0.4:1:2 --param shafts.g=0:0.5:2 --param shafts.bias=0:1:2
+expect 2 "swept twice" sweep "$s" -o "$o" --param shafts.K=0.4:1:2 --param shafts.K=0.5:1:2
+expect 2 "no --param" sweep "$s" -o "$o"
+expect 2 "--metric psnr: unknown metric" sweep "$s" -o "$o" --param shafts.K=0.4:1:2 --metric psnr
+expect 2 "--frames" sweep "$s" -o "$o" --param shafts.K=0.4:1:2 --frames 5:1:1
+expect 2 "--view" sweep "$s" -o "$o" --param shafts.K=0.4:1:2 --view 10
+expect 2 "no scene" sweep --param shafts.K=0.4:1:2
+expect 2 "shafts.K" sweep "$s" -o "$o" --param shafts.K=0.4:1:2 --set shafts.K=0
+# tune
+expect 2 "--params shafts.nope: unknown shafts setting" tune "$s" -o "$o" --params shafts.nope
+expect 2 "integer setting" tune "$s" -o "$o" --params shafts.K,shafts.N
+expect 2 "not a numeric setting" tune "$s" -o "$o" --params shafts.target_format
+expect 2 "empty parameter name" tune "$s" -o "$o" --params shafts.K,,shafts.g
+expect 2 "given twice" tune "$s" -o "$o" --params shafts.K,shafts.K
+expect 2 "--bounds shafts.K=2:1: empty range" tune "$s" -o "$o" --params shafts.K --bounds shafts.K=2:1
+expect 2 "LO and HI must be finite numbers" tune "$s" -o "$o" --params shafts.K --bounds shafts.K=a:b
+expect 2 "not among the --params" tune "$s" -o "$o" --params shafts.K --bounds shafts.g=0:0.5
+expect 2 "--start" tune "$s" -o "$o" --params shafts.K --start shafts.K=x
+expect 2 "--starts" tune "$s" -o "$o" --params shafts.K --starts 0
+expect 2 "no --params" tune "$s" -o "$o"
+# pareto
+expect 2 "--size" pareto "$s" -o "$o" --size 0x5
+expect 2 "--repeat" pareto "$s" -o "$o" --repeat 0
+[ -e "$o" ] && { echo "FAIL: output folder created by a failing command"; fail=1; }
+exit $fail
