@@ -154,10 +154,11 @@ static inline void slab_range(const gr_beams *b, uint32_t t, uint32_t k, uint32_
     *lo = k + 1 == nslab ? -INFINITY : b->ytop[t] - (float)(k + 1) * b->dy[t];
 }
 
-static void beam_bounds(const struct RTCBoundsFunctionArguments *args)
+/* The box of primitive `prim` (a triangle's beam over one slab) in sheared coordinates:
+ * lo/hi = {u, y, w}. */
+static void prim_box(const gr_beams *b, uint32_t prim, float lo3[3], float hi3[3])
 {
-    const gr_beams *b = args->geometryUserPtr;
-    uint32_t prim = args->primID, t = b->prim_tri[prim];
+    uint32_t t = b->prim_tri[prim];
     uint32_t nslab = b->first[t + 1] - b->first[t], k = prim - b->first[t];
     float lo, hi;
     slab_range(b, t, k, nslab, &lo, &hi);
@@ -180,7 +181,7 @@ static void beam_bounds(const struct RTCBoundsFunctionArguments *args)
         float dmax = b->ybar[t] - ylo;
         if (dmax > 0.0f) {
             float rho = (float)b->kc_rho * 1.0001f;
-            float ku = dmax * rho * hypotf(M[0], M[1]), kw = dmax * rho * hypotf(M[2], M[3]);
+            float ku = dmax * rho * sqrtf(M[0] * M[0] + M[1] * M[1]), kw = dmax * rho * sqrtf(M[2] * M[2] + M[3] * M[3]);
             u0 -= ku; u1 += ku;
             w0 -= kw; w1 += kw;
         }
@@ -188,33 +189,37 @@ static void beam_bounds(const struct RTCBoundsFunctionArguments *args)
     /* widen by a few ulps of the coordinates so float rounding in the test cannot fall outside */
     float eu = 1e-5f * (1.0f + fmaxf(fabsf(u0), fabsf(u1))), ew = 1e-5f * (1.0f + fmaxf(fabsf(w0), fabsf(w1)));
     float ey = 1e-5f * (1.0f + fmaxf(fabsf(ylo), fabsf(yhi)));
-    struct RTCBounds *o = args->bounds_o;
-    o->lower_x = u0 - eu; o->upper_x = u1 + eu;
-    o->lower_y = ylo - ey; o->upper_y = yhi + ey;
-    o->lower_z = w0 - ew; o->upper_z = w1 + ew;
+    lo3[0] = u0 - eu; hi3[0] = u1 + eu;
+    lo3[1] = ylo - ey; hi3[1] = yhi + ey;
+    lo3[2] = w0 - ew; hi3[2] = w1 + ew;
 }
 
-/* Never traced with rays: only point queries walk this BVH. */
-static void beam_intersect(const struct RTCIntersectFunctionNArguments *args) { (void)args; }
-static void beam_occluded(const struct RTCOccludedFunctionNArguments *args) { (void)args; }
+static void beam_bounds(const struct RTCBoundsFunctionArguments *args)
+{
+    float lo[3], hi[3];
+    prim_box(args->geometryUserPtr, args->primID, lo, hi);
+    struct RTCBounds *o = args->bounds_o;
+    o->lower_x = lo[0]; o->upper_x = hi[0];
+    o->lower_y = lo[1]; o->upper_y = hi[1];
+    o->lower_z = lo[2]; o->upper_z = hi[2];
+}
 
 typedef struct lookup_state {
-    const gr_beams *b;
-    float u, y, w;
+    float u, y, w;           /* the point, sheared */
     gr_beam_hit *hits;
     int n, max, overflow;
 } lookup_state;
 
-static bool beam_query(struct RTCPointQueryFunctionArguments *args)
+/* The exact test of one primitive: is the point in the slab's height interval and in the
+ * beam's (disc-blurred) cross-section? Appends the hit to s. */
+static void beam_test(const gr_beams *b, uint32_t prim, lookup_state *s)
 {
-    lookup_state *s = args->userPtr;
-    const gr_beams *b = s->b;
-    uint32_t prim = args->primID, t = b->prim_tri[prim];
+    uint32_t t = b->prim_tri[prim];
     uint32_t nslab = b->first[t + 1] - b->first[t], k = prim - b->first[t];
     float lo, hi;
     slab_range(b, t, k, nslab, &lo, &hi);
     float y = s->y;
-    if (!(y >= lo && y < hi)) return false;
+    if (!(y >= lo && y < hi)) return;
     uint32_t idx[3];
     tri_vertices(b, t, idx);
     const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
@@ -231,9 +236,9 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
     float dd = b->kern ? b->ybar[t] - y : 0.0f; /* depth below the beam's top: the kernel's scale */
     if (!(dd > 0.0f)) {
         /* a point sun (or the top of the beam): the point-in-triangle test */
-        if (det == 0.0f) return false; /* a measure-zero set: the exact focus */
+        if (det == 0.0f) return; /* a measure-zero set: the exact focus */
         float inv = 1.0f / det;
-        if (f0 * inv < 0.0f || f1 * inv < 0.0f || f2 * inv < 0.0f) return false;
+        if (f0 * inv < 0.0f || f1 * inv < 0.0f || f2 * inv < 0.0f) return;
         e_h = b->phi[t] / (0.5f * fabsf(det));
     } else {
         /* Disc average (docs/reference.md, "The sun's disc"): the fraction of the kernel
@@ -251,7 +256,7 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
             float bx = sg * dd * (M[0] * g[i][0] + M[2] * g[i][1]);
             float by = sg * dd * (M[1] * g[i][0] + M[3] * g[i][1]);
             float ai = sg * fa[i], ext = rho * sqrtf(bx * bx + by * by);
-            if (ai < -ext) return false;     /* the kernel lies wholly outside edge i */
+            if (ai < -ext) return;     /* the kernel lies wholly outside edge i */
             if (ai < ext) cut |= 1u << i;
             a[i] = ai;
             bb[2 * i] = bx;
@@ -261,7 +266,7 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
         float areaK = dd * dd * fabsf(detM) * (float)b->kc_area; /* the kernel's area (m^2) */
         if (!cut) {
             /* the kernel lies wholly inside the cross-section: the beam's own irradiance */
-            if (det == 0.0f) return false;
+            if (det == 0.0f) return;
             e_h = b->phi[t] / (0.5f * fabsf(det));
         } else {
             /* the cross-section wholly inside the kernel (near a focus): flux / area(K).
@@ -278,9 +283,9 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
             if (tri_in) {
                 e_h = b->phi[t] / areaK;
             } else {
-                if (det == 0.0f) return false;
+                if (det == 0.0f) return;
                 double frac = clip_area((const double (*)[2])b->kc, GR_BEAM_KERNEL_N, a, bb, cut) / b->kc_area;
-                if (!(frac > 0.0)) return false;
+                if (!(frac > 0.0)) return;
                 /* exact: flux area(tri n K) / (|A| area(K)) <= flux / area(K); the bound only
                  * guards the rounding of a nearly collapsed cross-section */
                 e_h = (float)fmin((double)b->phi[t] * frac / (0.5 * fabs((double)det)), (double)b->phi[t] / areaK);
@@ -298,9 +303,9 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
     }
     /* distance from the surface along the beam; negative above the surface (in air) */
     float path = l0 * d0 * v0->ity + l1 * d1 * v1->ity + l2 * d2 * v2->ity;
-    if (path < 0.0f) return false;
-    if (!(e_h > 0.0f)) return false;
-    if (s->n >= s->max) { s->overflow = 1; return false; }
+    if (path < 0.0f) return;
+    if (!(e_h > 0.0f)) return;
+    if (s->n >= s->max) { s->overflow = 1; return; }
     gr_beam_hit *h = &s->hits[s->n++];
     h->prim = prim;
     h->e_h = e_h;
@@ -308,7 +313,86 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
     h->T = gr_v3_norm(gr_v3(l0 * v0->tx + l1 * v1->tx + l2 * v2->tx,
                             l0 * v0->ty + l1 * v1->ty + l2 * v2->ty,
                             l0 * v0->tz + l1 * v1->tz + l2 * v2->tz));
+}
+
+typedef struct query_state {
+    const gr_beams *b;
+    lookup_state *s;
+} query_state;
+
+static bool beam_query(struct RTCPointQueryFunctionArguments *args)
+{
+    query_state *q = args->userPtr;
+    beam_test(q->b, args->primID, q->s);
     return false;
+}
+
+/* ---- all the beams along one camera ray ----
+ * One Embree traversal per camera ray (rtcOccluded1 on the sheared ray; the occluded
+ * callback never reports a hit, so it sees every primitive whose box the ray may cross)
+ * replaces one point query per march point: the march points then test the primitives
+ * whose box they lie in, found by a sweep along t. The same exact test as
+ * gr_beams_lookup, on a superset of the same candidates: the same hits. */
+typedef struct ray_prim { float t0, t1; uint32_t prim; } ray_prim;
+
+struct gr_beam_ray {
+    struct RTCIntersectContext ctx; /* first member: Embree hands it to the callback */
+    const gr_beams *b;
+    float o[3], d[3], tmax;      /* the ray in sheared coordinates */
+    ray_prim *p;                 /* collected, then sorted by t0 */
+    size_t n, cap;
+    uint32_t *act;               /* active primitives (indices into p) */
+    size_t nact, capact, next;
+    int oom;
+};
+
+static void beam_intersect(const struct RTCIntersectFunctionNArguments *args) { (void)args; }
+
+static void beam_occluded(const struct RTCOccludedFunctionNArguments *args)
+{
+    if (!args->valid[0]) return;
+    gr_beam_ray *r = (gr_beam_ray *)(void *)args->context;
+    float lo[3], hi[3];
+    prim_box(r->b, args->primID, lo, hi);
+    /* slab method: the t interval of the ray inside the box */
+    float t0 = 0.0f, t1 = r->tmax;
+    for (int a = 0; a < 3; a++) {
+        if (r->d[a] == 0.0f) {
+            if (r->o[a] < lo[a] || r->o[a] > hi[a]) return;
+            continue;
+        }
+        float inv = 1.0f / r->d[a], ta = (lo[a] - r->o[a]) * inv, tb = (hi[a] - r->o[a]) * inv;
+        if (ta > tb) { float x = ta; ta = tb; tb = x; }
+        t0 = fmaxf(t0, ta);
+        t1 = fminf(t1, tb);
+    }
+    /* widened: float rounding of the interval must not drop a point the box holds */
+    float eps = 1e-5f * (1.0f + r->tmax);
+    t0 -= eps;
+    t1 += eps;
+    if (t0 > t1) return;
+    if (r->n == r->cap) {
+        size_t cap = r->cap ? 2 * r->cap : 256;
+        ray_prim *np = realloc(r->p, cap * sizeof *np);
+        if (!np) { r->oom = 1; return; }
+        r->p = np;
+        r->cap = cap;
+    }
+    r->p[r->n].t0 = t0;
+    r->p[r->n].t1 = t1;
+    r->p[r->n].prim = args->primID;
+    r->n++;
+}
+
+/* sort by primitive id: the sum over beams then has one order whatever the BVH */
+static void sort_hits(gr_beam_hit *hits, int n)
+{
+    for (int i = 1; i < n; i++) {
+        gr_beam_hit h = hits[i];
+        int j = i - 1;
+        while (j >= 0 && hits[j].prim > h.prim) { hits[j + 1] = hits[j]; j--; }
+        hits[j + 1] = h;
+    }
 }
 
 int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hit *hits, int max_hits, int *overflow)
@@ -316,7 +400,6 @@ int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hit *hits, int max_hit
     if (overflow) *overflow = 0;
     if (!b || !b->bvh) return 0;
     lookup_state s;
-    s.b = b;
     s.y = p.y;
     s.u = p.x - b->sx * p.y;
     s.w = p.z - b->sz * p.y;
@@ -328,15 +411,90 @@ int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hit *hits, int max_hit
     q.x = s.u; q.y = s.y; q.z = s.w; q.time = 0.0f; q.radius = 0.0f;
     struct RTCPointQueryContext ctx;
     rtcInitPointQueryContext(&ctx);
-    rtcPointQuery(b->bvh, &q, &ctx, beam_query, &s);
-    /* sort by primitive id: the sum over beams then has one order whatever the BVH */
-    for (int i = 1; i < s.n; i++) {
-        gr_beam_hit h = hits[i];
-        int j = i - 1;
-        while (j >= 0 && hits[j].prim > h.prim) { hits[j + 1] = hits[j]; j--; }
-        hits[j + 1] = h;
-    }
+    query_state qs = {b, &s};
+    rtcPointQuery(b->bvh, &q, &ctx, beam_query, &qs);
+    sort_hits(hits, s.n);
     if (overflow) *overflow = s.overflow;
+    return s.n;
+}
+
+gr_beam_ray *gr_beam_ray_create(void) { return calloc(1, sizeof(gr_beam_ray)); }
+
+void gr_beam_ray_destroy(gr_beam_ray *r)
+{
+    if (!r) return;
+    free(r->p);
+    free(r->act);
+    free(r);
+}
+
+static int cmp_ray_prim(const void *a, const void *b)
+{
+    const ray_prim *x = a, *y = b;
+    if (x->t0 != y->t0) return x->t0 < y->t0 ? -1 : 1;
+    return (x->prim > y->prim) - (x->prim < y->prim);
+}
+
+int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, gr_beam_ray *r)
+{
+    r->b = b;
+    r->n = r->nact = r->next = 0;
+    r->oom = 0;
+    if (!b || !b->bvh || !(tmax > 0.0f)) return 0;
+    r->o[0] = o.x - b->sx * o.y; r->o[1] = o.y; r->o[2] = o.z - b->sz * o.y;
+    r->d[0] = d.x - b->sx * d.y; r->d[1] = d.y; r->d[2] = d.z - b->sz * d.y;
+    r->tmax = tmax;
+    rtcInitIntersectContext(&r->ctx);
+    struct RTCRay ray;
+    memset(&ray, 0, sizeof ray);
+    ray.org_x = r->o[0]; ray.org_y = r->o[1]; ray.org_z = r->o[2];
+    ray.dir_x = r->d[0]; ray.dir_y = r->d[1]; ray.dir_z = r->d[2];
+    ray.tnear = 0.0f;
+    ray.tfar = tmax;
+    ray.mask = ~0u;
+    rtcOccluded1(b->bvh, &r->ctx, &ray);
+    if (r->oom) return -1;
+    qsort(r->p, r->n, sizeof *r->p, cmp_ray_prim);
+    /* a primitive split across BVH leaves could arrive twice: keep one */
+    size_t k = 0;
+    for (size_t i = 0; i < r->n; i++)
+        if (!k || r->p[i].prim != r->p[k - 1].prim || r->p[i].t0 != r->p[k - 1].t0) r->p[k++] = r->p[i];
+    r->n = k;
+    return 0;
+}
+
+int gr_beams_ray_lookup(const gr_beams *b, gr_beam_ray *r, float t, gr_vec3 p, gr_beam_hit *hits, int max_hits,
+                        int *overflow)
+{
+    if (overflow) *overflow = 0;
+    if (!b || !b->bvh) return 0;
+    /* admit the primitives whose interval has begun, drop those that have ended */
+    while (r->next < r->n && r->p[r->next].t0 <= t) {
+        if (r->nact == r->capact) {
+            size_t cap = r->capact ? 2 * r->capact : 64;
+            uint32_t *na = realloc(r->act, cap * sizeof *na);
+            if (!na) { if (overflow) *overflow = 1; break; }
+            r->act = na;
+            r->capact = cap;
+        }
+        r->act[r->nact++] = (uint32_t)r->next++;
+    }
+    lookup_state s;
+    s.y = p.y;
+    s.u = p.x - b->sx * p.y;
+    s.w = p.z - b->sz * p.y;
+    s.hits = hits;
+    s.n = 0;
+    s.max = max_hits;
+    s.overflow = 0;
+    for (size_t i = 0; i < r->nact;) {
+        const ray_prim *rp = &r->p[r->act[i]];
+        if (rp->t1 < t) { r->act[i] = r->act[--r->nact]; continue; }
+        beam_test(b, rp->prim, &s);
+        i++;
+    }
+    sort_hits(hits, s.n);
+    if (overflow) *overflow |= s.overflow;
     return s.n;
 }
 

@@ -334,14 +334,17 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
 }
 
 /* Sunlight arriving at the local point x: every beam through it under waves, the closed
- * form on flat water (and outside the lit region, where the waves' mean is used). */
-static int light_at(const gr_ref_renderer *r, gr_vec3 x, ref_light *out, gr_beam_hit *hits, int *overflow)
+ * form on flat water (and outside the lit region, where the waves' mean is used). With
+ * `ray` (the beams collected along a camera ray), x must be the ray's point at t. */
+static int light_at(const gr_ref_renderer *r, gr_vec3 x, gr_beam_ray *ray, float t, ref_light *out, gr_beam_hit *hits,
+                    int *overflow)
 {
     if (!r->flat) {
         double u = x.x - r->sx * x.y, w = x.z - r->sz * x.y;
         const gr_beam_region *g = &r->region;
         if (x.y >= g->y_min && u >= g->u0 && u <= g->u1 && w >= g->w0 && w <= g->w1) {
-            int n = gr_beams_lookup(r->beams, x, hits, REF_MAX_HITS, overflow);
+            int n = ray ? gr_beams_ray_lookup(r->beams, ray, t, x, hits, REF_MAX_HITS, overflow)
+                        : gr_beams_lookup(r->beams, x, hits, REF_MAX_HITS, overflow);
             int m = 0;
             for (int i = 0; i < n; i++) {
                 if (!(hits[i].T.y < 0.0f)) continue;
@@ -367,7 +370,7 @@ double gr_ref_irradiance_h(const gr_ref_renderer *r, gr_dvec3 world)
     ref_light l[REF_MAX_HITS];
     int of = 0;
     gr_vec3 x = gr_d3_to_f(gr_d3_sub(world, r->origin));
-    int n = light_at(r, x, l, hits, &of);
+    int n = light_at(r, x, NULL, 0.0f, l, hits, &of);
     double e = 0.0;
     for (int i = 0; i < n; i++) e += (double)l[i].eperp * -(double)l[i].T.y;
     return e;
@@ -419,13 +422,28 @@ typedef struct ref_job {
 
 typedef struct ref_counters { long long queries, shadow_rays, overflows; } ref_counters;
 
-/* One camera sample: L (RGB) along the ray through the jittered pixel position. */
-static void render_sample(const gr_ref_renderer *r, int px, int py, ref_rng *g, double L[3], double *trans,
-                          double *len, ref_counters *cnt, gr_beam_hit *hits, ref_light *lights)
+/* Stratum j of n over the pixel: an nx x ny grid of cells (nx the largest divisor of n not
+ * above sqrt(n)); the sample is jittered within its cell. */
+static void pixel_stratum(int j, int n, ref_rng *g, double *jx, double *jy)
+{
+    int nx = 1;
+    for (int d = 1; d * d <= n; d++)
+        if (n % d == 0) nx = d;
+    int ny = n / nx, ix = j % nx, iy = j / nx;
+    *jx = (ix + rng_u(g)) / nx;
+    *jy = (iy + rng_u(g)) / ny;
+}
+
+/* One camera sample: L (RGB) along the ray through the jittered pixel position; the
+ * sample is stratum j of the n camera samples its batch takes in this round. */
+static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, ref_rng *g, double L[3],
+                          double *trans, double *len, ref_counters *cnt, gr_beam_hit *hits, ref_light *lights,
+                          gr_beam_ray *ray)
 {
     const gr_camera *c = &r->scene.camera;
     double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), aspect = (double)c->width / (double)c->height;
-    double jx = rng_u(g), jy = rng_u(g);
+    double jx, jy;
+    pixel_stratum(j, n_strata, g, &jx, &jy);
     gr_dvec3 dd = cam_dir(r, (2.0 * (px + jx) / c->width - 1.0) * tf * aspect, (1.0 - 2.0 * (py + jy) / c->height) * tf);
     gr_vec3 d = gr_d3_to_f(dd), o = r->cam;
     L[0] = L[1] = L[2] = 0.0;
@@ -442,6 +460,9 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, ref_rng *g, 
     *len = D;
     *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
     if (D == 0.0f) return;
+    /* the beams along this ray, once: the march points then sweep through them */
+    if (!r->flat && gr_beams_ray_collect(r->beams, o, d, D, ray) != 0) ray = NULL; /* out of memory: per point */
+    if (r->flat || getenv("GR_NORAY")) ray = NULL;
     int n = r->set.steps;
     /* March density ~ exp(-lam t) on [0, D], lam = sig_ref (1 - w_y / mu_t0): the camera
      * ray's extinction times the sunlight's extinction down to the point on flat water, so
@@ -462,7 +483,7 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, ref_rng *g, 
         double t = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
         gr_vec3 x = gr_v3_madd(o, d, (float)t);
         int of = 0;
-        int m = light_at(r, x, lights, hits, &of);
+        int m = light_at(r, x, ray, (float)t, lights, hits, &of);
         cnt->queries++;
         cnt->overflows += of;
         for (int i = 0; i < m; i++) {
@@ -494,11 +515,16 @@ static void *worker(void *arg)
     ref_accum *acc = job->acc;
     gr_beam_hit *hits = malloc(REF_MAX_HITS * sizeof *hits);
     ref_light *lights = malloc(REF_MAX_HITS * sizeof *lights);
+    gr_beam_ray *ray = gr_beam_ray_create();
     ref_counters cnt = {0, 0, 0};
-    if (!hits || !lights) {
+    /* camera samples are stratified over the pixel within a batch (like the passes' strata):
+     * this pass is the k-th of its batch in the round */
+    int per_batch = r->passes_per_round / r->batches, k_in_batch = (job->pass % r->passes_per_round) / r->batches;
+    if (!hits || !lights || !ray) {
         atomic_store(&job->stop, 2);
         free(hits);
         free(lights);
+        gr_beam_ray_destroy(ray);
         return NULL;
     }
     for (;;) {
@@ -512,7 +538,8 @@ static void *worker(void *arg)
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
-                render_sample(r, x, y, &g, L, &tr, &len, &cnt, hits, lights);
+                render_sample(r, x, y, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, &g, L, &tr, &len, &cnt,
+                              hits, lights, ray);
                 sum[0] += L[0];
                 sum[1] += L[1];
                 sum[2] += L[2];
@@ -530,6 +557,7 @@ static void *worker(void *arg)
     atomic_fetch_add(&job->overflows, cnt.overflows);
     free(hits);
     free(lights);
+    gr_beam_ray_destroy(ray);
     return NULL;
 }
 

@@ -13,6 +13,7 @@
 #include "compare/metrics.h"
 #include "realtime/shafts.h"
 #include "report/report.h"
+#include "tune/page.h"
 #include "tune/pareto.h"
 #include "tune/session.h"
 #include "tune/truth.h"
@@ -25,9 +26,10 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: godrays pareto SCENE [-o DIR] [options]\n"
             "\n"
-            "Speed against error. Renders a high-quality ground truth (4x the default sun directions,\n"
-            "2x the march steps, 1.5x the surface resolution, another seed; cached), then\n"
-            "  - the ground truth at increasing quality (q0..q4: sun directions, batches, steps,\n"
+            "Speed against error. Renders a high-quality ground truth (2x the default passes\n"
+            "(sun_samples), 2x the march steps, 1.5x the surface resolution, another seed; cached),\n"
+            "then\n"
+            "  - the ground truth at increasing quality (q0..q3 = default: passes, batches, steps,\n"
             "    surface resolution; each timed, never cached), error against the high-quality one;\n"
             "  - the real-time shafts for N in {6, 11, 21}, target scale in {0.25, 0.5, 1} and\n"
             "    rgba8/rgba16f targets (median time of --repeat renders in one context), error after\n"
@@ -40,9 +42,9 @@ static void usage(FILE *f)
             "options:\n"
             "  -o, --output DIR   folder (default: out/SCENE_NAME/pareto)\n"
             "  --size WxH         image size (default 320x180: the high-quality ground truth costs\n"
-            "                     about 8x a default-quality one)\n"
+            "                     about 4x a default-quality one)\n"
             "  --set KEY=VALUE    override a scene value (repeatable)\n"
-            "  --quick            fewer points (q0..q2, N in {6, 11}, scale 0.5 and 1), for tests\n"
+            "  --quick            fewer points (q0, q1, N in {6, 11}, scale 0.5 and 1), for tests\n"
             "  --repeat R         shafts renders per setting; time = median (default 5)\n"
             "  --no-cache         render the high-quality ground truth even if cached\n"
             "  --gl-platform P    auto, surfaceless or device\n"
@@ -71,10 +73,10 @@ typedef struct ref_level {
     int sun_samples, batches, steps, surface_res, spp;
 } ref_level;
 static const ref_level levels[] = {
-    {"q0", 1, 1, 16, 64, 1},  {"q1", 2, 2, 32, 128, 1},  {"q2", 4, 4, 48, 192, 1},
-    {"q3 (default)", 8, 8, 64, 256, 1}, {"q4", 16, 8, 96, 256, 1},
+    {"q0", 2, 2, 16, 64, 1},  {"q1", 2, 2, 32, 128, 1},  {"q2", 4, 4, 48, 192, 1},
+    {"q3 (default)", 8, 8, 64, 256, 1},
 };
-static const ref_level hq = {"hq", 32, 8, 128, 384, 1};
+static const ref_level hq = {"hq", 16, 8, 128, 384, 1};
 
 static void set_level(gr_scene *s, const ref_level *l)
 {
@@ -190,7 +192,7 @@ int cmd_pareto(int argc, char **argv)
     mo.skip_blur = 1;
     gr_metrics m;
     /* ground truth ladder */
-    int n_levels = quick ? 3 : (int)(sizeof levels / sizeof levels[0]);
+    int n_levels = quick ? 2 : (int)(sizeof levels / sizeof levels[0]);
     for (int l = 0; l < n_levels; l++) {
         memcpy(work, scene, sizeof *work);
         set_level(work, &levels[l]);
@@ -291,19 +293,36 @@ int cmd_pareto(int argc, char **argv)
     snprintf(path, sizeof path, "%s/pareto.png", outdir);
     if (gr_pareto_write_plot(path, pts, n, title, tlabel, &drawn, &err) != GR_OK) goto fail;
 
-    printf("scene '%s' (%d x %d); high-quality ground truth %.1f s (%s); shafts on %s\n", scene->name,
+    gr_strbuf sum;
+    gr_sb_init(&sum);
+    gr_sb_printf(&sum, "scene '%s' (%d x %d); high-quality ground truth %.1f s (%s); shafts on %s\n", scene->name,
            scene->camera.width, scene->camera.height, ti.seconds, ti.cached ? "from the cache" : "rendered", glr);
-    printf("%-10s %-34s %12s %12s %12s %6s\n", "family", "setting", "time ms", "GL timers ms", "rel. RMSE Y", "front");
+    gr_sb_printf(&sum, "%-10s %-34s %12s %12s %12s %6s\n", "family", "setting", "time ms", "GL timers ms", "rel. RMSE Y", "front");
     for (int i = 0; i < n; i++) {
         char g[32];
         if (pts[i].gpu_s >= 0) snprintf(g, sizeof g, "%.3f", 1e3 * pts[i].gpu_s);
         else snprintf(g, sizeof g, "n/a");
-        printf("%-10s %-34s %12.2f %12s %12.4g %6s\n", pts[i].family ? "shafts" : "reference", pts[i].label,
+        gr_sb_printf(&sum, "%-10s %-34s %12.2f %12s %12.4g %6s\n", pts[i].family ? "shafts" : "reference", pts[i].label,
                1e3 * pts[i].time_s, g, pts[i].error, pts[i].on_front ? "*" : "");
     }
-    printf("GL pass timers %s; shaft times are %s\n", gpu_any ? "available" : "unavailable",
+    gr_sb_printf(&sum, "GL pass timers %s; shaft times are %s\n", gpu_any ? "available" : "unavailable",
            is_llvmpipe ? "llvmpipe (CPU) wall times" : "wall times on the GPU");
-    printf("written: %s/pareto.csv%s\n", outdir, drawn ? ", pareto.png" : " (no plot: charts need PLplot)");
+    gr_sb_printf(&sum, "written: %s/pareto.csv%s\n", outdir, drawn ? ", pareto.png" : " (no plot: charts need PLplot)");
+    fputs(gr_sb_str(&sum), stdout);
+    {
+        gr_strbuf pg;
+        gr_sb_init(&pg);
+        char ptitle[300];
+        snprintf(ptitle, sizeof ptitle, "godrays pareto: %s", scene->name);
+        gr_tune_page_begin(&pg, ptitle);
+        if (drawn) gr_tune_page_figure(&pg, "pareto.png", title);
+        gr_tune_page_pre(&pg, gr_sb_str(&sum));
+        gr_sb_puts(&pg, "<p>Data: <a href=\"pareto.csv\">pareto.csv</a>.</p>\n");
+        gr_status pst = gr_tune_page_write(&pg, outdir, &err);
+        gr_sb_free(&pg);
+        gr_sb_free(&sum);
+        if (pst != GR_OK) goto fail;
+    }
     goto done;
 fail:
     rc = gr_cli_report(cmd, &err);

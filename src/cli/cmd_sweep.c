@@ -11,6 +11,7 @@
 
 #include "image/oiio.h"
 #include "report/report.h"
+#include "tune/page.h"
 #include "tune/cliopts.h"
 #include "tune/sweep.h"
 
@@ -232,6 +233,9 @@ int cmd_sweep(int argc, char **argv)
 
     progress_ctx pc = {!c.quiet && isatty(2)};
     if (gr_sweep_run(p, &r, progress, &pc, &err) != GR_OK) goto fail;
+    /* the sweep's own accounting, before the extra render of best.png */
+    const long long sw_renders = p->renders;
+    const double sw_render_s = p->render_s, sw_metrics_s = p->metrics_s;
     int bx = r.best % r.nx, by = r.best / r.nx;
     double xbest[2] = {r.xs[bx], r.ys[by]};
     snippet = gr_tune_snippet(p, xbest, p->fit ? r.scale[r.best] : 0.0);
@@ -251,18 +255,37 @@ int cmd_sweep(int argc, char **argv)
     if (gr_sweep_write_plot(path, p, &r, &drawn, &err) != GR_OK) goto fail;
     if (write_images(outdir, p, xbest, &err) != GR_OK) goto fail;
 
-    printf("scene '%s' (%d x %d), %d case(s), metric %s of Y%s\n", s.base->name, s.base->camera.width,
+    gr_strbuf sum;
+    gr_sb_init(&sum);
+    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s\n", s.base->name, s.base->camera.width,
            s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "");
-    printf("minimum %.6g at %s = %.6g", r.err[r.best], p->params[0].key, xbest[0]);
-    if (n_params > 1) printf(", %s = %.6g", p->params[1].key, xbest[1]);
-    printf(" (fitted scale %.4g)\n", r.scale[r.best]);
-    printf("%lld renders in %.2f s (%.1f ms each: render + readback %.2f s, metrics %.2f s, other %.2f s; %s)\n",
-           p->renders, r.wall_s, p->renders ? 1e3 * r.wall_s / (double)p->renders : 0.0, p->render_s, p->metrics_s,
-           r.wall_s - p->render_s - p->metrics_s, gr_gl_renderer(gr_shafts_gl(p->renderer)));
-    printf("ground truth: %.1f s (%s)\n", s.truth_seconds, s.truth[0].cached ? "from the cache" : "rendered");
-    printf("best settings for the scene:\n%s\n", snippet);
-    printf("written: %s/sweep.csv, sweep.json, %s, reference.png, best.png\n", outdir,
+    gr_sb_printf(&sum, "minimum %.6g at %s = %.6g", r.err[r.best], p->params[0].key, xbest[0]);
+    if (n_params > 1) gr_sb_printf(&sum, ", %s = %.6g", p->params[1].key, xbest[1]);
+    gr_sb_printf(&sum, " (fitted scale %.4g)\n", r.scale[r.best]);
+    gr_sb_printf(&sum, "%lld renders in %.2f s (%.1f ms each: render + readback %.2f s, metrics %.2f s, other %.2f s; %s)\n",
+           sw_renders, r.wall_s, sw_renders ? 1e3 * r.wall_s / (double)sw_renders : 0.0, sw_render_s, sw_metrics_s,
+           r.wall_s - sw_render_s - sw_metrics_s, gr_gl_renderer(gr_shafts_gl(p->renderer)));
+    gr_sb_printf(&sum, "ground truth: %.1f s (%s)\n", s.truth_seconds, s.truth[0].cached ? "from the cache" : "rendered");
+    gr_sb_printf(&sum, "best settings for the scene:\n%s\n", snippet);
+    gr_sb_printf(&sum, "written: %s/sweep.csv, sweep.json, %s, reference.png, best.png\n", outdir,
            drawn ? "sweep.png" : "(no sweep.png: charts need PLplot)");
+    fputs(gr_sb_str(&sum), stdout);
+    {
+        gr_strbuf pg;
+        gr_sb_init(&pg);
+        char title[300];
+        snprintf(title, sizeof title, "godrays sweep: %s", s.base->name);
+        gr_tune_page_begin(&pg, title);
+        if (drawn) gr_tune_page_figure(&pg, "sweep.png", "error surface; the cross marks the minimum");
+        gr_tune_page_figure(&pg, "reference.png", "ground truth (case 0)");
+        gr_tune_page_figure(&pg, "best.png", "shafts at the minimum, x the fitted scale, same exposure");
+        gr_tune_page_pre(&pg, gr_sb_str(&sum));
+        gr_sb_puts(&pg, "<p>Data: <a href=\"sweep.csv\">sweep.csv</a>, <a href=\"sweep.json\">sweep.json</a>.</p>\n");
+        gr_status pst = gr_tune_page_write(&pg, outdir, &err);
+        gr_sb_free(&pg);
+        gr_sb_free(&sum);
+        if (pst != GR_OK) goto fail;
+    }
     goto done;
 fail:
     rc = gr_cli_report(cmd, &err);

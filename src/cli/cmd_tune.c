@@ -13,6 +13,7 @@
 
 #include "image/oiio.h"
 #include "report/report.h"
+#include "tune/page.h"
 #include "tune/cliopts.h"
 #include "tune/optimize.h"
 
@@ -378,31 +379,54 @@ int cmd_tune(int argc, char **argv)
     snprintf(path, sizeof path, "%s/tune.json", outdir);
     if (gr_tune_write_text(path, json, &err) != GR_OK) goto fail;
 
-    printf("scene '%s' (%d x %d), %d case(s), metric %s of Y%s\n", s.base->name, s.base->camera.width,
+    gr_strbuf sum;
+    gr_sb_init(&sum);
+    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s\n", s.base->name, s.base->camera.width,
            s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "");
-    printf("%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
+    gr_sb_printf(&sum, "%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
     for (int k = 0; k < n_params; k++)
-        printf("%-28s %12.5g %12.5g    [%g, %g]%s\n", params[k].key, xb[k], res.x[k], lo[k], hi[k],
+        gr_sb_printf(&sum, "%-28s %12.5g %12.5g    [%g, %g]%s\n", params[k].key, xb[k], res.x[k], lo[k], hi[k],
                params[k].kind == GR_TK_RGB_SCALE ? " (scale)" : "");
-    printf("starts:\n");
+    gr_sb_printf(&sum, "starts:\n");
     for (int j = 0; j < res.n_starts; j++) {
-        printf("  %d: from (", j);
-        for (int k = 0; k < n_params; k++) printf("%s%.4g", k ? ", " : "", res.starts[j].x0[k]);
-        printf(") to (");
-        for (int k = 0; k < n_params; k++) printf("%s%.5g", k ? ", " : "", res.starts[j].x[k]);
-        printf(") error %.6g, %d evaluations%s\n", res.starts[j].f, res.starts[j].evals,
+        gr_sb_printf(&sum, "  %d: from (", j);
+        for (int k = 0; k < n_params; k++) gr_sb_printf(&sum, "%s%.4g", k ? ", " : "", res.starts[j].x0[k]);
+        gr_sb_printf(&sum, ") to (");
+        for (int k = 0; k < n_params; k++) gr_sb_printf(&sum, "%s%.5g", k ? ", " : "", res.starts[j].x[k]);
+        gr_sb_printf(&sum, ") error %.6g, %d evaluations%s\n", res.starts[j].f, res.starts[j].evals,
                res.starts[j].converged ? "" : " (budget reached)");
     }
-    printf("%d of %d starts reached the best value within 2 %%; their spread:", agreeing, res.n_starts);
-    for (int k = 0; k < n_params; k++) printf(" %s %.2f %%", params[k].key, 100.0 * spread[k]);
-    printf(" of the box\n");
-    printf("error per case (%s):        before        after\n", gr_tune_metric_name(p->metric));
-    for (int i = 0; i < s.n_cases; i++) printf("  %-24s %12.6g %12.6g\n", s.labels[i], before[i], after[i]);
-    printf("  %-24s %12.6g %12.6g (%.1f %% lower)\n", "mean", fb, fa, fb > 0 ? 100.0 * (1.0 - fa / fb) : 0.0);
-    printf("%d evaluations (%lld renders) in %.1f s; ground truth %.1f s\n", res.evals, p->renders,
+    gr_sb_printf(&sum, "%d of %d starts reached the best value within 2 %%; their spread:", agreeing, res.n_starts);
+    for (int k = 0; k < n_params; k++) gr_sb_printf(&sum, " %s %.2f %%", params[k].key, 100.0 * spread[k]);
+    gr_sb_printf(&sum, " of the box\n");
+    gr_sb_printf(&sum, "error per case (%s):        before        after\n", gr_tune_metric_name(p->metric));
+    for (int i = 0; i < s.n_cases; i++) gr_sb_printf(&sum, "  %-24s %12.6g %12.6g\n", s.labels[i], before[i], after[i]);
+    gr_sb_printf(&sum, "  %-24s %12.6g %12.6g (%.1f %% lower)\n", "mean", fb, fa, fb > 0 ? 100.0 * (1.0 - fa / fb) : 0.0);
+    gr_sb_printf(&sum, "%d evaluations (%lld renders) in %.1f s; ground truth %.1f s\n", res.evals, p->renders,
            p->render_s + p->metrics_s, s.truth_seconds);
-    printf("best settings for the scene:\n%s\n", snippet);
-    printf("written: %s/tune.json, trace.csv, compare.png, reference_NN.png, before_NN.png, after_NN.png\n", outdir);
+    gr_sb_printf(&sum, "best settings for the scene:\n%s\n", snippet);
+    gr_sb_printf(&sum, "written: %s/tune.json, trace.csv, compare.png, reference_NN.png, before_NN.png, after_NN.png\n", outdir);
+    fputs(gr_sb_str(&sum), stdout);
+    {
+        gr_strbuf pg;
+        gr_sb_init(&pg);
+        char title[300];
+        snprintf(title, sizeof title, "godrays tune: %s", s.base->name);
+        gr_tune_page_begin(&pg, title);
+        gr_tune_page_figure(&pg, "compare.png", "ground truth | shafts before | shafts after tuning (case 0)");
+        for (int i = 1; i < s.n_cases && i < 8; i++) {
+            char f[64], cap[128];
+            snprintf(f, sizeof f, "after_%02d.png", i);
+            snprintf(cap, sizeof cap, "after tuning, %s (reference_%02d.png, before_%02d.png beside)", s.labels[i], i, i);
+            gr_tune_page_figure(&pg, f, cap);
+        }
+        gr_tune_page_pre(&pg, gr_sb_str(&sum));
+        gr_sb_puts(&pg, "<p>Data: <a href=\"tune.json\">tune.json</a>, <a href=\"trace.csv\">trace.csv</a>.</p>\n");
+        gr_status pst = gr_tune_page_write(&pg, outdir, &err);
+        gr_sb_free(&pg);
+        gr_sb_free(&sum);
+        if (pst != GR_OK) goto fail;
+    }
     goto done;
 fail:
     rc = gr_cli_report(cmd, &err);

@@ -115,7 +115,7 @@ gr_status gr_pareto_write_plot(const char *path, const gr_pareto_point *pts, int
          .style = GR_PLOT_DASHED},
     };
     gr_plot_spec spec = {.width = 900, .height = 560, .title = title, .xlabel = "time per frame (s)",
-                         .ylabel = "relative RMSE of Y vs high-quality ground truth", .log_x = 1, .log_y = 1,
+                         .ylabel = "rel. RMSE of Y vs HQ ground truth", .log_x = 1, .log_y = 1,
                          .series = s, .n_series = 4, .legend_headroom = 0.0};
     gr_status st = gr_plot_write(path, &spec, err);
     free(buf);

@@ -20,7 +20,7 @@ check() { if ! eval "$1"; then echo "FAIL: $2"; fail=1; else echo "ok: $2"; fi; 
 "$bin" sweep "$dir/s.json" -q -o "$dir/sw" --param shafts.K=0.4:1.2:4 --param shafts.extinction=0.5:2:3 >"$dir/out1" 2>"$dir/err1"
 check '[ $? -eq 0 ]' "sweep exits 0"
 cat "$dir/err1"
-for f in sweep.csv sweep.json sweep.png reference.png best.png; do
+for f in sweep.csv sweep.json sweep.png reference.png best.png index.html; do
   check "[ -s '$dir/sw/$f' ]" "sweep wrote $f"
 done
 check "[ \$(wc -l <'$dir/sw/sweep.csv') -eq 13 ]" "sweep.csv has a header and 12 rows"
@@ -47,7 +47,7 @@ check "[ \$(wc -l <'$dir/sw2/sweep.csv') -eq 4 ]" "one-axis sweep.csv has 3 rows
   --frames 0:15:15 --view 60,20 >"$dir/out3" 2>"$dir/err3"
 check '[ $? -eq 0 ]' "tune exits 0"
 cat "$dir/err3"
-for f in tune.json trace.csv compare.png reference_00.png before_03.png after_03.png; do
+for f in tune.json trace.csv compare.png reference_00.png before_03.png after_03.png index.html; do
   check "[ -s '$dir/tu/$f' ]" "tune wrote $f"
 done
 check "grep -q 't=0.5s,view1' '$dir/out3'" "tune reports the error per frame and view"

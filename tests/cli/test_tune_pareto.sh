@@ -1,0 +1,40 @@
+#!/bin/sh
+# `godrays pareto --quick` on a small scene: exit 0, pareto.csv with the documented columns and
+# one row per point (2 ground-truth levels + 2 N x 2 target scales x 2 formats = 10), times and
+# errors positive and finite, each family with at least one point on its front, and the lowest
+# time and the lowest error of each family on its front (a property of any Pareto front).
+bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+export GODRAYS_CACHE="$dir/cache"
+cat >"$dir/s.json" <<'JSON'
+{"name": "small", "water": {"waves": [{"amplitude_m": 0.1, "wavelength_m": 8, "direction_deg": 30}]},
+ "sun": {"elevation_deg": 60, "azimuth_deg": 30},
+ "medium": {"absorption_per_m": [0.3, 0.06, 0.03], "scattering_per_m": 0.03, "g": 0.8},
+ "camera": {"position_m": [0, -8, 0], "yaw_deg": 30, "pitch_deg": 40, "fov_deg": 60, "width": 48, "height": 27}}
+JSON
+"$bin" pareto "$dir/s.json" -q --quick --size 40x24 --repeat 2 -o "$dir/p" >"$dir/out" 2>"$dir/err"
+rc=$?
+cat "$dir/err"
+if [ $rc -ne 0 ]; then echo "FAIL: pareto exit $rc"; exit 1; fi
+cat "$dir/out"
+[ -s "$dir/p/pareto.png" ] && [ -s "$dir/p/index.html" ] || { echo "FAIL: no pareto.png or index.html"; exit 1; }
+python3 - "$dir/p/pareto.csv" <<'PY'
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert list(rows[0].keys()) == ["family", "label", "settings", "time_s", "gpu_s", "error", "on_front"], rows[0].keys()
+assert len(rows) == 10, len(rows)
+for fam, n in (("reference", 2), ("shafts", 8)):
+    pts = [r for r in rows if r["family"] == fam]
+    assert len(pts) == n, (fam, len(pts))
+    for r in pts:
+        t, e = float(r["time_s"]), float(r["error"])
+        assert math.isfinite(t) and t > 0 and math.isfinite(e) and e >= 0, r
+    front = [r for r in pts if r["on_front"] == "1"]
+    assert front, fam
+    tmin = min(float(r["time_s"]) for r in pts)
+    emin = min(float(r["error"]) for r in pts)
+    assert any(float(r["time_s"]) == tmin for r in front), (fam, "fastest not on front")
+    assert any(float(r["error"]) == emin for r in front), (fam, "most accurate not on front")
+print("pareto.csv ok")
+PY
