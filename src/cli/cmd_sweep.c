@@ -68,6 +68,7 @@ static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, cons
     cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
     cJSON_AddStringToObject(root, "channel", "Y");
     cJSON_AddBoolToObject(root, "fit_scale", p->fit);
+    cJSON_AddBoolToObject(root, "normalized", p->normalize);
     cJSON_AddNumberToObject(root, "width", s->base->camera.width);
     cJSON_AddNumberToObject(root, "height", s->base->camera.height);
     cJSON *axes = cJSON_AddArrayToObject(root, "axes");
@@ -213,6 +214,7 @@ int cmd_sweep(int argc, char **argv)
     memcpy(p->params, params, sizeof params);
     p->metric = c.metric;
     p->fit = c.fit;
+    p->normalize = c.normalize;
     if (gr_tune_problem_init(p, &err) != GR_OK) goto fail;
     /* every grid value must be a valid setting before the first render */
     for (int k = 0; k < n_params; k++) {
@@ -257,8 +259,9 @@ int cmd_sweep(int argc, char **argv)
 
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s\n", s.base->name, s.base->camera.width,
-           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "");
+    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", s.base->name, s.base->camera.width,
+           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+           p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "minimum %.6g at %s = %.6g", r.err[r.best], p->params[0].key, xbest[0]);
     if (n_params > 1) gr_sb_printf(&sum, ", %s = %.6g", p->params[1].key, xbest[1]);
     gr_sb_printf(&sum, " (fitted scale %.4g)\n", r.scale[r.best]);

@@ -245,6 +245,7 @@ int cmd_tune(int argc, char **argv)
     memcpy(p->params, params, sizeof params);
     p->metric = c.metric;
     p->fit = c.fit;
+    p->normalize = c.normalize;
     if (gr_tune_problem_init(p, &err) != GR_OK) goto fail;
     double lo[GR_TUNE_MAX_PARAMS], hi[GR_TUNE_MAX_PARAMS], xb[GR_TUNE_MAX_PARAMS];
     for (int k = 0; k < n_params; k++) {
@@ -314,6 +315,7 @@ int cmd_tune(int argc, char **argv)
         cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
         cJSON_AddStringToObject(root, "channel", "Y");
         cJSON_AddBoolToObject(root, "fit_scale", p->fit);
+        cJSON_AddBoolToObject(root, "normalized", p->normalize);
         cJSON_AddNumberToObject(root, "width", s.base->camera.width);
         cJSON_AddNumberToObject(root, "height", s.base->camera.height);
         cJSON *pa = cJSON_AddArrayToObject(root, "params");
@@ -381,8 +383,9 @@ int cmd_tune(int argc, char **argv)
 
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s\n", s.base->name, s.base->camera.width,
-           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "");
+    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", s.base->name, s.base->camera.width,
+           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+           p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
     for (int k = 0; k < n_params; k++)
         gr_sb_printf(&sum, "%-28s %12.5g %12.5g    [%g, %g]%s\n", params[k].key, xb[k], res.x[k], lo[k], hi[k],

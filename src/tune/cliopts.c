@@ -13,6 +13,8 @@ const char gr_tune_cli_help[] =
     "                       after blurs at 1, 4, 16 px); all on luminance Y\n"
     "  --fit / --no-fit     score the shafts after the best scale fit a = <t,r>/<t,t> (default:\n"
     "                       on, unless shafts.intensity is a parameter)\n"
+    "  --normalize          divide rmse/msrmse by each case's mean reference Y, so that every\n"
+    "                       frame and view weighs the same in the mean\n"
     "  --set KEY=VALUE      override a scene value before validation (repeatable), e.g.\n"
     "                       reference.spp=2 or shafts.N=15\n"
     "  --size WxH           image size (camera.width/height)\n"
@@ -50,6 +52,10 @@ int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *
     const char *a = argv[*i];
     if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
         c->quiet = 1;
+        return 1;
+    }
+    if (!strcmp(a, "--normalize")) {
+        c->normalize = 1;
         return 1;
     }
     if (!strcmp(a, "--no-cache")) {

@@ -17,6 +17,7 @@ typedef struct gr_tune_cli {
     const char *outdir;           /* NULL: out/SCENE/<command> */
     gr_tune_metric metric;
     int fit;                      /* -1: auto (on unless shafts.intensity is a parameter) */
+    int normalize;                /* --normalize */
     int quiet;
     double fps;
     const char *frames_spec;      /* parsed in gr_tune_cli_finish (needs --fps) */

@@ -152,6 +152,11 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
         if ((st = render_score(p, i, &s, p->scratch, &opt, &m, err)) != GR_OK) return st;
         const gr_metrics_set *set = p->fit ? &m.fit : &m.raw;
         double v = gr_tune_metric_value(set, p->metric);
+        if (p->normalize && (p->metric == GR_TM_RMSE || p->metric == GR_TM_MSRMSE)) {
+            /* relative error: a bright view (toward the sun) would otherwise outweigh the rest */
+            double mean_y = set->ch[GR_MCH_Y].ref_mean;
+            v = mean_y > 0 ? v / mean_y : v;
+        }
         sum += v;
         if (per_case) per_case[i] = v;
         if (scale) scale[i] = p->fit ? m.fit.scale : 1.0;

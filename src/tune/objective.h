@@ -49,6 +49,8 @@ typedef struct gr_tune_problem {
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
     gr_tune_metric metric;
     int fit;                            /* score the test after the best scale fit */
+    int normalize;                      /* rmse/msrmse divided by the case's mean reference Y,
+                                           so that every frame and view weighs the same */
     double stderr_bound;                /* passed to the metrics (0: default) */
     /* filled by gr_tune_problem_init */
     gr_image *scratch;                  /* one frame (R, G, B) */

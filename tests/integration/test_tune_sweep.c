@@ -72,6 +72,22 @@ int main(void)
     CHECK(drawn == 1);
     gr_sweep_result_free(&res);
 
+    /* --normalize: each case's RMSE over its mean reference luminance, the mean computed here
+     * from the pixels with the Rec. 709 weights (the truth has no stderr: every pixel scored) */
+    double mean_y = 0.0;
+    for (int k = 0; k < 160 * 90; k++) {
+        const float *px = truth->pixels + (size_t)k * 3;
+        mean_y += 0.2126 * px[0] + 0.7152 * px[1] + 0.0722 * px[2];
+    }
+    mean_y /= 160.0 * 90.0;
+    double f_raw, f_norm, xq[2] = {0.7, 1.5};
+    CHECK_OK(gr_tune_evaluate(p, xq, &f_raw, NULL, NULL, &err), err);
+    p->normalize = 1;
+    CHECK_OK(gr_tune_evaluate(p, xq, &f_norm, NULL, NULL, &err), err);
+    p->normalize = 0;
+    CHECK(mean_y > 0 && f_raw > 0);
+    CHECK_REL(f_norm, f_raw / mean_y, 1e-6);
+
     /* one integer axis: N = 5, 7, 9, 11 against a render at N = 9 */
     p->n_params = 1;
     CHECK_OK(gr_tune_param_parse_sweep("--param", "shafts.N=5:11:4", &p->params[0], &err), err);
