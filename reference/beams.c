@@ -29,13 +29,14 @@ struct gr_beams {
     /* sun-disc kernel (NULL without it), per triangle: M = R J (2x2, row-major: shift in u,
      * w per unit depth for a unit offset in the disc frame), and ybar = the mean height of
      * the triangle's surface vertices, from which the depth d = ybar - y is measured */
-    float *kern, *ybar;
+    float *kern, *ybar, *kr;  /* kr: rho |M|_F, a bound of the kernel's radius per unit depth */
     double kc[GR_BEAM_KERNEL_N][2]; /* the unit kernel polygon (area pi) */
     double kc_area;          /* its area by the shoelace formula (pi up to rounding) */
     double kc_rho, kc_rin;   /* its circumradius and inradius */
     float *ytop, *dy;        /* per triangle: top of the beam, slab height */
     uint32_t *first;         /* per triangle: first primitive (size ntri + 1) */
     uint32_t *prim_tri;      /* per primitive: its triangle */
+    float *box;              /* per primitive: its box, sheared {u, y, w} lower then upper */
     double y_min;
     float sx, sz;            /* shear: T0x / T0y, T0z / T0y */
     RTCScene bvh, surface;
@@ -105,6 +106,38 @@ static double clip_area(const double (*kc)[2], int n, const double a[3], const d
         if (m < 3) return 0.0;
     }
     return fabs(polygon_area((const double (*)[2])buf[cur], m));
+}
+
+/* The same for one half-plane (the bit set in `mask`), by Green's theorem along the
+ * polygon without building the clipped vertex list: the common case. */
+static double clip1_area(const double (*kc)[2], int n, const double a3[3], const double b6[6], unsigned mask)
+{
+    int i = mask == 1u ? 0 : mask == 2u ? 1 : 2;
+    double a = a3[i], bx = b6[2 * i], by = b6[2 * i + 1];
+    double acc = 0.0, xo[2] = {0.0, 0.0}, xi[2] = {0.0, 0.0};
+    const double *p = kc[n - 1];
+    double fp = a + bx * p[0] + by * p[1];
+    for (int j = 0; j < n; j++) {
+        const double *q = kc[j];
+        double fq = a + bx * q[0] + by * q[1];
+        if (fp >= 0.0 && fq >= 0.0) {
+            acc += p[0] * q[1] - q[0] * p[1];
+        } else if (fp >= 0.0) { /* leaves the half-plane */
+            double t = fp / (fp - fq);
+            xo[0] = p[0] + t * (q[0] - p[0]);
+            xo[1] = p[1] + t * (q[1] - p[1]);
+            acc += p[0] * xo[1] - xo[0] * p[1];
+        } else if (fq >= 0.0) { /* enters it */
+            double t = fp / (fp - fq);
+            xi[0] = p[0] + t * (q[0] - p[0]);
+            xi[1] = p[1] + t * (q[1] - p[1]);
+            acc += xi[0] * q[1] - q[0] * xi[1];
+        }
+        p = q;
+        fp = fq;
+    }
+    acc += xo[0] * xi[1] - xi[0] * xo[1]; /* along the cut, from the exit to the entry */
+    return fabs(0.5 * acc);
 }
 
 double gr_beam_kernel_coverage(const double a[3], const double b[6])
@@ -196,12 +229,12 @@ static void prim_box(const gr_beams *b, uint32_t prim, float lo3[3], float hi3[3
 
 static void beam_bounds(const struct RTCBoundsFunctionArguments *args)
 {
-    float lo[3], hi[3];
-    prim_box(args->geometryUserPtr, args->primID, lo, hi);
+    const gr_beams *b = args->geometryUserPtr;
+    const float *bx = b->box + 6 * (size_t)args->primID;
     struct RTCBounds *o = args->bounds_o;
-    o->lower_x = lo[0]; o->upper_x = hi[0];
-    o->lower_y = lo[1]; o->upper_y = hi[1];
-    o->lower_z = lo[2]; o->upper_z = hi[2];
+    o->lower_x = bx[0]; o->upper_x = bx[3];
+    o->lower_y = bx[1]; o->upper_y = bx[4];
+    o->lower_z = bx[2]; o->upper_z = bx[5];
 }
 
 typedef struct lookup_state {
@@ -248,14 +281,20 @@ static void beam_test(const gr_beams *b, uint32_t prim, lookup_state *s)
         const float *M = b->kern + 4 * (size_t)t;
         float sg = det < 0.0f ? -1.0f : 1.0f;
         float g[3][2] = {{-(e2w - e1w), e2u - e1u}, {e2w, -e2u}, {-e1w, e1u}}; /* grad f_i in (u, w) */
-        float fa[3] = {f0, f1, f2};
+        float fa[3] = {sg * f0, sg * f1, sg * f2};
+        /* quick reject: the kernel's radius is at most kr dd (kr = rho |M|_F), so a point
+         * farther than that outside an edge is out (most candidates end here) */
+        float kd2 = dd * b->kr[t];
+        kd2 *= kd2;
+        for (int i = 0; i < 3; i++)
+            if (fa[i] < 0.0f && fa[i] * fa[i] > kd2 * (g[i][0] * g[i][0] + g[i][1] * g[i][1])) return;
         double a[3], bb[6];
         unsigned cut = 0; /* edges that cross the kernel */
         float rho = (float)b->kc_rho;
         for (int i = 0; i < 3; i++) {
             float bx = sg * dd * (M[0] * g[i][0] + M[2] * g[i][1]);
             float by = sg * dd * (M[1] * g[i][0] + M[3] * g[i][1]);
-            float ai = sg * fa[i], ext = rho * sqrtf(bx * bx + by * by);
+            float ai = fa[i], ext = rho * sqrtf(bx * bx + by * by);
             if (ai < -ext) return;     /* the kernel lies wholly outside edge i */
             if (ai < ext) cut |= 1u << i;
             a[i] = ai;
@@ -284,7 +323,9 @@ static void beam_test(const gr_beams *b, uint32_t prim, lookup_state *s)
                 e_h = b->phi[t] / areaK;
             } else {
                 if (det == 0.0f) return;
-                double frac = clip_area((const double (*)[2])b->kc, GR_BEAM_KERNEL_N, a, bb, cut) / b->kc_area;
+                double frac = (cut & (cut - 1u)) ? clip_area((const double (*)[2])b->kc, GR_BEAM_KERNEL_N, a, bb, cut)
+                                                 : clip1_area((const double (*)[2])b->kc, GR_BEAM_KERNEL_N, a, bb, cut);
+                frac /= b->kc_area;
                 if (!(frac > 0.0)) return;
                 /* exact: flux area(tri n K) / (|A| area(K)) <= flux / area(K); the bound only
                  * guards the rounding of a nearly collapsed cross-section */
@@ -296,7 +337,8 @@ static void beam_test(const gr_beams *b, uint32_t prim, lookup_state *s)
     float l0 = 1.0f / 3.0f, l1 = l0, l2 = l0;
     if (det != 0.0f) {
         float inv = 1.0f / det;
-        l0 = fmaxf(f0 * inv, 0.0f); l1 = fmaxf(f1 * inv, 0.0f); l2 = fmaxf(f2 * inv, 0.0f);
+        l0 = f0 * inv; l1 = f1 * inv; l2 = f2 * inv;
+        l0 = l0 > 0.0f ? l0 : 0.0f; l1 = l1 > 0.0f ? l1 : 0.0f; l2 = l2 > 0.0f ? l2 : 0.0f;
         float sum = l0 + l1 + l2;
         if (sum > 0.0f) { l0 /= sum; l1 /= sum; l2 /= sum; }
         else l0 = l1 = l2 = 1.0f / 3.0f;
@@ -330,19 +372,25 @@ static bool beam_query(struct RTCPointQueryFunctionArguments *args)
 /* ---- all the beams along one camera ray ----
  * One Embree traversal per camera ray (rtcOccluded1 on the sheared ray; the occluded
  * callback never reports a hit, so it sees every primitive whose box the ray may cross)
- * replaces one point query per march point: the march points then test the primitives
- * whose box they lie in, found by a sweep along t. The same exact test as
- * gr_beams_lookup, on a superset of the same candidates: the same hits. */
-typedef struct ray_prim { float t0, t1; uint32_t prim; } ray_prim;
+ * replaces one point query per march point: each collected primitive is binned to the
+ * march points that lie inside its box (their t within its interval), and each point then
+ * runs the exact test on its bin. The same exact test as gr_beams_lookup on a superset of
+ * the same candidates: the same hits, for one BVH traversal per ray. */
+typedef struct ray_prim { float t0, t1; uint32_t prim; int k0; } ray_prim;
 
 struct gr_beam_ray {
     struct RTCIntersectContext ctx; /* first member: Embree hands it to the callback */
     const gr_beams *b;
     float o[3], d[3], tmax;      /* the ray in sheared coordinates */
-    ray_prim *p;                 /* collected, then sorted by t0 */
+    ray_prim *p;                 /* collected primitives and their t intervals */
     size_t n, cap;
-    uint32_t *act;               /* active primitives (indices into p) */
-    size_t nact, capact, next;
+    uint32_t *stamp;             /* per primitive: the serial of the last ray that took it */
+    size_t nstamp;
+    uint32_t serial;
+    int *first;                  /* per march point: start of its bin (n_points + 1) */
+    int *tab;                    /* first march point of each part of [0, tmax] (2 n_points + 1) */
+    uint32_t *bin;               /* primitive ids, binned by march point */
+    size_t capfirst, capbin;
     int oom;
 };
 
@@ -352,19 +400,22 @@ static void beam_occluded(const struct RTCOccludedFunctionNArguments *args)
 {
     if (!args->valid[0]) return;
     gr_beam_ray *r = (gr_beam_ray *)(void *)args->context;
-    float lo[3], hi[3];
-    prim_box(r->b, args->primID, lo, hi);
+    uint32_t prim = args->primID;
+    if (r->stamp[prim] == r->serial) return; /* already taken (a primitive split across leaves) */
+    r->stamp[prim] = r->serial;
+    const float *bx = r->b->box + 6 * (size_t)prim;
     /* slab method: the t interval of the ray inside the box */
     float t0 = 0.0f, t1 = r->tmax;
     for (int a = 0; a < 3; a++) {
+        float lo = bx[a], hi = bx[3 + a];
         if (r->d[a] == 0.0f) {
-            if (r->o[a] < lo[a] || r->o[a] > hi[a]) return;
+            if (r->o[a] < lo || r->o[a] > hi) return;
             continue;
         }
-        float inv = 1.0f / r->d[a], ta = (lo[a] - r->o[a]) * inv, tb = (hi[a] - r->o[a]) * inv;
+        float inv = 1.0f / r->d[a], ta = (lo - r->o[a]) * inv, tb = (hi - r->o[a]) * inv;
         if (ta > tb) { float x = ta; ta = tb; tb = x; }
-        t0 = fmaxf(t0, ta);
-        t1 = fminf(t1, tb);
+        t0 = ta > t0 ? ta : t0;
+        t1 = tb < t1 ? tb : t1;
     }
     /* widened: float rounding of the interval must not drop a point the box holds */
     float eps = 1e-5f * (1.0f + r->tmax);
@@ -380,7 +431,7 @@ static void beam_occluded(const struct RTCOccludedFunctionNArguments *args)
     }
     r->p[r->n].t0 = t0;
     r->p[r->n].t1 = t1;
-    r->p[r->n].prim = args->primID;
+    r->p[r->n].prim = prim;
     r->n++;
 }
 
@@ -424,23 +475,42 @@ void gr_beam_ray_destroy(gr_beam_ray *r)
 {
     if (!r) return;
     free(r->p);
-    free(r->act);
+    free(r->stamp);
+    free(r->first);
+    free(r->tab);
+    free(r->bin);
     free(r);
 }
 
-static int cmp_ray_prim(const void *a, const void *b)
-{
-    const ray_prim *x = a, *y = b;
-    if (x->t0 != y->t0) return x->t0 < y->t0 ? -1 : 1;
-    return (x->prim > y->prim) - (x->prim < y->prim);
-}
-
-int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, gr_beam_ray *r)
+int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, const float *t, int npts,
+                         gr_beam_ray *r)
 {
     r->b = b;
-    r->n = r->nact = r->next = 0;
+    r->n = 0;
     r->oom = 0;
-    if (!b || !b->bvh || !(tmax > 0.0f)) return 0;
+    if ((size_t)npts + 1 > r->capfirst) {
+        int *nf = realloc(r->first, ((size_t)npts + 1) * sizeof *nf);
+        if (nf) r->first = nf;
+        int *nt = realloc(r->tab, (2 * (size_t)npts + 1) * sizeof *nt);
+        if (nt) r->tab = nt;
+        if (!nf || !nt) return -1;
+        r->capfirst = (size_t)npts + 1;
+    }
+    memset(r->first, 0, ((size_t)npts + 1) * sizeof *r->first);
+    if (!b || !b->bvh || !(tmax > 0.0f) || npts < 1) return 0;
+    size_t np = b->stats.prims;
+    if (r->nstamp < np) {
+        uint32_t *ns = realloc(r->stamp, np * sizeof *ns);
+        if (!ns) return -1;
+        memset(ns, 0, np * sizeof *ns);
+        r->stamp = ns;
+        r->nstamp = np;
+        r->serial = 0;
+    }
+    if (++r->serial == 0) { /* wrapped: forget every stamp */
+        memset(r->stamp, 0, r->nstamp * sizeof *r->stamp);
+        r->serial = 1;
+    }
     r->o[0] = o.x - b->sx * o.y; r->o[1] = o.y; r->o[2] = o.z - b->sz * o.y;
     r->d[0] = d.x - b->sx * d.y; r->d[1] = d.y; r->d[2] = d.z - b->sz * d.y;
     r->tmax = tmax;
@@ -454,31 +524,48 @@ int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, gr
     ray.mask = ~0u;
     rtcOccluded1(b->bvh, &r->ctx, &ray);
     if (r->oom) return -1;
-    qsort(r->p, r->n, sizeof *r->p, cmp_ray_prim);
-    /* a primitive split across BVH leaves could arrive twice: keep one */
-    size_t k = 0;
-    for (size_t i = 0; i < r->n; i++)
-        if (!k || r->p[i].prim != r->p[k - 1].prim || r->p[i].t0 != r->p[k - 1].t0) r->p[k++] = r->p[i];
-    r->n = k;
+    /* bin: the march points k with t[k] in [t0, t1] (t ascending), counted then filled.
+     * The first point at or after t0 comes from a table over 2 npts equal parts of [0, tmax]
+     * (its part's first point, then a few steps on). */
+    int nparts = 2 * npts;
+    float scale = (float)nparts / tmax;
+    for (int c = 0, k = 0; c <= nparts; c++) {
+        float tc = (float)c / scale;
+        while (k < npts && t[k] < tc) k++;
+        r->tab[c] = k;
+    }
+    size_t total = 0;
+    for (size_t i = 0; i < r->n; i++) {
+        ray_prim *q = &r->p[i];
+        float c = q->t0 * scale;
+        int k = c <= 0.0f ? 0 : c >= (float)nparts ? r->tab[nparts] : r->tab[(int)c];
+        if (k > 0 && t[k - 1] >= q->t0) k = 0; /* rounding of the part: start over (never seen) */
+        while (k < npts && t[k] < q->t0) k++;
+        q->k0 = k;
+        for (; k < npts && t[k] <= q->t1; k++) { r->first[k + 1]++; total++; }
+    }
+    if (total > r->capbin) {
+        uint32_t *nb = realloc(r->bin, total * sizeof *nb);
+        if (!nb) return -1;
+        r->bin = nb;
+        r->capbin = total;
+    }
+    for (int k = 0; k < npts; k++) r->first[k + 1] += r->first[k];
+    for (size_t i = 0; i < r->n; i++) {
+        const ray_prim *q = &r->p[i];
+        /* first[k] runs ahead as the fill cursor of bin k; restored below */
+        for (int k = q->k0; k < npts && t[k] <= q->t1; k++) r->bin[r->first[k]++] = q->prim;
+    }
+    for (int k = npts; k > 0; k--) r->first[k] = r->first[k - 1];
+    r->first[0] = 0;
     return 0;
 }
 
-int gr_beams_ray_lookup(const gr_beams *b, gr_beam_ray *r, float t, gr_vec3 p, gr_beam_hit *hits, int max_hits,
+int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 p, gr_beam_hit *hits, int max_hits,
                         int *overflow)
 {
     if (overflow) *overflow = 0;
     if (!b || !b->bvh) return 0;
-    /* admit the primitives whose interval has begun, drop those that have ended */
-    while (r->next < r->n && r->p[r->next].t0 <= t) {
-        if (r->nact == r->capact) {
-            size_t cap = r->capact ? 2 * r->capact : 64;
-            uint32_t *na = realloc(r->act, cap * sizeof *na);
-            if (!na) { if (overflow) *overflow = 1; break; }
-            r->act = na;
-            r->capact = cap;
-        }
-        r->act[r->nact++] = (uint32_t)r->next++;
-    }
     lookup_state s;
     s.y = p.y;
     s.u = p.x - b->sx * p.y;
@@ -487,14 +574,9 @@ int gr_beams_ray_lookup(const gr_beams *b, gr_beam_ray *r, float t, gr_vec3 p, g
     s.n = 0;
     s.max = max_hits;
     s.overflow = 0;
-    for (size_t i = 0; i < r->nact;) {
-        const ray_prim *rp = &r->p[r->act[i]];
-        if (rp->t1 < t) { r->act[i] = r->act[--r->nact]; continue; }
-        beam_test(b, rp->prim, &s);
-        i++;
-    }
+    for (int i = r->first[k]; i < r->first[k + 1]; i++) beam_test(b, r->bin[i], &s);
     sort_hits(hits, s.n);
-    if (overflow) *overflow |= s.overflow;
+    if (overflow) *overflow = s.overflow;
     return s.n;
 }
 
@@ -564,13 +646,14 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         jv = malloc(nv * 4 * sizeof *jv);
         b->kern = malloc(ntri * 4 * sizeof *b->kern);
         b->ybar = malloc(ntri * sizeof *b->ybar);
+        b->kr = malloc(ntri * sizeof *b->kr);
         kernel_polygon(b->kc);
         b->kc_area = polygon_area((const double (*)[2])b->kc, GR_BEAM_KERNEL_N);
         b->kc_rho = gr_beam_kernel_radius();
         b->kc_rin = b->kc_rho * cos(GR_PI / GR_BEAM_KERNEL_N);
     }
     if (!pos || !b->v || !b->phi || !b->ytop || !b->dy || !b->first || !drift ||
-        (disc && (!jv || !b->kern || !b->ybar))) {
+        (disc && (!jv || !b->kern || !b->ybar || !b->kr))) {
         free(pos); free(drift); free(jv); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu surface vertices (reference.surface_res)", nv);
     }
@@ -621,6 +704,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         if (disc) {
             memset(b->kern + 4 * t, 0, 4 * sizeof *b->kern);
             b->ybar[t] = b->ytop[t];
+            b->kr[t] = 0.0f;
         }
         drift[t] = 0.0f;
         if (v0->ft < 0.0f || v1->ft < 0.0f || v2->ft < 0.0f) continue;
@@ -638,6 +722,8 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
                                                                      jv[4 * (size_t)idx[1] + (size_t)c] +
                                                                      jv[4 * (size_t)idx[2] + (size_t)c]) / 3.0);
             b->ybar[t] = (v0->py + v1->py + v2->py) / 3.0f;
+            const float *M = b->kern + 4 * t;
+            b->kr[t] = (float)b->kc_rho * 1.0001f * sqrtf(M[0] * M[0] + M[1] * M[1] + M[2] * M[2] + M[3] * M[3]);
         }
         float d = 0.0f;
         const beam_vertex *vs[3] = {v0, v1, v2};
@@ -678,6 +764,12 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->first[ntri] = np;
     free(drift);
     free(jv);
+    b->box = malloc((np ? np : 1) * 6 * sizeof *b->box);
+    if (!b->box) {
+        free(pos); gr_beams_destroy(b);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %u beam primitives", np);
+    }
+    for (uint32_t k = 0; k < np; k++) prim_box(b, k, b->box + 6 * (size_t)k, b->box + 6 * (size_t)k + 3);
 
     RTCDevice dev = rtc->device;
     gr_status st = GR_OK;
@@ -710,7 +802,8 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->stats.triangles = ntri;
     b->stats.lit_triangles = lit;
     b->stats.prims = np;
-    b->stats.bytes = nv * sizeof *b->v + ntri * ((disc ? 8 : 3) * sizeof(float) + sizeof(uint32_t)) + np * sizeof(uint32_t);
+    b->stats.bytes = nv * sizeof *b->v + ntri * ((disc ? 8 : 3) * sizeof(float) + sizeof(uint32_t)) +
+                     np * (sizeof(uint32_t) + 6 * sizeof(float));
     b->stats.build_s = now_s() - t_start;
     *out = b;
     return GR_OK;
@@ -728,9 +821,11 @@ void gr_beams_destroy(gr_beams *b)
     free(b->phi);
     free(b->kern);
     free(b->ybar);
+    free(b->kr);
     free(b->ytop);
     free(b->dy);
     free(b->first);
     free(b->prim_tri);
+    free(b->box);
     free(b);
 }

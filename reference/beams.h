@@ -79,19 +79,20 @@ typedef struct gr_beam_hit {
  * (at most max_hits, *overflow set to 1 if more were found), sorted by primitive id. */
 int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hit *hits, int max_hits, int *overflow);
 
-/* The beams along one camera ray, for a march: collect once, then look up the march
- * points in increasing t. Gives the same hits as gr_beams_lookup at each point (the same
- * exact test on the primitives whose boxes hold the point), for one BVH traversal per ray
- * instead of one per point. One gr_beam_ray per thread (scratch memory, reused). */
+/* The beams along one camera ray, for a march: one BVH traversal per ray instead of one
+ * point query per march point, with the same hits as gr_beams_lookup at each point (the
+ * same exact test on the primitives whose boxes hold the point). One gr_beam_ray per
+ * thread (scratch memory, reused). */
 typedef struct gr_beam_ray gr_beam_ray;
 gr_beam_ray *gr_beam_ray_create(void);      /* NULL when out of memory */
 void gr_beam_ray_destroy(gr_beam_ray *r);   /* accepts NULL */
-/* Collects the primitives whose boxes the local segment o + t d, t in [0, tmax], crosses.
- * Returns 0, or -1 when out of memory. */
-int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, gr_beam_ray *r);
-/* Every beam through p = o + t d, like gr_beams_lookup; t must not decrease between calls
- * after one collect. */
-int gr_beams_ray_lookup(const gr_beams *b, gr_beam_ray *r, float t, gr_vec3 p, gr_beam_hit *hits, int max_hits,
+/* Collects the primitives whose boxes the local segment o + t d, t in [0, tmax], crosses
+ * and bins them to the march points t[0..npts-1] (ascending). Returns 0, or -1 when out of
+ * memory. */
+int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, const float *t, int npts,
+                         gr_beam_ray *r);
+/* Every beam through march point k, p = o + t[k] d, like gr_beams_lookup. */
+int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 p, gr_beam_hit *hits, int max_hits,
                         int *overflow);
 
 /* The disc kernel's polygon (exposed for tests): GR_BEAM_KERNEL_N vertices on a circle of

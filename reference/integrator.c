@@ -335,15 +335,15 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
 
 /* Sunlight arriving at the local point x: every beam through it under waves, the closed
  * form on flat water (and outside the lit region, where the waves' mean is used). With
- * `ray` (the beams collected along a camera ray), x must be the ray's point at t. */
-static int light_at(const gr_ref_renderer *r, gr_vec3 x, gr_beam_ray *ray, float t, ref_light *out, gr_beam_hit *hits,
-                    int *overflow)
+ * `ray` (the beams collected along a camera ray), x must be the ray's march point k. */
+static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray, int k, ref_light *out,
+                    gr_beam_hit *hits, int *overflow)
 {
     if (!r->flat) {
         double u = x.x - r->sx * x.y, w = x.z - r->sz * x.y;
         const gr_beam_region *g = &r->region;
         if (x.y >= g->y_min && u >= g->u0 && u <= g->u1 && w >= g->w0 && w <= g->w1) {
-            int n = ray ? gr_beams_ray_lookup(r->beams, ray, t, x, hits, REF_MAX_HITS, overflow)
+            int n = ray ? gr_beams_ray_lookup(r->beams, ray, k, x, hits, REF_MAX_HITS, overflow)
                         : gr_beams_lookup(r->beams, x, hits, REF_MAX_HITS, overflow);
             int m = 0;
             for (int i = 0; i < n; i++) {
@@ -370,7 +370,7 @@ double gr_ref_irradiance_h(const gr_ref_renderer *r, gr_dvec3 world)
     ref_light l[REF_MAX_HITS];
     int of = 0;
     gr_vec3 x = gr_d3_to_f(gr_d3_sub(world, r->origin));
-    int n = light_at(r, x, NULL, 0.0f, l, hits, &of);
+    int n = light_at(r, x, NULL, 0, l, hits, &of);
     double e = 0.0;
     for (int i = 0; i < n; i++) e += (double)l[i].eperp * -(double)l[i].T.y;
     return e;
@@ -436,10 +436,42 @@ static void pixel_stratum(int j, int n, ref_rng *g, double *jx, double *jy)
 
 /* One camera sample: L (RGB) along the ray through the jittered pixel position; the
  * sample is stratum j of the n camera samples its batch takes in this round. */
-static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, ref_rng *g, double L[3],
-                          double *trans, double *len, ref_counters *cnt, gr_beam_hit *hits, ref_light *lights,
-                          gr_beam_ray *ray)
+/* Per-thread scratch memory of the march. */
+typedef struct ref_scratch {
+    gr_beam_hit *hits;
+    ref_light *lights;
+    gr_beam_ray *ray;
+    double *t;     /* march points along the ray (m) */
+    float *tf;     /* the same in float, as the points are placed */
+} ref_scratch;
+
+static void scratch_free(ref_scratch *sc)
 {
+    free(sc->hits);
+    free(sc->lights);
+    gr_beam_ray_destroy(sc->ray);
+    free(sc->t);
+    free(sc->tf);
+}
+
+static int scratch_alloc(ref_scratch *sc, int steps)
+{
+    sc->hits = malloc(REF_MAX_HITS * sizeof *sc->hits);
+    sc->lights = malloc(REF_MAX_HITS * sizeof *sc->lights);
+    sc->ray = gr_beam_ray_create();
+    sc->t = malloc((size_t)steps * sizeof *sc->t);
+    sc->tf = malloc((size_t)steps * sizeof *sc->tf);
+    if (sc->hits && sc->lights && sc->ray && sc->t && sc->tf) return 0;
+    scratch_free(sc);
+    memset(sc, 0, sizeof *sc);
+    return -1;
+}
+
+static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, ref_rng *g, double L[3],
+                          double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
+{
+    gr_beam_hit *hits = sc->hits;
+    ref_light *lights = sc->lights;
     const gr_camera *c = &r->scene.camera;
     double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), aspect = (double)c->width / (double)c->height;
     double jx, jy;
@@ -460,9 +492,6 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n
     *len = D;
     *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
     if (D == 0.0f) return;
-    /* the beams along this ray, once: the march points then sweep through them */
-    if (!r->flat && gr_beams_ray_collect(r->beams, o, d, D, ray) != 0) ray = NULL; /* out of memory: per point */
-    if (r->flat || getenv("GR_NORAY")) ray = NULL;
     int n = r->set.steps;
     /* March density ~ exp(-lam t) on [0, D], lam = sig_ref (1 - w_y / mu_t0): the camera
      * ray's extinction times the sunlight's extinction down to the point on flat water, so
@@ -480,10 +509,17 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n
     double hg_g = r->scene.medium.g;
     for (int k = 0; k < n; k++) {
         double u = (k + rng_u(g)) / n;
-        double t = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
-        gr_vec3 x = gr_v3_madd(o, d, (float)t);
+        sc->t[k] = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
+        sc->tf[k] = (float)sc->t[k];
+    }
+    /* the beams along this ray, found once and binned to the march points */
+    const gr_beam_ray *ray = NULL;
+    if (!r->flat && gr_beams_ray_collect(r->beams, o, d, D, sc->tf, n, sc->ray) == 0) ray = sc->ray;
+    for (int k = 0; k < n; k++) {
+        double t = sc->t[k];
+        gr_vec3 x = gr_v3_madd(o, d, sc->tf[k]);
         int of = 0;
-        int m = light_at(r, x, ray, (float)t, lights, hits, &of);
+        int m = light_at(r, x, ray, k, lights, hits, &of);
         cnt->queries++;
         cnt->overflows += of;
         for (int i = 0; i < m; i++) {
@@ -513,18 +549,13 @@ static void *worker(void *arg)
     ref_job *job = arg;
     const gr_ref_renderer *r = job->r;
     ref_accum *acc = job->acc;
-    gr_beam_hit *hits = malloc(REF_MAX_HITS * sizeof *hits);
-    ref_light *lights = malloc(REF_MAX_HITS * sizeof *lights);
-    gr_beam_ray *ray = gr_beam_ray_create();
+    ref_scratch sc;
     ref_counters cnt = {0, 0, 0};
     /* camera samples are stratified over the pixel within a batch (like the passes' strata):
      * this pass is the k-th of its batch in the round */
     int per_batch = r->passes_per_round / r->batches, k_in_batch = (job->pass % r->passes_per_round) / r->batches;
-    if (!hits || !lights || !ray) {
+    if (scratch_alloc(&sc, r->set.steps) != 0) {
         atomic_store(&job->stop, 2);
-        free(hits);
-        free(lights);
-        gr_beam_ray_destroy(ray);
         return NULL;
     }
     for (;;) {
@@ -539,7 +570,7 @@ static void *worker(void *arg)
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
                 render_sample(r, x, y, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, &g, L, &tr, &len, &cnt,
-                              hits, lights, ray);
+                              &sc);
                 sum[0] += L[0];
                 sum[1] += L[1];
                 sum[2] += L[2];
@@ -555,9 +586,7 @@ static void *worker(void *arg)
     atomic_fetch_add(&job->queries, cnt.queries);
     atomic_fetch_add(&job->shadow_rays, cnt.shadow_rays);
     atomic_fetch_add(&job->overflows, cnt.overflows);
-    free(hits);
-    free(lights);
-    gr_beam_ray_destroy(ray);
+    scratch_free(&sc);
     return NULL;
 }
 

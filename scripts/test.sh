@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Everything CI checks: install what is missing, build build/ with warnings as errors, build
 # build-asan/ with AddressSanitizer + UndefinedBehaviorSanitizer and run the unit, cli and
-# integration tests there (slow ones excluded), then run every test in build/. Exits non-zero
+# integration tests there (labels slow and heavy excluded: see tests/CMakeLists.txt), then run
+# every test in build/. Exits non-zero
 # on any failure.
 #   ./scripts/test.sh          slow tests reduced in CI (CI=true), full locally
 #   ./scripts/test.sh --full   slow tests full even in CI (same as GODRAYS_TEST_FULL=1)
@@ -61,9 +62,9 @@ if [ "$asan" -eq 1 ]; then
   if cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGODRAYS_SANITIZE=ON &&
      cmake --build build-asan -j "$JOBS"; then
     phase "configure + build (ASan+UBSan)"
-    (cd build-asan && ctest --output-on-failure -j "$JOBS" -L 'unit|cli|integration' -LE slow) ||
+    (cd build-asan && ctest --output-on-failure -j "$JOBS" -L 'unit|cli|integration' -LE 'slow|heavy') ||
       { status=1; echo "test.sh: FAILED: tests in build-asan/ (ASan+UBSan)" >&2; }
-    phase "ctest build-asan/ (no slow)"
+    phase "ctest build-asan/ (no slow/heavy)"
   else
     status=1
     echo "test.sh: FAILED: ASan+UBSan build" >&2

@@ -42,7 +42,7 @@ int main(void)
     double xa[2] = {lo[0] + 0.1 * (hi[0] - lo[0]), lo[1] + 0.15 * (hi[1] - lo[1])};
     double xb[2] = {lo[0] + 0.9 * (hi[0] - lo[0]), lo[1] + 0.85 * (hi[1] - lo[1])};
     int reduced = tune_test_reduced();
-    gr_opt_options oa = {.n_starts = reduced ? 3 : 4, .x0 = xa, .max_evals = reduced ? 60 : 100};
+    gr_opt_options oa = {.n_starts = reduced ? 6 : 8, .x0 = xa, .max_evals = reduced ? 160 : 240};
     gr_opt_options ob = oa;
     ob.x0 = xb;
     gr_opt_result ra, rb;
