@@ -90,7 +90,11 @@ int main(void)
         free(rel);
         gr_ref_result_free(&r);
     }
-    CHECK_MSG(med[0] / med[1] > 1.5 && med[0] / med[1] < 2.6, "4x samples must halve the error, ratio %.2f", med[0] / med[1]);
+    /* Camera samples and march steps are jittered strata: the standard error falls between
+     * N^-1/2 (independent samples) and N^-1 (smooth integrand, stratified), so 4x samples cut
+     * it by a factor between 2 and 4; the margins allow for the noise of a 4-batch estimate. */
+    CHECK_MSG(med[0] / med[1] > 1.5 && med[0] / med[1] < 4.6, "4x samples must cut the error 2x to 4x, ratio %.2f",
+              med[0] / med[1]);
 #ifdef GR_HAVE_PLPLOT
     const char *out = getenv("GODRAYS_TEST_OUT");
     char png[4096];
