@@ -13,7 +13,7 @@
  * of the refracted ray's horizontal slope T_xz / T_y with respect to delta (per beam: the
  * mean of its vertices' J). Averaged over the disc, the horizontal irradiance at p is
  *   E(p) = flux * area(triangle(y) n (p - K(y))) / (|A(y)| area(K(y))),  K = d J disc,
- * computed exactly with K approximated by an equal-area 16-gon (convex clipping).
+ * computed exactly (K an ellipse: segment and sector areas in the kernel's own units).
  *
  * Lookups go through an Embree BVH (user geometry): one primitive per beam and depth slab,
  * in coordinates sheared along the mean refracted direction T0 (u = x - T0x/T0y y,
@@ -48,6 +48,9 @@ typedef struct gr_beam_params {
     double disc_radius;
     gr_dvec3 disc_e1, disc_e2;
     int surface_mesh;        /* 1: also build the displaced surface as an Embree mesh */
+    double slab_cells;       /* drift of a beam per depth slab, in cells; 0 = 1. Thinner slabs
+                                (0.5) give tighter boxes: fewer candidates per lookup for a
+                                render's march, twice the primitives to build */
 } gr_beam_params;
 
 typedef struct gr_beams gr_beams;
@@ -95,13 +98,11 @@ int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, co
 int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 p, gr_beam_hit *hits, int max_hits,
                         int *overflow);
 
-/* The disc kernel's polygon (exposed for tests): GR_BEAM_KERNEL_N vertices on a circle of
- * radius gr_beam_kernel_radius(), whose area is exactly pi (the unit disc's). */
-#define GR_BEAM_KERNEL_N 16
-double gr_beam_kernel_radius(void);
-/* Area of the convex polygon (unit kernel polygon) intersected with the three half-planes
- * a_i + b_i . c >= 0 (i = 0..2), divided by the polygon's area: the fraction of the kernel
- * that lies inside a triangle. b is {b0x, b0y, b1x, b1y, b2x, b2y}. */
-double gr_beam_kernel_coverage(const double a[3], const double b[6]);
+/* The kernel's geometry in its own units (the disc of directions = the unit disc), exposed
+ * for tests: the fraction of the unit disc on the side c . n >= -s of a line at signed
+ * distance s from its centre; the fraction of the unit disc inside the triangle
+ * v = {x0, y0, x1, y1, x2, y2} (either orientation). */
+double gr_beam_disc_halfplane(double s);
+double gr_beam_disc_triangle(const double v[6]);
 
 #endif

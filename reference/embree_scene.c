@@ -122,6 +122,23 @@ gr_status gr_ref_geometry_create(gr_rtc *rtc, const gr_scene *s, gr_dvec3 origin
     g->origin = origin;
     g->n_occluders = s->n_occluders;
     g->has_seabed = s->has_seabed;
+    if (s->n_occluders > 0) {
+        g->bound = calloc((size_t)s->n_occluders, sizeof *g->bound);
+        if (!g->bound) { free(g); return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the occluders"); }
+        for (int i = 0; i < s->n_occluders; i++) {
+            const gr_occluder *o = &s->occluders[i];
+            gr_ref_bound *b = &g->bound[i];
+            gr_dvec3 c = gr_d3_sub(gr_d3(o->center_m[0], o->center_m[1], o->center_m[2]), origin);
+            b->c[0] = (float)c.x; b->c[1] = (float)c.y; b->c[2] = (float)c.z;
+            b->sphere = o->type == GR_OCC_SPHERE;
+            /* padded well beyond float rounding, so the prefilter never misses a hit */
+            b->r = (float)(o->radius_m * 1.0001 + 1e-3);
+            for (int k = 0; k < 3; k++) b->h[k] = (float)(0.5 * o->size_m[k] * 1.0001 + 1e-3);
+            double a = o->yaw_deg * 3.14159265358979323846 / 180.0;
+            b->ca = (float)cos(a);
+            b->sa = (float)sin(a);
+        }
+    }
     RTCDevice dev = rtc->device;
     if (s->n_occluders > 0 || s->has_seabed) {
         g->ends = rtcNewScene(dev);
@@ -168,6 +185,7 @@ void gr_ref_geometry_destroy(gr_ref_geometry *g)
     if (!g) return;
     if (g->ends) rtcReleaseScene(g->ends);
     if (g->shadow) rtcReleaseScene(g->shadow);
+    free(g->bound);
     free(g);
 }
 
@@ -208,4 +226,40 @@ int gr_rtc_occluded(RTCScene scene, gr_vec3 o, gr_vec3 d, float tnear, float tfa
     r.mask = ~0u;
     rtcOccluded1(scene, &ctx, &r);
     return r.tfar < 0.0f; /* Embree sets tfar = -inf on a hit */
+}
+
+/* Does the segment o + t d, t in [0, tmax] (unit d), touch the padded shape? */
+static int segment_touches(const gr_ref_bound *b, gr_vec3 o, gr_vec3 d, float tmax)
+{
+    float v[3] = {b->c[0] - o.x, b->c[1] - o.y, b->c[2] - o.z};
+    if (b->sphere) {
+        float t = v[0] * d.x + v[1] * d.y + v[2] * d.z;
+        t = t < 0.0f ? 0.0f : t > tmax ? tmax : t;
+        float q[3] = {v[0] - t * d.x, v[1] - t * d.y, v[2] - t * d.z};
+        return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= b->r * b->r;
+    }
+    /* into the box's frame: ex = (cos, 0, -sin), ey = y, ez = (sin, 0, cos) (add_box) */
+    float lo[3] = {-v[0] * b->ca + v[2] * b->sa, -v[1], -v[0] * b->sa - v[2] * b->ca};
+    float dl[3] = {d.x * b->ca - d.z * b->sa, d.y, d.x * b->sa + d.z * b->ca};
+    float t0 = 0.0f, t1 = tmax;
+    for (int k = 0; k < 3; k++) {
+        if (dl[k] == 0.0f) {
+            if (lo[k] < -b->h[k] || lo[k] > b->h[k]) return 0;
+            continue;
+        }
+        float inv = 1.0f / dl[k], ta = (-b->h[k] - lo[k]) * inv, tb = (b->h[k] - lo[k]) * inv;
+        if (ta > tb) { float x = ta; ta = tb; tb = x; }
+        t0 = ta > t0 ? ta : t0;
+        t1 = tb < t1 ? tb : t1;
+        if (t0 > t1) return 0;
+    }
+    return 1;
+}
+
+int gr_ref_shadowed(const gr_ref_geometry *g, gr_vec3 o, gr_vec3 d, float tfar)
+{
+    if (!g->shadow || !(tfar > 0.0f)) return 0;
+    int near = 0;
+    for (int i = 0; i < g->n_occluders && !near; i++) near = segment_touches(&g->bound[i], o, d, tfar);
+    return near ? gr_rtc_occluded(g->shadow, o, d, 0.0f, tfar) : 0;
 }

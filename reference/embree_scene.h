@@ -25,6 +25,12 @@ void gr_rtc_destroy(gr_rtc *r); /* accepts NULL */
  * `what`), clears it and returns its status; else GR_OK. */
 gr_status gr_rtc_check(gr_rtc *r, const char *what, gr_error *err);
 
+/* An occluder's padded shape in the local frame, for the shadow rays' prefilter. */
+typedef struct gr_ref_bound {
+    int sphere;          /* 1: sphere (c, r); 0: box (c, half extents h, yaw as cos/sin) */
+    float c[3], h[3], r, ca, sa;
+} gr_ref_bound;
+
 /* Static scene in the local frame (local = world - origin). */
 typedef struct gr_ref_geometry {
     RTCScene ends;       /* occluders + seabed: where camera rays stop (NULL if empty) */
@@ -32,6 +38,7 @@ typedef struct gr_ref_geometry {
     gr_dvec3 origin;     /* world position of the local origin */
     int n_occluders;
     int has_seabed;
+    gr_ref_bound *bound; /* one per occluder, padded by 1e-4 relative + 1 mm */
 } gr_ref_geometry;
 
 /* Builds the static scenes. seabed_half_size_m: half extent of the seabed quad around
@@ -47,5 +54,9 @@ float gr_rtc_intersect(RTCScene scene, gr_vec3 o, gr_vec3 d, float tnear, float 
                        unsigned *hit_geom, float *ng_y);
 /* 1 if anything in scene blocks the segment o + t d, t in (tnear, tfar); 0 if scene NULL. */
 int gr_rtc_occluded(RTCScene scene, gr_vec3 o, gr_vec3 d, float tnear, float tfar);
+/* The same against g->shadow (unit d), with a prefilter: a segment that misses every
+ * occluder's padded shape (tested here in closed form) is not traced; the others go to
+ * Embree, whose answer counts. */
+int gr_ref_shadowed(const gr_ref_geometry *g, gr_vec3 o, gr_vec3 d, float tfar);
 
 #endif

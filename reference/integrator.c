@@ -54,6 +54,7 @@ struct gr_ref_renderer {
     double sx, sz;            /* shear T0x / T0y, T0z / T0y */
     double sun_radius;        /* angular radius in air (rad) */
     int convolve;             /* 1: the disc by the analytic convolution, passes use I0 */
+    int rendering;            /* 1 inside gr_ref_render (beam sets for the march) */
     double cutoff_d;
     gr_beam_region region;
     double pad;
@@ -321,6 +322,9 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     bp.jitter[1] = jit[1];
     bp.max_prims = r->opt.max_prims;
     bp.surface_mesh = 1;
+    /* a render's march looks up millions of points per beam set: thinner slabs pay off
+     * there (docs/reference.md, "Lookups"); probes keep the cheaper build */
+    bp.slab_cells = r->rendering ? 0.5 : 1.0;
     if (r->convolve) {
         bp.disc_radius = r->sun_radius;
         bp.disc_e1 = r->e1;
@@ -526,14 +530,16 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n
             const ref_light *l = &lights[i];
             if (r->geom->shadow) {
                 cnt->shadow_rays++;
-                if (gr_rtc_occluded(r->geom->shadow, x, gr_v3_scale(l->T, -1.0f), 0.0f, l->path)) continue;
+                if (gr_ref_shadowed(r->geom, x, gr_v3_scale(l->T, -1.0f), l->path)) continue;
             }
             double ph = gr_hg_phase(-(double)gr_v3_dot(l->T, d), hg_g);
             double base = ph * l->eperp * wbase;
             for (int ch = 0; ch < 3; ch++) {
                 /* sun-to-point and point-to-camera extinction, divided by the march density */
                 double ex = r->sig_t[ch] * ((double)l->path + t) - lam * t;
-                if (ex < REF_EXP_LIMIT) L[ch] += r->sig_s[ch] * r->E[ch] * base * exp(-ex);
+                /* float exp where its range suffices (per-sample work), double below that */
+                double tr = ex < 80.0 ? (double)expf((float)-ex) : ex < REF_EXP_LIMIT ? exp(-ex) : 0.0;
+                L[ch] += r->sig_s[ch] * r->E[ch] * base * tr;
             }
         }
     }
@@ -828,6 +834,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     ref_errors e;
     memset(&e, 0, sizeof e);
     int pass = 0;
+    r->rendering = 1;
     for (int round = 0; round < rounds && st == GR_OK && !out->partial; round++) {
         for (int pp = 0; pp < P && st == GR_OK; pp++, pass++) {
             if (r->opt.interrupt && *r->opt.interrupt) { out->partial = 1; break; }
@@ -885,6 +892,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             if (e.rel_mean < r->set.target_error && e.rel_p95 < r->set.target_error) break;
         }
     }
+    r->rendering = 0;
     gr_progress_finish(prog);
     gr_progress_destroy(prog);
     free(th);

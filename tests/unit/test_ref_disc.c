@@ -9,10 +9,12 @@
  *    tessellation with no first-order assumption, converging as N grows (N and N/4 are
  *    compared to show how far it has converged).
  * Probes: a grid across the caustic sheets (z over one wavelength, 5 depths through the
- * focus, 3 x positions averaged). Checks, for the real 0.53 deg disc and a 4x wider one:
- * the relative L1 difference between the two fields, the difference of their peaks, their
- * means (flux: both must agree to rounding), and that the disc really acts (its peak is far
- * below the point-sun peak of the same tessellation). */
+ * focus, 3 x positions averaged). Checks, for the real 0.53 deg disc and a 4x wider one
+ * (where the first-order error is 16x larger): the relative L1 difference between the two
+ * fields, the difference of their peaks (mean of the top 1% of the probes), their means
+ * (flux), each within a tolerance plus the brute force's own N/4-vs-N difference; and that
+ * the disc really acts (its peak is far below the point-sun peak of the same tessellation).
+ * Figures are quoted in docs/reference.md. */
 #include "check.h"
 #include "test_ref_util.h"
 
@@ -121,7 +123,25 @@ static double l1_rel(const double *a, const double *b)
     return d / s;
 }
 
+/* The mean of the 1% largest values: the peak, robust to one noisy probe. */
 static double peak(const double *E)
+{
+    static double tmp[NP];
+    memcpy(tmp, E, sizeof tmp);
+    double m = 0.0;
+    for (int k = 0; k < NP / 100; k++) {
+        int best = k;
+        for (int i = k + 1; i < NP; i++)
+            if (tmp[i] > tmp[best]) best = i;
+        double x = tmp[k];
+        tmp[k] = tmp[best];
+        tmp[best] = x;
+        m += tmp[k] / (NP / 100);
+    }
+    return m;
+}
+
+static double maxv(const double *E)
 {
     double m = 0.0;
     for (int i = 0; i < NP; i++) m = fmax(m, E[i]);
@@ -145,25 +165,29 @@ static void run(setup *u, double diam_deg, int n, double tol_l1, double tol_peak
     brute(u, R, n / 4, Eq);
     brute(u, R, n, Eb);
     double l1 = l1_rel(Ec, Eb), conv = l1_rel(Eq, Eb);
-    double pc = peak(Ec), pb = peak(Eb), p0 = peak(E0);
+    double pc = peak(Ec), pb = peak(Eb), pq = peak(Eq), p0 = peak(E0);
+    double mc = mean(Ec), mb = mean(Eb), mq = mean(Eq);
     printf("disc %.2f deg: convolved vs %d directions: relative L1 difference %.4f (brute force %d vs %d "
-           "directions: %.4f); peaks %.3f vs %.3f (%+.2f%%), point sun %.3f; means %.6f vs %.6f (%.2f s)\n",
-           diam_deg, n, l1, n / 4, n, conv, pc, pb, 100.0 * (pc / pb - 1.0), p0, mean(Ec), mean(Eb),
+           "directions: %.4f); peaks (top 1%%) %.3f vs %.3f (%+.2f%%; brute force %d vs %d: %+.2f%%), point sun %.3f; "
+           "maxima: convolved %.3f, point sun %.3f; means %.6f vs %.6f (%.2f s)\n",
+           diam_deg, n, l1, n / 4, n, conv, pc, pb, 100.0 * (pc / pb - 1.0), n / 4, n, 100.0 * (pq / pb - 1.0), p0, maxv(Ec), maxv(E0), mc, mb,
            (double)(clock() - c0) / CLOCKS_PER_SEC);
     /* the brute force's own quadrature error is at most about its N/4-vs-N difference */
     CHECK_MSG(l1 <= tol_l1 + conv, "L1 difference %g over %g + %g", l1, tol_l1, conv);
-    CHECK_MSG(fabs(pc / pb - 1.0) <= tol_peak, "peaks %g vs %g", pc, pb);
-    CHECK_REL(mean(Ec), mean(Eb), 5e-3);
-    CHECK_MSG(pc < 0.7 * p0, "the disc must lower the point-sun peak: %g vs %g", pc, p0);
+    CHECK_MSG(fabs(pc / pb - 1.0) <= tol_peak + fabs(pq / pb - 1.0), "peaks %g vs %g", pc, pb);
+    /* flux: the convolution conserves it exactly; the probe means differ by sampling only */
+    CHECK_MSG(fabs(mc - mb) <= 2e-3 * mb + fabs(mq - mb), "means %g vs %g", mc, mb);
+    CHECK_MSG(maxv(Ec) < 0.6 * maxv(E0), "the disc must lower the point-sun maximum: %g vs %g", maxv(Ec), maxv(E0));
 }
 
 int main(void)
 {
     setup u;
     make(&u, ref_reduced() ? 40 : 48);
-    int n = ref_reduced() ? 256 : 1024;
-    run(&u, 0.53, n, 0.01, 0.03);
-    run(&u, 2.12, n, 0.02, 0.05);
+    int n = ref_reduced() ? 128 : 512;
+    /* tolerances: the first-order error grows as the square of the disc's radius */
+    run(&u, 0.53, n, 0.01, 0.02);
+    run(&u, 2.12, n, 0.02, 0.08);
     gr_rtc_destroy(u.rtc);
     free(u.s);
     CHECK_DONE();

@@ -1,10 +1,15 @@
-/* The sun-disc kernel's geometry (reference/beams.h): the equal-area 16-gon and the
- * fraction of it inside a triangle (Sutherland-Hodgman clipping), against values computed
- * here independently:
- *  - the polygon has the unit disc's area (pi) and nearly its mean squared radius (1/2);
- *  - half-planes: through the centre 1/2 (any direction), beyond the circumradius 0 or 1;
- *  - random triangles (three half-planes): a 1000 x 1000 point grid over the polygon,
- *    counting the points inside the polygon and inside all three half-planes. */
+/* The sun-disc kernel's geometry (reference/beams.h): in the kernel's own units the disc of
+ * directions is the unit disc; the fraction of it inside a triangle (the beam's
+ * cross-section) is computed in closed form (segments and sectors). Checked here against
+ * values computed independently:
+ *  - a half-plane at signed distance s from the centre: the circular segment from the
+ *    angle 2 acos(s) (textbook form, written differently: (t - sin t) / (2 pi)), and the
+ *    same line as a triangle whose other two edges lie far outside the disc;
+ *  - triangles around, across and inside the disc, and one containing the whole disc:
+ *    a 2000 x 2000 point grid over the disc's bounding square, counting the points inside
+ *    the disc and the triangle (written here: sign of three cross products);
+ *  - a cross-section collapsed to a sliver inside the disc: its own area / pi, to rounding.
+ * The sectors use float atan2: fractions are exact to ~1e-8. */
 #include "check.h"
 
 #include <math.h>
@@ -12,30 +17,27 @@
 
 static const double PI = 3.14159265358979323846;
 
-static double vx[GR_BEAM_KERNEL_N], vy[GR_BEAM_KERNEL_N];
+static double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
 
-static int in_polygon(double x, double y)
+static int in_triangle(const double v[6], double x, double y)
 {
-    for (int i = 0; i < GR_BEAM_KERNEL_N; i++) {
-        int j = (i + 1) % GR_BEAM_KERNEL_N;
-        if ((vx[j] - vx[i]) * (y - vy[i]) - (vy[j] - vy[i]) * (x - vx[i]) < 0.0) return 0;
-    }
-    return 1;
+    double c0 = cross(v[2] - v[0], v[3] - v[1], x - v[0], y - v[1]);
+    double c1 = cross(v[4] - v[2], v[5] - v[3], x - v[2], y - v[3]);
+    double c2 = cross(v[0] - v[4], v[1] - v[5], x - v[4], y - v[5]);
+    return (c0 >= 0 && c1 >= 0 && c2 >= 0) || (c0 <= 0 && c1 <= 0 && c2 <= 0);
 }
 
-/* Fraction of the polygon's grid points inside a_i + b_i . c >= 0 for all i. */
-static double raster(const double a[3], const double b[6], int n)
+/* Fraction of the unit disc's grid points inside the triangle. */
+static double raster(const double v[6], int n)
 {
-    double rho = gr_beam_kernel_radius(), step = 2.0 * rho / n;
+    double step = 2.0 / n;
     long in = 0, tot = 0;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++) {
-            double x = -rho + (i + 0.5) * step, y = -rho + (j + 0.5) * step;
-            if (!in_polygon(x, y)) continue;
+            double x = -1.0 + (i + 0.5) * step, y = -1.0 + (j + 0.5) * step;
+            if (x * x + y * y > 1.0) continue;
             tot++;
-            int ok = 1;
-            for (int k = 0; k < 3 && ok; k++) ok = a[k] + b[2 * k] * x + b[2 * k + 1] * y >= 0.0;
-            in += ok;
+            in += in_triangle(v, x, y);
         }
     return (double)in / (double)tot;
 }
@@ -49,59 +51,52 @@ static double urand(void)
 
 int main(void)
 {
-    double rho = gr_beam_kernel_radius(), area = 0.0, m2 = 0.0;
-    for (int i = 0; i < GR_BEAM_KERNEL_N; i++) {
-        vx[i] = rho * cos(2.0 * PI * i / GR_BEAM_KERNEL_N);
-        vy[i] = rho * sin(2.0 * PI * i / GR_BEAM_KERNEL_N);
+    /* half-planes: segment of half-angle acos(s) cut off on the far side */
+    double worst_hp = 0.0;
+    for (int k = 0; k <= 40; k++) {
+        double s = -1.2 + 2.4 * k / 40.0, expect;
+        if (s >= 1.0) expect = 1.0;
+        else if (s <= -1.0) expect = 0.0;
+        else {
+            double th = 2.0 * acos(s); /* the angle of the cut-off segment */
+            expect = 1.0 - (th - sin(th)) / (2.0 * PI);
+        }
+        double got = gr_beam_disc_halfplane(s);
+        worst_hp = fmax(worst_hp, fabs(got - expect));
+        CHECK_NEAR(got, expect, 1e-12);
+        /* the same half-plane as a huge triangle: the line y = -s, the apex far above */
+        double v[6] = {-50.0, -s, 50.0, -s, 0.0, 80.0};
+        CHECK_NEAR(gr_beam_disc_triangle(v), expect, 1e-7); /* float sectors */
+        /* reversed orientation gives the same fraction */
+        double w[6] = {0.0, 80.0, 50.0, -s, -50.0, -s};
+        CHECK_NEAR(gr_beam_disc_triangle(w), expect, 1e-7);
     }
-    for (int i = 0; i < GR_BEAM_KERNEL_N; i++) {
-        int j = (i + 1) % GR_BEAM_KERNEL_N;
-        double cr = vx[i] * vy[j] - vx[j] * vy[i];
-        area += 0.5 * cr;
-        /* second moment of the triangle (0, v_i, v_j): cr/12 (|v_i|^2 + v_i . v_j + |v_j|^2) */
-        m2 += cr / 12.0 * (vx[i] * vx[i] + vy[i] * vy[i] + vx[i] * vx[j] + vy[i] * vy[j] + vx[j] * vx[j] + vy[j] * vy[j]);
-    }
-    printf("kernel polygon: radius %.6f, area %.9f (pi %.9f), mean squared radius %.6f (disc 0.5)\n", rho, area, PI,
-           m2 / area);
-    CHECK_REL(area, PI, 1e-12);
-    CHECK_REL(m2 / area, 0.5, 2e-3);
+    printf("half-planes: largest deviation from the segment formula %.2e\n", worst_hp);
 
-    /* half-planes through the centre, and wholly inside / outside */
-    for (int k = 0; k < 16; k++) {
-        double t = 2.0 * PI * urand(), a[3] = {0.0, 1.0, 1.0}, b[6] = {cos(t), sin(t), 0, 0, 0, 0};
-        CHECK_NEAR(gr_beam_kernel_coverage(a, b), 0.5, 1e-12);
-        a[0] = 1.0001 * rho;
-        CHECK_NEAR(gr_beam_kernel_coverage(a, b), 1.0, 1e-12);
-        a[0] = -1.0001 * rho;
-        CHECK_NEAR(gr_beam_kernel_coverage(a, b), 0.0, 1e-12);
-    }
-    /* random triangles against the raster count (grid error ~ perimeter x step / area) */
-    const int n = 1000;
+    /* a triangle containing the disc, one far outside, a sliver inside */
+    double big[6] = {-3.0, -2.0, 3.0, -2.0, 0.0, 4.0}, far[6] = {5.0, 5.0, 6.0, 5.0, 5.0, 7.0};
+    CHECK_NEAR(gr_beam_disc_triangle(big), 1.0, 1e-7);
+    CHECK_NEAR(gr_beam_disc_triangle(far), 0.0, 1e-7);
+    double sl[6] = {-0.3, 0.1, 0.4, 0.1000001, 0.2, 0.1000003};
+    double sl_area = 0.5 * fabs(cross(sl[2] - sl[0], sl[3] - sl[1], sl[4] - sl[0], sl[5] - sl[1]));
+    CHECK_REL(gr_beam_disc_triangle(sl), sl_area / PI, 1e-6);
+
+    /* random triangles against the raster count (its error ~ perimeter x step / area) */
+    const int n = 2000;
     double worst = 0.0;
-    for (int k = 0; k < 40; k++) {
-        double a[3], b[6];
-        /* a triangle with vertices around the kernel: edge normals from its vertices */
-        double px[3], py[3];
+    for (int k = 0; k < 30; k++) {
+        double v[6];
         for (int i = 0; i < 3; i++) {
-            double r = 2.0 * rho * urand(), t = 2.0 * PI * urand();
-            px[i] = r * cos(t);
-            py[i] = r * sin(t);
+            double r = 2.0 * urand(), t = 2.0 * PI * urand();
+            v[2 * i] = r * cos(t);
+            v[2 * i + 1] = r * sin(t);
         }
-        double s = (px[1] - px[0]) * (py[2] - py[0]) - (py[1] - py[0]) * (px[2] - px[0]);
-        if (fabs(s) < 0.05) { k--; continue; }
-        for (int i = 0; i < 3; i++) {
-            int j = (i + 1) % 3;
-            /* edge i from vertex i to j; inside = left of it for a counter-clockwise triangle */
-            double ex = px[j] - px[i], ey = py[j] - py[i], sg = s > 0.0 ? 1.0 : -1.0;
-            b[2 * i] = -ey * sg;
-            b[2 * i + 1] = ex * sg;
-            a[i] = -(b[2 * i] * px[i] + b[2 * i + 1] * py[i]);
-        }
-        double c = gr_beam_kernel_coverage(a, b), ref = raster(a, b, n);
+        if (fabs(cross(v[2] - v[0], v[3] - v[1], v[4] - v[0], v[5] - v[1])) < 0.05) { k--; continue; }
+        double c = gr_beam_disc_triangle(v), ref = raster(v, n);
         worst = fmax(worst, fabs(c - ref));
         CHECK_NEAR(c, ref, 3e-4);
-        CHECK(c >= 0.0 && c <= 1.0);
+        CHECK(c >= 0.0 && c <= 1.0 + 1e-12);
     }
-    printf("40 random triangles: largest |clipped - raster| = %.2e\n", worst);
+    printf("30 random triangles: largest |closed form - raster| = %.2e\n", worst);
     CHECK_DONE();
 }

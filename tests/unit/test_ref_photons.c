@@ -100,7 +100,7 @@ int main(void)
     int reduced = ref_reduced();
     const double bins[][3] = {{0.3, 2.1, -8.0}, {-1.7, 4.4, -8.0}, {2.6, 6.0, -8.0}, {1.0, 3.0, -20.0}};
     const int nbins = reduced ? 2 : 4;
-    const long nphot = reduced ? 300000 : 1000000;
+    const long nphot = reduced ? 300000 : 4000000;
     const double b = 0.25;
     for (int k = 0; k < nbins; k++) {
         double bx = bins[k][0], bz = bins[k][1], y = bins[k][2];
