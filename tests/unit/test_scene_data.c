@@ -66,7 +66,7 @@ static void test_default(void)
     gr_scene *s = load("default.json");
     CHECK(s->water.n_waves == 8);
     for (int i = 0; i < s->water.n_waves; i++)
-        CHECK(s->water.waves[i].wavelength_m >= 1.5 && s->water.waves[i].wavelength_m <= 12.0);
+        CHECK(s->water.waves[i].wavelength_m >= 1.0 && s->water.waves[i].wavelength_m <= 12.0);
     double st = steepness(s);
     CHECK_MSG(st >= 0.3 && st <= 0.5, "steepness %g", st);
     CHECK(s->sun.elevation_deg >= 55.0 && s->sun.elevation_deg <= 65.0);
