@@ -32,6 +32,8 @@ typedef gr_rng ref_rng;
 static inline ref_rng rng_make(uint64_t seed, uint64_t stream, uint64_t index) { return gr_rng_make(seed, stream, index); }
 static inline double rng_u(ref_rng *r) { return gr_rng_double(r); } /* [0, 1) */
 enum { STREAM_PASS = 1, STREAM_PIXEL0 = 16 };
+/* the surface-bias probe's pixel grid and passes (surface_bias_probe) */
+enum { PROBE_STRIDE = 5, PROBE_PASSES = 4 };
 
 typedef struct ref_light {
     gr_vec3 T;        /* unit refracted direction */
@@ -67,6 +69,12 @@ struct gr_ref_renderer {
     float flat_eperp;         /* F_t cos(theta_i) / cos(theta_t): Oracle 1's E_w / E_sun */
     float mu_t;
     double beam_build_s;
+    /* surface-bias probe: mean |bias| / mean (-1 = not estimated), its cost and size */
+    double bias_rel, bias_probe_s;
+    gr_beam_stats main_beams; /* the main passes' last beam set (the probe builds others) */
+    int have_main_beams;
+    long long bias_probe_pixels;
+    int bias_probe_passes;
 };
 
 void gr_ref_options_default(gr_ref_options *o)
@@ -204,6 +212,7 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
     if (!r->opt.max_rounds) r->opt.max_rounds = 64;
     r->set = s->reference;
     r->beams_pass = -1;
+    r->bias_rel = -1.0;
     r->flat = is_flat(&s->water) && !r->opt.force_beams;
     const gr_reference_settings *st = &r->set;
     if (st->batches < 2) {
@@ -417,6 +426,9 @@ typedef struct ref_job {
     gr_ref_renderer *r;
     ref_accum *acc;
     int pass, batch;
+    /* accumulator pixel (x, y) is image pixel (x stride + off, y stride + off): stride 1 for
+     * the image, a sparse grid for the surface-bias probe */
+    int stride, off, img_w;
     atomic_int next_row;
     atomic_int rows_done;
     atomic_int stop;
@@ -569,21 +581,23 @@ static void *worker(void *arg)
         int y = atomic_fetch_add(&job->next_row, 1);
         if (y >= acc->H) break;
         for (int x = 0; x < acc->W; x++) {
-            size_t pix = (size_t)y * acc->W + x;
-            double *sum = acc->sum + (pix * acc->B + job->batch) * 3;
+            int px = x * job->stride + job->off, py = y * job->stride + job->off;
+            size_t pix = (size_t)py * (size_t)job->img_w + (size_t)px; /* the image pixel: its RNG stream */
+            size_t ai = (size_t)y * acc->W + x;
+            double *sum = acc->sum + (ai * acc->B + job->batch) * 3;
             for (int s = 0; s < r->spp_pass; s++) {
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
-                render_sample(r, x, y, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, &g, L, &tr, &len, &cnt,
+                render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, &g, L, &tr, &len, &cnt,
                               &sc);
                 sum[0] += L[0];
                 sum[1] += L[1];
                 sum[2] += L[2];
-                acc->count[pix * acc->B + job->batch]++;
+                acc->count[ai * acc->B + job->batch]++;
                 if (acc->aov) {
-                    acc->aov[pix * 2] += tr;
-                    acc->aov[pix * 2 + 1] += len;
+                    acc->aov[ai * 2] += tr;
+                    acc->aov[ai * 2 + 1] += len;
                 }
             }
         }
@@ -765,6 +779,8 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
         snprintf(key, sizeof key, "godrays:reference.%s", t->params[i].name);
         double v = gr_param_get_number(&t->params[i], &r->set, 0);
         if (t->params[i].type == GR_PT_DOUBLE) SET(gr_meta_set_double(m, key, v));
+        else if (t->params[i].type == GR_PT_ENUM && t->params[i].enum_names) /* the name, as in the scene */
+            SET(gr_meta_set_string(m, key, t->params[i].enum_names[(int)v]));
         else SET(gr_meta_set_int(m, key, (long long)v));
     }
     SET(gr_meta_set_int(m, "godrays:spp", out->spp));
@@ -787,23 +803,143 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     snprintf(buf, sizeof buf, "u [%.3f, %.3f] w [%.3f, %.3f] y_min %.3f pad %.3f (local sheared, m)",
              r->region.u0, r->region.u1, r->region.w0, r->region.w1, r->region.y_min, r->pad);
     SET(gr_meta_set_string(m, "godrays:lit_region", buf));
-    if (r->beams) {
-        const gr_beam_stats *bs = gr_beams_stats(r->beams);
+    if (r->have_main_beams) {
+        const gr_beam_stats *bs = &r->main_beams;
         SET(gr_meta_set_double(m, "godrays:surface_cell_m", bs->cell_m));
         SET(gr_meta_set_int(m, "godrays:beam_prims", (long long)bs->prims));
     }
-    /* bias bounds next to the noise (docs/reference.md section 4): the surface tessellation
-     * is the only discretization bias; its size was measured on data/scenes/default.json
-     * (2.2e-3 of the image mean, mean |pixel| difference, at surface_res 256) and scales as h^2 */
-    SET(gr_meta_set_double(m, "godrays:bias_surface_rel_est",
-                           r->flat ? 0.0 : 2.2e-3 * pow(256.0 / r->set.surface_res, 2.0)));
+    /* bias next to the noise (docs/reference.md section 4): the surface tessellation is the
+     * only discretization bias; measured on this scene by the probe (surface_bias_probe) */
+    SET(gr_meta_set_double(m, "godrays:bias_surface_rel_est", finite_or(r->bias_rel, -1.0)));
+    if (r->flat)
+        snprintf(buf, sizeof buf, "none: flat water takes the closed form (no tessellation)");
+    else if (r->bias_rel >= 0.0)
+        snprintf(buf, sizeof buf,
+                 "Richardson (O(h^2)) from %lld pixels (every %dth) x %d passes at surface_res %d and %d, %.2f s",
+                 r->bias_probe_pixels, PROBE_STRIDE, r->bias_probe_passes, r->set.surface_res,
+                 r->set.surface_res / 2 > 2 ? r->set.surface_res / 2 : 2, r->bias_probe_s);
+    else
+        snprintf(buf, sizeof buf, "not estimated (reference.bias_probe = false or interrupted); -1");
+    SET(gr_meta_set_string(m, "godrays:bias_surface_probe", buf));
     SET(gr_meta_set_string(m, "godrays:bias_note",
-                           "surface_res: O(h^2), 2.2e-3 of the image mean at 256 on default.json; march steps and "
-                           "sun-disc sampling: unbiased (jittered strata), noise only; cutoff tail <= "
-                           "transmittance_cutoff * S_max / sigma_t (docs/reference.md)"));
+                           "bias_surface_rel_est = mean |pixel bias| / image mean from the surface tessellation "
+                           "(measured here, see bias_surface_probe); march steps and sun-disc passes: unbiased "
+                           "(jittered strata), noise only; cutoff tail <= transmittance_cutoff * S_max / sigma_t "
+                           "(docs/reference.md)"));
     SET(gr_meta_set_string(m, "godrays:error_bars",
                            "stderr.* channels: batch-mean spread (noise only); discretization bias: docs/reference.md"));
 #undef SET
+    return st;
+}
+
+typedef struct ref_march_totals { double march_s; long long queries, shadows, overflows; } ref_march_totals;
+
+/* Marches one pass over every row of acc with r->threads workers (thread handles in th),
+ * the progress bar going from frac0 to frac0 + span. *complete = 0 when interrupted. */
+static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int batch, int stride, int off,
+                            pthread_t *th, gr_progress *prog, double frac0, double span, const char *note,
+                            ref_march_totals *tot, int *complete, gr_error *err)
+{
+    ref_job job;
+    job.r = r;
+    job.acc = acc;
+    job.pass = pass;
+    job.batch = batch;
+    job.stride = stride;
+    job.off = off;
+    job.img_w = r->scene.camera.width;
+    atomic_init(&job.next_row, 0);
+    atomic_init(&job.rows_done, 0);
+    atomic_init(&job.stop, 0);
+    atomic_init(&job.queries, 0);
+    atomic_init(&job.shadow_rays, 0);
+    atomic_init(&job.overflows, 0);
+    *complete = 0;
+    double tm = mono_s();
+    int started = 0;
+    for (int i = 0; i < r->threads; i++) {
+        if (pthread_create(&th[i], NULL, worker, &job) != 0) break;
+        started++;
+    }
+    if (!started)
+        return gr_fail(err, GR_E_RUNTIME, "reference: could not start worker threads (reference.threads = %d)", r->threads);
+    for (;;) {
+        int done = atomic_load(&job.rows_done);
+        gr_progress_update(prog, frac0 + span * (double)done / acc->H, note);
+        if (done >= acc->H || atomic_load(&job.stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
+        /* short sleeps first so tiny renders (tests) do not wait on the poll */
+        double waited = mono_s() - tm;
+        struct timespec ts = {0, waited < 0.05 ? 500 * 1000 : 20 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+    }
+    for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
+    tot->march_s += mono_s() - tm;
+    tot->queries += atomic_load(&job.queries);
+    tot->shadows += atomic_load(&job.shadow_rays);
+    tot->overflows += atomic_load(&job.overflows);
+    if (atomic_load(&job.stop) == 2) return gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
+    *complete = atomic_load(&job.rows_done) >= acc->H;
+    return GR_OK;
+}
+
+/* Surface-bias probe (docs/reference.md, section 4). Every PROBE_STRIDE-th pixel in x and y
+ * is rendered again for the first PROBE_PASSES passes, once with the beam sets of surface_res
+ * (cell h) and once with those of surface_res / 2 (2h), from the same random numbers (camera
+ * samples, march steps, sun directions, grid offsets in cells). The tessellation's error is
+ * O(h^2) (section 2.2), so Richardson's extrapolation gives the bias at h per pixel as
+ * (L_2h - L_h) / 3; r->bias_rel = the mean of its absolute value over the probe pixels
+ * divided by their mean value: the same figure as the convergence study's table. What noise
+ * the common random numbers leave in the difference makes it an overestimate. */
+static gr_status surface_bias_probe(gr_ref_renderer *r, pthread_t *th, gr_progress *prog, double frac0, double span,
+                                    ref_march_totals *tot, gr_error *err)
+{
+    int W = r->scene.camera.width, H = r->scene.camera.height;
+    int off = W > PROBE_STRIDE / 2 && H > PROBE_STRIDE / 2 ? PROBE_STRIDE / 2 : 0;
+    ref_accum a[2];
+    memset(a, 0, sizeof a);
+    for (int k = 0; k < 2; k++) {
+        a[k].W = (W - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
+        a[k].H = (H - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
+        a[k].B = 1;
+    }
+    size_t np = (size_t)a[0].W * a[0].H;
+    int res = r->set.surface_res, res2 = res / 2 > 2 ? res / 2 : 2;
+    int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
+    gr_status st = GR_OK;
+    for (int k = 0; k < 2 && st == GR_OK; k++) {
+        a[k].sum = calloc(np * 3, sizeof *a[k].sum);
+        a[k].count = calloc(np, sizeof *a[k].count);
+        if (!a[k].sum || !a[k].count) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
+    }
+    int complete = 1;
+    for (int p = 0; p < passes && st == GR_OK && complete; p++)
+        for (int k = 0; k < 2 && st == GR_OK && complete; k++) {
+            r->set.surface_res = k ? res2 : res;
+            r->beams_pass = -1; /* another resolution: rebuild */
+            st = gr_ref_prepare_pass(r, p, err);
+            if (st == GR_OK)
+                st = march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, th, prog, frac0 + span * (2 * p + k) / (2.0 * passes),
+                                span / (2.0 * passes), "surface-bias probe", tot, &complete, err);
+        }
+    r->set.surface_res = res;
+    r->beams_pass = -1;
+    if (st == GR_OK && complete) {
+        double d = 0.0, v = 0.0;
+        for (size_t i = 0; i < np; i++) {
+            if (!a[0].count[i] || !a[1].count[i]) continue;
+            double lh = (a[0].sum[3 * i] + a[0].sum[3 * i + 1] + a[0].sum[3 * i + 2]) / (3.0 * a[0].count[i]);
+            double l2h = (a[1].sum[3 * i] + a[1].sum[3 * i + 1] + a[1].sum[3 * i + 2]) / (3.0 * a[1].count[i]);
+            d += fabs(l2h - lh) / 3.0; /* Richardson, p = 2: e_h = (L_2h - L_h) / (2^2 - 1) */
+            v += lh;
+        }
+        r->bias_rel = v > 0.0 && isfinite(d) ? d / v : (d > 0.0 ? -1.0 : 0.0);
+        r->bias_probe_pixels = (long long)np;
+        r->bias_probe_passes = passes;
+    }
+    for (int k = 0; k < 2; k++) {
+        free(a[k].sum);
+        free(a[k].count);
+    }
     return st;
 }
 
@@ -828,62 +964,28 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     }
     int P = r->passes_per_round;
     int rounds = r->set.target_error > 0.0 ? r->opt.max_rounds : 1;
-    long long queries = 0, shadows = 0, overflows = 0;
-    double march_s = 0.0;
+    long long queries, shadows, overflows;
+    double march_s;
     gr_status st = GR_OK;
     ref_errors e;
     memset(&e, 0, sizeof e);
     int pass = 0;
     r->rendering = 1;
+    int probe = r->set.bias_probe && !r->flat;
+    double mainw = probe ? 0.95 : 1.0; /* share of the progress bar for the main passes */
+    ref_march_totals tot = {0.0, 0, 0, 0};
     for (int round = 0; round < rounds && st == GR_OK && !out->partial; round++) {
         for (int pp = 0; pp < P && st == GR_OK; pp++, pass++) {
             if (r->opt.interrupt && *r->opt.interrupt) { out->partial = 1; break; }
             st = gr_ref_prepare_pass(r, pass, err);
             if (st != GR_OK) break;
-            ref_job job;
-            job.r = r;
-            job.acc = &acc;
-            job.pass = pass;
-            job.batch = pass % acc.B;
-            atomic_init(&job.next_row, 0);
-            atomic_init(&job.rows_done, 0);
-            atomic_init(&job.stop, 0);
-            atomic_init(&job.queries, 0);
-            atomic_init(&job.shadow_rays, 0);
-            atomic_init(&job.overflows, 0);
-            double tm = mono_s();
-            int started = 0;
-            for (int i = 0; i < r->threads; i++) {
-                if (pthread_create(&th[i], NULL, worker, &job) != 0) break;
-                started++;
-            }
-            if (!started) {
-                st = gr_fail(err, GR_E_RUNTIME, "reference: could not start worker threads (reference.threads = %d)", r->threads);
-                break;
-            }
-            for (;;) {
-                int done = atomic_load(&job.rows_done);
-                double frac = rounds > 1 ? ((double)pp + (double)done / acc.H) / P
-                                         : ((double)pass + (double)done / acc.H) / P;
-                char note[64];
-                snprintf(note, sizeof note, "pass %d/%d%s", pp + 1, P, rounds > 1 ? " (refining)" : "");
-                gr_progress_update(prog, frac, note);
-                if (done >= acc.H || atomic_load(&job.stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
-                /* short sleeps first so tiny renders (tests) do not wait on the poll */
-                double waited = mono_s() - tm;
-                struct timespec ts = {0, waited < 0.05 ? 500 * 1000 : 20 * 1000 * 1000};
-                nanosleep(&ts, NULL);
-            }
-            for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
-            march_s += mono_s() - tm;
-            queries += atomic_load(&job.queries);
-            shadows += atomic_load(&job.shadow_rays);
-            overflows += atomic_load(&job.overflows);
-            if (atomic_load(&job.stop) == 2) {
-                st = gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
-                break;
-            }
-            if (atomic_load(&job.rows_done) < acc.H) { out->partial = 1; break; }
+            char note[64];
+            snprintf(note, sizeof note, "pass %d/%d%s", pp + 1, P, rounds > 1 ? " (refining)" : "");
+            int complete = 0;
+            st = march_pass(r, &acc, pass, pass % acc.B, 1, 0, th, prog, mainw * (rounds > 1 ? pp : pass) / P,
+                            mainw / P, note, &tot, &complete, err);
+            if (st != GR_OK) break;
+            if (!complete) { out->partial = 1; break; }
             out->passes++;
         }
         if (st != GR_OK || out->partial) break;
@@ -891,6 +993,20 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             if (image_errors(&acc, &e) != GR_OK) { st = gr_fail(err, GR_E_NOMEM, "reference: out of memory"); break; }
             if (e.rel_mean < r->set.target_error && e.rel_p95 < r->set.target_error) break;
         }
+    }
+    march_s = tot.march_s;
+    queries = tot.queries;
+    shadows = tot.shadows;
+    overflows = tot.overflows;
+    /* the tessellation's bias, measured on this scene (flat water has none: closed form) */
+    r->bias_rel = r->flat ? 0.0 : -1.0;
+    r->have_main_beams = r->beams != NULL;
+    if (r->beams) r->main_beams = *gr_beams_stats(r->beams);
+    if (st == GR_OK && probe && !out->partial) {
+        ref_march_totals ptot = {0.0, 0, 0, 0};
+        double tp = mono_s();
+        st = surface_bias_probe(r, th, prog, mainw, 1.0 - mainw, &ptot, err);
+        r->bias_probe_s = mono_s() - tp;
     }
     r->rendering = 0;
     gr_progress_finish(prog);
@@ -906,6 +1022,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         out->queries_per_s = march_s > 0.0 ? (double)queries / march_s : 0.0;
         out->shadow_rays_per_s = march_s > 0.0 ? (double)shadows / march_s : 0.0;
         out->beam_build_s = r->beam_build_s;
+        out->bias_surface_rel = r->bias_rel;
         /* preview: the 99th percentile of the brightest channel maps to 0.8 */
         size_t n = np;
         double *v = malloc(n * sizeof *v);

@@ -45,6 +45,8 @@ static const gr_param reference_params[] = {
     {.name = "sun_disc", .type = GR_PT_ENUM, .offset = REF(sun_disc), .min = 0, .max = 1,
      .def = GR_SUN_DISC_CONVOLVE, .enum_names = sun_disc_names, .unit = "",
      .doc = "sun-disc average: analytic convolution of each beam's footprint, or one sampled direction per pass"},
+    {.name = "bias_probe", .type = GR_PT_BOOL, .offset = REF(bias_probe), .min = 0, .max = 1, .def = 1,
+     .unit = "", .doc = "estimate the surface-tessellation bias: every 5th pixel re-rendered at surface_res and surface_res/2 (Richardson), about 5 % more time"},
 };
 #undef REF
 

@@ -20,6 +20,8 @@ typedef struct gr_reference_settings {
     double patch_radius_m;        /* half size of the tessellated surface patch around the
                                      camera; beyond it the waves' mean sunlight is used */
     int sun_disc;                 /* gr_sun_disc_mode: how the sun's disc is averaged */
+    int bias_probe;               /* 1: estimate the surface-tessellation bias from a pixel
+                                     subsample rendered again at half the surface_res */
 } gr_reference_settings;
 
 /* reference.sun_disc: the disc average by the analytic convolution of each beam's footprint
