@@ -2,13 +2,13 @@
  * and a real-time frame, possibly captured from another engine), optional mask, reference
  * standard errors, best scale fit; with -o DIR also metrics.json and false-color differences. */
 #include "cli/cli.h"
+#include "cli/args.h"
 
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <time.h>
 
 #include <cjson/cJSON.h>
@@ -17,6 +17,7 @@
 #include "compare/metrics.h"
 #include "compare/metrics_io.h"
 #include "image/oiio.h"
+#include "report/report.h"
 
 static void usage(FILE *f)
 {
@@ -46,28 +47,6 @@ static void usage(FILE *f)
             "\n"
             "Exit codes: 0 ok, 1 runtime failure, 2 bad usage, unreadable input or size mismatch.\n",
             GR_METRICS_STDERR_BOUND);
-}
-
-/* Creates dir and its missing parents. */
-static gr_status make_dirs(const char *dir, gr_error *err)
-{
-    char buf[4096];
-    if (snprintf(buf, sizeof buf, "%s", dir) >= (int)sizeof buf)
-        return gr_fail(err, GR_E_USAGE, "%s: output directory name too long", dir);
-    for (char *p = buf + 1;; p++) {
-        if (*p == '/' || *p == '\0') {
-            char saved = *p;
-            *p = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-                return gr_fail(err, GR_E_IO, "%s: cannot create directory: %s", buf, strerror(errno));
-            *p = saved;
-            if (saved == '\0') break;
-        }
-    }
-    struct stat sb;
-    if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode))
-        return gr_fail(err, GR_E_IO, "%s: not a directory", dir);
-    return GR_OK;
 }
 
 /* Writes text to path through a temporary file renamed into place. */
@@ -127,15 +106,17 @@ int cmd_compare(int argc, char **argv)
     const char *paths[2] = {NULL, NULL}, *outdir = NULL, *mask_path = NULL;
     int npos = 0, json = 0, linearize = 1;
     gr_metrics_options opt = {0};
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
+    gr_args args; /* no overrides: nothing to free */
+    gr_args_create(&args, cmd, argc, argv);
+    for (; args.i < argc; args.i++) {
+        const char *a = argv[args.i], *v = NULL;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
             return 0;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--mask") ||
                    !strcmp(a, "--stderr-bound")) {
-            if (i + 1 >= argc) return gr_cli_usage_error(cmd, "%s needs a value", a);
-            const char *v = argv[++i];
+            const int rc = gr_args_value(&args, &v);
+            if (rc) return rc;
             if (!strcmp(a, "--mask")) {
                 mask_path = v;
             } else if (!strcmp(a, "--stderr-bound")) {
@@ -162,6 +143,10 @@ int cmd_compare(int argc, char **argv)
         }
     }
     if (npos != 2) return gr_cli_usage_error(cmd, "need two images, REF and TEST");
+    if (outdir) {
+        const int rc = gr_args_check_output_dir(&args, "-o", outdir);
+        if (rc) return rc;
+    }
 
     gr_error err = {0};
     gr_image *ref = NULL, *test = NULL, *mask = NULL, *diff[2] = {NULL, NULL};
@@ -228,7 +213,7 @@ int cmd_compare(int argc, char **argv)
             st = gr_fail(&err, GR_E_NOMEM, "out of memory printing the JSON");
             goto fail;
         }
-        st = make_dirs(outdir, &err);
+        st = gr_report_make_dir(outdir, &err);
         char path[4200];
         for (int k = 0; st == GR_OK && k < 2; k++) {
             if (snprintf(path, sizeof path, "%s/%s", outdir, names[k]) >= (int)sizeof path)

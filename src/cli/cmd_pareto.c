@@ -2,6 +2,7 @@
  * truth at increasing quality against a high-quality one, and the real-time shafts over
  * settings that trade speed for quality (N, target scale, 8-bit vs 16F). */
 #include "cli/cli.h"
+#include "cli/args.h"
 
 #include <errno.h>
 #include <math.h>
@@ -18,7 +19,6 @@
 #include "tune/session.h"
 #include "tune/truth.h"
 
-#define MAX_SETS 256
 #define MAX_POINTS 64
 
 static void usage(FILE *f)
@@ -87,17 +87,18 @@ static void set_level(gr_scene *s, const ref_level *l)
     s->reference.spp = l->spp;
 }
 
-int cmd_pareto(int argc, char **argv)
+/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
+static int pareto_with(gr_args *args)
 {
-    const char *cmd = "pareto";
-    const char *scene_path = NULL, *outdir = NULL;
-    const char *sets[MAX_SETS + 2];
-    char size_set[2][48];
-    int n_sets = 0, quiet = 0, quick = 0, use_cache = 1, have_size = 0;
+    const char *cmd = "pareto", *outopt = NULL;
+    const int argc = args->argc;
+    char **argv = args->argv;
+    int quiet = 0, quick = 0, use_cache = 1, rc = 0, taken = 0;
     long repeat = 5;
     gr_gl_platform platform = GR_GL_AUTO;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
+    args->size_example = "320x180";
+    for (; args->i < argc && !rc; args->i++) {
+        const char *a = argv[args->i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
             return 0;
@@ -107,69 +108,39 @@ int cmd_pareto(int argc, char **argv)
             quick = 1;
         } else if (!strcmp(a, "--no-cache")) {
             use_cache = 0;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--set") || !strcmp(a, "--size") ||
-                   !strcmp(a, "--repeat") || !strcmp(a, "--gl-platform")) {
-            if (i + 1 >= argc) return gr_cli_usage_error(cmd, "%s needs a value", a);
-            const char *v = argv[++i];
-            if (!strcmp(a, "--set")) {
-                if (n_sets >= MAX_SETS) return gr_cli_usage_error(cmd, "--set: more than %d overrides", MAX_SETS);
-                if (!strchr(v, '=')) return gr_cli_usage_error(cmd, "--set %s: expected KEY=VALUE", v);
-                sets[n_sets++] = v;
-            } else if (!strcmp(a, "--size")) {
-                int w = 0, h = 0;
-                char extra;
-                if (sscanf(v, "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1)
-                    return gr_cli_usage_error(cmd, "--size %s: expected WxH, e.g. 320x180", v);
-                snprintf(size_set[0], sizeof size_set[0], "camera.width=%d", w);
-                snprintf(size_set[1], sizeof size_set[1], "camera.height=%d", h);
-                have_size = 1;
-            } else if (!strcmp(a, "--repeat")) {
-                char *end = NULL;
-                errno = 0;
-                repeat = strtol(v, &end, 10);
-                if (errno || end == v || *end || repeat < 1 || repeat > 1000)
-                    return gr_cli_usage_error(cmd, "--repeat %s: expected an integer in [1, 1000]", v);
-            } else if (!strcmp(a, "--gl-platform")) {
-                if (!strcmp(v, "auto")) platform = GR_GL_AUTO;
-                else if (!strcmp(v, "surfaceless")) platform = GR_GL_SURFACELESS;
-                else if (!strcmp(v, "device")) platform = GR_GL_DEVICE;
-                else return gr_cli_usage_error(cmd, "--gl-platform %s: expected auto, surfaceless or device", v);
-            } else {
-                if (!v[0]) return gr_cli_usage_error(cmd, "%s: empty directory name", a);
-                outdir = v;
-            }
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return gr_cli_usage_error(cmd, "unknown option %s", a);
-        } else {
-            if (scene_path) return gr_cli_usage_error(cmd, "more than one scene given (%s, %s)", scene_path, a);
-            scene_path = a;
+        } else if (!strcmp(a, "--repeat")) {
+            const char *v;
+            char *end = NULL;
+            if ((rc = gr_args_value(args, &v)) != 0) break;
+            errno = 0;
+            repeat = strtol(v, &end, 10);
+            if (errno || end == v || *end || repeat < 1 || repeat > 1000)
+                rc = gr_cli_usage_error(cmd, "--repeat %s: expected an integer in [1, 1000]", v);
+        } else if ((rc = gr_args_take_common(args, &outopt, &platform, &taken)) == 0 && !taken) {
+            rc = gr_args_take_scene(args);
         }
     }
-    if (!scene_path) return gr_cli_usage_error(cmd, "no scene file given");
-    if (!have_size) {
-        snprintf(size_set[0], sizeof size_set[0], "camera.width=320");
-        snprintf(size_set[1], sizeof size_set[1], "camera.height=180");
-    }
-    sets[n_sets++] = size_set[0];
-    sets[n_sets++] = size_set[1];
+    if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
+    /* the default size after every override, so that it wins over --set camera.width/height */
+    if (!args->have_size && (rc = gr_args_add_set(args, "camera.width=320")) != 0) return rc;
+    if (!args->have_size && (rc = gr_args_add_set(args, "camera.height=180")) != 0) return rc;
 
     gr_error err = {GR_OK, ""};
-    gr_scene *scene = malloc(sizeof *scene), *work = malloc(sizeof *work);
+    gr_scene *scene = NULL, *work = malloc(sizeof *work);
     gr_image *truth = NULL, *img = NULL;
     gr_shafts *r = NULL;
     gr_pareto_point *pts = calloc(MAX_POINTS, sizeof *pts);
-    int n = 0, rc = 0;
+    int n = 0;
     char dirbuf[4096], path[4300];
-    if (!scene || !work || !pts) {
+    const char *outdir = NULL;
+    if (!work || !pts) {
         gr_fail(&err, GR_E_NOMEM, "out of memory");
         goto fail;
     }
-    if (gr_scene_load_file(scene_path, sets, n_sets, scene, &err) != GR_OK) goto fail;
+    if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
     if (gr_shafts_check_settings(&scene->shafts, &err) != GR_OK) goto fail;
-    if (!outdir) {
-        gr_tune_default_dir(scene->name, "pareto", dirbuf, sizeof dirbuf);
-        outdir = dirbuf;
-    }
+    /* The ground truths take minutes: a folder that cannot be made is refused before them. */
+    if ((rc = gr_args_output_dir(args, scene, outopt, "pareto", dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
     gr_shafts_options so;
     memset(&so, 0, sizeof so);
     so.gl.platform = platform;
@@ -312,14 +283,9 @@ int cmd_pareto(int argc, char **argv)
     {
         gr_strbuf pg;
         gr_sb_init(&pg);
-        char ptitle[300];
-        snprintf(ptitle, sizeof ptitle, "godrays pareto: %s", scene->name);
-        gr_tune_page_begin(&pg, ptitle);
+        gr_tune_page_begin(&pg, outdir, "godrays pareto: %s", scene->name);
         if (drawn) gr_tune_page_figure(&pg, "pareto.png", title);
-        gr_tune_page_pre(&pg, gr_sb_str(&sum));
-        gr_sb_puts(&pg, "<p>Data: <a href=\"pareto.csv\">pareto.csv</a>.</p>\n");
-        gr_status pst = gr_tune_page_write(&pg, outdir, &err);
-        gr_sb_free(&pg);
+        gr_status pst = gr_tune_page_write(&pg, gr_sb_str(&sum), "pareto.csv", outdir, &err);
         gr_sb_free(&sum);
         if (pst != GR_OK) goto fail;
     }
@@ -334,4 +300,9 @@ done:
     free(work);
     free(scene);
     return rc;
+}
+
+int cmd_pareto(int argc, char **argv)
+{
+    return gr_args_main("pareto", argc, argv, pareto_with);
 }

@@ -2,10 +2,11 @@
  * (or reuses a cached one), compares them (reference-stderr aware, raw and after the best
  * scale fit) and writes the report folder (src/report/report.h), then prints a short table. */
 #include "cli/cli.h"
+#include "cli/args.h"
+#include "cli/render.h"
 
 #include <errno.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,17 +20,6 @@
 #include "report/report.h"
 #include "scene/scene.h"
 
-#define MAX_SETS 256
-
-static volatile sig_atomic_t g_interrupt = 0;
-
-static void on_sigint(int sig)
-{
-    (void)sig;
-    g_interrupt = 1;
-    signal(SIGINT, SIG_DFL); /* a second Ctrl-C ends the process at once */
-}
-
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -40,6 +30,8 @@ static void usage(FILE *f)
             "  DIR/index.html    images side by side, metrics, charts, timings, scene and settings\n"
             "  DIR/summary.png   labelled contact sheet;  DIR/metrics.json  every number\n"
             "  DIR/reference.exr, DIR/shafts.exr  the two linear images (for godrays compare)\n"
+            "index.html links DIR/sweep, DIR/tune and DIR/pareto (godrays sweep, tune, pareto) when\n"
+            "they exist, and gives the command that makes each one that does not.\n"
             "The ground truth is cached (key: the scene's content and the reference settings) and\n"
             "reused by later runs. How to read the report: docs/report.md.\n"
             "\n"
@@ -65,28 +57,13 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* "out/" + the scene name with every character outside [A-Za-z0-9._-] replaced by '_'. */
-static void default_dir(const char *name, char *buf, size_t n)
+/* The command line, each argument shell-quoted where it needs it, for the report. */
+static void command_line(int argc, char **argv, gr_strbuf *b)
 {
-    size_t j = (size_t)snprintf(buf, n, "out/");
-    for (const char *p = name; *p && j + 1 < n; p++) {
-        const char ch = *p;
-        const int ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '.' ||
-                       ch == '_' || ch == '-';
-        buf[j++] = ok ? ch : '_';
-    }
-    buf[j] = '\0';
-    if (!strcmp(buf, "out/") || !strcmp(buf, "out/.") || !strcmp(buf, "out/..")) snprintf(buf, n, "out/scene");
-}
-
-/* The command line, arguments with spaces or quotes single-quoted, for the report. */
-static void command_line(int argc, char **argv, char *buf, size_t n)
-{
-    size_t j = (size_t)snprintf(buf, n, "godrays");
-    for (int i = 0; i < argc && j < n; i++) {
-        const char *a = argv[i];
-        const int quote = a[0] == '\0' || strpbrk(a, " \t\"'$\\") != NULL;
-        j += (size_t)snprintf(buf + j, n - j, quote ? " '%s'" : " %s", a);
+    gr_sb_puts(b, "godrays");
+    for (int i = 0; i < argc; i++) {
+        gr_sb_puts(b, " ");
+        gr_sb_shell_word(b, argv[i]);
     }
 }
 
@@ -151,18 +128,8 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
     gr_ref_options opt;
     gr_ref_options_default(&opt);
     opt.progress = !quiet;
-    opt.interrupt = &g_interrupt;
-    gr_ref_renderer *r = NULL;
-    if ((st = gr_ref_create(scene, &opt, &r, err)) != GR_OK) return st;
-    struct sigaction sa, old;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_sigint;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old);
     gr_ref_result res;
-    st = gr_ref_render(r, &res, err);
-    sigaction(SIGINT, &old, NULL);
-    gr_ref_destroy(r);
+    st = gr_cli_render_reference(scene, &opt, &res, NULL, err);
     if (st != GR_OK) return st;
     if (res.partial) {
         gr_ref_result_free(&res);
@@ -228,15 +195,16 @@ static void print_summary(const char *dir, const gr_scene *scene, const gr_metri
     printf("\nreport: %s/index.html (also summary.png, metrics.json)\n", dir);
 }
 
-int cmd_run(int argc, char **argv)
+/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
+static int run_with(gr_args *args)
 {
+    const int argc = args->argc;
+    char **argv = args->argv;
     const char *cmd = "run";
-    const char *scene_path = NULL, *outdir = NULL;
-    const char *sets[MAX_SETS + 2];
-    char size_set[2][48];
-    int n_sets = 0, quiet = 0, use_cache = 1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
+    const char *outdir = NULL;
+    int quiet = 0, use_cache = 1, rc = 0, taken = 0;
+    for (; args->i < argc && !rc; args->i++) {
+        const char *a = argv[args->i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
             return 0;
@@ -244,57 +212,33 @@ int cmd_run(int argc, char **argv)
             quiet = 1;
         } else if (!strcmp(a, "--no-cache")) {
             use_cache = 0;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--set") || !strcmp(a, "--size")) {
-            if (i + 1 >= argc) return gr_cli_usage_error(cmd, "%s needs a value", a);
-            const char *v = argv[++i];
-            if (!strcmp(a, "--set")) {
-                if (n_sets >= MAX_SETS) return gr_cli_usage_error(cmd, "--set: more than %d overrides", MAX_SETS);
-                if (!strchr(v, '=')) return gr_cli_usage_error(cmd, "--set %s: expected KEY=VALUE", v);
-                sets[n_sets++] = v;
-            } else if (!strcmp(a, "--size")) {
-                int w = 0, h = 0;
-                char extra;
-                if (sscanf(v, "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1)
-                    return gr_cli_usage_error(cmd, "--size %s: expected WxH, e.g. 640x360", v);
-                snprintf(size_set[0], sizeof size_set[0], "camera.width=%d", w);
-                snprintf(size_set[1], sizeof size_set[1], "camera.height=%d", h);
-                sets[n_sets++] = size_set[0];
-                sets[n_sets++] = size_set[1];
-            } else {
-                if (!v[0]) return gr_cli_usage_error(cmd, "%s: empty directory name", a);
-                outdir = v;
-            }
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return gr_cli_usage_error(cmd, "unknown option %s", a);
-        } else {
-            if (scene_path) return gr_cli_usage_error(cmd, "more than one scene given (%s, %s)", scene_path, a);
-            scene_path = a;
+        } else if ((rc = gr_args_take_common(args, &outdir, NULL, &taken)) == 0 && !taken) {
+            rc = gr_args_take_scene(args);
         }
     }
-    if (!scene_path) return gr_cli_usage_error(cmd, "no scene file given");
+    if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
 
     gr_error err = {GR_OK, ""};
-    gr_scene *scene = malloc(sizeof *scene);
+    gr_scene *scene = NULL;
     gr_image *test = NULL;
     gr_metadata smeta;
     gr_meta_init(&smeta);
     ref_out ro;
     memset(&ro, 0, sizeof ro);
     gr_meta_init(&ro.meta);
-    int rc = 0;
-    char dirbuf[4096], cmdline[8192], path[4300];
-    if (!scene) {
-        gr_fail(&err, GR_E_NOMEM, "out of memory");
-        goto fail;
-    }
-    if (gr_scene_load_file(scene_path, sets, n_sets, scene, &err) != GR_OK) goto fail;
+    gr_strbuf cmdline, words;
+    gr_sb_init(&cmdline);
+    gr_sb_init(&words);
+    char dirbuf[4096], path[4300];
+    if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
     /* Bad settings are bad input (exit 2) before any slow or GL work. */
     if (gr_shafts_check_settings(&scene->shafts, &err) != GR_OK) goto fail;
-    if (!outdir) {
-        default_dir(scene->name, dirbuf, sizeof dirbuf);
-        outdir = dirbuf;
-    }
-    command_line(argc, argv, cmdline, sizeof cmdline);
+    /* The ground truth takes minutes: a folder that cannot be made is refused before it. */
+    if ((rc = gr_args_output_dir(args, scene, outdir, NULL, dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
+    command_line(argc, argv, &cmdline);
+    gr_args_scene_words(args, &words);
+    if (gr_sb_status(&cmdline, "the command line", &err) != GR_OK || gr_sb_status(&words, "the command line", &err) != GR_OK)
+        goto fail;
 
     /* The real-time side first: it takes a second, and a GL failure should not cost the user
      * a two-minute ground truth first. */
@@ -319,7 +263,8 @@ int cmd_run(int argc, char **argv)
      * points at a missing file. */
     if (!quiet) fprintf(stderr, "godrays run: writing the report...\n");
     gr_report_input in = {.scene = scene, .ref = ro.img, .ref_meta = &ro.meta, .test = test, .test_meta = &smeta,
-                          .metrics = &m, .command_line = cmdline, .ref_cached = ro.cached,
+                          .metrics = &m, .command_line = gr_sb_str(&cmdline),
+                          .scene_words = gr_sb_str(&words), .ref_cached = ro.cached,
                           .ref_cache_path = ro.cache_on ? ro.cache_path : NULL,
                           .ref_cache_note = ro.note[0] ? ro.note : NULL, .ref_seconds = t_ref,
                           .shafts_seconds = t_shafts, .compare_seconds = t_cmp, .ref_exr = "reference.exr",
@@ -347,5 +292,12 @@ done:
     gr_image_destroy(test);
     gr_meta_free(&smeta);
     free(scene);
+    gr_sb_free(&cmdline);
+    gr_sb_free(&words);
     return rc;
+}
+
+int cmd_run(int argc, char **argv)
+{
+    return gr_args_main("run", argc, argv, run_with);
 }

@@ -1,6 +1,7 @@
 /* godrays shafts: render a scene with seed 000's real-time shafts (src/realtime/shafts.h)
  * into an EXR god-ray layer (linear float, frame resolution) plus a PNG preview. */
 #include "cli/cli.h"
+#include "cli/args.h"
 
 #include <errno.h>
 #include <math.h>
@@ -12,8 +13,6 @@
 #include "image/oiio.h"
 #include "realtime/shafts.h"
 #include "scene/scene.h"
-
-#define MAX_SETS 256
 
 static void usage(FILE *f)
 {
@@ -145,19 +144,20 @@ static void median_stats(gr_shafts_stats *all, int n, gr_shafts_stats *out)
     free(dt);
 }
 
-int cmd_shafts(int argc, char **argv)
+/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
+static int shafts_with(gr_args *args)
 {
     const char *cmd = "shafts";
-    const char *scene_path = NULL, *out_path = "shafts.exr", *shader_dir = NULL, *target_path = NULL;
-    const char *sets[MAX_SETS];
-    int n_sets = 0, preview = 1, quiet = 0, have_time = 0, have_frames = 0;
+    const char *out_path = "shafts.exr", *shader_dir = NULL, *target_path = NULL;
+    const int argc = args->argc;
+    char **argv = args->argv;
+    int preview = 1, quiet = 0, have_time = 0, have_frames = 0, rc = 0;
     double time_s = 0.0, fps = 30.0, exposure = 0.0;
     long f0 = 0, f1 = 0, fstep = 1, repeat = 1;
     gr_gl_platform platform = GR_GL_AUTO;
 
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+    for (; args->i < argc; args->i++) {
+        const char *a = argv[args->i], *val = NULL;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
             return 0;
@@ -165,15 +165,15 @@ int cmd_shafts(int argc, char **argv)
             quiet = 1;
         } else if (!strcmp(a, "--no-preview")) {
             preview = 0;
+        } else if (!strcmp(a, "--set")) {
+            if ((rc = gr_args_take_set(args)) != 0) return rc;
+        } else if (!strcmp(a, "--gl-platform")) {
+            if ((rc = gr_args_take_gl_platform(args, &platform)) != 0) return rc;
         } else if (a[0] == '-' && a[1] != '\0') {
-            if (!val) return gr_cli_usage_error(cmd, "%s needs a value", a);
-            i++;
+            /* every other option takes a value */
+            if ((rc = gr_args_value(args, &val)) != 0) return rc;
             if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
                 out_path = val;
-            } else if (!strcmp(a, "--set")) {
-                if (n_sets >= MAX_SETS) return gr_cli_usage_error(cmd, "--set: more than %d overrides", MAX_SETS);
-                if (!strchr(val, '=')) return gr_cli_usage_error(cmd, "--set %s: expected KEY=VALUE", val);
-                sets[n_sets++] = val;
             } else if (!strcmp(a, "--save-target")) {
                 target_path = val;
             } else if (!strcmp(a, "--shader-dir")) {
@@ -196,36 +196,28 @@ int cmd_shafts(int argc, char **argv)
                     return gr_cli_usage_error(cmd, "--frames %s: expected START:END:STEP with 0 <= START <= END, STEP >= 1", val);
                 if ((f1 - f0) / fstep >= 100000) return gr_cli_usage_error(cmd, "--frames %s: too many frames", val);
                 have_frames = 1;
-            } else if (!strcmp(a, "--gl-platform")) {
-                if (!strcmp(val, "auto")) platform = GR_GL_AUTO;
-                else if (!strcmp(val, "surfaceless")) platform = GR_GL_SURFACELESS;
-                else if (!strcmp(val, "device")) platform = GR_GL_DEVICE;
-                else return gr_cli_usage_error(cmd, "--gl-platform %s: expected auto, surfaceless or device", val);
             } else {
                 return gr_cli_usage_error(cmd, "unknown option %s", a);
             }
-        } else {
-            if (scene_path) return gr_cli_usage_error(cmd, "more than one scene given (%s, %s)", scene_path, a);
-            scene_path = a;
+        } else if ((rc = gr_args_take_scene(args)) != 0) {
+            return rc;
         }
     }
-    if (!scene_path) return gr_cli_usage_error(cmd, "no scene file given");
+    if ((rc = gr_args_need_scene(args)) != 0) return rc;
 
     gr_error err = {GR_OK, ""};
-    gr_scene *scene = malloc(sizeof *scene);
+    gr_scene *scene = NULL;
     gr_shafts *r = NULL;
     gr_image *img = NULL;
     gr_shafts_stats *runs = NULL;
     gr_metadata meta;
     gr_meta_init(&meta);
-    int rc = 0;
-    if (!scene) {
-        gr_fail(&err, GR_E_NOMEM, "out of memory");
-        goto fail;
-    }
-    if (gr_scene_load_file(scene_path, sets, n_sets, scene, &err) != GR_OK) goto fail;
+    if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
     /* Settings are checked before any GL work, so bad input exits 2 even without GL. */
     if (gr_shafts_check_settings(&scene->shafts, &err) != GR_OK) goto fail;
+    /* So are the outputs (frames and previews go beside OUT). */
+    if ((rc = gr_args_check_output_file(args, "-o", out_path)) != 0) goto done;
+    if (target_path && (rc = gr_args_check_output_file(args, "--save-target", target_path)) != 0) goto done;
     double t_base = have_time ? time_s : scene->water.time_s;
 
     gr_shafts_options opts;
@@ -306,4 +298,9 @@ done:
     gr_shafts_destroy(r);
     free(scene);
     return rc;
+}
+
+int cmd_shafts(int argc, char **argv)
+{
+    return gr_args_main("shafts", argc, argv, shafts_with);
 }

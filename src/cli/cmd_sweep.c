@@ -1,6 +1,7 @@
 /* godrays sweep SCENE --param shafts.K=0.4:1.2:16 [--param ...]: the shafts' error surface over
  * a grid of one or two settings against the cached ground truth (src/tune/sweep.h). */
 #include "cli/cli.h"
+#include "cli/args.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -154,46 +155,45 @@ static gr_status write_images(const char *dir, gr_tune_problem *p, const double 
     return st;
 }
 
-int cmd_sweep(int argc, char **argv)
+/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
+static int sweep_with(gr_args *args)
 {
-    const char *cmd = "sweep";
+    const int argc = args->argc;
+    char **argv = args->argv;
+    const char *cmd = "sweep", *outopt = NULL;
     gr_tune_cli c;
     gr_tune_cli_init(&c);
     gr_tune_param params[2];
-    int n_params = 0;
+    int n_params = 0, rc = 0, taken = 0;
     gr_error err = {GR_OK, ""};
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
+    for (; args->i < argc && !rc; args->i++) {
+        const char *a = argv[args->i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
             return 0;
         }
         if (!strcmp(a, "--param")) {
-            if (i + 1 >= argc) return gr_cli_usage_error(cmd, "--param needs a value");
-            if (n_params >= 2) return gr_cli_usage_error(cmd, "--param %s: at most two axes", argv[i + 1]);
-            if (gr_tune_param_parse_sweep("--param", argv[++i], &params[n_params], &err) != GR_OK)
+            const char *v = NULL;
+            if ((rc = gr_args_value(args, &v)) != 0) return rc;
+            if (n_params >= 2) return gr_cli_usage_error(cmd, "--param %s: at most two axes", v);
+            if (gr_tune_param_parse_sweep("--param", v, &params[n_params], &err) != GR_OK)
                 return gr_cli_report(cmd, &err);
             for (int k = 0; k < n_params; k++)
                 if (!strcmp(params[k].key, params[n_params].key))
-                    return gr_cli_usage_error(cmd, "--param %s: %s swept twice", argv[i], params[k].key);
+                    return gr_cli_usage_error(cmd, "--param %s: %s swept twice", v, params[k].key);
             n_params++;
-            continue;
+        } else if ((rc = gr_args_take_common(args, &outopt, &c.so.gl_platform, &taken)) == 0 && !taken) {
+            int r = gr_tune_cli_option(&c, argc, argv, &args->i, &err);
+            if (r < 0) rc = gr_cli_report(cmd, &err);
+            else if (r == 0) rc = gr_args_take_scene(args);
         }
-        int r = gr_tune_cli_option(&c, argc, argv, &i, &err);
-        if (r < 0) return gr_cli_report(cmd, &err);
-        if (r > 0) continue;
-        if (a[0] == '-' && a[1] != '\0') return gr_cli_usage_error(cmd, "unknown option %s", a);
-        if (c.so.scene_path) return gr_cli_usage_error(cmd, "more than one scene given (%s, %s)", c.so.scene_path, a);
-        c.so.scene_path = a;
     }
-    if (!c.so.scene_path) return gr_cli_usage_error(cmd, "no scene file given");
+    if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
     if (n_params == 0) return gr_cli_usage_error(cmd, "no --param given (e.g. --param shafts.K=0.4:1.2:16)");
     if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
-    if (c.fit < 0) {
-        c.fit = 1;
-        for (int k = 0; k < n_params; k++)
-            if (!strcmp(params[k].p->name, "intensity")) c.fit = 0;
-    }
+    c.so.scene_path = args->scene_path;
+    c.so.sets = gr_args_sets(args);
+    c.so.n_sets = args->n_sets;
     c.so.progress_label = "godrays sweep";
 
     gr_tune_session s;
@@ -202,20 +202,15 @@ int cmd_sweep(int argc, char **argv)
     memset(&r, 0, sizeof r);
     char dirbuf[4096], path[4300];
     char *json = NULL, *snippet = NULL;
-    int rc = 0;
+    const char *outdir = NULL;
+    memset(&s, 0, sizeof s);
     if (!p) {
         gr_fail(&err, GR_E_NOMEM, "out of memory");
-        memset(&s, 0, sizeof s);
         goto fail;
     }
-    if (gr_tune_session_open(&c.so, &s, &err) != GR_OK) goto fail;
-    gr_tune_session_problem(&s, p);
-    p->n_params = n_params;
-    memcpy(p->params, params, sizeof params);
-    p->metric = c.metric;
-    p->fit = c.fit;
-    p->normalize = c.normalize;
-    if (gr_tune_problem_init(p, &err) != GR_OK) goto fail;
+    /* The ground truths take minutes: a folder that cannot be made is refused before them. */
+    if ((rc = gr_args_output_dir(args, NULL, outopt, "sweep", dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
+    if (gr_tune_cli_open(&c, params, n_params, &s, p, &err) != GR_OK) goto fail;
     /* every grid value must be a valid setting before the first render */
     for (int k = 0; k < n_params; k++) {
         gr_shafts_settings t = p->base;
@@ -225,11 +220,6 @@ int cmd_sweep(int argc, char **argv)
                 gr_error_prefix(&err, "--param %s", params[k].key);
                 goto fail;
             }
-    }
-    const char *outdir = c.outdir;
-    if (!outdir) {
-        gr_tune_default_dir(s.base->name, "sweep", dirbuf, sizeof dirbuf);
-        outdir = dirbuf;
     }
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
 
@@ -276,16 +266,11 @@ int cmd_sweep(int argc, char **argv)
     {
         gr_strbuf pg;
         gr_sb_init(&pg);
-        char title[300];
-        snprintf(title, sizeof title, "godrays sweep: %s", s.base->name);
-        gr_tune_page_begin(&pg, title);
+        gr_tune_page_begin(&pg, outdir, "godrays sweep: %s", s.base->name);
         if (drawn) gr_tune_page_figure(&pg, "sweep.png", "error surface; the cross marks the minimum");
         gr_tune_page_figure(&pg, "reference.png", "ground truth (case 0)");
         gr_tune_page_figure(&pg, "best.png", "shafts at the minimum, x the fitted scale, same exposure");
-        gr_tune_page_pre(&pg, gr_sb_str(&sum));
-        gr_sb_puts(&pg, "<p>Data: <a href=\"sweep.csv\">sweep.csv</a>, <a href=\"sweep.json\">sweep.json</a>.</p>\n");
-        gr_status pst = gr_tune_page_write(&pg, outdir, &err);
-        gr_sb_free(&pg);
+        gr_status pst = gr_tune_page_write(&pg, gr_sb_str(&sum), "sweep.csv,sweep.json", outdir, &err);
         gr_sb_free(&sum);
         if (pst != GR_OK) goto fail;
     }
@@ -300,4 +285,9 @@ done:
     free(p);
     gr_tune_session_close(&s);
     return rc;
+}
+
+int cmd_sweep(int argc, char **argv)
+{
+    return gr_args_main("sweep", argc, argv, sweep_with);
 }

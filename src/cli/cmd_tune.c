@@ -2,6 +2,7 @@
  * minimize the error against the ground truth over frames and views, found by bounded
  * Nelder-Mead with restarts (src/tune/optimize.h). */
 #include "cli/cli.h"
+#include "cli/args.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -150,26 +151,28 @@ static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune
     return st;
 }
 
-int cmd_tune(int argc, char **argv)
+/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
+static int tune_with(gr_args *args)
 {
-    const char *cmd = "tune";
+    const char *cmd = "tune", *outopt = NULL;
+    const int argc = args->argc;
+    char **argv = args->argv;
     gr_tune_cli c;
     gr_tune_cli_init(&c);
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
-    int n_params = 0, n_starts = 4, max_evals = 0;
+    int n_params = 0, n_starts = 4, max_evals = 0, rc = 0;
     const char *bounds[32], *starts[32];
     int n_bounds = 0, n_start_specs = 0;
     gr_error err = {GR_OK, ""};
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
+    for (; args->i < argc; args->i++) {
+        const char *a = argv[args->i], *v = NULL;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
             return 0;
         }
         if (!strcmp(a, "--params") || !strcmp(a, "--bounds") || !strcmp(a, "--start") || !strcmp(a, "--starts") ||
             !strcmp(a, "--max-evals")) {
-            if (i + 1 >= argc) return gr_cli_usage_error(cmd, "%s needs a value", a);
-            const char *v = argv[++i];
+            if ((rc = gr_args_value(args, &v)) != 0) return rc;
             if (!strcmp(a, "--params")) {
                 if (n_params) return gr_cli_usage_error(cmd, "--params given twice");
                 if (gr_tune_param_parse_list(a, v, params, GR_TUNE_MAX_PARAMS, &n_params, &err) != GR_OK)
@@ -189,14 +192,15 @@ int cmd_tune(int argc, char **argv)
             }
             continue;
         }
-        int r = gr_tune_cli_option(&c, argc, argv, &i, &err);
-        if (r < 0) return gr_cli_report(cmd, &err);
-        if (r > 0) continue;
-        if (a[0] == '-' && a[1] != '\0') return gr_cli_usage_error(cmd, "unknown option %s", a);
-        if (c.so.scene_path) return gr_cli_usage_error(cmd, "more than one scene given (%s, %s)", c.so.scene_path, a);
-        c.so.scene_path = a;
+        int taken = 0;
+        if ((rc = gr_args_take_common(args, &outopt, &c.so.gl_platform, &taken)) == 0 && !taken) {
+            int r = gr_tune_cli_option(&c, argc, argv, &args->i, &err);
+            if (r < 0) return gr_cli_report(cmd, &err);
+            if (r == 0) rc = gr_args_take_scene(args);
+        }
+        if (rc) return rc;
     }
-    if (!c.so.scene_path) return gr_cli_usage_error(cmd, "no scene file given");
+    if ((rc = gr_args_need_scene(args)) != 0) return rc;
     if (!n_params) return gr_cli_usage_error(cmd, "no --params given (e.g. --params shafts.extinction,shafts.K)");
     for (int b = 0; b < n_bounds; b++)
         if (gr_tune_param_parse_bounds("--bounds", bounds[b], params, n_params, &err) != GR_OK)
@@ -220,11 +224,9 @@ int cmd_tune(int argc, char **argv)
         have_x0[idx] = 1;
     }
     if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
-    if (c.fit < 0) {
-        c.fit = 1;
-        for (int k = 0; k < n_params; k++)
-            if (!strcmp(params[k].p->name, "intensity")) c.fit = 0;
-    }
+    c.so.scene_path = args->scene_path;
+    c.so.sets = gr_args_sets(args);
+    c.so.n_sets = args->n_sets;
     c.so.progress_label = "godrays tune";
 
     gr_tune_session s;
@@ -234,19 +236,14 @@ int cmd_tune(int argc, char **argv)
     char *json = NULL, *snippet = NULL;
     FILE *trace = NULL;
     cJSON *root = NULL;
-    int rc = 0;
+    const char *outdir = NULL;
     if (!p) {
         gr_fail(&err, GR_E_NOMEM, "out of memory");
         goto fail;
     }
-    if (gr_tune_session_open(&c.so, &s, &err) != GR_OK) goto fail;
-    gr_tune_session_problem(&s, p);
-    p->n_params = n_params;
-    memcpy(p->params, params, sizeof params);
-    p->metric = c.metric;
-    p->fit = c.fit;
-    p->normalize = c.normalize;
-    if (gr_tune_problem_init(p, &err) != GR_OK) goto fail;
+    /* The ground truths take minutes: a folder that cannot be made is refused before them. */
+    if ((rc = gr_args_output_dir(args, NULL, outopt, "tune", dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
+    if (gr_tune_cli_open(&c, params, n_params, &s, p, &err) != GR_OK) goto fail;
     double lo[GR_TUNE_MAX_PARAMS], hi[GR_TUNE_MAX_PARAMS], xb[GR_TUNE_MAX_PARAMS];
     for (int k = 0; k < n_params; k++) {
         lo[k] = params[k].lo;
@@ -260,11 +257,6 @@ int cmd_tune(int argc, char **argv)
                 gr_error_prefix(&err, "bounds of %s", params[k].key);
                 goto fail;
             }
-    }
-    const char *outdir = c.outdir;
-    if (!outdir) {
-        gr_tune_default_dir(s.base->name, "tune", dirbuf, sizeof dirbuf);
-        outdir = dirbuf;
     }
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
     snprintf(path, sizeof path, "%s/trace.csv", outdir);
@@ -413,9 +405,7 @@ int cmd_tune(int argc, char **argv)
     {
         gr_strbuf pg;
         gr_sb_init(&pg);
-        char title[300];
-        snprintf(title, sizeof title, "godrays tune: %s", s.base->name);
-        gr_tune_page_begin(&pg, title);
+        gr_tune_page_begin(&pg, outdir, "godrays tune: %s", s.base->name);
         gr_tune_page_figure(&pg, "compare.png", "ground truth | shafts before | shafts after tuning (case 0)");
         for (int i = 1; i < s.n_cases && i < 8; i++) {
             char f[64], cap[128];
@@ -423,10 +413,7 @@ int cmd_tune(int argc, char **argv)
             snprintf(cap, sizeof cap, "after tuning, %s (reference_%02d.png, before_%02d.png beside)", s.labels[i], i, i);
             gr_tune_page_figure(&pg, f, cap);
         }
-        gr_tune_page_pre(&pg, gr_sb_str(&sum));
-        gr_sb_puts(&pg, "<p>Data: <a href=\"tune.json\">tune.json</a>, <a href=\"trace.csv\">trace.csv</a>.</p>\n");
-        gr_status pst = gr_tune_page_write(&pg, outdir, &err);
-        gr_sb_free(&pg);
+        gr_status pst = gr_tune_page_write(&pg, gr_sb_str(&sum), "tune.json,trace.csv", outdir, &err);
         gr_sb_free(&sum);
         if (pst != GR_OK) goto fail;
     }
@@ -442,4 +429,9 @@ done:
     free(p);
     gr_tune_session_close(&s);
     return rc;
+}
+
+int cmd_tune(int argc, char **argv)
+{
+    return gr_args_main("tune", argc, argv, tune_with);
 }

@@ -134,3 +134,21 @@ void gr_sb_html(gr_strbuf *b, const char *s)
         run = p + 1;
     }
 }
+
+void gr_sb_shell_word(gr_strbuf *b, const char *s)
+{
+    int plain = s[0] != '\0';
+    for (const char *p = s; *p && plain; p++)
+        plain = (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
+                strchr("_./=:,+%@-", *p) != NULL;
+    if (plain) {
+        gr_sb_puts(b, s);
+        return;
+    }
+    gr_sb_puts(b, "'");
+    for (const char *p = s; *p; p++) {
+        if (*p == '\'') gr_sb_puts(b, "'\\''");
+        else append(b, p, 1);
+    }
+    gr_sb_puts(b, "'");
+}

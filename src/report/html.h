@@ -27,5 +27,8 @@ void gr_sb_printf(gr_strbuf *b, const char *fmt, ...) __attribute__((format(prin
 void gr_sb_html(gr_strbuf *b, const char *s);
 /* printf, then escaped as gr_sb_html. */
 void gr_sb_htmlf(gr_strbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* s as one word of a POSIX shell command: as is when it holds only [A-Za-z0-9_./=:,+%@-] (and
+ * is not empty), else in single quotes, each ' written as '\''. Not HTML-escaped. */
+void gr_sb_shell_word(gr_strbuf *b, const char *s);
 
 #endif

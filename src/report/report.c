@@ -814,6 +814,49 @@ static gr_status build_json(ctx *c, char **text, gr_error *err)
     return GR_OK;
 }
 
+/* The pages of `godrays sweep`, `tune` and `pareto` in their folders inside the report's
+ * (docs/tuning.md): a link to each one that exists now, else the command that makes it. */
+static void html_tuning_pages(gr_strbuf *b, const ctx *c)
+{
+    static const struct { const char *sub, *what, *args; } pages[3] = {
+        {"sweep", "the error over a grid of one or two shaft settings",
+         " --param shafts.K=0.2:2:16 --param shafts.extinction=0.1:4:16"},
+        {"tune", "the shaft settings with the least error over frames and views", " --params shafts.K,shafts.extinction"},
+        {"pareto", "speed against error of both renderers", ""},
+    };
+    gr_sb_puts(b, "<h2>Sweep, tuning, speed against error</h2>\n<ul>\n");
+    for (int k = 0; k < 3; k++) {
+        char path[4300];
+        struct stat sb;
+        snprintf(path, sizeof path, "%s/%s/index.html", c->dir, pages[k].sub);
+        gr_sb_puts(b, "<li>");
+        if (stat(path, &sb) == 0 && S_ISREG(sb.st_mode)) {
+            gr_sb_printf(b, "<a href=\"%s/index.html\">%s/index.html</a>: ", pages[k].sub, pages[k].sub);
+            gr_sb_html(b, pages[k].what);
+        } else {
+            gr_strbuf cmd;
+            gr_sb_init(&cmd);
+            gr_sb_printf(&cmd, "godrays %s ", pages[k].sub);
+            if (c->in->scene_words) gr_sb_puts(&cmd, c->in->scene_words);
+            else gr_sb_shell_word(&cmd, c->in->scene->source_path);
+            gr_sb_printf(&cmd, "%s -o ", pages[k].args);
+            snprintf(path, sizeof path, "%s/%s", c->dir, pages[k].sub);
+            gr_sb_shell_word(&cmd, path);
+            gr_sb_printf(b, "%s/: ", pages[k].sub);
+            gr_sb_html(b, pages[k].what);
+            gr_sb_puts(b, "; not made yet: <code>");
+            gr_sb_html(b, gr_sb_str(&cmd));
+            gr_sb_puts(b, "</code>");
+            if (cmd.failed) b->failed = 1;
+            gr_sb_free(&cmd);
+        }
+        gr_sb_puts(b, "</li>\n");
+    }
+    gr_sb_puts(b, "</ul>\n<p class=\"sub\">Links to the pages that were in this folder when the report was written "
+                  "(a page made later links back here; the next <code>godrays run</code> into this folder links it). "
+                  "The commands run from the folder <code>godrays run</code> was started in; docs/tuning.md.</p>\n");
+}
+
 static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
 {
     const gr_report_input *in = c->in;
@@ -982,6 +1025,8 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     kv_num(b, "comparison (metrics) time", in->compare_seconds >= 0 ? in->compare_seconds : NAN, 1.0, "s");
     gr_sb_puts(b, "</table>\n</div>\n</div>\n<p class=\"sub\">GPU times are GL_TIME_ELAPSED queries (n/a where the "
                   "driver has no timer for a pass); on a machine without a GPU they measure Mesa's llvmpipe.</p>\n");
+
+    html_tuning_pages(b, c);
 
     /* Scene and settings */
     gr_sb_puts(b, "<h2>Scene and settings</h2>\n");

@@ -8,6 +8,8 @@
  *   reference.png, shafts.png (x the fitted scale, same exposure as the reference),
  *   shafts_raw.png (own exposure), diff.png, diff_signed.png, radial_profile.png,
  *   radial_profile_rgb.png, error_vs_blur.png
+ * index.html links the pages of `godrays sweep`, `tune` and `pareto` in DIR/sweep, DIR/tune and
+ * DIR/pareto that exist when it is written, and gives the command for each one that does not.
  * How to read it: docs/report.md. Library code: writes files, prints nothing. */
 #ifndef GR_REPORT_H
 #define GR_REPORT_H
@@ -33,6 +35,8 @@ typedef struct gr_report_input {
     double shafts_seconds;          /* real-time renderer: context, render, readback */
     double compare_seconds;
     const char *ref_exr, *test_exr; /* names (inside DIR) of EXR copies written beside; NULL: none */
+    const char *scene_words;        /* the scene and its --set/--size options, shell-quoted, for the
+                                       commands that make DIR/{sweep,tune,pareto} (NULL: the scene file) */
 } gr_report_input;
 
 typedef struct gr_report_result {

@@ -35,13 +35,11 @@ void gr_tune_cli_init(gr_tune_cli *c)
     c->fps = 30.0;
     c->so.use_cache = 1;
     c->so.progress = 1;
-    c->so.sets = c->sets;
 }
 
 static int needs_value(const char *a)
 {
-    static const char *const with_value[] = {"-o", "--output", "--metric", "--set", "--size", "--frames", "--fps",
-                                             "--times", "--view", "--gl-platform"};
+    static const char *const with_value[] = {"--metric", "--frames", "--fps", "--times", "--view"};
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
         if (!strcmp(a, with_value[k])) return 1;
     return 0;
@@ -73,26 +71,8 @@ int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *
     }
     const char *v = argv[++*i];
     gr_status st = GR_OK;
-    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-        if (!v[0]) st = gr_fail(err, GR_E_USAGE, "%s: empty directory name", a);
-        c->outdir = v;
-    } else if (!strcmp(a, "--metric")) {
+    if (!strcmp(a, "--metric")) {
         st = gr_tune_metric_parse(a, v, &c->metric, err);
-    } else if (!strcmp(a, "--set")) {
-        if (c->so.n_sets >= GR_TUNE_MAX_SETS) st = gr_fail(err, GR_E_USAGE, "--set: more than %d overrides", GR_TUNE_MAX_SETS);
-        else if (!strchr(v, '=')) st = gr_fail(err, GR_E_USAGE, "--set %s: expected KEY=VALUE", v);
-        else c->sets[c->so.n_sets++] = v;
-    } else if (!strcmp(a, "--size")) {
-        int w = 0, h = 0;
-        char extra;
-        if (sscanf(v, "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1) {
-            st = gr_fail(err, GR_E_USAGE, "--size %s: expected WxH, e.g. 640x360", v);
-        } else {
-            snprintf(c->size_sets[0], sizeof c->size_sets[0], "camera.width=%d", w);
-            snprintf(c->size_sets[1], sizeof c->size_sets[1], "camera.height=%d", h);
-            c->sets[c->so.n_sets++] = c->size_sets[0];
-            c->sets[c->so.n_sets++] = c->size_sets[1];
-        }
     } else if (!strcmp(a, "--frames")) {
         c->frames_spec = v;
     } else if (!strcmp(a, "--times")) {
@@ -109,11 +89,6 @@ int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *
             st = gr_fail(err, GR_E_USAGE, "--view: more than %d extra views", GR_TUNE_MAX_VIEWS);
         else if ((st = gr_tune_parse_view(a, v, &c->so.views[c->so.n_views], err)) == GR_OK)
             c->so.n_views++;
-    } else if (!strcmp(a, "--gl-platform")) {
-        if (!strcmp(v, "auto")) c->so.gl_platform = GR_GL_AUTO;
-        else if (!strcmp(v, "surfaceless")) c->so.gl_platform = GR_GL_SURFACELESS;
-        else if (!strcmp(v, "device")) c->so.gl_platform = GR_GL_DEVICE;
-        else st = gr_fail(err, GR_E_USAGE, "--gl-platform %s: expected auto, surfaceless or device", v);
     }
     return st == GR_OK ? 1 : -1;
 }
@@ -133,4 +108,23 @@ gr_status gr_tune_cli_finish(gr_tune_cli *c, gr_error *err)
     }
     c->so.progress = !c->quiet;
     return GR_OK;
+}
+
+gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_params, gr_tune_session *s,
+                           gr_tune_problem *p, gr_error *err)
+{
+    if (c->fit < 0) {
+        c->fit = 1;
+        for (int k = 0; k < n_params; k++)
+            if (!strcmp(params[k].p->name, "intensity")) c->fit = 0;
+    }
+    gr_status st = gr_tune_session_open(&c->so, s, err);
+    if (st != GR_OK) return st;
+    gr_tune_session_problem(s, p);
+    p->n_params = n_params;
+    memcpy(p->params, params, (size_t)n_params * sizeof *params);
+    p->metric = c->metric;
+    p->fit = c->fit;
+    p->normalize = c->normalize;
+    return gr_tune_problem_init(p, err);
 }

@@ -1,6 +1,7 @@
-/* Command-line options shared by `godrays sweep` and `godrays tune` (scene overrides, size,
- * frames, views, metric, scale fit, cache, output folder), parsed in one place so that both
- * commands accept and check them the same way. */
+/* Command-line options shared by `godrays sweep` and `godrays tune` (frames, views, metric,
+ * scale fit, cache), parsed in one place so that both commands accept and check them the same
+ * way. The options every command shares (-o, --set, --size, --gl-platform) are read by the
+ * command line's own src/cli/args.h; gr_tune_cli_help lists both. */
 #ifndef GR_TUNE_CLIOPTS_H
 #define GR_TUNE_CLIOPTS_H
 
@@ -8,13 +9,8 @@
 #include "tune/objective.h"
 #include "tune/session.h"
 
-#define GR_TUNE_MAX_SETS 256
-
 typedef struct gr_tune_cli {
-    gr_tune_session_options so;
-    const char *sets[GR_TUNE_MAX_SETS + 2];
-    char size_sets[2][48];
-    const char *outdir;           /* NULL: out/SCENE/<command> */
+    gr_tune_session_options so;   /* sets, n_sets, gl_platform, scene_path: the caller's */
     gr_tune_metric metric;
     int fit;                      /* -1: auto (on unless shafts.intensity is a parameter) */
     int normalize;                /* --normalize */
@@ -33,6 +29,13 @@ int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *
 
 /* After all arguments: the frames/times lists; progress follows quiet. */
 gr_status gr_tune_cli_finish(gr_tune_cli *c, gr_error *err);
+
+/* After gr_tune_cli_finish and the caller's own checks: the fit default (on, unless
+ * shafts.intensity is among params), gr_tune_session_open with c->so (s is the caller's; close
+ * it even after a failure), and p set up from the session, params, metric, fit and
+ * normalization, and initialized (gr_tune_problem_free it). */
+gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_params, gr_tune_session *s,
+                           gr_tune_problem *p, gr_error *err);
 
 /* The help text of the shared options. */
 extern const char gr_tune_cli_help[];

@@ -75,7 +75,7 @@ void gr_tune_default_dir(const char *name, const char *sub, char *buf, size_t n)
     buf[j] = '\0';
     if (!strcmp(buf, "out/") || !strcmp(buf, "out/.") || !strcmp(buf, "out/..")) snprintf(buf, n, "out/scene");
     size_t len = strlen(buf);
-    if (len + 1 < n) snprintf(buf + len, n - len, "/%s", sub);
+    if (sub && len + 1 < n) snprintf(buf + len, n - len, "/%s", sub);
 }
 
 gr_status gr_tune_write_text(const char *path, const char *text, gr_error *err)

@@ -58,7 +58,8 @@ gr_status gr_tune_parse_times(const char *flag, const char *spec, double *times,
 /* --view YAW,PITCH (degrees). */
 gr_status gr_tune_parse_view(const char *flag, const char *spec, gr_tune_view *v, gr_error *err);
 
-/* "out/" + the scene name (characters outside [A-Za-z0-9._-] as '_') + "/" + sub. */
+/* "out/" + the scene name (characters outside [A-Za-z0-9._-] as '_') + "/" + sub (sub NULL:
+ * the folder of `godrays run`, in which sweep, tune and pareto make theirs). */
 void gr_tune_default_dir(const char *scene_name, const char *sub, char *buf, size_t n);
 
 /* Writes text to path through a temporary file renamed into place. */

@@ -1,7 +1,9 @@
 #!/bin/sh
 # `godrays run` refuses bad usage and bad input with exit 2 and one stderr line naming the
 # problem, before any rendering (so before any output folder exists); an unreadable scene
-# file and an output path that is a file are I/O failures (exit 1) naming them.
+# file is an I/O failure (exit 1) naming it; an output folder that cannot be made (a path
+# through a file) is refused with exit 2 before any rendering (tests/cli/test_output_checks.sh
+# covers the other commands).
 set -u
 bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
@@ -39,7 +41,7 @@ expect 2 "medium.g" "$scene" --set medium.g=2 -o x
 [ -e x ] && { echo "FAIL: a refused run created its output folder"; fail=1; }
 [ -e cache ] && { echo "FAIL: a refused run touched the cache"; fail=1; }
 : >a_file
-expect 1 "a_file" "$scene" --size 32x18 --set reference.surface_res=16 --set reference.sun_samples=1 \
+expect 2 "-o a_file: cannot write into a_file: Not a directory" "$scene" --size 32x18 --set reference.surface_res=16 --set reference.sun_samples=1 \
     --set reference.batches=2 --set reference.steps=4 -q -o a_file
 "$bin" run --help >help.txt 2>&1
 [ $? -eq 0 ] && grep -q "usage: godrays run SCENE" help.txt || { echo "FAIL: run --help"; fail=1; }

@@ -3,6 +3,8 @@
 # one row per point (2 ground-truth levels + 2 N x 2 target scales x 2 formats = 10), times and
 # errors positive and finite, each family with at least one point on its front, and the lowest
 # time and the lowest error of each family on its front (a property of any Pareto front).
+# The folder's parent holds the files of a `godrays run` report (index.html, metrics.json;
+# stand-ins here), so the page links back to it (cli.report_links checks the rest).
 bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
@@ -13,12 +15,15 @@ cat >"$dir/s.json" <<'JSON'
  "medium": {"absorption_per_m": [0.3, 0.06, 0.03], "scattering_per_m": 0.03, "g": 0.8},
  "camera": {"position_m": [0, -8, 0], "yaw_deg": 30, "pitch_deg": 40, "fov_deg": 60, "width": 48, "height": 27}}
 JSON
+echo '<!DOCTYPE html><title>run</title>' >"$dir/index.html"
+echo '{}' >"$dir/metrics.json"
 "$bin" pareto "$dir/s.json" -q --quick --size 40x24 --repeat 2 -o "$dir/p" >"$dir/out" 2>"$dir/err"
 rc=$?
 cat "$dir/err"
 if [ $rc -ne 0 ]; then echo "FAIL: pareto exit $rc"; exit 1; fi
 cat "$dir/out"
 [ -s "$dir/p/pareto.png" ] && [ -s "$dir/p/index.html" ] || { echo "FAIL: no pareto.png or index.html"; exit 1; }
+grep -qF '<a href="../index.html">' "$dir/p/index.html" || { echo "FAIL: pareto page does not link ../index.html"; exit 1; }
 python3 - "$dir/p/pareto.csv" <<'PY'
 import csv, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))

@@ -1,0 +1,282 @@
+/* Shared argument handling of the godrays commands (args.h). */
+#include "cli/args.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli/cli.h"
+#include "tune/session.h"
+
+void gr_args_create(gr_args *a, const char *cmd, int argc, char **argv)
+{
+    memset(a, 0, sizeof *a);
+    a->cmd = cmd;
+    a->argc = argc;
+    a->argv = argv;
+    a->i = 1;
+}
+
+void gr_args_free(gr_args *a)
+{
+    if (!a) return;
+    for (int k = 0; k < a->n_sets; k++) free(a->sets[k]);
+    free(a->sets);
+    a->sets = NULL;
+    a->n_sets = a->cap_sets = 0;
+}
+
+int gr_args_main(const char *cmd, int argc, char **argv, int (*fn)(gr_args *a))
+{
+    gr_args a;
+    gr_args_create(&a, cmd, argc, argv);
+    const int rc = fn(&a);
+    gr_args_free(&a);
+    return rc;
+}
+
+const char *const *gr_args_sets(const gr_args *a)
+{
+    return (const char *const *)a->sets;
+}
+
+static int out_of_memory(const gr_args *a)
+{
+    fprintf(stderr, "godrays %s: out of memory for the command line\n", a->cmd);
+    return 1;
+}
+
+/* Appends an override the caller allocated (taken over, freed on failure). */
+static int push_set(gr_args *a, char *s)
+{
+    if (!s) return out_of_memory(a);
+    if (a->n_sets == a->cap_sets) {
+        int cap = a->cap_sets ? 2 * a->cap_sets : 16;
+        char **p = realloc(a->sets, (size_t)cap * sizeof *p);
+        if (!p) {
+            free(s);
+            return out_of_memory(a);
+        }
+        a->sets = p;
+        a->cap_sets = cap;
+    }
+    a->sets[a->n_sets++] = s;
+    return 0;
+}
+
+int gr_args_add_set(gr_args *a, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    char *s = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (s) {
+        va_start(ap, fmt);
+        vsnprintf(s, (size_t)n + 1, fmt, ap);
+        va_end(ap);
+    }
+    return push_set(a, s);
+}
+
+int gr_args_value(gr_args *a, const char **value)
+{
+    const char *flag = a->argv[a->i];
+    if (a->i + 1 >= a->argc) return gr_cli_usage_error(a->cmd, "%s needs a value", flag);
+    *value = a->argv[++a->i];
+    return 0;
+}
+
+int gr_args_dir(gr_args *a, const char **dir)
+{
+    const char *flag = a->argv[a->i];
+    int rc = gr_args_value(a, dir);
+    if (rc) return rc;
+    if (!(*dir)[0]) return gr_cli_usage_error(a->cmd, "%s: empty directory name", flag);
+    return 0;
+}
+
+int gr_args_take_set(gr_args *a)
+{
+    const char *v = NULL;
+    int rc = gr_args_value(a, &v);
+    if (rc) return rc;
+    if (!strchr(v, '=')) return gr_cli_usage_error(a->cmd, "--set %s: expected KEY=VALUE", v);
+    return gr_args_add_set(a, "%s", v);
+}
+
+int gr_args_take_size(gr_args *a)
+{
+    const char *v = NULL;
+    int rc = gr_args_value(a, &v);
+    if (rc) return rc;
+    int w = 0, h = 0;
+    char extra;
+    if (sscanf(v, "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1)
+        return gr_cli_usage_error(a->cmd, "--size %s: expected WxH, e.g. %s", v,
+                                  a->size_example ? a->size_example : "640x360");
+    a->have_size = 1;
+    if ((rc = gr_args_add_set(a, "camera.width=%d", w)) != 0) return rc;
+    return gr_args_add_set(a, "camera.height=%d", h);
+}
+
+int gr_args_take_setting(gr_args *a, const char *key)
+{
+    const char *v = NULL;
+    int rc = gr_args_value(a, &v);
+    if (rc) return rc;
+    return gr_args_add_set(a, "%s=%s", key, v);
+}
+
+int gr_args_take_gl_platform(gr_args *a, gr_gl_platform *platform)
+{
+    const char *v = NULL;
+    int rc = gr_args_value(a, &v);
+    if (rc) return rc;
+    if (!strcmp(v, "auto")) *platform = GR_GL_AUTO;
+    else if (!strcmp(v, "surfaceless")) *platform = GR_GL_SURFACELESS;
+    else if (!strcmp(v, "device")) *platform = GR_GL_DEVICE;
+    else return gr_cli_usage_error(a->cmd, "--gl-platform %s: expected auto, surfaceless or device", v);
+    return 0;
+}
+
+int gr_args_take_common(gr_args *a, const char **dir, gr_gl_platform *platform, int *taken)
+{
+    const char *f = a->argv[a->i];
+    *taken = 1;
+    if (!strcmp(f, "-o") || !strcmp(f, "--output")) return gr_args_dir(a, dir);
+    if (!strcmp(f, "--set")) return gr_args_take_set(a);
+    if (!strcmp(f, "--size")) return gr_args_take_size(a);
+    if (platform && !strcmp(f, "--gl-platform")) return gr_args_take_gl_platform(a, platform);
+    *taken = 0;
+    return 0;
+}
+
+int gr_args_take_scene(gr_args *a)
+{
+    const char *v = a->argv[a->i];
+    if (v[0] == '-' && v[1] != '\0') return gr_cli_usage_error(a->cmd, "unknown option %s", v);
+    if (a->scene_path) return gr_cli_usage_error(a->cmd, "more than one scene given (%s, %s)", a->scene_path, v);
+    a->scene_path = v;
+    return 0;
+}
+
+int gr_args_need_scene(const gr_args *a)
+{
+    return a->scene_path ? 0 : gr_cli_usage_error(a->cmd, "no scene file given");
+}
+
+int gr_args_load_scene(const gr_args *a, gr_scene **scene)
+{
+    gr_error err = {GR_OK, ""};
+    *scene = malloc(sizeof **scene);
+    if (!*scene) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        return gr_cli_report(a->cmd, &err);
+    }
+    if (gr_scene_load_file(a->scene_path, gr_args_sets(a), a->n_sets, *scene, &err) != GR_OK) {
+        free(*scene);
+        *scene = NULL;
+        return gr_cli_report(a->cmd, &err);
+    }
+    return 0;
+}
+
+void gr_args_scene_words(const gr_args *a, gr_strbuf *b)
+{
+    if (a->scene_path) gr_sb_shell_word(b, a->scene_path);
+    for (int k = 1; k + 1 < a->argc; k++) {
+        if (strcmp(a->argv[k], "--set") && strcmp(a->argv[k], "--size")) continue;
+        gr_sb_printf(b, " %s ", a->argv[k]);
+        gr_sb_shell_word(b, a->argv[++k]);
+    }
+}
+
+/* ---- output checks -------------------------------------------------------------------------- */
+
+static int output_error(const gr_args *a, const char *flag, const char *path, const char *what, const char *where,
+                        int e)
+{
+    gr_error err;
+    gr_fail(&err, GR_E_USAGE, "%s %s: %s%s: %s", flag, path, what, where, strerror(e));
+    return gr_cli_report(a->cmd, &err);
+}
+
+/* The folder part of path ("." for a bare name, "/" for a name at the root). */
+static void parent_of(const char *path, char *buf, size_t n)
+{
+    snprintf(buf, n, "%s", path);
+    char *slash = strrchr(buf, '/');
+    if (!slash) snprintf(buf, n, ".");
+    else if (slash == buf) buf[1] = '\0';
+    else *slash = '\0';
+}
+
+/* 0 if dir is a folder this process may create files in, else errno's reason. */
+static int writable_dir(const char *dir)
+{
+    struct stat sb;
+    if (stat(dir, &sb) != 0) return errno;
+    if (!S_ISDIR(sb.st_mode)) return ENOTDIR;
+    if (access(dir, W_OK | X_OK) != 0) return errno;
+    return 0;
+}
+
+int gr_args_check_output_file(const gr_args *a, const char *flag, const char *path)
+{
+    char dir[4096];
+    struct stat sb;
+    if (!path[0]) return output_error(a, flag, "''", "cannot write", "", ENOENT);
+    if (strlen(path) >= sizeof dir) return output_error(a, flag, path, "cannot write", "", ENAMETOOLONG);
+    if (path[strlen(path) - 1] == '/' || (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)))
+        return output_error(a, flag, path, "cannot write", "", EISDIR);
+    parent_of(path, dir, sizeof dir);
+    const int e = writable_dir(dir);
+    return e ? output_error(a, flag, path, "cannot write into ", dir, e) : 0;
+}
+
+int gr_args_check_output_dir(const gr_args *a, const char *flag, const char *path)
+{
+    char buf[4096], self[4096];
+    if (!path[0]) return output_error(a, flag, "''", "cannot create", "", ENOENT);
+    if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf)
+        return output_error(a, flag, path, "cannot create", "", ENAMETOOLONG);
+    /* Walk up to the nearest part that exists: the folder itself, or the ancestor in which
+     * the missing folders would be created. */
+    self[0] = '\0';
+    for (;;) {
+        size_t len = strlen(buf);
+        while (len > 1 && buf[len - 1] == '/') buf[--len] = '\0';
+        if (!self[0]) memcpy(self, buf, len + 1);
+        struct stat sb;
+        if (stat(buf, &sb) == 0) break;
+        if (errno != ENOENT && errno != ENOTDIR) return output_error(a, flag, path, "cannot use ", buf, errno);
+        char up[4096];
+        parent_of(buf, up, sizeof up);
+        if (!strcmp(up, buf)) break;
+        snprintf(buf, sizeof buf, "%s", up);
+    }
+    const int e = writable_dir(buf);
+    if (!e) return 0;
+    return output_error(a, flag, path, strcmp(buf, self) ? "cannot create a folder in " : "cannot write into ", buf, e);
+}
+
+int gr_args_output_dir(const gr_args *a, const gr_scene *scene, const char *given, const char *sub, char *buf,
+                       size_t n, const char **dir)
+{
+    if (given) {
+        *dir = given;
+        return gr_args_check_output_dir(a, "-o", given);
+    }
+    gr_scene *loaded = NULL;
+    int rc = scene ? 0 : gr_args_load_scene(a, &loaded);
+    if (rc) return rc;
+    gr_tune_default_dir(scene ? scene->name : loaded->name, sub, buf, n);
+    free(loaded);
+    *dir = buf;
+    return gr_args_check_output_dir(a, "default output folder", buf);
+}
