@@ -1023,6 +1023,8 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         out->shadow_rays_per_s = march_s > 0.0 ? (double)shadows / march_s : 0.0;
         out->beam_build_s = r->beam_build_s;
         out->bias_surface_rel = r->bias_rel;
+        out->rounds = P > 0 ? (out->passes + P - 1) / P : 0;
+        out->max_rounds = rounds;
         /* preview: the 99th percentile of the brightest channel maps to 0.8 */
         size_t n = np;
         double *v = malloc(n * sizeof *v);

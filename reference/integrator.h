@@ -58,6 +58,7 @@ typedef struct gr_ref_result {
     double queries_per_s;   /* beam lookups (or closed-form evaluations) per second, all threads */
     double shadow_rays_per_s;
     double beam_build_s;    /* total time spent building beam sets */
+    int rounds, max_rounds; /* rounds of passes done; the cap that --target-error refines up to */
     double bias_surface_rel;/* surface-tessellation bias: mean |pixel bias| / image mean,
                                measured by the probe (0 on flat water, -1 if not estimated) */
 } gr_ref_result;

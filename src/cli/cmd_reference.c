@@ -56,14 +56,13 @@ static void preview_path(const char *out, char *buf, size_t n)
     snprintf(buf + l, n - l, ".png");
 }
 
-/* --target-error stops refining at the round cap (gr_ref_options.max_rounds) whether or not the
+/* --target-error stops refining at the round cap (gr_ref_result.max_rounds) whether or not the
  * target was met: say so, even with --quiet, since the image is less accurate than asked. */
-static void warn_target(const gr_scene *scene, const gr_ref_options *opt, int passes_per_round,
-                        const gr_ref_result *res)
+static void warn_target(const gr_scene *scene, int passes_per_round, const gr_ref_result *res)
 {
     const double target = scene->reference.target_error;
     if (!(target > 0.0) || (res->rel_se_mean < target && res->rel_se_p95 < target)) return;
-    const int rounds = opt->max_rounds > 0 ? opt->max_rounds : 64; /* 0: the integrator's default */
+    const int rounds = res->max_rounds;
     fprintf(stderr,
             "godrays reference: warning: target error %g not reached after %d passes (the cap: %d rounds of %d): "
             "relative standard error of the image mean %.3g, of the 95th-percentile pixel %.3g; raise "
@@ -144,17 +143,22 @@ static int reference_with(gr_args *args)
         gr_ref_result_free(&res);
         goto done;
     }
+    char bias[64];
+    if (res.bias_surface_rel >= 0.0)
+        snprintf(bias, sizeof bias, "~%.2g%% of the mean (godrays:bias_surface_rel_est)", 100.0 * res.bias_surface_rel);
+    else
+        snprintf(bias, sizeof bias, "not estimated");
     if (!quiet)
         fprintf(stderr,
                 "godrays reference: wrote %s (%dx%d, %d spp, %.1f s%s): rel. std. error of the mean %.3g%%, "
-                "of the p95 pixel %.3g%%, %.1f%% of pixels within 1%%\n",
+                "of the p95 pixel %.3g%%, %.1f%% of pixels within 1%%; surface bias %s\n",
                 out_path, res.image->width, res.image->height, res.spp, res.wall_s, res.partial ? ", PARTIAL" : "",
-                100.0 * res.rel_se_mean, 100.0 * res.rel_se_p95, 100.0 * res.frac_se_1pct);
+                100.0 * res.rel_se_mean, 100.0 * res.rel_se_p95, 100.0 * res.frac_se_1pct, bias);
     if (res.partial) {
         fprintf(stderr, "godrays reference: interrupted; %s holds the partial result (godrays:partial = 1)\n", out_path);
         rc = 1;
     } else {
-        warn_target(scene, &opt, per_round, &res);
+        warn_target(scene, per_round, &res);
         rc = 0;
     }
     gr_ref_result_free(&res);
