@@ -1,6 +1,6 @@
 /* Headless OpenGL context through EGL: no window, no X, no surface.
- * Order in AUTO mode: the EGL device platform (EGL_EXT_device_enumeration +
- * EGL_EXT_platform_device) on a hardware device, else Mesa's surfaceless platform
+ * Order in AUTO mode: the EGL device platform (EGL_EXT_device_enumeration, or EGL_EXT_device_base
+ * which includes it, + EGL_EXT_platform_device) on a hardware device, else Mesa's surfaceless platform
  * (EGL_MESA_platform_surfaceless, llvmpipe on machines without a GPU). The context is made
  * current with EGL_NO_SURFACE (EGL_KHR_surfaceless_context); rendering goes into FBOs.
  * EGL binds a context to one thread: a gr_gl is created, used and destroyed on one thread. */
@@ -171,9 +171,13 @@ static gr_status try_surfaceless(gr_gl *gl, int debug, gr_error *err)
 static gr_status try_device(gr_gl *gl, int debug, int allow_software, gr_error *err)
 {
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-    if (!has_ext(client, "EGL_EXT_device_enumeration") || !has_ext(client, "EGL_EXT_platform_device"))
+    /* EGL_EXT_device_base is EGL_EXT_device_enumeration + EGL_EXT_device_query under one name:
+     * glvnd's libEGL with only NVIDIA's driver (580) lists device_base, not enumeration. */
+    int enumeration = has_ext(client, "EGL_EXT_device_enumeration") ||
+                      has_ext(client, "EGL_EXT_device_base");
+    if (!enumeration || !has_ext(client, "EGL_EXT_platform_device"))
         return gr_fail(err, GR_E_GL, "EGL device platform: libEGL lacks EGL_EXT_device_enumeration "
-                       "or EGL_EXT_platform_device; %s", GR_GL_INSTALL_HINT);
+                       "(or EGL_EXT_device_base) or EGL_EXT_platform_device; %s", GR_GL_INSTALL_HINT);
     PFNEGLQUERYDEVICESEXTPROC query_devices =
         (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
     PFNEGLQUERYDEVICESTRINGEXTPROC device_string =
