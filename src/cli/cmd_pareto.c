@@ -26,11 +26,12 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: godrays pareto SCENE [-o DIR] [options]\n"
             "\n"
-            "Speed against error. Renders a high-quality ground truth (2x the default passes\n"
-            "(sun_samples), 2x the march steps, 1.5x the surface resolution, another seed; cached),\n"
+            "Speed against error. Renders a high-quality ground truth (2x the scene's passes\n"
+            "(sun_samples), 2x its march steps, 1.5x its surface resolution, another seed; cached),\n"
             "then\n"
-            "  - the ground truth at increasing quality (q0..q3 = default: passes, batches, steps,\n"
-            "    surface resolution; each timed, never cached), error against the high-quality one;\n"
+            "  - the ground truth at increasing quality (q0..q3, q3 = the scene's reference settings,\n"
+            "    the others fractions of its passes, steps and surface resolution; each timed,\n"
+            "    never cached), error against the high-quality one;\n"
             "  - the real-time shafts for N in {6, 11, 21}, target scale in {0.25, 0.5, 1} and\n"
             "    rgba8/rgba16f targets (median time of --repeat renders in one context), error after\n"
             "    the best scale fit.\n"
@@ -67,16 +68,39 @@ static double rel_rmse(const gr_metrics_set *set)
     return y->ref_mean > 0 ? y->rmse / y->ref_mean : y->rmse;
 }
 
-/* Reference quality ladder (docs/tuning.md): each level about twice the work of the one before. */
+/* Reference quality ladder (docs/tuning.md), relative to the scene's own reference settings
+ * (q3): each level about twice the work of the one before; hq = 2x the passes, 2x the march
+ * steps and 1.5x the surface resolution of q3. */
 typedef struct ref_level {
-    const char *name;
+    char name[32];
     int sun_samples, batches, steps, surface_res, spp;
 } ref_level;
-static const ref_level levels[] = {
-    {"q0", 2, 2, 16, 64, 1},  {"q1", 2, 2, 32, 128, 1},  {"q2", 4, 4, 48, 192, 1},
-    {"q3 (default)", 8, 8, 64, 256, 1},
-};
-static const ref_level hq = {"hq", 16, 8, 128, 384, 1};
+enum { N_LEVELS = 4 };
+
+static int at_least(int v, int lo) { return v > lo ? v : lo; }
+
+/* Level k in 0..N_LEVELS-1 from the scene's settings; k = N_LEVELS gives hq. */
+static ref_level make_level(const gr_reference_settings *b, int k)
+{
+    /* fractions of q3's passes, steps and surface resolution for q0, q1, q2, q3 */
+    static const double pass_f[] = {0.25, 0.25, 0.5, 1.0}, step_f[] = {0.25, 0.5, 0.75, 1.0}, res_f[] = {0.25, 0.5, 0.75, 1.0};
+    ref_level l;
+    l.spp = b->spp;
+    if (k >= N_LEVELS) {
+        snprintf(l.name, sizeof l.name, "hq");
+        l.sun_samples = 2 * b->sun_samples;
+        l.batches = b->batches;
+        l.steps = 2 * b->steps;
+        l.surface_res = b->surface_res + b->surface_res / 2;
+        return l;
+    }
+    snprintf(l.name, sizeof l.name, k == N_LEVELS - 1 ? "q%d (scene's settings)" : "q%d", k);
+    l.sun_samples = at_least((int)(pass_f[k] * b->sun_samples + 0.5), 2);
+    l.batches = at_least(b->batches < l.sun_samples ? b->batches : l.sun_samples, 2);
+    l.steps = at_least((int)(step_f[k] * b->steps + 0.5), 1);
+    l.surface_res = at_least((int)(res_f[k] * b->surface_res + 0.5), 2);
+    return l;
+}
 
 static void set_level(gr_scene *s, const ref_level *l)
 {
@@ -149,6 +173,7 @@ static int pareto_with(gr_args *args)
     /* the high-quality ground truth, with its own seed so that no ladder level shares its
      * random numbers (a shared seed would make the lower levels look better than they are) */
     memcpy(work, scene, sizeof *work);
+    const ref_level hq = make_level(&scene->reference, N_LEVELS);
     set_level(work, &hq);
     work->reference.seed = scene->reference.seed + 7919;
     if (gr_scene_refresh(work, &err) != GR_OK) goto fail;
@@ -163,12 +188,13 @@ static int pareto_with(gr_args *args)
     mo.skip_blur = 1;
     gr_metrics m;
     /* ground truth ladder */
-    int n_levels = quick ? 2 : (int)(sizeof levels / sizeof levels[0]);
+    int n_levels = quick ? 2 : N_LEVELS;
     for (int l = 0; l < n_levels; l++) {
         memcpy(work, scene, sizeof *work);
-        set_level(work, &levels[l]);
+        const ref_level lv = make_level(&scene->reference, l);
+        set_level(work, &lv);
         if (gr_scene_refresh(work, &err) != GR_OK) goto fail;
-        if (!quiet) fprintf(stderr, "godrays pareto: ground truth %s...\n", levels[l].name);
+        if (!quiet) fprintf(stderr, "godrays pareto: ground truth %s...\n", lv.name);
         gr_image *ri = NULL;
         double secs = 0;
         if (gr_truth_render(work, !quiet, &ri, &secs, &err) != GR_OK) goto fail;
@@ -180,9 +206,9 @@ static int pareto_with(gr_args *args)
         if (st != GR_OK) goto fail;
         gr_pareto_point *p = &pts[n++];
         p->family = GR_PARETO_REFERENCE;
-        snprintf(p->label, sizeof p->label, "%s", levels[l].name);
+        snprintf(p->label, sizeof p->label, "%s", lv.name);
         snprintf(p->settings, sizeof p->settings, "sun_samples=%d;batches=%d;steps=%d;surface_res=%d;spp=%d",
-                 levels[l].sun_samples, levels[l].batches, levels[l].steps, levels[l].surface_res, levels[l].spp);
+                 lv.sun_samples, lv.batches, lv.steps, lv.surface_res, lv.spp);
         p->time_s = secs;
         p->gpu_s = -1;
         p->error = rel_rmse(&m.raw);
