@@ -77,6 +77,11 @@ int main(void)
             CHECK(meta_num(&m, "godrays:wall_s") > 0);
             CHECK(meta_num(&m, "godrays:rel_stderr_mean") > 0);
             CHECK(meta_num(&m, "godrays:spp") >= 8);
+            /* the wavy scene's surface bias is measured (probe on by default), the bound twice it */
+            double be = meta_num(&m, "godrays:bias_surface_rel_est"), bb = meta_num(&m, "godrays:bias_surface_rel_bound");
+            CHECK_MSG(be > 0.0 && be < 1.0, "bias estimate %g", be);
+            CHECK_NEAR(bb, 2.0 * be, 1e-12 * bb);
+            CHECK(gr_meta_get(&m, "godrays:bias_surface_probe") != NULL);
         }
         gr_image_destroy(img);
         gr_meta_free(&m);
