@@ -35,10 +35,10 @@ static void usage(FILE *f)
             "  - the real-time shafts for N in {6, 11, 21}, target scale in {0.25, 0.5, 1} and\n"
             "    rgba8/rgba16f targets (median time of --repeat renders in one context), error after\n"
             "    the best scale fit.\n"
-            "Error = RMSE of luminance Y / mean Y of the high-quality ground truth. Shafts time is\n"
-            "the wall time of a render with readback (llvmpipe without a GPU); GL pass timers are\n"
-            "listed too. Writes DIR/pareto.csv and DIR/pareto.png (both families and their Pareto\n"
-            "fronts). docs/tuning.md.\n"
+            "Error = RMSE of luminance Y / mean Y of the high-quality ground truth. The shafts are\n"
+            "ranked by the wall time of a render with readback on llvmpipe, by the GPU time of\n"
+            "their GL passes on a hardware GPU (both are listed). Writes DIR/pareto.csv and\n"
+            "DIR/pareto.png (both families and their Pareto fronts). docs/tuning.md.\n"
             "\n"
             "options:\n"
             "  -o, --output DIR   folder (default: out/SCENE_NAME/pareto)\n"
@@ -211,6 +211,7 @@ static int pareto_with(gr_args *args)
                  lv.sun_samples, lv.batches, lv.steps, lv.surface_res, lv.spp);
         p->time_s = secs;
         p->gpu_s = -1;
+        p->cost_s = secs;
         p->error = rel_rmse(&m.raw);
     }
 
@@ -275,12 +276,18 @@ static int pareto_with(gr_args *args)
             }
     free(times);
     free(gpus);
-    gr_pareto_mark_fronts(pts, n);
-
     const char *glr = gr_gl_renderer(gr_shafts_gl(r));
     int is_llvmpipe = glr && strstr(glr, "llvmpipe") != NULL;
+    /* What the shafts cost: on a hardware GPU the GL pass timers (a render's wall time there
+     * is mostly this harness's synchronous float readback: docs/benchmarks.md); on llvmpipe
+     * the wall time (its timers see a deferred rasterizer). */
+    int by_gpu = !is_llvmpipe && gpu_any;
+    for (int i = 0; i < n; i++)
+        if (pts[i].family == GR_PARETO_SHAFTS) pts[i].cost_s = by_gpu && pts[i].gpu_s >= 0 ? pts[i].gpu_s : pts[i].time_s;
+    gr_pareto_mark_fronts(pts, n);
+
     char tlabel[128], title[256];
-    snprintf(tlabel, sizeof tlabel, "%s wall time", is_llvmpipe ? "llvmpipe" : "GPU frame");
+    snprintf(tlabel, sizeof tlabel, "%s", is_llvmpipe ? "llvmpipe wall time" : by_gpu ? "GPU time of the GL passes" : "GPU frame wall time");
     snprintf(title, sizeof title, "speed vs error, scene '%s' %dx%d (shafts on %s)", scene->name, scene->camera.width,
              scene->camera.height, is_llvmpipe ? "llvmpipe, no GPU" : glr);
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
@@ -302,8 +309,8 @@ static int pareto_with(gr_args *args)
         gr_sb_printf(&sum, "%-10s %-34s %12.2f %12s %12.4g %6s\n", pts[i].family ? "shafts" : "reference", pts[i].label,
                1e3 * pts[i].time_s, g, pts[i].error, pts[i].on_front ? "*" : "");
     }
-    gr_sb_printf(&sum, "GL pass timers %s; shaft times are %s\n", gpu_any ? "available" : "unavailable",
-           is_llvmpipe ? "llvmpipe (CPU) wall times" : "wall times on the GPU");
+    gr_sb_printf(&sum, "GL pass timers %s; the shafts are ranked by %s\n", gpu_any ? "available" : "unavailable",
+           is_llvmpipe ? "llvmpipe (CPU) wall times" : by_gpu ? "the GPU time of their GL passes" : "wall times on the GPU");
     gr_sb_printf(&sum, "written: %s/pareto.csv%s\n", outdir, drawn ? ", pareto.png" : " (no plot: charts need PLplot)");
     fputs(gr_sb_str(&sum), stdout);
     {

@@ -31,7 +31,7 @@ void gr_pareto_mark_fronts(gr_pareto_point *pts, int n)
             int m = 0;
             for (int i = 0; i < n; i++)
                 if (pts[i].family == fam) {
-                    c[m] = pts[i].time_s;
+                    c[m] = pts[i].cost_s;
                     e[m] = pts[i].error;
                     idx[m++] = i;
                 }
@@ -52,10 +52,11 @@ gr_status gr_pareto_write_csv(const char *path, const gr_pareto_point *pts, int 
         return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
     FILE *f = fopen(tmp, "w");
     if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
-    fprintf(f, "family,label,settings,time_s,gpu_s,error,on_front\n");
+    fprintf(f, "family,label,settings,time_s,gpu_s,cost_s,error,on_front\n");
     for (int i = 0; i < n; i++)
-        fprintf(f, "%s,%s,%s,%.6g,%.6g,%.6g,%d\n", pts[i].family == GR_PARETO_REFERENCE ? "reference" : "shafts",
-                pts[i].label, pts[i].settings, pts[i].time_s, pts[i].gpu_s, pts[i].error, pts[i].on_front);
+        fprintf(f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g,%d\n", pts[i].family == GR_PARETO_REFERENCE ? "reference" : "shafts",
+                pts[i].label, pts[i].settings, pts[i].time_s, pts[i].gpu_s, pts[i].cost_s, pts[i].error,
+                pts[i].on_front);
     int bad = ferror(f);
     bad |= fclose(f) != 0;
     if (bad || rename(tmp, path) != 0) {
@@ -74,18 +75,18 @@ static int family_series(const gr_pareto_point *pts, int n, int fam, double *px,
     *nf = 0;
     for (int i = 0; i < n; i++) {
         if (pts[i].family != fam) continue;
-        px[m] = pts[i].time_s;
+        px[m] = pts[i].cost_s;
         py[m++] = pts[i].error;
         px[m] = NAN;
         py[m++] = NAN;
         if (pts[i].on_front) {
             int k = (*nf)++;
-            while (k > 0 && fx[k - 1] > pts[i].time_s) {
+            while (k > 0 && fx[k - 1] > pts[i].cost_s) {
                 fx[k] = fx[k - 1];
                 fy[k] = fy[k - 1];
                 k--;
             }
-            fx[k] = pts[i].time_s;
+            fx[k] = pts[i].cost_s;
             fy[k] = pts[i].error;
         }
     }

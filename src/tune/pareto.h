@@ -14,6 +14,9 @@ typedef struct gr_pareto_point {
     char settings[256];      /* the settings as KEY=VALUE;... for the CSV */
     double time_s;           /* wall time per frame (reference: whole render) */
     double gpu_s;            /* shafts: summed GL pass timers per frame; -1 unknown */
+    double cost_s;           /* what the fronts and the plot rank by: time_s, except for the
+                                shafts on a hardware GPU, where it is gpu_s (their wall time
+                                there is mostly the harness's synchronous float readback) */
     double error;            /* relative RMSE of Y against the high-quality reference */
     int on_front;            /* set by gr_pareto_mark_fronts */
 } gr_pareto_point;
@@ -22,10 +25,10 @@ typedef struct gr_pareto_point {
  * (non-finite points are never on the front and never dominate). O(n^2). */
 void gr_pareto_front(int n, const double *cost, const double *err, int *on_front);
 
-/* Marks each point's on_front within its own family. */
+/* Marks each point's on_front within its own family, by (cost_s, error). */
 void gr_pareto_mark_fronts(gr_pareto_point *pts, int n);
 
-/* pareto.csv: family,label,settings,time_s,gpu_s,error,on_front. */
+/* pareto.csv: family,label,settings,time_s,gpu_s,cost_s,error,on_front. */
 gr_status gr_pareto_write_csv(const char *path, const gr_pareto_point *pts, int n, gr_error *err);
 
 /* The plot (PLplot, log-log): both families as markers, their fronts as lines. time_label

@@ -27,7 +27,7 @@ grep -qF '<a href="../index.html">' "$dir/p/index.html" || { echo "FAIL: pareto 
 python3 - "$dir/p/pareto.csv" <<'PY'
 import csv, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
-assert list(rows[0].keys()) == ["family", "label", "settings", "time_s", "gpu_s", "error", "on_front"], rows[0].keys()
+assert list(rows[0].keys()) == ["family", "label", "settings", "time_s", "gpu_s", "cost_s", "error", "on_front"], rows[0].keys()
 assert len(rows) == 10, len(rows)
 for fam, n in (("reference", 2), ("shafts", 8)):
     pts = [r for r in rows if r["family"] == fam]
