@@ -968,8 +968,6 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     }
     int P = r->passes_per_round;
     int rounds = r->set.target_error > 0.0 ? r->opt.max_rounds : 1;
-    long long queries, shadows, overflows;
-    double march_s;
     gr_status st = GR_OK;
     ref_errors e;
     memset(&e, 0, sizeof e);
@@ -998,10 +996,6 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             if (e.rel_mean < r->set.target_error && e.rel_p95 < r->set.target_error) break;
         }
     }
-    march_s = tot.march_s;
-    queries = tot.queries;
-    shadows = tot.shadows;
-    overflows = tot.overflows;
     /* the tessellation's bias, measured on this scene (flat water has none: closed form) */
     r->bias_rel = r->flat ? 0.0 : -1.0;
     r->have_main_beams = r->beams != NULL;
@@ -1023,8 +1017,8 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         out->rel_se_mean = e.rel_mean;
         out->rel_se_p95 = e.rel_p95;
         out->frac_se_1pct = e.frac_1pct;
-        out->queries_per_s = march_s > 0.0 ? (double)queries / march_s : 0.0;
-        out->shadow_rays_per_s = march_s > 0.0 ? (double)shadows / march_s : 0.0;
+        out->queries_per_s = tot.march_s > 0.0 ? (double)tot.queries / tot.march_s : 0.0;
+        out->shadow_rays_per_s = tot.march_s > 0.0 ? (double)tot.shadows / tot.march_s : 0.0;
         out->beam_build_s = r->beam_build_s;
         out->bias_surface_rel = r->bias_rel;
         out->rounds = P > 0 ? (out->passes + P - 1) / P : 0;
@@ -1046,7 +1040,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for metadata");
         else {
             gr_meta_set_double(&out->meta, "godrays:shadow_rays_per_s", out->shadow_rays_per_s);
-            gr_meta_set_int(&out->meta, "godrays:beam_overflows", overflows);
+            gr_meta_set_int(&out->meta, "godrays:beam_overflows", tot.overflows);
         }
     }
     free(acc.sum);

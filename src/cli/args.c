@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -279,4 +280,13 @@ int gr_args_output_dir(const gr_args *a, const gr_scene *scene, const char *give
     free(loaded);
     *dir = buf;
     return gr_args_check_output_dir(a, "default output folder", buf);
+}
+
+void gr_args_preview_path(const char *exr, char *buf, size_t n)
+{
+    size_t len = strlen(exr);
+    if (len > 4 && !strcasecmp(exr + len - 4, ".exr"))
+        snprintf(buf, n, "%.*s.png", (int)(len - 4), exr);
+    else
+        snprintf(buf, n, "%s.png", exr);
 }

@@ -68,6 +68,10 @@ int gr_args_load_scene(const gr_args *a, gr_scene **scene);
  * and separated by spaces: the scene words of commands that an output suggests running next. */
 void gr_args_scene_words(const gr_args *a, gr_strbuf *b);
 
+/* The PNG preview beside an EXR: a trailing ".exr" (any case) becomes ".png", any other
+ * name gets ".png" appended (so frame files OUT.0007 keep distinct previews). */
+void gr_args_preview_path(const char *exr, char *buf, size_t n);
+
 /* Fails early (exit 2, nothing created) unless a file can be written at path: its folder
  * exists, is a folder and is writable, and path is not a folder. The message names flag
  * (e.g. "-o", or "default output" when the path was not given), the path and the reason. */

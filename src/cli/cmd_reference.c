@@ -24,7 +24,7 @@ static void usage(FILE *f)
             "once toward the camera) with per-pixel standard errors, and a PNG preview beside it.\n"
             "\n"
             "options (defaults: the scene's \"reference\" section):\n"
-            "  -o, --output FILE      EXR to write (required); the preview is FILE with .png\n"
+            "  -o, --output FILE      EXR to write (required); the PNG preview beside it\n"
             "  --spp N                camera samples per pixel in each batch\n"
             "  --steps N              stratified march steps per camera ray\n"
             "  --surface-res N        surface tessellation (N x N cells over the lit patch)\n"
@@ -45,15 +45,6 @@ static void usage(FILE *f)
             "                         with 1 and 2 threads, Embree's raw occlusion-ray throughput\n"
             "\n"
             "Ctrl-C stops the render and writes what is done, marked godrays:partial = 1 (exit 1).\n");
-}
-
-static void preview_path(const char *out, char *buf, size_t n)
-{
-    snprintf(buf, n, "%s", out);
-    char *dot = strrchr(buf, '.'), *slash = strrchr(buf, '/');
-    if (dot && (!slash || dot > slash)) *dot = '\0';
-    size_t l = strlen(buf);
-    snprintf(buf + l, n - l, ".png");
 }
 
 /* --target-error stops refining at the round cap (gr_ref_result.max_rounds) whether or not the
@@ -134,7 +125,7 @@ static int reference_with(gr_args *args)
     st = gr_exr_write(out_path, res.image, &res.meta, &err);
     if (st == GR_OK && preview) {
         char pp[4096];
-        preview_path(out_path, pp, sizeof pp);
+        gr_args_preview_path(out_path, pp, sizeof pp);
         const int rgb[3] = {0, 1, 2};
         st = gr_oiio_write_preview(pp, res.image, rgb, res.preview_exposure, &err);
     }

@@ -77,15 +77,6 @@ static void frame_path(const char *base, long frame, char *buf, size_t n)
         snprintf(buf, n, "%s.%04ld", base, frame);
 }
 
-static void preview_path(const char *exr, char *buf, size_t n)
-{
-    size_t len = strlen(exr);
-    if (len > 4 && !strcmp(exr + len - 4, ".exr"))
-        snprintf(buf, n, "%.*s.png", (int)(len - 4), exr);
-    else
-        snprintf(buf, n, "%s.png", exr);
-}
-
 static int cmp_float(const void *a, const void *b)
 {
     float x = *(const float *)a, y = *(const float *)b;
@@ -258,7 +249,7 @@ static int shafts_with(gr_args *args)
         if (gr_exr_write(path, img, &meta, &err) != GR_OK) goto fail;
         if (preview) {
             static const int rgb[3] = {0, 1, 2};
-            preview_path(path, png, sizeof png);
+            gr_args_preview_path(path, png, sizeof png);
             double e = exposure > 0 ? exposure : auto_exposure(img);
             if (gr_oiio_write_preview(png, img, rgb, e, &err) != GR_OK) goto fail;
         }
