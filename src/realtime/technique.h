@@ -1,0 +1,125 @@
+/* The real-time technique interface: every god-ray technique the harness measures (seed 000's
+ * shafts, the radial blurs of seeds 003/004, the volume techniques, a user's own shader from a
+ * manifest) is one gr_technique_class. Commands, tuning and the report only ever go through
+ * this header and the registry below: they never name a technique (docs/architecture.md).
+ *
+ * A class describes a technique: its name (= its scene section), a one-line description, its
+ * settings as a descriptor table (src/scene/params.h: key, type, range, default, unit, doc)
+ * and the callbacks. An instance (gr_technique) is created once per GL context and renders
+ * many (scene, settings) pairs: sweeps and tuning reuse it. A technique never prints.
+ *
+ * Settings: an opaque struct of cls->settings_size bytes laid out as cls->params describes
+ * (offsets into it). The scene loader parses the section named cls->name with that table
+ * (defaults, range checks, --set NAME.KEY=V), so a technique receives checked values. */
+#ifndef GR_TECHNIQUE_H
+#define GR_TECHNIQUE_H
+
+#include <stddef.h>
+
+#include "common/status.h"
+#include "gl/glctx.h"
+#include "image/image.h"
+#include "scene/params.h"
+#include "scene/scene.h"
+
+#define GR_TECH_NAME_MAX 32        /* names: [a-z][a-z0-9_]*, at most 31 characters */
+#define GR_TECH_MAX_PASSES 8       /* GL passes reported per render */
+#define GR_TECH_SETTINGS_MAX 1024  /* bytes of one technique's settings struct, at most */
+#define GR_TECH_MAX 32             /* techniques in one registry (built-in + user) */
+
+/* What one render cost. Filled by the technique; -1 where a figure is unavailable. */
+typedef struct gr_technique_stats {
+    int n_passes;
+    char pass_names[GR_TECH_MAX_PASSES][24]; /* "shadow", "shafts", "final", ... */
+    long long gpu_ns[GR_TECH_MAX_PASSES];    /* GL_TIME_ELAPSED of each pass; -1 if no timer */
+    double wall_ms;                          /* wall time of the render call, readback included */
+    long long fragments;                     /* fragments shaded in the main pass(es); -1 unknown */
+} gr_technique_stats;
+
+/* Options of an instance; zero = defaults. */
+typedef struct gr_technique_options {
+    const char *shader_dir; /* NULL: the technique's embedded shaders; else files there override */
+} gr_technique_options;
+
+typedef struct gr_technique_class gr_technique_class;
+
+struct gr_technique_class {
+    const char *name;          /* "shafts", "radial_blur", ...: CLI name and scene section */
+    const char *description;   /* one line for `godrays techniques` */
+    const gr_param_table *params; /* params->section == name */
+    size_t settings_size;      /* <= GR_TECH_SETTINGS_MAX */
+    const char *origin;        /* "built-in" or the manifest's path (user techniques) */
+    void *class_data;          /* the class's own data (a user technique's parsed manifest) */
+
+    /* Checks across settings beyond each one's range (e.g. N >= 2 and a target that fits).
+     * May be NULL. Errors name "NAME.KEY" and the reason (GR_E_INPUT). */
+    gr_status (*check)(const gr_technique_class *cls, const void *settings, gr_error *err);
+    /* Copies in to out with scene-derived defaults (GR_PF_FROM_SCENE, NaN) resolved from the
+     * scene (e.g. extinction from the medium). May be NULL: the generic resolution by each
+     * descriptor's scene_source is applied. */
+    void (*resolve)(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out);
+    /* Creates the technique's GL state (programs, buffers) in the CURRENT context gl, which
+     * outlives the instance. A shader compile/link failure is GR_E_GL with the GLSL log; a bad
+     * shader_dir GR_E_INPUT. */
+    gr_status (*create)(const gr_technique_class *cls, gr_gl *gl, const gr_technique_options *opts,
+                        void **state, gr_error *err);
+    void (*destroy)(void *state); /* accepts NULL */
+    /* Renders the god-ray layer of scene at scene->water.time_s with RESOLVED settings into
+     * out: camera.width x camera.height, channels "R", "G", "B" (linear radiance, the same
+     * units as the ground truth; others left alone). Never writes NaN or Inf. stats may be
+     * NULL. */
+    gr_status (*render)(void *state, const gr_scene *scene, const void *settings, gr_image *out,
+                        gr_technique_stats *stats, gr_error *err);
+    /* Adds technique-specific "godrays:*" metadata of a render (placement, counts, ...).
+     * May be NULL; the generic keys (technique, settings, pass times) are written by
+     * gr_technique_metadata. */
+    gr_status (*metadata)(void *state, const gr_scene *scene, const void *settings,
+                          const gr_technique_stats *stats, gr_metadata *meta, gr_error *err);
+};
+
+/* ---- registry --------------------------------------------------------------------------- */
+
+/* The techniques known to this process: the built-in ones (registered on first use) and the
+ * user techniques added with gr_technique_add_dir. Also makes their sections known to the
+ * scene loader, so load scenes AFTER adding user techniques. */
+int gr_technique_count(void);
+const gr_technique_class *gr_technique_at(int i);
+const gr_technique_class *gr_technique_find(const char *name); /* NULL if unknown */
+/* Index of a class in the registry (= index of its settings in a scene); -1 if absent. */
+int gr_technique_index(const gr_technique_class *cls);
+/* Registers a class (built-in or user). GR_E_INPUT for a bad or duplicate name, a table whose
+ * section differs from the name, or settings over GR_TECH_SETTINGS_MAX. */
+gr_status gr_technique_register(const gr_technique_class *cls, gr_error *err);
+/* Loads the user technique in dir (its manifest.json, docs/techniques.md) and registers it
+ * under the manifest's name. A bad manifest is GR_E_INPUT naming the file and JSON path. */
+gr_status gr_technique_add_dir(const char *dir, gr_error *err);
+/* "shafts,radial_blur,..." -> classes; GR_E_USAGE naming flag and the unknown name.
+ * NULL or "" -> every registered technique. Returns the count in *n. */
+gr_status gr_technique_parse_list(const char *flag, const char *list, const gr_technique_class **out,
+                                  int max, int *n, gr_error *err);
+
+/* The scene's settings of a technique (as loaded and overridden; scene-derived values
+ * unresolved), and the same resolved into out (settings_size bytes). */
+const void *gr_technique_scene_settings(const gr_technique_class *cls, const gr_scene *scene);
+void gr_technique_resolve(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out);
+gr_status gr_technique_check(const gr_technique_class *cls, const void *settings, gr_error *err);
+
+/* ---- instances -------------------------------------------------------------------------- */
+
+typedef struct gr_technique gr_technique; /* a class + its GL state; one thread */
+
+gr_status gr_technique_create(const gr_technique_class *cls, gr_gl *gl, const gr_technique_options *opts,
+                              gr_technique **out, gr_error *err);
+void gr_technique_destroy(gr_technique *t); /* accepts NULL */
+const gr_technique_class *gr_technique_class_of(const gr_technique *t);
+/* settings NULL: the scene's own, resolved. Checks the settings first (GR_E_INPUT). */
+gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out,
+                              gr_technique_stats *stats, gr_error *err);
+/* "godrays:technique", every setting (resolved, by name), GL strings, per-pass GPU ns, wall ms,
+ * fragments, then the class's own keys. */
+gr_status gr_technique_metadata(const gr_technique *t, const gr_scene *scene, const void *settings,
+                                const gr_technique_stats *stats, gr_metadata *meta, gr_error *err);
+/* Sum of the passes' GPU times in ms; -1 if none was timed. */
+double gr_technique_stats_gpu_ms(const gr_technique_stats *s);
+
+#endif
