@@ -35,7 +35,7 @@
 
 static const char *const format_names[] = {"rgba16f", "rgba8", NULL};
 static const char *const intensity_source =
-    "derived: sigma_s p_HG(0) D Omega_eff / (n^2 0.2 0.4 G_seed), docs/radial-blur.md";
+    "medium, camera and sun (docs/radial-blur.md, Units)";
 
 #define COMMON_PARAMS                                                                                            \
     {.name = "samples", .type = GR_PT_INT, .offset = RB(samples), .min = 1, .max = 1024, .def = SEED_SAMPLES,   \
