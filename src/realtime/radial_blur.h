@@ -37,7 +37,7 @@ typedef struct gr_radial_blur_settings {
     double threshold;        /* subtracted from the normalized light pass (1 = flat-water peak) */
     int occluders;           /* draw the occluders black in the light pass */
     /* output */
-    double intensity[3];     /* scale to the ground truth's units; NaN: derived from the scene */
+    double intensity[3];     /* factor on the derived scale to the ground truth's units (1) */
     int dither;              /* per-pixel jitter of the march (and of 8-bit storage) vs banding */
     double fade_margin;      /* NDC beyond the screen edge over which the rays fade out */
     /* radial_blur_local */
