@@ -79,8 +79,9 @@ static const gr_param local_params[] = {
      .def = 0.3, .unit = "", .doc = "quad half-size as a fraction of the frame height", .tune_lo = 0.05, .tune_hi = 1.0},
     {.name = "falloff", .type = GR_PT_DOUBLE, .offset = RB(falloff), .min = 0, .max = 16, .def = 2, .unit = "",
      .doc = "(1 - r)^falloff to the quad's edge: 1 linear, 2 quadratic (seed 003)", .tune_lo = 0.5, .tune_hi = 4.0},
-    {.name = "cell_px", .type = GR_PT_INT, .offset = RB(cell_px), .min = 1, .max = 1024, .def = 8, .unit = "px",
-     .doc = "light-selection cell size, in light-target pixels"},
+    {.name = "cell_size", .type = GR_PT_DOUBLE, .offset = RB(cell_size), .min = 0, .max = 1, .flags = LO_X,
+     .def = 0.05, .unit = "", .doc = "light-selection cell side as a fraction of the frame height",
+     .tune_lo = 0.01, .tune_hi = 0.2},
     {.name = "min_fraction", .type = GR_PT_DOUBLE, .offset = RB(min_fraction), .min = 0, .max = 1, .def = 0.02,
      .unit = "", .doc = "cells dimmer than this fraction of the brightest one are no light"},
     {.name = "normalize_overlap", .type = GR_PT_BOOL, .offset = RB(normalize_overlap), .min = 0, .max = 1,
@@ -449,7 +450,11 @@ static int cell_cmp(const void *a, const void *b)
  * at most s->lights, each placed at its cell's luminance-weighted centroid (docs, "Lights"). */
 static gr_status select_lights(rb_state *r, const gr_radial_blur_settings *s, gr_error *err)
 {
-    int w = r->light_w, h = r->light_h, cp = s->cell_px;
+    int w = r->light_w, h = r->light_h;
+    /* cells relative to the frame, so the lights (and their overlap) do not grow in number
+     * with the resolution */
+    int cp = (int)lround(s->cell_size * h);
+    if (cp < 1) cp = 1;
     int cw = (w + cp - 1) / cp, chh = (h + cp - 1) / cp;
     size_t need = (size_t)w * h * 4;
     if (need > r->readback_cap) {
@@ -761,6 +766,39 @@ int gr_radial_blur_local_lights(void *state, double (*uv)[2], int max)
     return r->n_lights;
 }
 
+/* The light pass of the last render (RGBA float, top row first, as stored: the normalized
+ * light pass s of docs/radial-blur.md). */
+static gr_status rb_read_target(void *state, gr_image **out, gr_error *err)
+{
+    rb_state *r = state;
+    *out = NULL;
+    if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "radial blur: no render yet, no light pass to read");
+    gr_status st = gr_gl_make_current(r->gl, err);
+    if (st != GR_OK) return st;
+    int w = r->light_w, h = r->light_h;
+    gr_image *img = gr_image_create(w, h, 4, NULL);
+    float *tmp = malloc((size_t)w * h * 4 * sizeof *tmp);
+    if (!img || !tmp) {
+        gr_image_destroy(img);
+        free(tmp);
+        return gr_fail(err, GR_E_NOMEM, "radial blur: out of memory for the light pass readback");
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, r->light_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, tmp);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    size_t row = (size_t)w * 4;
+    for (int y = 0; y < h; y++) memcpy(img->pixels + (size_t)y * row, tmp + (size_t)(h - 1 - y) * row, row * sizeof *tmp);
+    free(tmp);
+    if ((st = gr_gl_check("radial blur light pass readback", err)) != GR_OK) {
+        gr_image_destroy(img);
+        return st;
+    }
+    *out = img;
+    return GR_OK;
+}
+
 /* ---- metadata ----------------------------------------------------------------------------- */
 
 static gr_status rb_metadata(void *state, const gr_scene *scene, const void *settings, const gr_technique_stats *stats,
@@ -795,6 +833,7 @@ const gr_technique_class gr_radial_blur_class = {
     .destroy = rb_destroy,
     .render = rb_render,
     .metadata = rb_metadata,
+    .read_target = rb_read_target,
 };
 
 const gr_technique_class gr_radial_blur_local_class = {
@@ -809,4 +848,5 @@ const gr_technique_class gr_radial_blur_local_class = {
     .destroy = rb_destroy,
     .render = rb_render,
     .metadata = rb_metadata,
+    .read_target = rb_read_target,
 };

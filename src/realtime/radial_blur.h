@@ -44,7 +44,7 @@ typedef struct gr_radial_blur_settings {
     int lights;              /* at most this many lights (quads) */
     double quad_size;        /* quad half-size as a fraction of the frame height */
     double falloff;          /* (1 - r)^falloff to the quad's edge: 1 linear, 2 quadratic */
-    int cell_px;             /* light-selection cell size in light-target pixels */
+    double cell_size;        /* light-selection cell side / frame height */
     double min_fraction;     /* cells dimmer than this fraction of the brightest are no light */
     int normalize_overlap;   /* divide by the summed falloff where quads overlap (> 1) */
 } gr_radial_blur_settings;
