@@ -1015,7 +1015,8 @@ static const char ut_shadow_helper[] =
     "    vec4 c = u_light_view_proj * vec4(p, 1.0);\n"
     "    vec3 s = c.xyz / c.w * 0.5 + 0.5;\n"
     "    if (any(lessThan(s.xy, vec2(0.0))) || any(greaterThan(s.xy, vec2(1.0))) || s.z <= 0.0) return 1.0;\n"
-    "    return s.z <= texture(t_shadow_map, s.xy).r + bias ? 1.0 : 0.0;\n"
+    "    float d = texture(t_shadow_map, s.xy).r;  // 1: no caster in this texel\n"
+    "    return (d >= 1.0 || s.z <= d + bias) ? 1.0 : 0.0;\n"
     "}\n";
 
 static const char ut_depth_helper[] =
@@ -1121,8 +1122,20 @@ static char *with_prelude(const char *prelude, const char *src)
     if (!out) return NULL;
     memcpy(out, prelude, lp);
     memcpy(out + lp, src, ls + 1);
+    /* #version may follow comments and blank lines only (GLSL 4.50 section 3.3) */
     char *q = out + lp;
-    while (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r') q++;
+    for (;;) {
+        while (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r') q++;
+        if (q[0] == '/' && q[1] == '/') {
+            while (*q && *q != '\n') q++;
+        } else if (q[0] == '/' && q[1] == '*') {
+            char *e = strstr(q + 2, "*/");
+            if (!e) break;
+            q = e + 2;
+        } else {
+            break;
+        }
+    }
     if (!strncmp(q, "#version", 8))
         while (*q && *q != '\n') *q++ = ' ';
     return out;
@@ -1317,27 +1330,8 @@ static void set3(GLint loc, const double v[3])
     if (loc >= 0) glUniform3f(loc, (float)v[0], (float)v[1], (float)v[2]);
 }
 
-/* Seed 000's listing 5.5.1 packing: groups of 4 waves, 5 vec4 each: kx, kz, A/k, A, w t - phi0
- * (its phase = kx x0 + kz z0 - wt, = eq. 5.5.7's k.X0 - w t + phi0). */
-static void pack_seed_waves(const gr_scene *scene, float *out /* GR_MAX_WAVES / 4 * 5 * 4 */)
-{
-    memset(out, 0, sizeof(float) * GR_MAX_WAVES / 4 * 5 * 4);
-    const gr_water *w = &scene->water;
-    for (int i = 0; i < w->n_waves && i < GR_MAX_WAVES; i++) {
-        const gr_wave *wv = &w->waves[i];
-        float *g = out + (size_t)(i / 4) * 20;
-        int lane = i % 4;
-        g[0 * 4 + lane] = (float)(wv->k * wv->dir[0]);
-        g[1 * 4 + lane] = (float)(wv->k * wv->dir[1]);
-        g[2 * 4 + lane] = wv->k > 0 ? (float)(wv->amplitude_m / wv->k) : 0.0f;
-        g[3 * 4 + lane] = (float)wv->amplitude_m;
-        g[4 * 4 + lane] = (float)fmod(wv->omega_rad_s * w->time_s - wv->phase_rad, 2.0 * GR_PI);
-    }
-}
-
 typedef struct ut_frame_inputs {
     gr_frame f;
-    float seed_waves[GR_MAX_WAVES / 4 * 5 * 4];
     double light_vp[16];
     double shadow_half_extent;
     GLuint shadow_tex, depth_tex;
@@ -1382,8 +1376,8 @@ static void set_uniforms(const ut_state *s, int p, const ut_frame_inputs *fi, co
     if (u[U_N_WAVES] >= 0) glUniform1i(u[U_N_WAVES], f->n_waves);
     if (u[U_WAVE_A] >= 0) glUniform4fv(u[U_WAVE_A], GR_MAX_WAVES, &f->waves_a[0][0]);
     if (u[U_WAVE_B] >= 0) glUniform4fv(u[U_WAVE_B], GR_MAX_WAVES, &f->waves_b[0][0]);
-    if (u[U_WAVE_GROUPS] >= 0) glUniform1i(u[U_WAVE_GROUPS], (f->n_waves + 3) / 4);
-    if (u[U_WAVES] >= 0) glUniform4fv(u[U_WAVES], GR_MAX_WAVES / 4 * 5, fi->seed_waves);
+    if (u[U_WAVE_GROUPS] >= 0) glUniform1i(u[U_WAVE_GROUPS], f->n_wave_groups);
+    if (u[U_WAVES] >= 0) glUniform4fv(u[U_WAVES], GR_MAX_WAVES / 4 * 5, &f->waves_seed[0][0]);
     set3(u[U_ABSORPTION], f->absorption);
     set3(u[U_SCATTERING], f->scattering);
     set3(u[U_EXTINCTION], f->extinction);
@@ -1480,7 +1474,6 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
     if ((st = gr_gl_make_current(s->gl, err)) != GR_OK) goto done;
     for (int t = 0; t < m->n_targets; t++)
         if ((st = ensure_target(s, t, tw[t], th[t], err)) != GR_OK) goto done;
-    pack_seed_waves(scene, fi->seed_waves);
 
     /* harness inputs, timed as passes of their own */
     int slot = 0;
