@@ -469,6 +469,8 @@ static gr_status parse_settings(ut_ctx *c, ut_manifest *m, const cJSON *obj)
             if (!cJSON_IsBool(vdef)) return vfail(c, q, "must be true or false, got %s", type_name(vdef));
             gp->def = cJSON_IsTrue(vdef) ? 1 : 0;
         } else {
+            if (s->type == UT_RGB && cJSON_IsArray(vdef))
+                return vfail(c, q, "an rgb setting's default is one number (the same for r, g and b)");
             if ((st = number_at(c, vdef, q, &gp->def))) return st;
             if (s->type == UT_INT && gp->def != floor(gp->def)) return vfail(c, q, "must be an integer, got %g", gp->def);
             int below = (gp->flags & GR_PF_MIN_EXCL) ? !(gp->def > gp->min) : !(gp->def >= gp->min);
