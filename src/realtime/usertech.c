@@ -25,6 +25,7 @@
 #define UT_MAX_FACTORS 4
 #define UT_NAME_MAX 24
 #define UT_MAX_SIZE 16384
+#define UT_MAX_LADDER 16
 
 /* ---- the parsed manifest ---------------------------------------------------------------- */
 
@@ -103,6 +104,9 @@ typedef struct ut_manifest {
     int allow_black;
     int uses_shadow_map, uses_eye_depth;
     ut_value shadow_size, shadow_half_extent;
+    int n_ladder;
+    gr_technique_level ladder[UT_MAX_LADDER];
+    char *ladder_text[UT_MAX_LADDER];
     gr_technique_class cls;
 } ut_manifest;
 
@@ -114,6 +118,41 @@ static char *dup_string(const char *s)
     char *d = malloc(n);
     if (d) memcpy(d, s, n);
     return d;
+}
+
+typedef struct strbuf {
+    char *s;
+    size_t len, cap;
+    int failed;
+} strbuf;
+
+static void sb_add(strbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void sb_add(strbuf *b, const char *fmt, ...)
+{
+    if (b->failed) return;
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        int n = vsnprintf(b->s ? b->s + b->len : NULL, b->s ? b->cap - b->len : 0, fmt, ap);
+        va_end(ap);
+        if (n < 0) {
+            b->failed = 1;
+            return;
+        }
+        if (b->s && b->len + (size_t)n < b->cap) {
+            b->len += (size_t)n;
+            return;
+        }
+        size_t nc = (b->cap ? b->cap * 2 : 4096);
+        while (nc < b->len + (size_t)n + 1) nc *= 2;
+        char *ns = realloc(b->s, nc);
+        if (!ns) {
+            b->failed = 1;
+            return;
+        }
+        b->s = ns;
+        b->cap = nc;
+    }
 }
 
 typedef struct ut_ctx {
@@ -401,7 +440,7 @@ static gr_status shader_file(ut_ctx *c, const ut_manifest *m, const char *file, 
 static gr_status parse_settings(ut_ctx *c, ut_manifest *m, const cJSON *obj)
 {
     static const char *const keys[] = {"type", "default", "min", "max", "min_exclusive", "max_exclusive",
-                                       "unit", "doc", NULL};
+                                       "tune", "unit", "doc", NULL};
     gr_status st = check_object(c, obj, "settings", NULL);
     if (st) return st;
     size_t offset = 0;
@@ -479,6 +518,26 @@ static gr_status parse_settings(ut_ctx *c, ut_manifest *m, const cJSON *obj)
                 char r[80];
                 return vfail(c, q, "%g is outside the setting's range %s", gp->def, gr_param_range_text(gp, r, sizeof r));
             }
+        }
+        /* default tuning box */
+        const cJSON *vt = cJSON_GetObjectItemCaseSensitive(it, "tune");
+        if (vt) {
+            join(q, sizeof q, p, "tune");
+            if (s->type != UT_NUMBER && s->type != UT_RGB)
+                return vfail(c, q, "only number and rgb settings are tuned (int settings are swept)");
+            if (!cJSON_IsArray(vt) || cJSON_GetArraySize(vt) != 2) return vfail(c, q, "must be [lo, hi]");
+            double lh[2] = {0, 0};
+            for (int k = 0; k < 2; k++) {
+                char e[380];
+                snprintf(e, sizeof e, "%s[%d]", q, k);
+                if ((st = number_at(c, cJSON_GetArrayItem(vt, k), e, &lh[k]))) return st;
+            }
+            if (!(lh[0] < lh[1])) return vfail(c, q, "lo (%g) must be below hi (%g)", lh[0], lh[1]);
+            if (s->type == UT_NUMBER && (lh[0] < gp->min || lh[1] > gp->max))
+                return vfail(c, q, "[%g, %g] is not within the setting's range [%g, %g]", lh[0], lh[1], gp->min, gp->max);
+            if (s->type == UT_RGB && lh[0] < 0) return vfail(c, q, "an rgb setting is tuned as a scale: lo must be >= 0");
+            gp->tune_lo = lh[0];
+            gp->tune_hi = lh[1];
         }
         const char *unit = "", *doc = "";
         if ((st = get_string(c, it, p, "unit", 0, &unit))) return st;
@@ -687,10 +746,70 @@ static gr_status parse_pass(ut_ctx *c, ut_manifest *m, const cJSON *it, int idx,
     return GR_OK;
 }
 
+/* "ladder": [{"settings": {KEY: value, ...}, "quick": bool}, ...] -> "KEY=VALUE,..." levels */
+static gr_status parse_ladder(ut_ctx *c, ut_manifest *m, const cJSON *lad)
+{
+    static const char *const keys[] = {"settings", "quick", NULL};
+    if (!cJSON_IsArray(lad)) return vfail(c, "ladder", "must be an array of levels, got %s", type_name(lad));
+    if (cJSON_GetArraySize(lad) > UT_MAX_LADDER) return vfail(c, "ladder", "more than %d levels", UT_MAX_LADDER);
+    int i = 0;
+    gr_status st;
+    for (const cJSON *lv = lad->child; lv; lv = lv->next, i++) {
+        char p[64], q[320];
+        snprintf(p, sizeof p, "ladder[%d]", i);
+        if ((st = check_object(c, lv, p, keys))) return st;
+        const cJSON *set = cJSON_GetObjectItemCaseSensitive(lv, "settings");
+        join(q, sizeof q, p, "settings");
+        if (!set) return vfail(c, q, "missing (required: {\"KEY\": value, ...})");
+        if ((st = check_object(c, set, q, NULL))) return st;
+        strbuf b = {0};
+        for (const cJSON *e = set->child; e; e = e->next) {
+            char r[360], num[40];
+            join(r, sizeof r, q, e->string);
+            int k = find_setting(m, e->string);
+            if (k < 0) {
+                free(b.s);
+                return vfail(c, r, "'%s' is not a setting of this technique", e->string);
+            }
+            double v = 0;
+            if (m->settings[k].type == UT_BOOL) {
+                if (!cJSON_IsBool(e)) {
+                    free(b.s);
+                    return vfail(c, r, "must be true or false, got %s", type_name(e));
+                }
+                v = cJSON_IsTrue(e);
+            } else if ((st = number_at(c, e, r, &v))) {
+                free(b.s);
+                return st;
+            }
+            gr_error perr;
+            if (gr_param_check(&m->table, &m->params[k], v, 0, &perr) != GR_OK) {
+                free(b.s);
+                return vfail(c, r, "%s", perr.msg);
+            }
+            if (m->settings[k].type == UT_BOOL) snprintf(num, sizeof num, "%s", v != 0 ? "true" : "false");
+            else gr_format_double(v, num, sizeof num);
+            sb_add(&b, "%s%s=%s", b.len ? "," : "", e->string, num);
+        }
+        if (b.failed || !b.s) {
+            free(b.s);
+            if (!set->child) return vfail(c, q, "must name at least one setting");
+            return gr_fail(c->err, GR_E_NOMEM, "%s: out of memory", c->path);
+        }
+        m->ladder_text[i] = b.s;
+        m->ladder[i].settings = b.s;
+        int quick = 0;
+        if ((st = get_bool(c, lv, p, "quick", &quick))) return st;
+        m->ladder[i].quick = quick;
+        m->n_ladder = i + 1;
+    }
+    return GR_OK;
+}
+
 static gr_status parse_manifest(ut_ctx *c, ut_manifest *m, const cJSON *root)
 {
-    static const char *const keys[] = {"version", "name", "description", "settings", "shadow_map", "targets",
-                                       "passes", "output", "allow_black", NULL};
+    static const char *const keys[] = {"version", "name", "description", "settings", "gain", "ladder", "shadow_map",
+                                       "targets", "passes", "output", "allow_black", NULL};
     static const char *const sm_keys[] = {"size", "half_extent_m", NULL};
     gr_status st = check_object(c, root, "", keys);
     if (st) return st;
@@ -713,6 +832,19 @@ static gr_status parse_manifest(ut_ctx *c, ut_manifest *m, const cJSON *root)
     const cJSON *set = cJSON_GetObjectItemCaseSensitive(root, "settings");
     m->settings_size = sizeof(double);
     if (set && (st = parse_settings(c, m, set))) return st;
+
+    const cJSON *gain = cJSON_GetObjectItemCaseSensitive(root, "gain");
+    if (gain) {
+        if (!cJSON_IsString(gain)) return vfail(c, "gain", "must be a setting's name, got %s", type_name(gain));
+        int g = find_setting(m, gain->valuestring);
+        if (g < 0) return vfail(c, "gain", "'%s' is not a setting of this technique", gain->valuestring);
+        if (m->settings[g].type != UT_NUMBER && m->settings[g].type != UT_RGB)
+            return vfail(c, "gain", "setting '%s' must be of type number or rgb (a linear scale on the output)",
+                         gain->valuestring);
+        m->cls.gain_key = m->settings[g].key;
+    }
+    const cJSON *lad = cJSON_GetObjectItemCaseSensitive(root, "ladder");
+    if (lad && (st = parse_ladder(c, m, lad))) return st;
 
     const cJSON *tg = cJSON_GetObjectItemCaseSensitive(root, "targets");
     if (!tg) return vfail(c, "targets", "missing (required: the render targets, e.g. {\"out\": {\"format\": \"rgba32f\"}})");
@@ -790,6 +922,7 @@ static void manifest_free(ut_manifest *m)
         free(m->param_strings[i][0]);
         free(m->param_strings[i][1]);
     }
+    for (int i = 0; i < UT_MAX_LADDER; i++) free(m->ladder_text[i]);
     free(m->description);
     free(m->dir);
     free(m->path);
@@ -880,6 +1013,8 @@ gr_status gr_usertech_load(const char *dir, gr_technique_class **out, gr_error *
     cls->settings_size = m->settings_size;
     cls->origin = m->path;
     cls->class_data = m;
+    cls->ladder = m->n_ladder ? m->ladder : NULL;
+    cls->n_ladder = m->n_ladder;
     cls->check = NULL;
     cls->resolve = ut_resolve;
     cls->create = ut_create;
@@ -1024,41 +1159,6 @@ static const char ut_shadow_helper[] =
 static const char ut_depth_helper[] =
     "// Distance (m) from the eye to the first occluder or the seabed through uv (u_far if none).\n"
     "float gr_eye_depth(vec2 uv) { return texture(t_eye_depth, uv).r; }\n";
-
-typedef struct strbuf {
-    char *s;
-    size_t len, cap;
-    int failed;
-} strbuf;
-
-static void sb_add(strbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void sb_add(strbuf *b, const char *fmt, ...)
-{
-    if (b->failed) return;
-    for (;;) {
-        va_list ap;
-        va_start(ap, fmt);
-        int n = vsnprintf(b->s ? b->s + b->len : NULL, b->s ? b->cap - b->len : 0, fmt, ap);
-        va_end(ap);
-        if (n < 0) {
-            b->failed = 1;
-            return;
-        }
-        if (b->s && b->len + (size_t)n < b->cap) {
-            b->len += (size_t)n;
-            return;
-        }
-        size_t nc = (b->cap ? b->cap * 2 : 4096);
-        while (nc < b->len + (size_t)n + 1) nc *= 2;
-        char *ns = realloc(b->s, nc);
-        if (!ns) {
-            b->failed = 1;
-            return;
-        }
-        b->s = ns;
-        b->cap = nc;
-    }
-}
 
 static const char *glsl_version_for(int major, int minor)
 {
