@@ -14,6 +14,7 @@ static const gr_command commands[] = {
     {"run", "the main job: ground truth (cached) + real-time shafts + comparison + HTML report", cmd_run},
     {"tune", "find the shafts settings that minimize the error over frames and views (Nelder-Mead)", cmd_tune},
     {"sweep", "error surface of the shafts over a grid of one or two settings (CSV, JSON, heat map)", cmd_sweep},
+    {"export", "the scene for other engines: glTF 2.0 (water, camera, sun, occluders), shader constants", cmd_export},
     {"pareto", "speed against error of both renderers: quality ladders, Pareto fronts, CSV + plot", cmd_pareto},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
