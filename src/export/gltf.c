@@ -370,6 +370,8 @@ static cJSON *extras_json(const gr_scene *s, const water_grid *g, const gr_gltf_
     cJSON_AddItemToObject(ca, "forward", vec3_json(cm->forward));
     cJSON_AddItemToObject(ca, "right", vec3_json(cm->right));
     cJSON_AddItemToObject(ca, "up", vec3_json(cm->up));
+    cJSON_AddNumberToObject(ca, "yaw_deg", cm->yaw_deg);
+    cJSON_AddNumberToObject(ca, "pitch_deg", cm->pitch_deg);
     cJSON_AddNumberToObject(ca, "fov_y_deg", cm->fov_deg);
     cJSON_AddNumberToObject(ca, "width", cm->width);
     cJSON_AddNumberToObject(ca, "height", cm->height);

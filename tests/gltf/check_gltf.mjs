@@ -101,8 +101,34 @@ console.error(`check_gltf: ${checked} sampled vertices over ${frames.length} fra
 if (!(worst <= TOL)) fail(`water position differs from the Gerstner surface by ${worst} m > ${TOL}`);
 if (!(worstN <= 1e-4)) fail(`normal length off by ${worstN}`);
 
+// camera and sun: the nodes' quaternions turn local -z into the directions that the scene's
+// conventions give from its angles (scene.h: azimuth from +z toward +x, pitch/elevation up)
+function rotate(q, v) { // q = [x, y, z, w] unit; v' = v + 2 w (u x v) + 2 u x (u x v)
+  const [x, y, z, w] = q, cr = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const u = [x, y, z], t = cr(u, v).map((c) => 2 * c), t2 = cr(u, t);
+  return [0, 1, 2].map((k) => v[k] + w * t[k] + t2[k]);
+}
+const rad = Math.PI / 180;
 const byName = (n) => gltf.nodes.find((q) => q.name === n);
 const cam = byName('camera'), sun = byName('sun');
+const C = x.camera, yaw = C.yaw_deg * rad, pitch = C.pitch_deg * rad;
+const fwdWant = [Math.cos(pitch) * Math.sin(yaw), Math.sin(pitch), Math.cos(pitch) * Math.cos(yaw)];
+const fwd = rotate(cam.rotation, [0, 0, -1]);
+const el = x.sun.elevation_deg * rad, az = x.sun.azimuth_deg * rad;
+const sunWant = [-Math.cos(el) * Math.sin(az), -Math.sin(el), -Math.cos(el) * Math.cos(az)];
+const sdir = rotate(sun.rotation, [0, 0, -1]);
+const dmax = (a, b) => Math.max(...a.map((v, k) => Math.abs(v - b[k])));
+const camErr = Math.max(dmax(fwd, fwdWant), dmax(cam.translation, C.position_m));
+const sunErr = dmax(sdir, sunWant);
+const yfovErr = Math.abs(gltf.cameras[cam.camera].perspective.yfov - C.fov_y_deg * rad);
+const L = gltf.extensions.KHR_lights_punctual.lights[sun.extensions.KHR_lights_punctual.light];
+const irrErr = dmax(L.color.map((c) => c * L.intensity), x.sun.irradiance_W_m2);
+// the camera stays upright: its right vector (local +x) is horizontal (scene.h)
+const rightY = Math.abs(rotate(cam.rotation, [1, 0, 0])[1]);
+console.error(`check_gltf: camera forward/position error ${camErr.toExponential(2)}, yfov ${yfovErr.toExponential(2)}, ` +
+              `right.y ${rightY.toExponential(2)}; sun direction error ${sunErr.toExponential(2)}, irradiance ${irrErr.toExponential(2)}`);
+if (!(camErr <= 1e-9 && yfovErr <= 1e-12 && rightY <= 1e-9)) fail('camera node does not match the scene camera');
+if (!(sunErr <= 1e-9 && irrErr <= 1e-9 * Math.max(1, ...x.sun.irradiance_W_m2))) fail('sun light does not match the scene sun');
 console.log(JSON.stringify({ camera: { translation: cam.translation, rotation: cam.rotation,
                                        yfov: gltf.cameras[cam.camera].perspective.yfov },
                              sun: { rotation: sun.rotation, light: gltf.extensions.KHR_lights_punctual.lights[0] },
