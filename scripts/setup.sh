@@ -23,6 +23,9 @@ GODRAYS_PACKAGES=(
   chromium
   # Node.js for the test tools installed from npm below (npm_tools)
   nodejs
+  # Blender round trip of the glTF export (tests/cli/test_export_blender.sh); its glTF
+  # importer needs NumPy, only a Recommends of blender
+  blender python3-numpy
 )
 
 installed() {

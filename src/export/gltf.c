@@ -292,7 +292,7 @@ static cJSON *extras_json(const gr_scene *s, const water_grid *g, const gr_gltf_
     cJSON_AddStringToObject(u, "time", "s");
     cJSON_AddStringToObject(u, "angle", "rad, except keys ending in _deg");
     cJSON_AddStringToObject(u, "irradiance", "W/m^2 per RGB channel on a plane facing the sun (the scene's "
-                            "units); the KHR light's intensity is max(E) in these units, not lux");
+                            "units); the KHR light's intensity is 683 lm/W x max(E) in lux, its colour E / max(E)");
     cJSON_AddStringToObject(u, "coefficients", "1/m");
     cJSON_AddStringToObject(u, "radiance_of_the_god_ray_layer", "W/(m^2 sr) per RGB channel, linear");
     cJSON *ax = cJSON_AddObjectToObject(x, "axes");
@@ -680,7 +680,10 @@ gr_status gr_gltf_write(const gr_scene *s, const gr_gltf_options *opt, const cha
         cJSON_AddStringToObject(l, "name", "sun");
         cJSON_AddStringToObject(l, "type", "directional");
         cJSON_AddItemToObject(l, "color", num_array(col, 3));
-        cJSON_AddNumberToObject(l, "intensity", emax);
+        /* KHR_lights_punctual: a directional intensity is in lux. E is radiometric (W/m^2); the
+         * standard luminous efficacy 683 lm/W turns it into lux, the factor importers such as
+         * Blender's divide by to get W/m^2 back (docs/engines.md, 1.2) */
+        cJSON_AddNumberToObject(l, "intensity", GR_GLTF_LM_PER_W * emax);
         cJSON_AddItemToArray(lights, l);
         gr_dvec3 z = d3v(sn->to_sun);
         gr_dvec3 xa = gr_d3_cross(gr_d3(0, 1, 0), z);

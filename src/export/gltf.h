@@ -10,6 +10,7 @@
 #include "scene/scene.h"
 
 #define GR_GLTF_MAX_FRAMES 1000
+#define GR_GLTF_LM_PER_W 683.0 /* luminous efficacy for W/m^2 -> lux in the KHR light (docs/engines.md) */
 
 typedef struct gr_gltf_options {
     int grid_cells;        /* water mesh cells per side (0: 512) */

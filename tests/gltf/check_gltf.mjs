@@ -122,7 +122,7 @@ const camErr = Math.max(dmax(fwd, fwdWant), dmax(cam.translation, C.position_m))
 const sunErr = dmax(sdir, sunWant);
 const yfovErr = Math.abs(gltf.cameras[cam.camera].perspective.yfov - C.fov_y_deg * rad);
 const L = gltf.extensions.KHR_lights_punctual.lights[sun.extensions.KHR_lights_punctual.light];
-const irrErr = dmax(L.color.map((c) => c * L.intensity), x.sun.irradiance_W_m2);
+const irrErr = dmax(L.color.map((c) => c * L.intensity / 683), x.sun.irradiance_W_m2); // lux -> W/m^2
 // the camera stays upright: its right vector (local +x) is horizontal (scene.h)
 const rightY = Math.abs(rotate(cam.rotation, [1, 0, 0])[1]);
 console.error(`check_gltf: camera forward/position error ${camErr.toExponential(2)}, yfov ${yfovErr.toExponential(2)}, ` +
