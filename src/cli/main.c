@@ -20,6 +20,7 @@ static const gr_command commands[] = {
     {"tune", "find a technique's settings that minimize the error over frames and views (Nelder-Mead)", cmd_tune},
     {"sweep", "error surface of a technique over a grid of one or two settings (CSV, JSON, heat map)", cmd_sweep},
     {"pareto", "speed against error of the ground truth and each technique: Pareto fronts, CSV + plot", cmd_pareto},
+    {"export", "the scene for other engines: glTF 2.0 (water, camera, sun, occluders), shader constants", cmd_export},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
 
