@@ -16,6 +16,7 @@ static const gr_command commands[] = {
     {"sweep", "error surface of the shafts over a grid of one or two settings (CSV, JSON, heat map)", cmd_sweep},
     {"pareto", "speed against error of both renderers: quality ladders, Pareto fronts, CSV + plot", cmd_pareto},
     {"merge", "assemble the parts of a ground-truth render (reference --tile) into one EXR, bit for bit", cmd_merge},
+    {"farm", "ground truths of frames and views as a Slurm job array of parts, merged into the cache", cmd_farm},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
 
