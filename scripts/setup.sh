@@ -21,6 +21,8 @@ GODRAYS_PACKAGES=(
   libplplot-dev plplot-driver-qt
   # headless browser for the report's test (tests/cli/test_report_browser.sh)
   chromium
+  # a single-node Slurm cluster for the farm test (tests/farm/test_slurm.sh, docs/farm.md)
+  slurm-wlm munge
 )
 
 installed() {
