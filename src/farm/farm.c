@@ -264,14 +264,17 @@ gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_erro
     if ((st = wopen(&w, plan, "merge.sh", err)) != GR_OK) return st;
     f = w.f;
     header(f, plan, "merge each case's parts into the ground-truth cache");
-    fputs("# Runs after the parts (whatever their outcome). A case whose truth is cached is skipped; a\n"
-          "# case with missing parts is reported with the tail of their logs (exit 1 at the end).\n",
+    fputs("# An array after the parts (whatever their outcome): task C merges case C (bash merge.sh:\n"
+          "# every case, here). A case whose truth is cached is skipped; a case with missing parts is\n"
+          "# reported with the tail of their logs (exit 1).\n",
           f);
-    sbatch_common(f, plan, "godrays-merge", "merge");
+    sbatch_common(f, plan, "godrays-merge", "merge-%a");
     vars(f, plan);
     fputs("mkdir -p \"$FARM/truth\"\n"
           "fail=0\n"
-          "for C in \"${!CASE_KEYS[@]}\"; do\n"
+          "CASES=(\"${!CASE_KEYS[@]}\")\n"
+          "if [ -n \"${SLURM_ARRAY_TASK_ID:-}\" ]; then CASES=(\"$SLURM_ARRAY_TASK_ID\"); fi\n"
+          "for C in \"${CASES[@]}\"; do\n"
           "  KEY=${CASE_KEYS[$C]}\n"
           "  if [ -e \"$GODRAYS_CACHE/reference-$KEY.exr\" ]; then echo \"case $C: in the cache\"; continue; fi\n"
           "  parts=(); missing=0\n"
@@ -336,14 +339,25 @@ gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_erro
           "set -eu\nFARM=",
           f);
     sq(f, plan->dir);
-    fprintf(f, "\ncd \"$FARM\"\nARRAY=\"%s\"   # of 0-%d\nMAX_PARALLEL=\"%s%d\"\n", todo, plan->n_cases * per - 1,
-            plan->max_parallel > 0 ? "%" : "", plan->max_parallel);
-    if (plan->max_parallel <= 0) fputs("MAX_PARALLEL=\"\"\n", f);
-    fprintf(f, "UNMERGED=%d   # cases whose truth is not in the cache yet\n", unmerged);
+    fprintf(f, "\ncd \"$FARM\"\nARRAY=\"%s\"   # of 0-%d\n", todo, plan->n_cases * per - 1);
+    if (plan->max_parallel > 0) fprintf(f, "MAX_PARALLEL=\"%%%d\"   # at most this many tasks at once\n", plan->max_parallel);
+    else fputs("MAX_PARALLEL=\"\"   # \"%K\": at most K tasks at once (farm --max-parallel K)\n", f);
+    char mtodo[8192] = "";
+    for (int c = 0, start = -1; c <= plan->n_cases; c++) { /* the cases still to merge */
+        int todo_c = c < plan->n_cases && !plan->cases[c].merged;
+        size_t l = strlen(mtodo);
+        if (todo_c && start < 0) start = c;
+        if (!todo_c && start >= 0) {
+            if (c - 1 > start) snprintf(mtodo + l, sizeof mtodo - l, "%s%d-%d", l ? "," : "", start, c - 1);
+            else snprintf(mtodo + l, sizeof mtodo - l, "%s%d", l ? "," : "", start);
+            start = -1;
+        }
+    }
+    fprintf(f, "MERGE_ARRAY=\"%s\"   # cases whose truth is not in the cache yet (%d)\n", mtodo, unmerged);
     fputs("P=\"\"; M=\"\"; F=\"\"\n"
           "if [ -n \"$ARRAY\" ]; then P=$(sbatch --parsable --array=\"$ARRAY$MAX_PARALLEL\" parts.sh); P=${P%%;*}; fi\n"
-          "if [ \"$UNMERGED\" -gt 0 ]; then\n"
-          "  M=$(sbatch --parsable ${P:+--dependency=afterany:$P} merge.sh); M=${M%%;*}\n"
+          "if [ -n \"$MERGE_ARRAY\" ]; then\n"
+          "  M=$(sbatch --parsable --array=\"$MERGE_ARRAY\" ${P:+--dependency=afterany:$P} merge.sh); M=${M%%;*}\n"
           "fi\n",
           f);
     if (strcmp(plan->then, "none") != 0)

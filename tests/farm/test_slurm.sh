@@ -133,7 +133,7 @@ if [ -n "$killed" ]; then
   grep -h "" "$T/farm/logs/$killed.out" "$T/farm/logs/$killed.err"
 fi
 grep -h "done in" "$T"/farm/logs/part-*.out
-cat "$T/farm/logs/merge.out" "$T/farm/logs/merge.err" 2>/dev/null
+cat "$T"/farm/logs/merge-*.out "$T"/farm/logs/merge-*.err 2>/dev/null
 n=$(ls "$T"/cache/reference-*.exr 2>/dev/null | wc -l)
 check "two merged truths in the cache ($n)" test "$n" -eq 2
 for c in 0 1; do
