@@ -21,6 +21,8 @@ static const gr_command commands[] = {
     {"sweep", "error surface of a technique over a grid of one or two settings (CSV, JSON, heat map)", cmd_sweep},
     {"pareto", "speed against error of the ground truth and each technique: Pareto fronts, CSV + plot", cmd_pareto},
     {"export", "the scene for other engines: glTF 2.0 (water, camera, sun, occluders), shader constants", cmd_export},
+    {"merge", "assemble the parts of a ground-truth render (reference --tile) into one EXR, bit for bit", cmd_merge},
+    {"farm", "ground truths of frames and views as a Slurm job array of parts, merged into the cache", cmd_farm},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
 
