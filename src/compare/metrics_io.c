@@ -213,3 +213,37 @@ void gr_metrics_print_table(FILE *f, const gr_metrics *m)
         if (m->fit_defined) print_set(f, m, &m->fit);
     }
 }
+
+cJSON *gr_flip_to_json(const gr_flip_result *r, double scale)
+{
+    if (!r) return NULL;
+    cJSON *o = cJSON_CreateObject();
+    if (!o) return NULL;
+    int ok = cJSON_AddStringToObject(o, "mode", gr_flip_mode_name(r->mode)) && add_num(o, "pixels_per_degree", r->ppd) &&
+             add_num(o, "test_scale", scale) && add_num(o, "pooled_pixels", (double)r->n_pooled) &&
+             add_num(o, "mean", r->mean) && add_num(o, "min", r->min) && add_num(o, "max", r->max) &&
+             add_num(o, "q1", r->q1) && add_num(o, "median", r->median) && add_num(o, "q3", r->q3);
+    if (ok && r->mode == GR_FLIP_HDR) {
+        cJSON *e = cJSON_AddObjectToObject(o, "exposures");
+        ok = e && cJSON_AddStringToObject(o, "tone_mapper", gr_flip_tonemapper_name(r->tonemapper)) &&
+             add_num(e, "start", r->start_exposure) && add_num(e, "stop", r->stop_exposure) &&
+             add_num(e, "count", r->n_exposures);
+    }
+    if (!ok) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
+}
+
+void gr_flip_print(FILE *f, const char *label, const gr_flip_result *r, double scale)
+{
+    if (!f || !r) return;
+    fprintf(f, "  %-24s mean %.6f  median %.6f  q1 %.6f  q3 %.6f  min %.6f  max %.6f\n", label, r->mean, r->median,
+            r->q1, r->q3, r->min, r->max);
+    fprintf(f, "  %-24s %s-FLIP, %.4g px/degree, test x %.6g", "", r->mode == GR_FLIP_HDR ? "HDR" : "LDR", r->ppd, scale);
+    if (r->mode == GR_FLIP_HDR)
+        fprintf(f, ", %s, exposures %.4f .. %.4f (%d)", gr_flip_tonemapper_name(r->tonemapper), r->start_exposure,
+                r->stop_exposure, r->n_exposures);
+    fprintf(f, ", %lld pixels pooled\n", r->n_pooled);
+}

@@ -7,6 +7,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "compare/flip.h"
 #include "compare/metrics.h"
 
 /* A new JSON object with every field of m and the conventions used (luminance weights, rel
@@ -17,5 +18,12 @@ cJSON *gr_metrics_to_json(const gr_metrics *m);
 /* Prints the metrics as an aligned table (rows: metrics, columns R G B RGB Y) with the
  * scoring counts, exclusions and conventions stated; the fitted table follows if present. */
 void gr_metrics_print_table(FILE *f, const gr_metrics *m);
+
+/* FLIP (compare/flip.h) as JSON: mode, ppd, tone mapper and exposures (HDR), the scale the
+ * test was multiplied by, and the pooled statistics. NULL if out of memory. */
+cJSON *gr_flip_to_json(const gr_flip_result *r, double scale);
+
+/* One or two lines stating a FLIP result and its settings, under `label`. */
+void gr_flip_print(FILE *f, const char *label, const gr_flip_result *r, double scale);
 
 #endif
