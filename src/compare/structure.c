@@ -62,9 +62,13 @@ static gr_status resolve(const gr_structure_options *in, int w, int h, gr_struct
     if (o->eps_rel == 0.0) o->eps_rel = 0.01;
     if (o->n_annuli == 0) o->n_annuli = 4;
     if (o->n_theta == 0) o->n_theta = 1024;
-    if (o->m_max == 0) o->m_max = 128;
+    if (o->m_max == 0) o->m_max = 256;
     if (o->m_min == 0) o->m_min = 2;
-    if (o->r_min_px == 0.0) o->r_min_px = 0.1 * (double)h;
+    if (o->r_min_px == 0.0) {
+        /* 0.1 height, or where the image begins when the vanishing point lies outside it */
+        const double cx = fmin(fmax(o->vp_x, 0.0), (double)w), cy = fmin(fmax(o->vp_y, 0.0), (double)h);
+        o->r_min_px = fmax(0.1 * (double)h, hypot(cx - o->vp_x, cy - o->vp_y));
+    }
     if (o->r_max_px == 0.0) {
         for (int c = 0; c < 4; c++) {
             const double dx = (c & 1 ? (double)w : 0.0) - o->vp_x, dy = (c & 2 ? (double)h : 0.0) - o->vp_y;
@@ -111,27 +115,42 @@ static double sample(const double *f, const unsigned char *scored, int w, int h,
     return (1 - ty) * ((1 - tx) * f[i00] + tx * f[i01]) + ty * ((1 - tx) * f[i10] + tx * f[i11]);
 }
 
-/* Angular spectrum of one annulus of the smoothed luminance s. Returns the arc analysed in
- * degrees (0: unusable) and fills P[0..m_max]. */
-static double annulus_spectrum(const double *s, const unsigned char *scored, int w, int h,
-                               const gr_structure_options *o, double r0, double r1, double *P, double *buf,
-                               unsigned char *valid)
+/* The angular profile of the smoothed de-glowed field s on the annulus [r0, r1] (radii in 1-px
+ * steps): at theta_j = 2 pi j / n_theta, f[j] = mean over the radii that sample inside the
+ * image (and scored pixels) of s - 1; valid[j] = 1 when at least half the radii do. s has ring
+ * mean 1 (the radial profile is divided out), so f is the relative fluctuation around the
+ * vanishing point; a radial streak is constant along r and survives the average. */
+static void arc_profile(const double *s, const unsigned char *scored, int w, int h, const gr_structure_options *o,
+                        double r0, double r1, double *f, unsigned char *valid)
 {
     const int nt = o->n_theta;
     int nr = (int)floor(r1 - r0);
     if (nr < 1) nr = 1;
     const double dr = (r1 - r0) / nr;
-    /* valid[j]: every radius of the annulus samples inside the image at theta_j */
     for (int j = 0; j < nt; j++) {
-        valid[j] = 1;
         const double th = 2.0 * PI * j / nt, c = cos(th), sn = sin(th);
-        for (int k = 0; k < nr && valid[j]; k++) {
+        double acc = 0.0;
+        int nin = 0;
+        for (int k = 0; k < nr; k++) {
             const double r = r0 + (k + 0.5) * dr;
             int ok = 1;
-            sample(s, scored, w, h, o->vp_x + r * c, o->vp_y + r * sn, &ok);
-            valid[j] = (unsigned char)ok;
+            const double v = sample(s, scored, w, h, o->vp_x + r * c, o->vp_y + r * sn, &ok);
+            if (ok) acc += v - 1.0, nin++;
         }
+        valid[j] = (unsigned char)(2 * nin >= nr && nin > 0);
+        f[j] = valid[j] ? acc / nin : 0.0;
     }
+}
+
+/* Angular spectrum of one annulus of the smoothed de-glowed field s. Returns the arc analysed
+ * in degrees (0: unusable) and fills P[0..m_max]. buf: 2 n_theta doubles. */
+static double annulus_spectrum(const double *s, const unsigned char *scored, int w, int h,
+                               const gr_structure_options *o, double r0, double r1, double *P, double *buf,
+                               unsigned char *valid)
+{
+    const int nt = o->n_theta;
+    double *f = buf, *wt = buf + nt;
+    arc_profile(s, scored, w, h, o, r0, r1, f, valid);
     /* the longest circular run of valid angles */
     int nvalid = 0;
     for (int j = 0; j < nt; j++) nvalid += valid[j];
@@ -147,43 +166,22 @@ static double annulus_spectrum(const double *s, const unsigned char *scored, int
         }
     }
     memset(P, 0, (size_t)(o->m_max + 1) * sizeof(double));
-    if (len < nt / 16) return 0.0; /* under 22.5 degrees: too short for a spectrum */
-    /* f_j = mean over the radii of (I(r, theta_j) / mean_theta I(r, .) - 1): the relative
-     * fluctuation, each radius normalized by its own ring mean (the glow's radial falloff
-     * divides out; a radial streak is constant along r and survives the average). */
-    for (int l = 0; l < len; l++) buf[l] = 0.0;
-    int nrad = 0;
-    for (int k = 0; k < nr; k++) {
-        const double r = r0 + (k + 0.5) * dr;
-        double mean = 0.0;
-        for (int l = 0; l < len; l++) {
-            const double th = 2.0 * PI * ((start + l) % nt) / nt;
-            int ok = 1;
-            buf[len + l] = sample(s, scored, w, h, o->vp_x + r * cos(th), o->vp_y + r * sin(th), &ok);
-            mean += buf[len + l];
-        }
-        mean /= len;
-        if (!(mean > 0.0)) continue;
-        for (int l = 0; l < len; l++) buf[l] += buf[len + l] / mean - 1.0;
-        nrad++;
-    }
-    if (nrad == 0) return 0.0;
+    /* an arc must hold 32 samples (11 degrees at the default 1024 per turn) */
+    if (len < 32) return 0.0;
     /* window: none on a full turn (periodic); Hann on a partial arc (limits leakage from the
      * arc's ends); the weighted mean is removed first */
     double sw = 0.0, swf = 0.0;
     for (int l = 0; l < len; l++) {
-        buf[l] /= nrad;
-        const double wl = len == nt ? 1.0 : pow(sin(PI * (l + 0.5) / len), 2.0);
-        buf[len + l] = wl;
-        sw += wl, swf += wl * buf[l];
+        wt[l] = len == nt ? 1.0 : pow(sin(PI * (l + 0.5) / len), 2.0);
+        sw += wt[l], swf += wt[l] * f[(start + l) % nt];
     }
-    for (int l = 0; l < len; l++) buf[l] -= swf / sw;
     for (int m = 1; m <= o->m_max; m++) {
         double re = 0.0, im = 0.0;
         for (int l = 0; l < len; l++) {
-            const double th = 2.0 * PI * ((start + l) % nt) / nt;
-            re += buf[len + l] * buf[l] * cos(m * th);
-            im -= buf[len + l] * buf[l] * sin(m * th);
+            const int j = (start + l) % nt;
+            const double th = 2.0 * PI * j / nt, v = wt[l] * (f[j] - swf / sw);
+            re += v * cos(m * th);
+            im -= v * sin(m * th);
         }
         P[m] = 2.0 * (re * re + im * im) / (sw * sw);
     }
@@ -213,6 +211,36 @@ static gr_status fields(const gr_image *img, const gr_structure_options *o, doub
         if (!o->scored || o->scored[p]) sum += y[p], cnt++;
     }
     *mean_y = cnt ? sum / (double)cnt : 0.0;
+    /* De-glow: divide Y by its own radial profile around the vanishing point (the mean over
+     * scored pixels of each 1-px ring). What remains is the structure that no function of the
+     * distance to the vanishing point (a glow around the sun) can explain; the glow itself is
+     * measured by the radial profile chart (report/profile). */
+    int nring = 1;
+    for (int c = 0; c < 4; c++) {
+        const double d = hypot((c & 1 ? (double)w : 0.0) - o->vp_x, (c & 2 ? (double)h : 0.0) - o->vp_y);
+        if ((int)d + 2 > nring) nring = (int)d + 2;
+    }
+    double *ring = calloc(2 * (size_t)nring, sizeof(double));
+    if (!ring) {
+        free(wt);
+        return gr_fail(err, GR_E_NOMEM, "structure: out of memory");
+    }
+    for (int py = 0; py < h; py++)
+        for (int px = 0; px < w; px++) {
+            const size_t p = (size_t)py * (size_t)w + (size_t)px;
+            if (o->scored && !o->scored[p]) continue;
+            const int k = (int)hypot(px + 0.5 - o->vp_x, py + 0.5 - o->vp_y);
+            ring[2 * k] += y[p], ring[2 * k + 1] += 1.0;
+        }
+    const double floor_y = 1e-3 * fabs(*mean_y) + 1e-30;
+    for (int py = 0; py < h; py++)
+        for (int px = 0; px < w; px++) {
+            const size_t p = (size_t)py * (size_t)w + (size_t)px;
+            const int k = (int)hypot(px + 0.5 - o->vp_x, py + 0.5 - o->vp_y);
+            const double rm = ring[2 * k + 1] > 0 ? ring[2 * k] / ring[2 * k + 1] : 0.0;
+            y[p] = y[p] / (fmax(rm, 0.0) + floor_y);
+        }
+    free(ring);
     const double *src[1] = {y};
     double *dst[1] = {gf};
     gr_status st = gr_blur_fields(src, 1, wt, w, h, o->sigma_fine_px, gr_blur_radius(o->sigma_fine_px), dst, NULL, err);
@@ -290,6 +318,31 @@ static gr_status check_img(const gr_image *img, const char *role, gr_error *err)
         if (!isfinite(img->pixels[i]))
             return gr_fail(err, GR_E_INPUT, "structure: the %s image has a non-finite sample", role);
     return GR_OK;
+}
+
+gr_status gr_structure_angular_profile(const gr_image *img, const gr_structure_options *opt, double r0, double r1,
+                                       double *f, unsigned char *valid, gr_error *err)
+{
+    if (!f || !valid) return gr_fail(err, GR_E_INPUT, "structure: NULL profile arrays");
+    gr_status st = check_img(img, "input", err);
+    gr_structure_options o;
+    if (st == GR_OK) st = resolve(opt, img->width, img->height, &o, err);
+    if (st != GR_OK) return st;
+    if (!(r0 >= 0.0) || !(r1 > r0) || !isfinite(r1)) return gr_fail(err, GR_E_INPUT, "structure: need 0 <= r0 < r1");
+    const int w = img->width, h = img->height;
+    const size_t n = (size_t)w * (size_t)h;
+    double *y = malloc(n * sizeof(double)), *gf = malloc(n * sizeof(double)), *gc = malloc(n * sizeof(double));
+    if (!y || !gf || !gc) {
+        st = gr_fail(err, GR_E_NOMEM, "structure: out of memory");
+        goto done;
+    }
+    double mean_y, eps;
+    st = fields(img, &o, y, gf, gc, &mean_y, &eps, err);
+    if (st != GR_OK) goto done;
+    arc_profile(gf, o.scored, w, h, &o, r0, r1, f, valid);
+done:
+    free(y), free(gf), free(gc);
+    return st;
 }
 
 gr_status gr_structure_image_compute(const gr_image *img, const gr_structure_options *opt, gr_structure_image *out,

@@ -4,8 +4,11 @@
  * image and a beam pattern is a function of the angle. Three measures, each per image and
  * compared with the truth's (derivations: docs/metrics.md "Beam structure"):
  *
- *  - local band-pass contrast C = (G_f * Y - G_c * Y) / (G_c * Y + eps), a difference of
- *    Gaussians over the local mean (Peli's band-limited contrast) of Rec. 709 luminance Y;
+ *  - all on the de-glowed luminance D = Y / R(r): Rec. 709 luminance over its own mean on the
+ *    ring at distance r from the vanishing point, so that any function of r alone (a glow
+ *    around the sun) becomes flat and only the structure beside it remains;
+ *  - local band-pass contrast C = (G_f * D - G_c * D) / (G_c * D + eps), a difference of
+ *    Gaussians over the local mean (Peli's band-limited contrast);
  *    its RMS over the image is the *streak contrast*, and the Pearson correlation of the
  *    test's C with the truth's is the *band-pass correlation* (1: beams in the same places);
  *  - the *angular power spectrum* of the relative luminance fluctuation around the vanishing
@@ -31,9 +34,10 @@ typedef struct gr_structure_options {
     double sigma_coarse_px;      /* 0: 4 sigma_fine */
     double eps_rel;              /* contrast denominator floor, times mean(G_c * Y); 0: 0.01 */
     int n_annuli;                /* 0: 4 (at most GR_STRUCT_MAX_ANNULI) */
-    double r_min_px, r_max_px;   /* annuli span; 0: 0.1 height, and the farthest image corner */
+    double r_min_px, r_max_px;   /* annuli span; 0: the larger of 0.1 height and the distance to
+                                    the image (vanishing point outside), and the farthest corner */
     int n_theta;                 /* angular samples per turn; 0: 1024 */
-    int m_max;                   /* highest angular frequency; 0: 128 (at most GR_STRUCT_MAX_M) */
+    int m_max;                   /* highest angular frequency; 0: 256 (at most GR_STRUCT_MAX_M) */
     int m_min;                   /* lowest angular frequency in the summaries; 0: 2 */
     const unsigned char *scored; /* per pixel, may be NULL (all); unscored pixels are left out of
                                     every sum, blur and ring */
@@ -72,6 +76,14 @@ gr_status gr_structure_vanishing_point(const gr_camera *cam, const double dir[3]
 /* The vanishing point of the god rays of scene s (the refracted sun direction, seed eq. 5.5.1
  * at the rest surface, as gr_profile_sun_view_dir), on s's camera scaled to width x height. */
 gr_status gr_structure_scene_vp(const gr_scene *s, int width, int height, double *x, double *y, gr_error *err);
+
+/* The relative angular fluctuation of img's de-glowed, finely smoothed luminance S around the
+ * vanishing point on the annulus [r0, r1] (radii in 1-px steps), at theta_j = 2 pi j / n_theta:
+ * f[j] = mean over the radii sampling inside the image (and scored pixels) of S - 1, valid[j] = 1
+ * where at least half the radii do (f[j] = 0 elsewhere). f and valid have n_theta entries (after
+ * defaults). For following beams over time (compare/temporal). */
+gr_status gr_structure_angular_profile(const gr_image *img, const gr_structure_options *opt, double r0, double r1,
+                                       double *f, unsigned char *valid, gr_error *err);
 
 /* The measures of one image. contrast (may be NULL) receives the field C, width * height. */
 gr_status gr_structure_image_compute(const gr_image *img, const gr_structure_options *opt, gr_structure_image *out,
