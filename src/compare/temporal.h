@@ -40,7 +40,8 @@ typedef struct gr_temporal_pair {    /* frames i -> i + 1 */
     double diff_rmse;                /* sqrt(max(0, raw^2 - noise^2)) */
     double truth_diff_rms;           /* sqrt(max(0, mean dR^2 - noise^2)) */
     double test_diff_rms;            /* RMS of a dT */
-    double drift_ref_deg, drift_test_deg; /* signed (counter-clockwise on the image positive) */
+    double drift_ref_deg, drift_test_deg; /* signed: + toward larger theta = atan2(y - vy, x - vx),
+                                             y down (clockwise as seen) */
     double drift_err_deg;            /* |test - ref| */
 } gr_temporal_pair;
 
