@@ -16,6 +16,8 @@
 
 #include "compare/diffmap.h"
 #include "compare/flip.h"
+#include "compare/structure.h"
+#include "scene/scene.h"
 #include "compare/metrics.h"
 #include "compare/metrics_io.h"
 #include "image/oiio.h"
@@ -45,7 +47,13 @@ static void usage(FILE *f)
             "                       exceeds B (default %g; inf: score all)\n"
             "  --no-linearize       read 8-bit files as code / 255 (default: sRGB-decode them)\n"
             "  --metric LIST        which metric groups to compute, comma-separated: basic (the\n"
-            "                       table above), flip, or all (default: all)\n"
+            "                       table above), flip, structure, or all (default: all; structure\n"
+            "                       only with --vp or --scene)\n"
+            "  --vp X,Y             the beams' vanishing point in image coordinates (pixel centres\n"
+            "                       at +0.5; may lie outside) for the structure metrics\n"
+            "  --scene FILE         take the vanishing point from FILE's camera and refracted sun\n"
+            "  --set KEY=VALUE      override a value of that scene, e.g. camera.yaw_deg=120\n"
+            "                       (repeatable)\n"
             "  --flip-mode M        ldr or hdr (default: hdr when REF is .exr, .hdr or .pfm, else\n"
             "                       ldr); FLIP is computed on a * TEST with the fitted a if any\n"
             "  --ppd P              FLIP's observer: pixels per degree (default 67.02: 0.7 m from\n"
@@ -117,6 +125,11 @@ int cmd_compare(int argc, char **argv)
     const char *cmd = "compare";
     const char *paths[2] = {NULL, NULL}, *outdir = NULL, *mask_path = NULL;
     int npos = 0, json = 0, linearize = 1, do_basic = 1, do_flip = 1;
+    int do_struct = -1; /* -1: when a vanishing point is given */
+    int have_vp = 0;
+    double vp[2] = {0.0, 0.0};
+    const char *scene_path = NULL, *sets[32];
+    int n_sets = 0;
     int flip_mode = -1; /* -1: from REF's file extension */
     gr_metrics_options opt = {0};
     gr_flip_options fopt = {0};
@@ -143,22 +156,41 @@ int cmd_compare(int argc, char **argv)
             } else {
                 outdir = v;
             }
+        } else if (!strcmp(a, "--vp") || !strcmp(a, "--scene") || !strcmp(a, "--set")) {
+            const int rc = gr_args_value(&args, &v);
+            if (rc) return rc;
+            if (!strcmp(a, "--set")) {
+                if (n_sets >= (int)(sizeof sets / sizeof sets[0]))
+                    return gr_cli_usage_error(cmd, "--set: at most %d overrides", (int)(sizeof sets / sizeof sets[0]));
+                sets[n_sets++] = v;
+            } else if (!strcmp(a, "--scene")) {
+                scene_path = v;
+            } else {
+                int used = 0;
+                if (sscanf(v, "%lf,%lf%n", &vp[0], &vp[1], &used) != 2 || v[used] != '\0' || !isfinite(vp[0]) ||
+                    !isfinite(vp[1]))
+                    return gr_cli_usage_error(cmd, "--vp '%s': need X,Y (two numbers)", v);
+                have_vp = 1;
+            }
         } else if (!strcmp(a, "--metric") || !strcmp(a, "--flip-mode") || !strcmp(a, "--ppd") ||
                    !strcmp(a, "--tone-mapper") || !strcmp(a, "--exposures")) {
             const int rc = gr_args_value(&args, &v);
             if (rc) return rc;
             if (!strcmp(a, "--metric")) {
-                do_basic = do_flip = 0;
+                do_basic = do_flip = do_struct = 0;
                 char buf[256];
                 if (strlen(v) >= sizeof buf) return gr_cli_usage_error(cmd, "--metric '%s': too long", v);
                 strcpy(buf, v);
                 for (char *save = NULL, *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
                     if (!strcmp(t, "basic")) do_basic = 1;
                     else if (!strcmp(t, "flip")) do_flip = 1;
-                    else if (!strcmp(t, "all")) do_basic = do_flip = 1;
-                    else return gr_cli_usage_error(cmd, "--metric '%s': unknown metric '%s' (basic, flip, all)", v, t);
+                    else if (!strcmp(t, "structure")) do_struct = 1;
+                    else if (!strcmp(t, "all")) do_basic = do_flip = 1, do_struct = -1;
+                    else
+                        return gr_cli_usage_error(cmd, "--metric '%s': unknown metric '%s' (basic, flip, structure, all)",
+                                                  v, t);
                 }
-                if (!do_basic && !do_flip) return gr_cli_usage_error(cmd, "--metric '%s': names no metric", v);
+                if (!do_basic && !do_flip && !do_struct) return gr_cli_usage_error(cmd, "--metric '%s': names no metric", v);
             } else if (!strcmp(a, "--flip-mode")) {
                 if (!strcmp(v, "ldr")) flip_mode = GR_FLIP_LDR;
                 else if (!strcmp(v, "hdr")) flip_mode = GR_FLIP_HDR;
@@ -196,6 +228,11 @@ int cmd_compare(int argc, char **argv)
         }
     }
     if (npos != 2) return gr_cli_usage_error(cmd, "need two images, REF and TEST");
+    if (have_vp && scene_path) return gr_cli_usage_error(cmd, "give --vp or --scene, not both");
+    if (n_sets && !scene_path) return gr_cli_usage_error(cmd, "--set needs --scene");
+    if (do_struct == 1 && !have_vp && !scene_path)
+        return gr_cli_usage_error(cmd, "--metric structure needs the vanishing point: --vp X,Y or --scene FILE");
+    if (do_struct == -1) do_struct = have_vp || scene_path;
     if (outdir) {
         const int rc = gr_args_check_output_dir(&args, "-o", outdir);
         if (rc) return rc;
@@ -266,6 +303,35 @@ int cmd_compare(int argc, char **argv)
         if (st != GR_OK) goto fail;
     }
 
+    gr_structure_compare sres;
+    double t_struct = 0.0;
+    if (do_struct) {
+        if (scene_path) {
+            gr_scene sc;
+            st = gr_scene_load_file(scene_path, sets, n_sets, &sc, &err);
+            if (st == GR_OK) st = gr_structure_scene_vp(&sc, ref->width, ref->height, &vp[0], &vp[1], &err);
+            if (st != GR_OK) {
+                if (st != GR_E_NOMEM) err.status = GR_E_INPUT;
+                gr_error_prefix(&err, "--scene %s", scene_path);
+                goto fail;
+            }
+        }
+        if (!scored) {
+            scored = malloc((size_t)ref->width * (size_t)ref->height);
+            if (!scored) {
+                st = gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
+                goto fail;
+            }
+            st = gr_metrics_scored_pixels(ref, mask, opt.stderr_bound, scored, NULL, NULL, &err);
+            if (st != GR_OK) goto fail;
+        }
+        gr_structure_options so = {.vp_x = vp[0], .vp_y = vp[1], .scored = scored};
+        const double t2 = now_s();
+        st = gr_structure_compare_images(ref, test, &so, &sres, &err);
+        t_struct = now_s() - t2;
+        if (st != GR_OK) goto fail;
+    }
+
     root = gr_metrics_to_json(&m);
     cJSON *rj = root ? image_json(paths[0], ref, m.ref_rgb) : NULL;
     cJSON *tj = root ? image_json(paths[1], test, m.test_rgb) : NULL;
@@ -273,6 +339,13 @@ int cmd_compare(int argc, char **argv)
         !cJSON_AddItemToObject(root, "test", tj) || !cJSON_AddBoolToObject(root, "linearized_8bit", linearize) ||
         !cJSON_AddNumberToObject(root, "metrics_time_s", t_metrics) ||
         (mask_path && !cJSON_AddStringToObject(root, "mask", mask_path))) {
+        st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
+        goto fail;
+    }
+    cJSON *sj = do_struct ? gr_structure_to_json(&sres, vp[0], vp[1]) : NULL;
+    if (do_struct && (!sj || !cJSON_AddNumberToObject(sj, "time_s", t_struct) ||
+                      !cJSON_AddItemToObject(root, "structure", sj))) {
+        cJSON_Delete(sj);
         st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
         goto fail;
     }
@@ -352,6 +425,7 @@ int cmd_compare(int argc, char **argv)
         printf("reference %s, test %s\n", paths[0], paths[1]);
         if (do_basic) gr_metrics_print_table(stdout, &m);
         if (do_flip) gr_flip_print(stdout, "FLIP", &fres, scale);
+        if (do_struct) gr_structure_print(stdout, &sres, vp[0], vp[1]);
         if (outdir)
             printf("wrote %s/metrics.json, %s/diff.png, %s/diff_signed.png%s%s%s\n", outdir, outdir, outdir,
                    do_flip ? ", " : "", do_flip ? outdir : "", do_flip ? "/flip.png" : "");

@@ -64,6 +64,8 @@ static gr_status resolve(const gr_structure_options *in, int w, int h, gr_struct
     if (o->n_theta == 0) o->n_theta = 1024;
     if (o->m_max == 0) o->m_max = 256;
     if (o->m_min == 0) o->m_min = 2;
+    if (o->radial && !(o->radial_bin > 0.0 && isfinite(o->radial_bin)))
+        return gr_fail(err, GR_E_INPUT, "structure: radial_bin %g is not > 0", o->radial_bin);
     if (o->r_min_px == 0.0) {
         /* 0.1 height, or where the image begins when the vanishing point lies outside it */
         const double cx = fmin(fmax(o->vp_x, 0.0), (double)w), cy = fmin(fmax(o->vp_y, 0.0), (double)h);
@@ -211,16 +213,23 @@ static gr_status fields(const gr_image *img, const gr_structure_options *o, doub
         if (!o->scored || o->scored[p]) sum += y[p], cnt++;
     }
     *mean_y = cnt ? sum / (double)cnt : 0.0;
-    /* De-glow: divide Y by its own radial profile around the vanishing point (the mean over
-     * scored pixels of each 1-px ring). What remains is the structure that no function of the
-     * distance to the vanishing point (a glow around the sun) can explain; the glow itself is
-     * measured by the radial profile chart (report/profile). */
-    int nring = 1;
-    for (int c = 0; c < 4; c++) {
-        const double d = hypot((c & 1 ? (double)w : 0.0) - o->vp_x, (c & 2 ? (double)h : 0.0) - o->vp_y);
-        if ((int)d + 2 > nring) nring = (int)d + 2;
-    }
-    double *ring = calloc(2 * (size_t)nring, sizeof(double));
+    /* De-glow: divide Y by its own radial profile, the mean over scored pixels of each ring of
+     * the radial coordinate q (the distance to the vanishing point in px, or the caller's field
+     * such as the angle to the sun), linearly interpolated in q between the rings' mean q. What
+     * remains is the structure that no function of q (a glow around the sun) can explain; the
+     * glow itself is measured by the radial profile chart (report/profile). Interpolating
+     * matters: a step profile leaves a sawtooth on a steep core that any two images with the
+     * same core share. */
+    const double bin = o->radial ? o->radial_bin : 1.0;
+    double qmax = 0.0;
+    for (int py = 0; py < h; py++)
+        for (int px = 0; px < w; px++) {
+            const size_t p = (size_t)py * (size_t)w + (size_t)px;
+            const double q = o->radial ? o->radial[p] : hypot(px + 0.5 - o->vp_x, py + 0.5 - o->vp_y);
+            if (q > qmax) qmax = q;
+        }
+    const int nring = (int)(qmax / bin) + 2;
+    double *ring = calloc(3 * (size_t)nring, sizeof(double)); /* sum y, count, sum q */
     if (!ring) {
         free(wt);
         return gr_fail(err, GR_E_NOMEM, "structure: out of memory");
@@ -229,15 +238,26 @@ static gr_status fields(const gr_image *img, const gr_structure_options *o, doub
         for (int px = 0; px < w; px++) {
             const size_t p = (size_t)py * (size_t)w + (size_t)px;
             if (o->scored && !o->scored[p]) continue;
-            const int k = (int)hypot(px + 0.5 - o->vp_x, py + 0.5 - o->vp_y);
-            ring[2 * k] += y[p], ring[2 * k + 1] += 1.0;
+            const double q = o->radial ? o->radial[p] : hypot(px + 0.5 - o->vp_x, py + 0.5 - o->vp_y);
+            const int k = (int)(fmax(q, 0.0) / bin);
+            ring[3 * k] += y[p], ring[3 * k + 1] += 1.0, ring[3 * k + 2] += q;
         }
     const double floor_y = 1e-3 * fabs(*mean_y) + 1e-30;
     for (int py = 0; py < h; py++)
         for (int px = 0; px < w; px++) {
             const size_t p = (size_t)py * (size_t)w + (size_t)px;
-            const int k = (int)hypot(px + 0.5 - o->vp_x, py + 0.5 - o->vp_y);
-            const double rm = ring[2 * k + 1] > 0 ? ring[2 * k] / ring[2 * k + 1] : 0.0;
+            const double q = o->radial ? o->radial[p] : hypot(px + 0.5 - o->vp_x, py + 0.5 - o->vp_y);
+            const int k = (int)(fmax(q, 0.0) / bin);
+            double rm = 0.0;
+            if (ring[3 * k + 1] > 0) {
+                const double ck = ring[3 * k + 2] / ring[3 * k + 1], mk = ring[3 * k] / ring[3 * k + 1];
+                const int j = q < ck ? k - 1 : k + 1;
+                rm = mk;
+                if (j >= 0 && j < nring && ring[3 * j + 1] > 0) {
+                    const double cj = ring[3 * j + 2] / ring[3 * j + 1], mj = ring[3 * j] / ring[3 * j + 1];
+                    if (cj != ck) rm = mk + (mj - mk) * (q - ck) / (cj - ck);
+                }
+            }
             y[p] = y[p] / (fmax(rm, 0.0) + floor_y);
         }
     free(ring);

@@ -4,9 +4,10 @@
  * image and a beam pattern is a function of the angle. Three measures, each per image and
  * compared with the truth's (derivations: docs/metrics.md "Beam structure"):
  *
- *  - all on the de-glowed luminance D = Y / R(r): Rec. 709 luminance over its own mean on the
- *    ring at distance r from the vanishing point, so that any function of r alone (a glow
- *    around the sun) becomes flat and only the structure beside it remains;
+ *  - all on the de-glowed luminance D = Y / R(q): Rec. 709 luminance over its own mean on the
+ *    ring of radial coordinate q (the distance to the vanishing point, or the angle to the
+ *    sun), interpolated, so that any function of q alone (a glow around the sun) becomes flat
+ *    and only the structure beside it remains;
  *  - local band-pass contrast C = (G_f * D - G_c * D) / (G_c * D + eps), a difference of
  *    Gaussians over the local mean (Peli's band-limited contrast);
  *    its RMS over the image is the *streak contrast*, and the Pearson correlation of the
@@ -41,6 +42,11 @@ typedef struct gr_structure_options {
     int m_min;                   /* lowest angular frequency in the summaries; 0: 2 */
     const unsigned char *scored; /* per pixel, may be NULL (all); unscored pixels are left out of
                                     every sum, blur and ring */
+    const float *radial;         /* per pixel, may be NULL: the radial coordinate whose rings the
+                                    de-glow divides out; NULL: the distance (px) to the vanishing
+                                    point. Pass the angle to the sun (report/profile's
+                                    gr_profile_angles) to make any function of it exactly flat. */
+    double radial_bin;           /* ring width in radial's unit (required with radial) */
 } gr_structure_options;
 
 typedef struct gr_structure_image {
