@@ -586,6 +586,9 @@ static void *worker(void *arg)
             size_t ai = (size_t)y * acc->W + x;
             double *sum = acc->sum + (ai * acc->B + job->batch) * 3;
             for (int s = 0; s < r->spp_pass; s++) {
+                /* Ctrl-C within about a second even at thousands of samples per pixel per pass:
+                 * a volatile read every 16 samples (the row then stays unfinished: partial) */
+                if ((s & 15) == 15 && r->opt.interrupt && *r->opt.interrupt) break;
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
@@ -601,6 +604,7 @@ static void *worker(void *arg)
                 }
             }
         }
+        if (r->opt.interrupt && *r->opt.interrupt) break; /* the row may be unfinished: not counted */
         atomic_fetch_add(&job->rows_done, 1);
     }
     atomic_fetch_add(&job->queries, cnt.queries);
@@ -663,6 +667,7 @@ static gr_status image_errors(const ref_accum *acc, ref_errors *e)
         nb++;
     }
     double mean = 0.0;
+    size_t nr = 0; /* rendered pixels */
     for (size_t p = 0; p < np; p++) {
         double s = 0.0, s2 = 0.0;
         uint32_t n = 0;
@@ -682,13 +687,15 @@ static gr_status image_errors(const ref_accum *acc, ref_errors *e)
         v[p] = n ? tot / (3.0 * n) : 0.0;
         double mm = kb ? s / kb : 0.0;
         se[p] = kb >= 2 ? sqrt(fmax(0.0, (s2 - kb * mm * mm) / (kb - 1)) / kb) : fabs(v[p]);
+        if (!n) se[p] = -1.0; /* not rendered (interrupted): no estimate, not "converged" */
         mean += v[p];
+        nr += n > 0;
     }
-    mean /= (double)np;
+    mean /= (double)(nr ? nr : 1);
     size_t ok = 0;
-    for (size_t p = 0; p < np; p++) ok += se[p] <= 0.01 * fmax(v[p], mean);
+    for (size_t p = 0; p < np; p++) ok += se[p] >= 0.0 && se[p] <= 0.01 * fmax(v[p], mean);
     e->mean = mean;
-    e->frac_1pct = (double)ok / (double)np;
+    e->frac_1pct = (double)ok / (double)np; /* unrendered pixels count as not within 1 % */
     memcpy(tmp, v, np * sizeof *v);
     e->p95 = percentile(tmp, np, 0.95);
     if (nb >= 2) {

@@ -1,5 +1,6 @@
 /* godrays: entry point and subcommand dispatch. */
 #include "cli/cli.h"
+#include "common/signals.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -64,6 +65,7 @@ int main(int argc, char **argv)
         printf("godrays 0.1.0\n");
         return 0;
     }
+    gr_signals_install(); /* SIGINT, SIGTERM: temporary files removed, renders stopped cleanly */
     for (int i = 0; i < n_commands; i++)
         if (!strcmp(argv[1], commands[i].name)) return commands[i].run(argc - 1, argv + 1);
     fprintf(stderr, "godrays: unknown command '%s' (see godrays --help)\n", argv[1]);
