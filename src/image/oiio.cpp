@@ -47,66 +47,6 @@ float srgb_decode(float c)
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
-// Writes w x h x nc pixels of type `type` to a temporary file (common/outfile) in the format
-// that `path`'s extension names, reads it back (OpenImageIO's PNG writer does not report a
-// failed write: a full disk left a 0-byte or truncated file), then renames it over `path`.
-gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::TypeDesc type,
-                         const void *data, gr_error *err)
-{
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) return fail(err, GR_E_INPUT, path, "no writer for this file type", OIIO::geterror());
-    gr_outfile of;
-    gr_status st = gr_outfile_begin(&of, path, err);
-    if (st != GR_OK) return st;
-    const std::string tmp = of.tmp;
-    const std::string format = out->format_name();
-    if (!out->open(tmp, spec)) {
-        st = fail(err, GR_E_IO, path, "cannot create file", out->geterror());
-    } else {
-        if (!out->write_image(type, data))
-            st = fail(err, GR_E_IO, path, "writing pixels", out->geterror());
-        if (!out->close() && st == GR_OK)
-            st = fail(err, GR_E_IO, path, "closing file", out->geterror());
-    }
-    out.reset();
-    if (st == GR_OK) {
-        auto in = OIIO::ImageInput::create(format);
-        std::vector<unsigned char> back(spec.image_bytes());
-        OIIO::ImageSpec got;
-        if (!in || !in->open(tmp, got) || got.width != spec.width || got.height != spec.height ||
-            !in->read_image(0, 0, 0, spec.nchannels, spec.format, back.data()))
-            st = gr_fail(err, GR_E_IO, "%s: cannot write: the file written does not read back whole (is the disk full?)",
-                         path);
-        if (in) {
-            in->close();
-            (void)in->geterror();
-        }
-        (void)OIIO::geterror();
-    }
-    if (st == GR_OK) return gr_outfile_commit(&of, 1, err);
-    gr_outfile_abort(&of);
-    return st;
-}
-
-bool image_ok(const gr_image *img)
-{
-    return img && img->pixels && img->width > 0 && img->height > 0 && img->nchannels > 0 &&
-           img->nchannels <= GR_IMAGE_MAX_CHANNELS;
-}
-
-gr_status exception_status(gr_error *err, const char *path, const char *what)
-{
-    try {
-        throw;
-    } catch (const std::bad_alloc &) {
-        return gr_fail(err, GR_E_NOMEM, "%s: %s: out of memory", path ? path : "(null)", what);
-    } catch (const std::exception &e) {
-        return gr_fail(err, GR_E_RUNTIME, "%s: %s: %s", path ? path : "(null)", what, one_line(e.what()).c_str());
-    } catch (...) {
-        return gr_fail(err, GR_E_RUNTIME, "%s: %s: unknown exception", path ? path : "(null)", what);
-    }
-}
-
 // Redirects stderr (fd 2) into a temporary file while it lives: libpng's default handlers
 // print a line of their own ("libpng error: IHDR: CRC error") where the CLI promises one. The
 // text is taken into the error message; the capture is used by the CLI's single thread that
@@ -155,6 +95,67 @@ class StderrCapture {
     FILE *f_ = nullptr;
     int saved_ = -1;
 };
+
+// Writes w x h x nc pixels of type `type` to a temporary file (common/outfile) in the format
+// that `path`'s extension names, reads it back (OpenImageIO's PNG writer does not report a
+// failed write: a full disk left a 0-byte or truncated file), then renames it over `path`.
+gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::TypeDesc type,
+                         const void *data, gr_error *err)
+{
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) return fail(err, GR_E_INPUT, path, "no writer for this file type", OIIO::geterror());
+    gr_outfile of;
+    gr_status st = gr_outfile_begin(&of, path, err);
+    if (st != GR_OK) return st;
+    const std::string tmp = of.tmp;
+    const std::string format = out->format_name();
+    if (!out->open(tmp, spec)) {
+        st = fail(err, GR_E_IO, path, "cannot create file", out->geterror());
+    } else {
+        if (!out->write_image(type, data))
+            st = fail(err, GR_E_IO, path, "writing pixels", out->geterror());
+        if (!out->close() && st == GR_OK)
+            st = fail(err, GR_E_IO, path, "closing file", out->geterror());
+    }
+    out.reset();
+    if (st == GR_OK) {
+        StderrCapture quiet; // libpng's own line about the truncated file: the message says it
+        auto in = OIIO::ImageInput::create(format);
+        std::vector<unsigned char> back(spec.image_bytes());
+        OIIO::ImageSpec got;
+        if (!in || !in->open(tmp, got) || got.width != spec.width || got.height != spec.height ||
+            !in->read_image(0, 0, 0, spec.nchannels, spec.format, back.data()))
+            st = gr_fail(err, GR_E_IO, "%s: cannot write: the file written does not read back whole (is the disk full?)",
+                         path);
+        if (in) {
+            in->close();
+            (void)in->geterror();
+        }
+        (void)OIIO::geterror();
+    }
+    if (st == GR_OK) return gr_outfile_commit(&of, 1, err);
+    gr_outfile_abort(&of);
+    return st;
+}
+
+bool image_ok(const gr_image *img)
+{
+    return img && img->pixels && img->width > 0 && img->height > 0 && img->nchannels > 0 &&
+           img->nchannels <= GR_IMAGE_MAX_CHANNELS;
+}
+
+gr_status exception_status(gr_error *err, const char *path, const char *what)
+{
+    try {
+        throw;
+    } catch (const std::bad_alloc &) {
+        return gr_fail(err, GR_E_NOMEM, "%s: %s: out of memory", path ? path : "(null)", what);
+    } catch (const std::exception &e) {
+        return gr_fail(err, GR_E_RUNTIME, "%s: %s: %s", path ? path : "(null)", what, one_line(e.what()).c_str());
+    } catch (...) {
+        return gr_fail(err, GR_E_RUNTIME, "%s: %s: unknown exception", path ? path : "(null)", what);
+    }
+}
 
 } // namespace
 
