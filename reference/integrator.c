@@ -327,6 +327,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     bp.region = r->region;
     bp.pad_m = r->pad;
     bp.res = r->set.surface_res;
+    bp.interrupt = r->opt.interrupt;
     bp.jitter[0] = jit[0];
     bp.jitter[1] = jit[1];
     bp.max_prims = r->opt.max_prims;
@@ -928,6 +929,7 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, pthread_t *th, gr_progre
             r->set.surface_res = k ? res2 : res;
             r->beams_pass = -1; /* another resolution: rebuild */
             st = gr_ref_prepare_pass(r, p, err);
+            if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; break; }
             if (st == GR_OK)
                 st = march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, th, prog, frac0 + span * (2 * p + k) / (2.0 * passes),
                                 span / (2.0 * passes), "surface-bias probe", tot, &complete, err);
@@ -987,6 +989,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         for (int pp = 0; pp < P && st == GR_OK; pp++, pass++) {
             if (r->opt.interrupt && *r->opt.interrupt) { out->partial = 1; break; }
             st = gr_ref_prepare_pass(r, pass, err);
+            if (st == GR_E_INTERRUPTED) { st = GR_OK; out->partial = 1; break; }
             if (st != GR_OK) break;
             char note[64];
             snprintf(note, sizeof note, "pass %d/%d%s", pp + 1, P, rounds > 1 ? " (refining)" : "");
