@@ -2,6 +2,7 @@
  * and a real-time frame, possibly captured from another engine), optional mask, reference
  * standard errors, best scale fit; with -o DIR also metrics.json and false-color differences. */
 #include "cli/cli.h"
+#include "common/outfile.h"
 #include "cli/args.h"
 
 #include <errno.h>
@@ -69,21 +70,18 @@ static void usage(FILE *f)
             GR_METRICS_STDERR_BOUND);
 }
 
-/* Writes text to path through a temporary file renamed into place. */
+/* Writes text and a newline to path atomically (common/outfile). */
 static gr_status write_text(const char *path, const char *text, gr_error *err)
 {
-    char tmp[4300];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
-    int ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok || rename(tmp, path) != 0) {
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    }
-    return GR_OK;
+    size_t n = strlen(text);
+    char *t = malloc(n + 2);
+    if (!t) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
+    memcpy(t, text, n);
+    t[n] = '\n';
+    t[n + 1] = '\0';
+    gr_status st = gr_outfile_write(path, t, (long long)n + 1, err);
+    free(t);
+    return st;
 }
 
 /* Reads one input; any failure is bad input (exit 2) naming the role and the file. */

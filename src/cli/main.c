@@ -1,5 +1,6 @@
 /* godrays: entry point and subcommand dispatch. */
 #include "cli/cli.h"
+#include "common/signals.h"
 
 #include <stdarg.h>
 #include <stdint.h>
@@ -83,6 +84,7 @@ int main(int argc, char **argv)
     }
     /* the built-in techniques (and so their scene sections) before any scene is read */
     gr_technique_count();
+    gr_signals_install(); /* SIGINT, SIGTERM: temporary files removed, renders stopped cleanly */
     for (int i = 0; i < n_commands; i++)
         if (!strcmp(argv[1], commands[i].name)) return commands[i].run(argc - 1, argv + 1);
     for (int i = 0; i < n_aliases; i++) {
