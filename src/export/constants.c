@@ -12,6 +12,7 @@
 
 #include "core/optics.h"
 #include "core/shaftgeom.h"
+#include "realtime/shafts.h"
 
 /* c = a b, column-major 4x4 */
 static void mat_mul(const double a[16], const double b[16], double out[16])
@@ -65,6 +66,9 @@ static void set3(double *d, const double *s) { d[0] = s[0], d[1] = s[1], d[2] = 
 
 gr_status gr_constants_compute(const gr_scene *s, gr_shader_constants *c, gr_error *err)
 {
+    /* seed 000's constants use the scene's shafts section, scene-derived defaults resolved */
+    gr_shafts_settings sh;
+    gr_shafts_resolve(s, gr_shafts_scene_settings(s), &sh);
     memset(c, 0, sizeof *c);
     const gr_camera *cam = &s->camera;
     const gr_water *w = &s->water;
@@ -83,7 +87,7 @@ gr_status gr_constants_compute(const gr_scene *s, gr_shader_constants *c, gr_err
     c->P[0] = P.x, c->P[1] = P.y, c->P[2] = P.z;
     c->refr_dir[0] = T.x, c->refr_dir[1] = T.y, c->refr_dir[2] = T.z;
     for (int k = 0; k < 3; k++) c->to_refr_sun[k] = -c->refr_dir[k];
-    c->S = gr_shafts_spacing(s->shafts.K, c->depth_m, cam->fov_deg * GR_PI / 180.0, s->shafts.N);
+    c->S = gr_shafts_spacing(sh.K, c->depth_m, cam->fov_deg * GR_PI / 180.0, sh.N);
     if (!(isfinite(P.x) && isfinite(P.z) && T.y < 0.0 && c->S > 0.0 && isfinite(c->S)))
         return gr_fail(err, GR_E_INPUT, "sun.elevation_deg: no finite shaft centre P for this sun and camera");
 
@@ -137,17 +141,17 @@ gr_status gr_constants_compute(const gr_scene *s, gr_shader_constants *c, gr_err
     set3(c->extinction, s->medium.extinction);
     c->g = s->medium.g;
     c->ior = s->medium.ior;
-    set3(c->shaft_extinction, s->shafts.extinction);
-    c->shaft_g = s->shafts.g;
-    c->shaft_bias = s->shafts.bias;
-    set3(c->shaft_intensity, s->shafts.intensity);
+    set3(c->shaft_extinction, sh.extinction);
+    c->shaft_g = sh.g;
+    c->shaft_bias = sh.bias;
+    set3(c->shaft_intensity, sh.intensity);
     c->hgg[0] = 1.0 - c->shaft_g * c->shaft_g;
     c->hgg[1] = 1.0 + c->shaft_g * c->shaft_g;
     c->hgg[2] = 2.0 * c->shaft_g;
-    c->shaft_N = s->shafts.N;
-    c->shaft_K = s->shafts.K;
-    c->shaft_length_m = s->shafts.shaft_length_m;
-    c->shaft_width = s->shafts.shaft_width;
+    c->shaft_N = sh.N;
+    c->shaft_K = sh.K;
+    c->shaft_length_m = sh.shaft_length_m;
+    c->shaft_width = sh.shaft_width;
     c->seabed_y = s->has_seabed ? w->rest_height_m - s->seabed_depth_m : -1e30;
     return GR_OK;
 }
