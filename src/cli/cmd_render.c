@@ -1,6 +1,6 @@
 /* godrays render TECHNIQUE SCENE: render a scene with any registered real-time technique
  * (src/realtime/technique.h) into an EXR god-ray layer (linear float, frame resolution) plus
- * a PNG preview. (`godrays shafts` is main.c's alias of `render shafts`.) */
+ * a PNG preview. (main.c's aliases name a technique; nothing here does.) */
 #include "cli/cli.h"
 #include "cli/args.h"
 

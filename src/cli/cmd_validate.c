@@ -19,7 +19,7 @@ static void usage(FILE *f)
             "  --set PATH=VALUE  override one value before validation; VALUE is JSON (a number,\n"
             "                    array, true/false, \"string\") or a bare word taken as a string.\n"
             "                    Examples: --set camera.fov_deg=50  --set sun.irradiance=[1,0.9,0.8]\n"
-            "                    --set water.waves[0].amplitude_m=0.2  --set shafts.target_format=rgba16f\n"
+            "                    --set water.waves[0].amplitude_m=0.2  --set TECHNIQUE.KEY=V\n"
             "  -h, --help        this help\n"
             "\n"
             "Exit codes: 0 valid; 2 bad usage or invalid scene; 1 file cannot be read.\n");
