@@ -38,6 +38,7 @@ static void usage(FILE *f)
             "  --cutoff T             stop camera rays where their transmittance falls below T\n"
             "  --size WxH             override the image size\n"
             "  --set KEY=VALUE        any scene override, e.g. --set medium.g=0.9 (repeatable)\n"
+            "  --technique-dir DIR    add the user technique in DIR (for a scene with its section)\n"
             "  --aov                  add transmittance and ray_length channels\n"
             "  --no-preview           do not write the PNG preview\n"
             "  --quiet                no progress bar\n"
@@ -90,10 +91,13 @@ static int reference_with(gr_args *args)
         else if (!strcmp(a, "-o") || !strcmp(a, "--output")) rc = gr_args_value(args, &out_path);
         else if (!strcmp(a, "--set")) rc = gr_args_take_set(args);
         else if (!strcmp(a, "--size")) rc = gr_args_take_size(args);
+        else if (!strcmp(a, "--technique-dir")) rc = gr_args_take_technique_dir(args);
         else rc = gr_args_take_scene(args);
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
     if (!out_path && !bench) return gr_cli_usage_error(cmd, "no output given (-o OUT.exr)");
+    /* a scene with a user technique's section loads once that technique is known */
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) goto done;
     if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
     /* A render takes minutes: an output that cannot be written is refused before it. */
     if (!bench && (rc = gr_args_check_output_file(args, "-o", out_path)) != 0) goto done;
