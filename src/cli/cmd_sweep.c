@@ -66,6 +66,7 @@ static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, cons
     cJSON *root = cJSON_CreateObject();
     if (!root) return NULL;
     cJSON_AddStringToObject(root, "scene", s->base->name);
+    cJSON_AddStringToObject(root, "technique", p->cls->name);
     cJSON_AddStringToObject(root, "scene_file", s->base->source_path);
     cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
     cJSON_AddStringToObject(root, "channel", "Y");
@@ -254,8 +255,8 @@ static int sweep_with(gr_args *args)
 
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", s.base->name, s.base->camera.width,
-           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+    gr_sb_printf(&sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
+           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
            p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "minimum %.6g at %s = %.6g", r.err[r.best], p->params[0].key, xbest[0]);
     if (n_params > 1) gr_sb_printf(&sum, ", %s = %.6g", p->params[1].key, xbest[1]);

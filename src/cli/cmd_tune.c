@@ -310,6 +310,7 @@ static int tune_with(gr_args *args)
     root = cJSON_CreateObject();
     if (root) {
         cJSON_AddStringToObject(root, "scene", s.base->name);
+        cJSON_AddStringToObject(root, "technique", p->cls->name);
         cJSON_AddStringToObject(root, "scene_file", s.base->source_path);
         cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
         cJSON_AddStringToObject(root, "channel", "Y");
@@ -382,8 +383,8 @@ static int tune_with(gr_args *args)
 
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", s.base->name, s.base->camera.width,
-           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+    gr_sb_printf(&sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
+           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
            p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
     for (int k = 0; k < n_params; k++)
