@@ -169,6 +169,9 @@ static int render_with(gr_args *args)
         }
     }
     if (!tech_name) return gr_cli_usage_error(cmd, "no technique given (`godrays techniques` lists them)");
+    if (!args->scene_path && (strchr(tech_name, '/') || strchr(tech_name, '.')))
+        return gr_cli_usage_error(cmd, "%s: expected TECHNIQUE SCENE, the technique first (`godrays techniques` lists them)",
+                                  tech_name);
     if ((rc = gr_args_need_scene(args)) != 0) return rc;
     /* user techniques before the scene, whose sections they add */
     const gr_technique_class *cls = NULL;

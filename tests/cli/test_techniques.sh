@@ -74,6 +74,7 @@ expect 2 "unknown technique 'no_such_technique'" render no_such_technique "$scen
 first=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["techniques"][0]["name"])' "$dir/list.json")
 expect 2 "$first" render no_such_technique "$scene" -o "$dir/x.exr" # the message lists the known ones
 expect 2 "no technique given" render
+expect 2 "expected TECHNIQUE SCENE" render "$scene"
 expect 2 "$dir/no_such_dir" techniques --technique-dir "$dir/no_such_dir"
 expect 2 "$dir/no_such_dir" render "$first" "$scene" --technique-dir "$dir/no_such_dir" -o "$dir/x.exr"
 expect 2 "unknown argument --bogus" techniques --bogus
