@@ -247,7 +247,8 @@ int main(void)
         s.lights = 1;
         a = rb_test_render(lc, ls, fl, &s, NULL);
         nl = gr_radial_blur_local_lights(ls, uv, 1);
-        double cell_u = 1.5 * s.cell_px / (161 * s.target_scale), cell_v = 1.5 * s.cell_px / (91 * s.target_scale);
+        double cpx = fmax(1.0, round(s.cell_size * lround(91 * s.target_scale)));
+        double cell_u = 1.5 * cpx / lround(161 * s.target_scale), cell_v = 1.5 * cpx / lround(91 * s.target_scale);
         printf("one light at %.4f %.4f (sun 0.5 0.5)\n", uv[0][0], uv[0][1]);
         CHECK(nl == 1 && fabs(uv[0][0] - 0.5) < cell_u && fabs(uv[0][1] - 0.5) < cell_v);
         gr_image_destroy(a);
