@@ -785,7 +785,8 @@ static gr_status parse_ladder(ut_ctx *c, ut_manifest *m, const cJSON *lad)
             gr_error perr;
             if (gr_param_check(&m->table, &m->params[k], v, 0, &perr) != GR_OK) {
                 free(b.s);
-                return vfail(c, r, "%s", perr.msg);
+                const char *why = strstr(perr.msg, ": "); /* drop gr_param_check's "NAME.KEY: " */
+                return vfail(c, r, "%s", why ? why + 2 : perr.msg);
             }
             if (m->settings[k].type == UT_BOOL) snprintf(num, sizeof num, "%s", v != 0 ? "true" : "false");
             else gr_format_double(v, num, sizeof num);
@@ -832,6 +833,9 @@ static gr_status parse_manifest(ut_ctx *c, ut_manifest *m, const cJSON *root)
     const cJSON *set = cJSON_GetObjectItemCaseSensitive(root, "settings");
     m->settings_size = sizeof(double);
     if (set && (st = parse_settings(c, m, set))) return st;
+    m->table.section = m->name;
+    m->table.params = m->params;
+    m->table.count = (size_t)m->n_settings;
 
     const cJSON *gain = cJSON_GetObjectItemCaseSensitive(root, "gain");
     if (gain) {
