@@ -1,5 +1,6 @@
 /* Shared argument handling of the godrays commands (args.h). */
 #include "cli/args.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -270,6 +271,13 @@ int gr_args_check_output_file(const gr_args *a, const char *flag, const char *pa
     if (strlen(path) >= sizeof dir) return output_error(a, flag, path, "cannot write", "", ENAMETOOLONG);
     if (path[strlen(path) - 1] == '/' || (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)))
         return output_error(a, flag, path, "cannot write", "", EISDIR);
+    gr_outfile probe; /* an existing device node, FIFO or socket is refused (common/outfile) */
+    gr_error perr;
+    if (gr_outfile_begin(&probe, path, &perr) != GR_OK) {
+        gr_error_prefix(&perr, "%s", flag);
+        return gr_cli_report(a->cmd, &perr);
+    }
+    gr_outfile_abort(&probe); /* nothing was created */
     parent_of(path, dir, sizeof dir);
     const int e = writable_dir(dir);
     return e ? output_error(a, flag, path, "cannot write into ", dir, e) : 0;

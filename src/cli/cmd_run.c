@@ -104,7 +104,7 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
         gr_error cerr = {GR_OK, ""};
         if (gr_cache_dir(dir, sizeof dir, &cerr) != GR_OK) {
             snprintf(ro->note, sizeof ro->note, "cache off: %.1000s", cerr.msg);
-            if (!quiet) fprintf(stderr, "godrays run: warning: %s\n", ro->note);
+            fprintf(stderr, "godrays run: warning: %s\n", ro->note); /* warnings even with -q */
         } else {
             if ((st = gr_cache_key(scene, key, err)) != GR_OK) return st;
             if ((st = gr_cache_path(dir, key, ro->cache_path, sizeof ro->cache_path, err)) != GR_OK) return st;
@@ -119,7 +119,7 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
             }
             if (strstr(why, "ignored")) {
                 snprintf(ro->note, sizeof ro->note, "%s", why);
-                if (!quiet) fprintf(stderr, "godrays run: warning: cache entry %s\n", why);
+                fprintf(stderr, "godrays run: warning: cache entry %s\n", why); /* even with -q */
             }
         }
     }
@@ -148,7 +148,7 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
         if (gr_cache_store(dir, key, ro->img, &ro->meta, &serr) != GR_OK) {
             /* A cache that cannot be written costs time later, not correctness now. */
             snprintf(ro->note, sizeof ro->note, "not cached: %.1200s", serr.msg);
-            if (!quiet) fprintf(stderr, "godrays run: warning: %s\n", ro->note);
+            fprintf(stderr, "godrays run: warning: %s\n", ro->note); /* warnings even with -q */
             ro->cache_on = 0;
         }
     }

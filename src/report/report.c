@@ -1,5 +1,6 @@
 /* The report of `godrays run` (see report.h; how to read it: docs/report.md). */
 #include "report/report.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <math.h>
@@ -64,22 +65,10 @@ static gr_status join(char *buf, size_t n, const char *dir, const char *name, gr
     return GR_OK;
 }
 
-/* Writes text to path through PATH.tmp-PID renamed into place. */
+/* Writes text to path atomically (common/outfile). */
 static gr_status write_text(const char *path, const char *text, gr_error *err)
 {
-    char tmp[4400];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()) >= (int)sizeof tmp)
-        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
-    int ok = fputs(text, f) >= 0;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok || rename(tmp, path) != 0) {
-        const int e = errno;
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(e));
-    }
-    return GR_OK;
+    return gr_outfile_write(path, text, -1, err);
 }
 
 static const gr_meta_item *meta_get(const gr_metadata *m, const char *key)

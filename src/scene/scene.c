@@ -7,6 +7,7 @@
  * Every error carries the JSON path it concerns, so an error caused by a --set override
  * can be attributed to that override rather than to the file. */
 #include "scene/scene.h"
+#include "common/outfile.h"
 
 #include <cjson/cJSON.h>
 #include <errno.h>
@@ -1352,6 +1353,8 @@ static gr_status load_file_impl(const char *path, const char *const *overrides, 
                                 gr_error *err)
 {
     if (!path) return gr_fail(err, GR_E_RUNTIME, "gr_scene_load_file: no path");
+    gr_status reg = gr_check_regular_input(path, err); /* a FIFO would block the open */
+    if (reg != GR_OK) return reg;
     FILE *f = fopen(path, "rb");
     if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, strerror(errno));
     size_t cap = 1 << 16, len = 0;
