@@ -26,6 +26,8 @@ GODRAYS_PACKAGES=(
   # Blender round trip of the glTF export (tests/cli/test_export_blender.sh); its glTF
   # importer needs NumPy, only a Recommends of blender
   blender python3-numpy
+  # a single-node Slurm cluster for the farm test (tests/farm/test_slurm.sh, docs/farm.md)
+  slurm-wlm munge
 )
 
 installed() {
