@@ -128,7 +128,8 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
             cJSON_AddNumberToObject(pv, "pid", (double)getpid());
             cJSON_AddStringToObject(pv, "date", date);
             cJSON_AddNumberToObject(pv, "wall_s", res->wall_s);
-            cJSON_AddNumberToObject(pv, "threads", scene->reference.threads);
+            const gr_meta_item *th = gr_meta_get(&res->meta, "godrays:threads");
+            cJSON_AddNumberToObject(pv, "threads", th ? th->num : scene->reference.threads);
             cJSON_AddStringToObject(pv, "version", GR_VERSION);
             cJSON_AddStringToObject(pv, "command", command ? command : "");
         }
@@ -200,7 +201,7 @@ static void part_free(part *p)
 }
 
 /* Reads and checks one part file (header fields, payload length and checksum). */
-static gr_status part_read(const char *path, int header_only, part *p, gr_error *err)
+static gr_status part_read(const char *path, part *p, gr_error *err)
 {
     memset(p, 0, sizeof *p);
     p->path = path;
@@ -225,7 +226,7 @@ static gr_status part_read(const char *path, int header_only, part *p, gr_error 
         fclose(f);
         return gr_fail(err, GR_E_INPUT, "%s: truncated header", path);
     }
-    size_t want = header_only ? hn : total;
+    size_t want = total;
     p->data = malloc(want + 1);
     if (!p->data) {
         fclose(f);
@@ -284,39 +285,13 @@ static gr_status part_read(const char *path, int header_only, part *p, gr_error 
                        path, total - hn, pn, expect);
     }
     p->pay_n = expect;
-    if (!header_only) {
-        p->pay = p->data + hn;
-        char h[20];
-        snprintf(h, sizeof h, "%016llx", gr_fnv1a64(GR_FNV_BASIS, p->pay, p->pay_n));
-        if (strcmp(h, fnv) != 0) {
-            part_free(p);
-            return gr_fail(err, GR_E_INPUT, "%s: payload checksum %s, the header says %s: damaged", path, h, fnv);
-        }
+    p->pay = p->data + hn;
+    char h[20];
+    snprintf(h, sizeof h, "%016llx", gr_fnv1a64(GR_FNV_BASIS, p->pay, p->pay_n));
+    if (strcmp(h, fnv) != 0) {
+        part_free(p);
+        return gr_fail(err, GR_E_INPUT, "%s: payload checksum %s, the header says %s: damaged", path, h, fnv);
     }
-    return GR_OK;
-}
-
-gr_status gr_part_check(const char *path, gr_part_info *info, gr_error *err)
-{
-    part p;
-    gr_status st = part_read(path, 0, &p, err);
-    if (st != GR_OK) return st;
-    memset(info, 0, sizeof *info);
-    snprintf(info->key, sizeof info->key, "%s", str(p.h, "cache_key"));
-    info->width = p.W;
-    info->height = p.H;
-    info->batches = p.B;
-    info->row0 = p.row0;
-    info->row1 = p.row1;
-    info->batch0 = p.b0;
-    info->batch1 = p.b1;
-    const cJSON *pv = cJSON_GetObjectItemCaseSensitive(p.h, "provenance");
-    int ok = 1;
-    info->wall_s = pv ? num(pv, "wall_s", &ok) : 0.0;
-    info->threads = pv ? (int)num(pv, "threads", &ok) : 0;
-    const char *host = pv ? str(pv, "host") : NULL;
-    snprintf(info->host, sizeof info->host, "%s", host ? host : "");
-    part_free(&p);
     return GR_OK;
 }
 
@@ -331,7 +306,7 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
     int *owner = NULL;
     gr_ref_sums *sums = NULL;
     gr_ref_renderer *r = NULL;
-    for (int i = 0; i < n && st == GR_OK; i++) st = part_read(paths[i], 0, &ps[i], err);
+    for (int i = 0; i < n && st == GR_OK; i++) st = part_read(paths[i], &ps[i], err);
     /* one scene, one set of settings, one image size (the cache key covers the scene's
      * content and every reference setting but threads) */
     const part *p0 = &ps[0];

@@ -44,16 +44,4 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
 gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_ref_result *out, char *key,
                          size_t key_n, gr_error *err);
 
-/* Reads only a part's header: its cache key, tile rows and batches, and whether it is
- * complete and intact (the payload's length and checksum). For `farm --status` and the
- * jobs' skip of finished parts. GR_E_INPUT when it is not a valid part. */
-typedef struct gr_part_info {
-    char key[64];
-    int width, height, batches, row0, row1, batch0, batch1;
-    double wall_s;
-    int threads;
-    char host[128];
-} gr_part_info;
-gr_status gr_part_check(const char *path, gr_part_info *info, gr_error *err);
-
 #endif
