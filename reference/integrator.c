@@ -343,6 +343,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     bp.region = r->region;
     bp.pad_m = r->pad;
     bp.res = r->set.surface_res;
+    bp.interrupt = r->opt.interrupt;
     bp.jitter[0] = jit[0];
     bp.jitter[1] = jit[1];
     bp.max_prims = r->opt.max_prims;
@@ -603,6 +604,9 @@ static void *worker(void *arg)
             size_t ai = (size_t)y * acc->W + x;
             double *sum = acc->sum + (ai * acc->B + job->batch) * 3;
             for (int s = 0; s < r->spp_pass; s++) {
+                /* Ctrl-C within about a second even at thousands of samples per pixel per pass:
+                 * a volatile read every 16 samples (the row then stays unfinished: partial) */
+                if ((s & 15) == 15 && r->opt.interrupt && *r->opt.interrupt) break;
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
@@ -618,6 +622,7 @@ static void *worker(void *arg)
                 }
             }
         }
+        if (r->opt.interrupt && *r->opt.interrupt) break; /* the row may be unfinished: not counted */
         atomic_fetch_add(&job->rows_done, 1);
     }
     atomic_fetch_add(&job->queries, cnt.queries);
@@ -680,6 +685,7 @@ static gr_status image_errors(const ref_accum *acc, ref_errors *e)
         nb++;
     }
     double mean = 0.0;
+    size_t nr = 0; /* rendered pixels */
     for (size_t p = 0; p < np; p++) {
         double s = 0.0, s2 = 0.0;
         uint32_t n = 0;
@@ -699,13 +705,15 @@ static gr_status image_errors(const ref_accum *acc, ref_errors *e)
         v[p] = n ? tot / (3.0 * n) : 0.0;
         double mm = kb ? s / kb : 0.0;
         se[p] = kb >= 2 ? sqrt(fmax(0.0, (s2 - kb * mm * mm) / (kb - 1)) / kb) : fabs(v[p]);
+        if (!n) se[p] = -1.0; /* not rendered (interrupted): no estimate, not "converged" */
         mean += v[p];
+        nr += n > 0;
     }
-    mean /= (double)np;
+    mean /= (double)(nr ? nr : 1);
     size_t ok = 0;
-    for (size_t p = 0; p < np; p++) ok += se[p] <= 0.01 * fmax(v[p], mean);
+    for (size_t p = 0; p < np; p++) ok += se[p] >= 0.0 && se[p] <= 0.01 * fmax(v[p], mean);
     e->mean = mean;
-    e->frac_1pct = (double)ok / (double)np;
+    e->frac_1pct = (double)ok / (double)np; /* unrendered pixels count as not within 1 % */
     memcpy(tmp, v, np * sizeof *v);
     e->p95 = percentile(tmp, np, 0.95);
     if (nb >= 2) {
@@ -963,6 +971,7 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, gr_ref_sums *keep, pthre
             r->set.surface_res = k ? res2 : res;
             r->beams_pass = -1; /* another resolution: rebuild */
             st = gr_ref_prepare_pass(r, p, err);
+            if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; break; }
             if (st == GR_OK)
                 st = march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, y0, y1, th, prog, frac0 + span * (2 * p + k) / (2.0 * passes),
                                 span / (2.0 * passes), "surface-bias probe", tot, &complete, err);
@@ -1113,6 +1122,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             if (pass % acc.B < r->opt.batch0 || pass % acc.B >= r->opt.batch1) continue; /* another part's batch */
             if (r->opt.interrupt && *r->opt.interrupt) { out->partial = 1; break; }
             st = gr_ref_prepare_pass(r, pass, err);
+            if (st == GR_E_INTERRUPTED) { st = GR_OK; out->partial = 1; break; }
             if (st != GR_OK) break;
             char note[64];
             snprintf(note, sizeof note, "pass %d/%d%s", pp + 1, P, rounds > 1 ? " (refining)" : "");

@@ -1,6 +1,7 @@
 // OpenImageIO 2.4 behind the C interface of oiio.h: the only C++ in the project.
 // Every extern "C" body is wrapped in try/catch(...) so that no exception reaches C code.
 extern "C" {
+#include "common/outfile.h"
 #include "common/status.h"
 }
 #include "image/oiio.h"
@@ -46,20 +47,68 @@ float srgb_decode(float c)
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
-std::string temp_name(const char *path)
-{
-    return std::string(path) + ".tmp-" + std::to_string(static_cast<long>(getpid()));
-}
+// Redirects stderr (fd 2) into a temporary file while it lives: libpng's default handlers
+// print a line of their own ("libpng error: IHDR: CRC error") where the CLI promises one. The
+// text is taken into the error message; the capture is used by the CLI's single thread that
+// reads inputs, never while a render runs.
+class StderrCapture {
+  public:
+    StderrCapture()
+    {
+        std::fflush(stderr);
+        f_ = std::tmpfile();
+        if (f_) saved_ = dup(2);
+        if (saved_ < 0 || dup2(fileno(f_), 2) < 0) restore();
+    }
+    ~StderrCapture() { restore(); }
+    // Restores stderr; returns what was captured as one line (libpng's "libpng error: " dropped).
+    std::string take()
+    {
+        if (!f_ || saved_ < 0) return std::string();
+        std::fflush(stderr);
+        std::string text;
+        std::rewind(f_);
+        char buf[512];
+        size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, f_)) > 0 && text.size() < 2048) text.append(buf, n);
+        restore();
+        text = text.empty() ? text : one_line(text);
+        const std::string pre = "libpng error: ";
+        if (text.compare(0, pre.size(), pre) == 0) text = "libpng: " + text.substr(pre.size());
+        return text;
+    }
 
-// Writes w x h x nc pixels of type `type` to a temporary file in the format that `path`'s
-// extension names, then renames it over `path`: nothing half-written is ever visible.
+  private:
+    void restore()
+    {
+        if (saved_ >= 0) {
+            std::fflush(stderr);
+            dup2(saved_, 2);
+            close(saved_);
+            saved_ = -1;
+        }
+        if (f_) {
+            std::fclose(f_);
+            f_ = nullptr;
+        }
+    }
+    FILE *f_ = nullptr;
+    int saved_ = -1;
+};
+
+// Writes w x h x nc pixels of type `type` to a temporary file (common/outfile) in the format
+// that `path`'s extension names, reads it back (OpenImageIO's PNG writer does not report a
+// failed write: a full disk left a 0-byte or truncated file), then renames it over `path`.
 gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::TypeDesc type,
                          const void *data, gr_error *err)
 {
     auto out = OIIO::ImageOutput::create(path);
     if (!out) return fail(err, GR_E_INPUT, path, "no writer for this file type", OIIO::geterror());
-    const std::string tmp = temp_name(path);
-    gr_status st = GR_OK;
+    gr_outfile of;
+    gr_status st = gr_outfile_begin(&of, path, err);
+    if (st != GR_OK) return st;
+    const std::string tmp = of.tmp;
+    const std::string format = out->format_name();
     if (!out->open(tmp, spec)) {
         st = fail(err, GR_E_IO, path, "cannot create file", out->geterror());
     } else {
@@ -69,9 +118,23 @@ gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::Ty
             st = fail(err, GR_E_IO, path, "closing file", out->geterror());
     }
     out.reset();
-    if (st == GR_OK && std::rename(tmp.c_str(), path) != 0)
-        st = gr_fail(err, GR_E_IO, "%s: cannot rename %s into place: %s", path, tmp.c_str(), std::strerror(errno));
-    if (st != GR_OK) std::remove(tmp.c_str());
+    if (st == GR_OK) {
+        StderrCapture quiet; // libpng's own line about the truncated file: the message says it
+        auto in = OIIO::ImageInput::create(format);
+        std::vector<unsigned char> back(spec.image_bytes());
+        OIIO::ImageSpec got;
+        if (!in || !in->open(tmp, got) || got.width != spec.width || got.height != spec.height ||
+            !in->read_image(0, 0, 0, spec.nchannels, spec.format, back.data()))
+            st = gr_fail(err, GR_E_IO, "%s: cannot write: the file written does not read back whole (is the disk full?)",
+                         path);
+        if (in) {
+            in->close();
+            (void)in->geterror();
+        }
+        (void)OIIO::geterror();
+    }
+    if (st == GR_OK) return gr_outfile_commit(&of, 1, err);
+    gr_outfile_abort(&of);
     return st;
 }
 
@@ -115,10 +178,15 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
     if (out) *out = nullptr;
     if (!path || !path[0] || !out) return gr_fail(err, GR_E_USAGE, "image read: no input path or output");
     gr_image *img = nullptr;
+    gr_status reg = gr_check_regular_input(path, err); // a FIFO blocks, /dev/zero spins
+    if (reg != GR_OK) return reg;
+    StderrCapture cap; // libpng prints its own line ("IHDR: CRC error"): kept for the message
     try {
         auto in = OIIO::ImageInput::open(path);
         if (!in) {
             std::string why = OIIO::geterror();
+            const std::string lib = cap.take();
+            if (!lib.empty()) why += " (" + lib + ")";
             // A missing or unreadable file is an I/O error; anything else is bad input.
             FILE *f = std::fopen(path, "rb");
             if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
@@ -129,6 +197,8 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         if (spec.deep) return gr_fail(err, GR_E_INPUT, "%s: deep images are not supported", path);
         if (spec.depth > 1) return gr_fail(err, GR_E_INPUT, "%s: volume images are not supported", path);
         const int nc = spec.nchannels;
+        gr_status cst = gr_image_check_size(path, spec.width, spec.height, nc, err);
+        if (cst != GR_OK) return cst;
         if (nc <= 0 || nc > GR_IMAGE_MAX_CHANNELS)
             return gr_fail(err, GR_E_INPUT, "%s: %d channels (1 to %d supported)", path, nc, GR_IMAGE_MAX_CHANNELS);
         static const char *const rgba[4] = {"R", "G", "B", "A"};
@@ -145,7 +215,10 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         img = gr_image_create(spec.width, spec.height, nc, cnames.data());
         if (!img) return gr_fail(err, GR_E_NOMEM, "%s: cannot allocate %d x %d x %d image", path, spec.width, spec.height, nc);
         if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, img->pixels)) {
-            gr_status st = fail(err, GR_E_INPUT, path, "reading pixels", in->geterror());
+            std::string why = in->geterror();
+            const std::string lib = cap.take();
+            if (!lib.empty()) why += " (" + lib + ")";
+            gr_status st = fail(err, GR_E_INPUT, path, "reading pixels", why);
             gr_image_destroy(img);
             return st;
         }

@@ -1,5 +1,6 @@
 /* The report of `godrays run` (see report.h; how to read it: docs/report.md). */
 #include "report/report.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <math.h>
@@ -64,22 +65,10 @@ static gr_status join(char *buf, size_t n, const char *dir, const char *name, gr
     return GR_OK;
 }
 
-/* Writes text to path through PATH.tmp-PID renamed into place. */
+/* Writes text to path atomically (common/outfile). */
 static gr_status write_text(const char *path, const char *text, gr_error *err)
 {
-    char tmp[4400];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()) >= (int)sizeof tmp)
-        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
-    int ok = fputs(text, f) >= 0;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok || rename(tmp, path) != 0) {
-        const int e = errno;
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(e));
-    }
-    return GR_OK;
+    return gr_outfile_write(path, text, -1, err);
 }
 
 static const gr_meta_item *meta_get(const gr_metadata *m, const char *key)
@@ -1032,8 +1021,13 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     gr_sb_puts(b, "<h2>Scene and settings</h2>\n");
     gr_sb_puts(b, "<h3>Ground-truth settings</h3>\n");
     html_settings_table(b, &gr_reference_param_table, &s->reference);
-    gr_sb_puts(b, "<h3>Real-time shaft settings</h3>\n");
-    html_settings_table(b, &gr_shafts_param_table, &s->shafts);
+    for (int i = 0; i < s->n_sections; i++) {
+        const gr_param_table *tab = gr_sections_table(i);
+        gr_sb_puts(b, "<h3>Real-time technique <code>");
+        gr_sb_html(b, tab->section);
+        gr_sb_puts(b, "</code></h3>\n");
+        html_settings_table(b, tab, gr_scene_section_const(s, i));
+    }
     gr_sb_puts(b, "<details><summary>The scene, normalized (every default filled in)</summary>\n<pre>");
     char *sj = gr_scene_to_json(s);
     if (!sj) return gr_fail(err, GR_E_NOMEM, "%s/index.html: out of memory printing the scene", c->dir);

@@ -38,7 +38,9 @@ ck "table states the stderr exclusion" grep -q "768 NOT SCORED: reference relati
 ck "metrics.json written" [ -s res/metrics.json ]
 ck "diff.png written" [ -s res/diff.png ]
 ck "diff_signed.png written" [ -s res/diff_signed.png ]
-ck "no temporary file left" [ -z "$(ls res | grep -v -e '^metrics.json$' -e '^diff.png$' -e '^diff_signed.png$')" ]
+ck "flip.png written" [ -s res/flip.png ]
+ck "no temporary file left" [ -z "$(ls res | grep -v -e '^metrics.json$' -e '^diff.png$' -e '^diff_signed.png$' -e '^flip.png$')" ]
+ck "json: FLIP of a constant pair (ref is .exr: HDR)" grep -q '"mode":[[:space:]]*"hdr"' res/metrics.json
 ck "diff.png is the image plus its colorbar (256 x 88)" sh -c 'iinfo res/diff.png | grep -q "256 x   88"'
 ck "json: 2304 scored" grep -q '"scored_pixels":[[:space:]]*2304,' res/metrics.json
 ck "json: 768 excluded" grep -q '"stderr_excluded_pixels":[[:space:]]*768,' res/metrics.json
