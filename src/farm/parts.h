@@ -11,12 +11,12 @@
  *   line 1  "GODRAYS-PART 1"
  *   line 2  N, the byte length of the header
  *   N bytes a JSON header: format, cache_key, scene (the normalized scene JSON), scene_path,
- *           width, height, batches, row0, row1, batch0, batch1, passes, probe fields, timing
- *           counters, provenance (host, pid, date, wall_s, threads, version), payload_bytes,
- *           payload_fnv1a64
+ *           width, height, batches, row0, row1, batch0, batch1, passes, probe fields
+ *           (levels, grid, its rows), timing counters, provenance (host, pid, date, wall_s,
+ *           threads, version, command), payload_bytes, payload_fnv1a64
  *   payload for rows y in [row0, row1), x in [0, W), batches b in [batch0, batch1):
  *           3 doubles (RGB sums), then the same order again as uint32 sample counts; if the
- *           part ran the probe (it holds batch 0), for each of its two accumulators the
+ *           part ran the probe (it holds batch 0), for each of its probe_levels accumulators the
  *           probe rows inside [row0, row1): 3 doubles per probe pixel, then uint32 counts.
  * Files are written to a temporary name and renamed: never half a part. */
 #ifndef GR_FARM_PARTS_H
