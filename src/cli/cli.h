@@ -14,7 +14,8 @@ typedef struct gr_command {
 int cmd_validate(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
-int cmd_shafts(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+int cmd_techniques(int argc, char **argv);
 int cmd_reference(int argc, char **argv);
 int cmd_run(int argc, char **argv);
 int cmd_sweep(int argc, char **argv);

@@ -14,7 +14,7 @@
 
 #include "compare/metrics.h"
 #include "image/exr.h"
-#include "realtime/shafts.h"
+#include "realtime/technique.h"
 #include "reference/integrator.h"
 #include "report/cache.h"
 #include "report/report.h"
@@ -67,21 +67,22 @@ static void command_line(int argc, char **argv, gr_strbuf *b)
     }
 }
 
-/* One render in a fresh context, as `godrays shafts` does. */
-static gr_status render_shafts(const gr_scene *scene, gr_image **img, gr_metadata *meta, gr_error *err)
+/* One render of technique cls in context gl, as `godrays render` does. */
+static gr_status render_technique(const gr_technique_class *cls, gr_gl *gl, const gr_scene *scene, gr_image **img,
+                                  gr_metadata *meta, gr_error *err)
 {
-    gr_shafts *r = NULL;
-    gr_status st = gr_shafts_create(NULL, &r, err);
+    gr_technique *r = NULL;
+    gr_status st = gr_technique_create(cls, gl, NULL, &r, err);
     if (st != GR_OK) return st;
     *img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
     if (!*img) {
-        gr_shafts_destroy(r);
+        gr_technique_destroy(r);
         return gr_fail(err, GR_E_NOMEM, "out of memory for a %d x %d image", scene->camera.width, scene->camera.height);
     }
-    gr_shafts_stats stats;
-    st = gr_shafts_render(r, scene, NULL, *img, &stats, err);
-    if (st == GR_OK) st = gr_shafts_metadata(r, scene, NULL, &stats, meta, err);
-    gr_shafts_destroy(r);
+    gr_technique_stats stats;
+    st = gr_technique_render(r, scene, NULL, *img, &stats, err);
+    if (st == GR_OK) st = gr_technique_metadata(r, scene, NULL, &stats, meta, err);
+    gr_technique_destroy(r);
     return st;
 }
 
@@ -161,16 +162,13 @@ static void print_summary(const char *dir, const gr_scene *scene, const gr_metri
     const gr_channel_metrics *yr = &raw->ch[GR_MCH_Y], *yf = &fit->ch[GR_MCH_Y];
     double gpu = 0.0;
     int any = 0;
-    static const char *const keys[3] = {"godrays:gpu_ns.shadow", "godrays:gpu_ns.shafts", "godrays:gpu_ns.final"};
-    for (int p = 0; p < 3; p++) {
-        const gr_meta_item *it = gr_meta_get(smeta, keys[p]);
-        if (it && it->type != GR_META_STRING && it->num >= 0) {
-            gpu += it->num * 1e-6;
-            any = 1;
-        }
+    const gr_meta_item *g = gr_meta_get(smeta, "godrays:gpu_ms");
+    if (g && g->type != GR_META_STRING && g->num >= 0) {
+        gpu = g->num;
+        any = 1;
     }
-    const gr_meta_item *cpu = gr_meta_get(smeta, "godrays:cpu_ms");
-    printf("scene '%s' (%d x %d): ground truth %.1f s (%s), real-time shafts %.2f s (GPU ",
+    const gr_meta_item *cpu = gr_meta_get(smeta, "godrays:wall_ms");
+    printf("scene '%s' (%d x %d): ground truth %.1f s (%s), real time %.2f s (GPU ",
            scene->name, scene->camera.width, scene->camera.height, t_ref, ro->cached ? "from the cache" : "rendered",
            t_shafts);
     if (any) printf("%.2f ms", gpu);
@@ -232,7 +230,8 @@ static int run_with(gr_args *args)
     char dirbuf[4096], path[4300];
     if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
     /* Bad settings are bad input (exit 2) before any slow or GL work. */
-    if (gr_shafts_check_settings(&scene->shafts, &err) != GR_OK) goto fail;
+    const gr_technique_class *cls = gr_technique_at(0);
+    if (gr_technique_check(cls, gr_technique_scene_settings(cls, scene), &err) != GR_OK) goto fail;
     /* The ground truth takes minutes: a folder that cannot be made is refused before it. */
     if ((rc = gr_args_output_dir(args, scene, outdir, NULL, dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
     command_line(argc, argv, &cmdline);
@@ -244,7 +243,13 @@ static int run_with(gr_args *args)
      * a two-minute ground truth first. */
     if (!quiet) fprintf(stderr, "godrays run: rendering the real-time shafts...\n");
     double t = now_s();
-    if (render_shafts(scene, &test, &smeta, &err) != GR_OK) goto fail;
+    {
+        gr_gl *gl = NULL;
+        if (gr_gl_create(NULL, &gl, &err) != GR_OK) goto fail;
+        gr_status rst = render_technique(cls, gl, scene, &test, &smeta, &err);
+        gr_gl_destroy(gl);
+        if (rst != GR_OK) goto fail;
+    }
     const double t_shafts = now_s() - t;
 
     t = now_s();

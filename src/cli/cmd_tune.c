@@ -95,9 +95,9 @@ static int parse_count(const char *s, int lo, int hi, int *out)
 static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune_problem *p, const double *xb,
                               const double *xa, gr_error *err)
 {
-    gr_shafts_settings sb, sa;
-    gr_status st = gr_tune_settings_at(p, xb, &sb, err);
-    if (st == GR_OK) st = gr_tune_settings_at(p, xa, &sa, err);
+    gr_section_store sb, sa;
+    gr_status st = gr_tune_settings_at(p, xb, sb.bytes, err);
+    if (st == GR_OK) st = gr_tune_settings_at(p, xa, sa.bytes, err);
     if (st != GR_OK) return st;
     int W = p->scratch->width, H = p->scratch->height;
     gr_image *ib = gr_image_create(W, H, 3, NULL), *ia = gr_image_create(W, H, 3, NULL);
@@ -106,8 +106,8 @@ static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune
     if (!ib || !ia) st = gr_fail(err, GR_E_NOMEM, "out of memory");
     for (int i = 0; st == GR_OK && i < s->n_cases; i++) {
         gr_metrics mb, ma;
-        if ((st = gr_tune_render_case(p, i, &sb, ib, &mb, err)) != GR_OK) break;
-        if ((st = gr_tune_render_case(p, i, &sa, ia, &ma, err)) != GR_OK) break;
+        if ((st = gr_tune_render_case(p, i, sb.bytes, ib, &mb, err)) != GR_OK) break;
+        if ((st = gr_tune_render_case(p, i, sa.bytes, ia, &ma, err)) != GR_OK) break;
         double e = gr_report_exposure(p->refs[i], 1.0, 0.99, 0.8);
         double ab = p->fit ? mb.fit.scale : 1.0, aa = p->fit ? ma.fit.scale : 1.0;
         int rr[3];
@@ -132,10 +132,13 @@ static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune
                      gr_tune_metric_value(p->fit ? &ma.fit : &ma.raw, p->metric),
                      100.0 * (1.0 - gr_tune_metric_value(p->fit ? &ma.fit : &ma.raw, p->metric) /
                                         fmax(1e-300, gr_tune_metric_value(p->fit ? &mb.fit : &mb.raw, p->metric))));
-            snprintf(l2, sizeof l2, "shafts shown x their fitted scale (%.3g, %.3g), same exposure as the reference", ab,
-                     aa);
+            snprintf(l2, sizeof l2, "%s shown x its fitted scale (%.3g, %.3g), same exposure as the reference",
+                     p->cls->name, ab, aa);
             const char *lines[3] = {l0, l1, l2};
-            const char *titles[3] = {"ground truth", "shafts before", "shafts after tuning"};
+            char t1[64], t2[80];
+            snprintf(t1, sizeof t1, "%s before", p->cls->name);
+            snprintf(t2, sizeof t2, "%s after tuning", p->cls->name);
+            const char *titles[3] = {"ground truth", t1, t2};
             int labelled = 0;
             const gr_image *panels[3] = {disp[0], disp[1], disp[2]};
             if ((st = gr_report_contact_sheet(panels, titles, lines, 3, 320, 640, &sheet, &labelled, err)) != GR_OK)
@@ -161,7 +164,7 @@ static int tune_with(gr_args *args)
     gr_tune_cli_init(&c);
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
     int n_params = 0, n_starts = 4, max_evals = 0, rc = 0;
-    const char *bounds[32], *starts[32];
+    const char *bounds[32], *starts[32], *params_spec = NULL;
     int n_bounds = 0, n_start_specs = 0;
     gr_error err = {GR_OK, ""};
     for (; args->i < argc; args->i++) {
@@ -174,9 +177,8 @@ static int tune_with(gr_args *args)
             !strcmp(a, "--max-evals")) {
             if ((rc = gr_args_value(args, &v)) != 0) return rc;
             if (!strcmp(a, "--params")) {
-                if (n_params) return gr_cli_usage_error(cmd, "--params given twice");
-                if (gr_tune_param_parse_list(a, v, params, GR_TUNE_MAX_PARAMS, &n_params, &err) != GR_OK)
-                    return gr_cli_report(cmd, &err);
+                if (params_spec) return gr_cli_usage_error(cmd, "--params given twice");
+                params_spec = v; /* parsed after the loop, once --technique-dir is known */
             } else if (!strcmp(a, "--bounds")) {
                 if (n_bounds >= 32) return gr_cli_usage_error(cmd, "--bounds: too many");
                 bounds[n_bounds++] = v;
@@ -201,7 +203,10 @@ static int tune_with(gr_args *args)
         if (rc) return rc;
     }
     if ((rc = gr_args_need_scene(args)) != 0) return rc;
-    if (!n_params) return gr_cli_usage_error(cmd, "no --params given (e.g. --params shafts.extinction,shafts.K)");
+    if (!params_spec) return gr_cli_usage_error(cmd, "no --params given (e.g. --params TECHNIQUE.KEY,TECHNIQUE.KEY)");
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    if (gr_tune_param_parse_list("--params", params_spec, params, GR_TUNE_MAX_PARAMS, &n_params, &err) != GR_OK)
+        return gr_cli_report(cmd, &err);
     for (int b = 0; b < n_bounds; b++)
         if (gr_tune_param_parse_bounds("--bounds", bounds[b], params, n_params, &err) != GR_OK)
             return gr_cli_report(cmd, &err);
@@ -215,7 +220,7 @@ static int tune_with(gr_args *args)
         char key[64];
         double v;
         if (parse_kv(starts[b], key, sizeof key, &v))
-            return gr_cli_usage_error(cmd, "--start %s: expected shafts.KEY=VALUE", starts[b]);
+            return gr_cli_usage_error(cmd, "--start %s: expected TECHNIQUE.KEY=VALUE", starts[b]);
         int idx = -1;
         for (int k = 0; k < n_params; k++)
             if (!strcmp(params[k].key, key)) idx = k;
@@ -248,11 +253,11 @@ static int tune_with(gr_args *args)
     for (int k = 0; k < n_params; k++) {
         lo[k] = params[k].lo;
         hi[k] = params[k].hi;
-        xb[k] = gr_tune_param_current(&params[k], &p->base, &p->base); /* the scene's own value */
+        xb[k] = gr_tune_param_current(&params[k], p->base.bytes, p->base.bytes); /* the scene's own value */
         if (!have_x0[k]) x0[k] = fmin(hi[k], fmax(lo[k], xb[k]));
-        gr_shafts_settings t = p->base;
+        gr_section_store t = p->base;
         for (int e = 0; e < 2; e++)
-            if (gr_tune_param_apply(&params[k], &p->base, e ? hi[k] : lo[k], &t, &err) != GR_OK) {
+            if (gr_tune_param_apply(&params[k], p->base.bytes, e ? hi[k] : lo[k], t.bytes, &err) != GR_OK) {
                 err.status = GR_E_USAGE;
                 gr_error_prefix(&err, "bounds of %s", params[k].key);
                 goto fail;
@@ -362,7 +367,7 @@ static int tune_with(gr_args *args)
             cJSON_AddNumberToObject(tm, "render_readback_s", p->render_s - render_s0);
             cJSON_AddNumberToObject(tm, "metrics_s", p->metrics_s - metrics_s0);
             cJSON_AddNumberToObject(tm, "ground_truth_s", s.truth_seconds);
-            cJSON_AddStringToObject(tm, "gl_renderer", gr_gl_renderer(gr_shafts_gl(p->renderer)));
+            cJSON_AddStringToObject(tm, "gl_renderer", gr_gl_renderer(gr_technique_gl(p->renderer)));
         }
         json = cJSON_Print(root);
     }

@@ -1032,8 +1032,13 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     gr_sb_puts(b, "<h2>Scene and settings</h2>\n");
     gr_sb_puts(b, "<h3>Ground-truth settings</h3>\n");
     html_settings_table(b, &gr_reference_param_table, &s->reference);
-    gr_sb_puts(b, "<h3>Real-time shaft settings</h3>\n");
-    html_settings_table(b, &gr_shafts_param_table, &s->shafts);
+    for (int i = 0; i < s->n_sections; i++) {
+        const gr_param_table *tab = gr_sections_table(i);
+        gr_sb_puts(b, "<h3>Real-time technique <code>");
+        gr_sb_html(b, tab->section);
+        gr_sb_puts(b, "</code></h3>\n");
+        html_settings_table(b, tab, gr_scene_section_const(s, i));
+    }
     gr_sb_puts(b, "<details><summary>The scene, normalized (every default filled in)</summary>\n<pre>");
     char *sj = gr_scene_to_json(s);
     if (!sj) return gr_fail(err, GR_E_NOMEM, "%s/index.html: out of memory printing the scene", c->dir);

@@ -83,13 +83,19 @@ gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
         if (!p->refs[i] || p->refs[i]->width != c->width || p->refs[i]->height != c->height)
             return gr_fail(err, GR_E_INPUT, "tuning: the ground truth of case %d is not %dx%d", i, c->width, c->height);
     }
-    gr_shafts_settings r;
-    gr_shafts_resolve(p->scenes[0], &p->base, &r);
+    if (!p->cls || !p->renderer || gr_technique_class_of(p->renderer) != p->cls)
+        return gr_fail(err, GR_E_INPUT, "tuning: no technique instance of the problem's class");
+    for (int k = 0; k < p->n_params; k++)
+        if (p->params[k].cls != p->cls)
+            return gr_fail(err, GR_E_USAGE, "%s: not a setting of technique %s (choose it with --technique)",
+                           p->params[k].key, p->cls->name);
+    gr_section_store r;
+    gr_technique_resolve(p->cls, p->scenes[0], p->base.bytes, r.bytes);
     p->base = r;
     p->scratch = gr_image_create(c0->width, c0->height, 3, NULL);
     if (!p->scratch) return gr_fail(err, GR_E_NOMEM, "tuning: out of memory for a %dx%d frame", c0->width, c0->height);
     p->renders = 0;
-    p->render_s = p->metrics_s = p->shafts_cpu_ms_sum = p->gpu_ms_sum = 0.0;
+    p->render_s = p->metrics_s = p->wall_ms_sum = p->gpu_ms_sum = 0.0;
     p->gpu_timed = 0;
     return GR_OK;
 }
@@ -101,29 +107,29 @@ void gr_tune_problem_free(gr_tune_problem *p)
     p->scratch = NULL;
 }
 
-gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, gr_shafts_settings *out, gr_error *err)
+gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, void *out, gr_error *err)
 {
-    *out = p->base;
+    memcpy(out, p->base.bytes, p->cls->settings_size);
     for (int k = 0; k < p->n_params; k++) {
-        gr_status st = gr_tune_param_apply(&p->params[k], &p->base, x[k], out, err);
+        gr_status st = gr_tune_param_apply(&p->params[k], p->base.bytes, x[k], out, err);
         if (st != GR_OK) return st;
     }
     return GR_OK;
 }
 
 /* One render + metrics; opt chooses which metrics are computed. */
-static gr_status render_score(gr_tune_problem *p, int i, const gr_shafts_settings *s, gr_image *out,
+static gr_status render_score(gr_tune_problem *p, int i, const void *s, gr_image *out,
                               const gr_metrics_options *opt, gr_metrics *m, gr_error *err)
 {
-    gr_shafts_stats stats;
+    gr_technique_stats stats;
     double t0 = now_s();
-    gr_status st = gr_shafts_render(p->renderer, p->scenes[i], s, out, &stats, err);
+    gr_status st = gr_technique_render(p->renderer, p->scenes[i], s, out, &stats, err);
     double t1 = now_s();
     p->render_s += t1 - t0;
     if (st != GR_OK) return st;
     p->renders++;
-    p->shafts_cpu_ms_sum += stats.cpu_ms;
-    for (int k = 0; k < GR_SHAFTS_NPASS; k++) {
+    p->wall_ms_sum += stats.wall_ms;
+    for (int k = 0; k < stats.n_passes; k++) {
         if (stats.gpu_ns[k] >= 0) {
             p->gpu_ms_sum += (double)stats.gpu_ns[k] * 1e-6;
             p->gpu_timed = 1;
@@ -137,8 +143,8 @@ static gr_status render_score(gr_tune_problem *p, int i, const gr_shafts_setting
 gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, double *per_case, double *scale,
                            gr_error *err)
 {
-    gr_shafts_settings s;
-    gr_status st = gr_tune_settings_at(p, x, &s, err);
+    gr_section_store s;
+    gr_status st = gr_tune_settings_at(p, x, s.bytes, err);
     if (st != GR_OK) return st;
     /* Only what the metric needs: the pointwise pass is cheap, SSIM and blurs are not. */
     gr_metrics_options opt = {0};
@@ -149,7 +155,7 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
     double sum = 0.0;
     for (int i = 0; i < p->n_cases; i++) {
         gr_metrics m;
-        if ((st = render_score(p, i, &s, p->scratch, &opt, &m, err)) != GR_OK) return st;
+        if ((st = render_score(p, i, s.bytes, p->scratch, &opt, &m, err)) != GR_OK) return st;
         const gr_metrics_set *set = p->fit ? &m.fit : &m.raw;
         double v = gr_tune_metric_value(set, p->metric);
         if (p->normalize && (p->metric == GR_TM_RMSE || p->metric == GR_TM_MSRMSE)) {
@@ -165,7 +171,7 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
     return GR_OK;
 }
 
-gr_status gr_tune_render_case(gr_tune_problem *p, int i, const gr_shafts_settings *s, gr_image *out, gr_metrics *m,
+gr_status gr_tune_render_case(gr_tune_problem *p, int i, const void *s, gr_image *out, gr_metrics *m,
                               gr_error *err)
 {
     if (i < 0 || i >= p->n_cases) return gr_fail(err, GR_E_INPUT, "tuning: no case %d", i);
@@ -198,27 +204,32 @@ static int add_rgb(cJSON *o, const char *name, const double *rgb)
 
 char *gr_tune_snippet(const gr_tune_problem *p, const double *x, double scale)
 {
-    gr_shafts_settings s;
+    gr_section_store s;
     gr_error e;
-    if (gr_tune_settings_at(p, x, &s, &e) != GR_OK) return NULL;
+    if (gr_tune_settings_at(p, x, s.bytes, &e) != GR_OK) return NULL;
     cJSON *root = cJSON_CreateObject();
-    cJSON *sh = root ? cJSON_AddObjectToObject(root, "shafts") : NULL;
-    int ok = sh != NULL, has_intensity = 0;
+    cJSON *sh = root ? cJSON_AddObjectToObject(root, p->cls->name) : NULL;
+    const gr_param *gain = p->cls->gain_key ? gr_param_find(p->cls->params, p->cls->gain_key) : NULL;
+    int ok = sh != NULL, has_gain = 0;
     for (int k = 0; ok && k < p->n_params; k++) {
         const gr_tune_param *tp = &p->params[k];
-        if (!strcmp(tp->p->name, "intensity")) has_intensity = 1;
+        if (tp->p == gain) has_gain = 1;
         if (tp->kind == GR_TK_RGB_SCALE) {
-            const double *rgb = (const double *)((const char *)&s + tp->p->offset);
+            const double *rgb = (const double *)(const void *)(s.bytes + tp->p->offset);
             ok = add_rgb(sh, tp->p->name, rgb);
         } else {
-            double v = gr_param_get_number(tp->p, &s, 0);
+            double v = gr_param_get_number(tp->p, s.bytes, 0);
             ok = cJSON_AddNumberToObject(sh, tp->p->name, tp->kind == GR_TK_INT ? v : round_sig(v, 5)) != NULL;
         }
     }
-    if (ok && !has_intensity && scale > 0 && scale != 1.0) {
-        double in[3];
-        for (int c = 0; c < 3; c++) in[c] = s.intensity[c] * scale;
-        ok = add_rgb(sh, "intensity", in);
+    if (ok && gain && !has_gain && scale > 0 && scale != 1.0) {
+        if (gain->type == GR_PT_RGB) {
+            double in[3];
+            for (int c = 0; c < 3; c++) in[c] = gr_param_get_number(gain, s.bytes, c) * scale;
+            ok = add_rgb(sh, gain->name, in);
+        } else {
+            ok = cJSON_AddNumberToObject(sh, gain->name, round_sig(gr_param_get_number(gain, s.bytes, 0) * scale, 5)) != NULL;
+        }
     }
     char *text = ok ? cJSON_Print(root) : NULL;
     cJSON_Delete(root);
