@@ -18,6 +18,7 @@
 #include "compare/diffmap.h"
 #include "compare/flip.h"
 #include "compare/structure.h"
+#include "report/profile.h"
 #include "scene/scene.h"
 #include "compare/metrics.h"
 #include "compare/metrics_io.h"
@@ -53,6 +54,8 @@ static void usage(FILE *f)
             "  --vp X,Y             the beams' vanishing point in image coordinates (pixel centres\n"
             "                       at +0.5; may lie outside) for the structure metrics\n"
             "  --scene FILE         take the vanishing point from FILE's camera and refracted sun\n"
+            "                       (and de-glow by the angle to that sun, not the distance to the\n"
+            "                       point)\n"
             "  --set KEY=VALUE      override a value of that scene, e.g. camera.yaw_deg=120\n"
             "                       (repeatable)\n"
             "  --flip-mode M        ldr or hdr (default: hdr when REF is .exr, .hdr or .pfm, else\n"
@@ -239,7 +242,7 @@ int cmd_compare(int argc, char **argv)
     gr_error err = {0};
     gr_image *ref = NULL, *test = NULL, *mask = NULL, *diff[3] = {NULL, NULL, NULL}, *scaled = NULL;
     unsigned char *scored = NULL;
-    float *flipmap = NULL;
+    float *flipmap = NULL, *angles = NULL;
     cJSON *root = NULL;
     char *text = NULL;
     int rc = 0;
@@ -304,6 +307,7 @@ int cmd_compare(int argc, char **argv)
     gr_structure_compare sres;
     double t_struct = 0.0;
     if (do_struct) {
+        gr_structure_options so = {0};
         if (scene_path) {
             gr_scene sc;
             st = gr_scene_load_file(scene_path, sets, n_sets, &sc, &err);
@@ -313,6 +317,17 @@ int cmd_compare(int argc, char **argv)
                 gr_error_prefix(&err, "--scene %s", scene_path);
                 goto fail;
             }
+            /* de-glow by the angle to the refracted sun, rings one pixel wide */
+            sc.camera.width = ref->width, sc.camera.height = ref->height;
+            angles = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
+            if (!angles) {
+                st = gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
+                goto fail;
+            }
+            double dir[3];
+            gr_profile_sun_view_dir(&sc, dir);
+            gr_profile_angles(&sc.camera, dir, angles);
+            so.radial = angles, so.radial_bin = sc.camera.fov_deg / ref->height;
         }
         if (!scored) {
             scored = malloc((size_t)ref->width * (size_t)ref->height);
@@ -323,7 +338,7 @@ int cmd_compare(int argc, char **argv)
             st = gr_metrics_scored_pixels(ref, mask, opt.stderr_bound, scored, NULL, NULL, &err);
             if (st != GR_OK) goto fail;
         }
-        gr_structure_options so = {.vp_x = vp[0], .vp_y = vp[1], .scored = scored};
+        so.vp_x = vp[0], so.vp_y = vp[1], so.scored = scored;
         const double t2 = now_s();
         st = gr_structure_compare_images(ref, test, &so, &sres, &err);
         t_struct = now_s() - t2;
@@ -443,5 +458,6 @@ done:
     gr_image_destroy(scaled);
     free(scored);
     free(flipmap);
+    free(angles);
     return rc;
 }
