@@ -1225,6 +1225,23 @@ static gr_status parse_text(const char *json, const char *label, cJSON **out, gr
         near[k++] = *q;
     }
     near[k] = '\0';
+    /* cJSON stops at CJSON_NESTING_LIMIT open brackets: say so rather than "malformed" */
+    int depth = 0, in_str = 0;
+    for (const char *q = json; q < end && *q; q++) {
+        if (in_str) {
+            if (*q == '\\' && q[1]) q++;
+            else if (*q == '"') in_str = 0;
+        } else if (*q == '"') {
+            in_str = 1;
+        } else if (*q == '[' || *q == '{') {
+            depth++;
+        } else if (*q == ']' || *q == '}') {
+            depth--;
+        }
+    }
+    if (depth >= CJSON_NESTING_LIMIT)
+        return gr_fail(err, GR_E_INPUT, "%s:%d:%d: JSON nested deeper than %d levels", label, line, col,
+                       CJSON_NESTING_LIMIT);
     if (k == 0) return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON at end of input", label, line, col);
     return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON near '%s'", label, line, col, near);
 }
