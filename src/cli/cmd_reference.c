@@ -2,6 +2,7 @@
  * PNG preview beside it. Quality flags become "reference.*" overrides of the scene, so they
  * are range-checked by the same tables as the file. */
 #include "cli/cli.h"
+#include "common/memlimit.h"
 #include "cli/args.h"
 #include "cli/render.h"
 
@@ -40,11 +41,26 @@ static void usage(FILE *f)
             "  --set KEY=VALUE        any scene override, e.g. --set medium.g=0.9 (repeatable)\n"
             "  --aov                  add transmittance and ray_length channels\n"
             "  --no-preview           do not write the PNG preview\n"
+            "  --max-memory SIZE      refuse (exit 2) a render estimated to need more (e.g. 8G;\n"
+            "                         default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  --quiet                no progress bar\n"
             "  --bench                benchmark instead of writing files: hot-loop lookups per second\n"
             "                         with 1 and 2 threads, Embree's raw occlusion-ray throughput\n"
             "\n"
             "Ctrl-C stops the render and writes what is done, marked godrays:partial = 1 (exit 1).\n");
+}
+
+/* --max-memory SIZE (common/memlimit). */
+static int take_max_memory(gr_args *args)
+{
+    const char *v = NULL;
+    int rc = gr_args_value(args, &v);
+    if (rc) return rc;
+    gr_error err;
+    double bytes;
+    if (gr_memlimit_parse("--max-memory", v, &bytes, &err) != GR_OK) return gr_cli_usage_error(args->cmd, "%s", err.msg);
+    gr_memlimit_set(bytes);
+    return 0;
 }
 
 /* --target-error stops refining at the round cap (gr_ref_result.max_rounds) whether or not the
@@ -90,6 +106,7 @@ static int reference_with(gr_args *args)
         else if (!strcmp(a, "-o") || !strcmp(a, "--output")) rc = gr_args_value(args, &out_path);
         else if (!strcmp(a, "--set")) rc = gr_args_take_set(args);
         else if (!strcmp(a, "--size")) rc = gr_args_take_size(args);
+        else if (!strcmp(a, "--max-memory")) rc = take_max_memory(args);
         else rc = gr_args_take_scene(args);
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
