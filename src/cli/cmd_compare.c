@@ -94,6 +94,17 @@ static cJSON *image_json(const char *path, const gr_image *img, const int rgb[3]
     return o;
 }
 
+/* Every compared sample of img is 0: a "perfect" fit (a = 0, RMSE 0, PSNR inf, SSIM 1) that
+ * means nothing. */
+static int all_zero(const gr_image *img, const int rgb[3])
+{
+    const size_t n = (size_t)img->width * (size_t)img->height, nc = (size_t)img->nchannels;
+    for (size_t p = 0; p < n; p++)
+        for (int k = 0; k < 3; k++)
+            if (img->pixels[p * nc + (size_t)rgb[k]] != 0.0f) return 0;
+    return 1;
+}
+
 static double now_s(void)
 {
     struct timespec ts;
@@ -170,6 +181,15 @@ int cmd_compare(int argc, char **argv)
     if (st == GR_OK && mask && (mask->width != ref->width || mask->height != ref->height))
         st = gr_fail(&err, GR_E_INPUT, "size mismatch: mask %s is %d x %d, images are %d x %d", mask_path, mask->width,
                      mask->height, ref->width, ref->height);
+    /* two channels: grey + alpha is compared as grey; anything else (R, G) has no defined
+     * luminance, so it is refused rather than compared as grey with a channel dropped */
+    for (int k = 0; st == GR_OK && k < 2; k++) {
+        const gr_image *im = k ? test : ref;
+        if (im->nchannels == 2 && strcmp(im->names[1], "A"))
+            st = gr_fail(&err, GR_E_INPUT, "%s %s: 2 channels (%s, %s): neither grey (+ alpha A) nor RGB; convert it "
+                         "first, e.g. oiiotool IN --ch R,G,B=0 -o OUT.exr", k ? "test" : "reference", paths[k],
+                         im->names[0], im->names[1]);
+    }
     if (st == GR_OK) {
         /* the metrics, blurs and difference images: about 170 bytes per pixel, measured
          * (2.8 GB for 4096 x 4096; docs/reliability.md) */
@@ -249,6 +269,10 @@ int cmd_compare(int argc, char **argv)
         }
     }
 
+    if (all_zero(ref, m.ref_rgb))
+        fprintf(stderr, "godrays compare: warning: the reference %s is zero everywhere scored: RMSE, PSNR, SSIM and the "
+                "scale fit say nothing about the test image (is the camera inside an occluder, or the medium "
+                "without scattering?)\n", paths[0]);
     if (json) {
         printf("%s\n", text);
     } else {

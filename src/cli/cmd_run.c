@@ -193,6 +193,9 @@ static void print_summary(const char *dir, const gr_scene *scene, const gr_metri
         printf("; after the fit %.1f %% of Y differences are within 2 std. errors",
                100.0 * (double)yf->n_not_significant / (double)yf->n_samples);
     printf("\nreport: %s/index.html (also summary.png, metrics.json)\n", dir);
+    if (yr->ref_mean == 0.0) /* the ground truth is >= 0: zero mean = zero everywhere scored */
+        fprintf(stderr, "godrays run: warning: the ground truth is zero everywhere scored: the metrics say nothing "
+                "(camera inside an occluder, no scattering, or no light reaching the view?)\n");
 }
 
 /* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
