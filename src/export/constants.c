@@ -8,8 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
+#include "common/outfile.h"
 #include "core/optics.h"
 #include "core/shaftgeom.h"
 #include "realtime/frame.h"
@@ -105,25 +105,7 @@ gr_status gr_constants_compute(const gr_scene *s, gr_shader_constants *c, gr_err
 
 static gr_status write_text(const char *path, const char *text, gr_error *err)
 {
-    size_t n = strlen(path) + 32;
-    char *tmp = malloc(n);
-    if (!tmp) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
-    snprintf(tmp, n, "%s.tmp-%ld", path, (long)getpid());
-    gr_status st = GR_OK;
-    FILE *f = fopen(tmp, "wb");
-    if (!f) {
-        st = gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    } else {
-        size_t len = strlen(text);
-        int bad = fwrite(text, 1, len, f) != len;
-        if (fclose(f) != 0) bad = 1;
-        if (bad) st = gr_fail(err, GR_E_IO, "%s: write failed: %s", path, strerror(errno));
-        else if (rename(tmp, path) != 0)
-            st = gr_fail(err, GR_E_IO, "%s: cannot rename into place: %s", path, strerror(errno));
-        if (st != GR_OK) remove(tmp);
-    }
-    free(tmp);
-    return st;
+    return gr_outfile_write(path, text, -1, err); /* atomic: common/outfile */
 }
 
 static cJSON *arr(const double *v, int n)
