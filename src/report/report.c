@@ -19,6 +19,7 @@
 #include "report/html.h"
 #include "report/plot.h"
 #include "report/profile.h"
+#include "report/viewer.h"
 #include "scene/params.h"
 #include "scene/sections.h"
 #include "scene/settings.h"
@@ -1242,6 +1243,15 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
         gr_sb_puts(b, "\n</div>\n");
     }
     html_leaderboard(b, c);
+    {
+        gr_viewer_item vi[GR_REPORT_MAX_TECHNIQUES];
+        for (int r = 0; r < in->n_techniques; r++) { /* leaderboard order: 1 = the best */
+            const tctx *tc = &c->t[c->order[r]];
+            vi[r] = (gr_viewer_item){.name = tc->t->name, .stem = tc->stem, .test = tc->t->test, .scale = tc->a};
+        }
+        gr_status vst = gr_viewer_write(c->dir, in->ref, vi, in->n_techniques, c->exposure, b, err);
+        if (vst != GR_OK) return vst;
+    }
     gr_sb_puts(b, "<p class=\"sub\">Every technique beside the reference with the key numbers: "
                   "<a href=\"summary.png\">summary.png</a>; every number: <a href=\"metrics.json\">metrics.json</a>.</p>\n");
     if (c->charts > 0) {
