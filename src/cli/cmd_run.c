@@ -19,12 +19,15 @@
 #include "reference/integrator.h"
 #include "report/cache.h"
 #include "report/report.h"
+#include "report/sequence.h"
 #include "scene/scene.h"
+#include "tune/objective.h"
+#include "tune/session.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays run SCENE [-o DIR] [--techniques A,B] [options]\n"
+            "usage: godrays run SCENE [-o DIR] [--techniques A,B] [--frames A:B:S | --times T,..] [options]\n"
             "\n"
             "The main job: renders SCENE with every real-time technique (OpenGL; `godrays techniques`\n"
             "lists them) and as ground truth (Embree single scattering, with error bars), compares\n"
@@ -47,6 +50,13 @@ static void usage(FILE *f)
             "  --set KEY=VALUE      override a scene value before validation, e.g. TECHNIQUE.KEY=V,\n"
             "                       reference.spp=4, medium.g=0.9 (repeatable)\n"
             "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"
+            "  --frames A:B:S       a sequence: frames A, A+S, ... B of the animated water (at --fps,\n"
+            "                       from the scene's water.time_s): every technique and the ground truth\n"
+            "                       per frame, and DIR/sequence/ (index.html: a chart per metric over\n"
+            "                       time, temporal metrics: flicker, frame-difference error, beam drift;\n"
+            "                       an animated GIF per technique); index.html compares the first frame\n"
+            "  --times T1,T2,...    a sequence at these water times (s)\n"
+            "  --fps F              frames per second of --frames (default 30)\n"
             "  --no-cache           render the ground truth even if a cached one exists, and do not\n"
             "                       store it\n"
             "  -q, --quiet          no progress bar or step messages (the summary table is printed)\n"
@@ -222,6 +232,7 @@ static int run_with(gr_args *args)
     char **argv = args->argv;
     const char *cmd = "run";
     const char *outdir = NULL, *tech_list = NULL;
+    const char *frames_spec = NULL, *times_spec = NULL, *fps_spec = NULL;
     int quiet = 0, use_cache = 1, rc = 0, taken = 0;
     for (; args->i < argc && !rc; args->i++) {
         const char *a = argv[args->i];
@@ -234,6 +245,12 @@ static int run_with(gr_args *args)
             use_cache = 0;
         } else if (!strcmp(a, "--techniques")) {
             rc = gr_args_value(args, &tech_list);
+        } else if (!strcmp(a, "--frames")) {
+            rc = gr_args_value(args, &frames_spec);
+        } else if (!strcmp(a, "--times")) {
+            rc = gr_args_value(args, &times_spec);
+        } else if (!strcmp(a, "--fps")) {
+            rc = gr_args_value(args, &fps_spec);
         } else if ((rc = gr_args_take_common(args, &outdir, NULL, &taken)) == 0 && !taken) {
             rc = gr_args_take_scene(args);
         }
@@ -247,8 +264,34 @@ static int run_with(gr_args *args)
     if (gr_technique_parse_list("--techniques", tech_list, cls, GR_REPORT_MAX_TECHNIQUES, &nt, &err) != GR_OK)
         return gr_cli_usage_error(cmd, "%s", err.msg);
     if (nt == 0) return gr_cli_usage_error(cmd, "no real-time technique to compare");
+    /* a sequence: --frames or --times (report/sequence.h) */
+    double fps = 30.0, times[GR_SEQUENCE_MAX_FRAMES];
+    long frame_no[GR_SEQUENCE_MAX_FRAMES];
+    int n_times = 0;
+    if (frames_spec && times_spec) return gr_cli_usage_error(cmd, "--frames and --times: give one of them");
+    if (fps_spec) {
+        char *end = NULL;
+        fps = strtod(fps_spec, &end);
+        if (end == fps_spec || *end || !isfinite(fps) || !(fps > 0))
+            return gr_cli_usage_error(cmd, "--fps %s: expected a number > 0", fps_spec);
+    }
+    if (frames_spec &&
+        gr_tune_parse_frames("--frames", frames_spec, fps, times, GR_SEQUENCE_MAX_FRAMES, &n_times, &err) != GR_OK)
+        return gr_cli_usage_error(cmd, "%s", err.msg);
+    if (times_spec && gr_tune_parse_times("--times", times_spec, times, GR_SEQUENCE_MAX_FRAMES, &n_times, &err) != GR_OK)
+        return gr_cli_usage_error(cmd, "%s", err.msg);
+    if ((frames_spec || times_spec) && n_times < 2)
+        return gr_cli_usage_error(cmd, "%s %s: one frame; a sequence needs two or more", frames_spec ? "--frames" : "--times",
+                                  frames_spec ? frames_spec : times_spec);
+    for (int i = 0; i < n_times; i++) frame_no[i] = lround(times[i] * fps);
+    const int nf = n_times > 0 ? n_times : 1;
 
-    gr_scene *scene = NULL;
+    gr_scene *scene = NULL, *cases = NULL;
+    gr_image **seq_test = NULL; /* seq_test[k * nf + i], i >= 1 (frame 0: test[k]) */
+    ref_out *seq_ref = NULL;    /* frames >= 1 (frame 0: ro) */
+    char *seq_json = NULL;
+    gr_sequence_result sres;
+    memset(&sres, 0, sizeof sres);
     gr_gl *gl = NULL;
     gr_image *test[GR_REPORT_MAX_TECHNIQUES] = {NULL};
     gr_metadata smeta[GR_REPORT_MAX_TECHNIQUES];
@@ -269,6 +312,25 @@ static int run_with(gr_args *args)
         goto fail;
     }
     if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
+    if (n_times > 0) { /* each frame's scene: the water at its time (--frames: from the scene's time) */
+        cases = calloc((size_t)nf, sizeof *cases);
+        seq_test = calloc((size_t)(nf * nt), sizeof *seq_test);
+        seq_ref = calloc((size_t)nf, sizeof *seq_ref);
+        if (!cases || !seq_test || !seq_ref) {
+            gr_fail(&err, GR_E_NOMEM, "out of memory");
+            goto fail;
+        }
+        for (int i = 0; i < nf; i++) {
+            gr_meta_init(&seq_ref[i].meta);
+            const double tw = times[i] + (frames_spec ? scene->water.time_s : 0.0);
+            if (gr_tune_make_case(scene, tw, NULL, &cases[i], &err) != GR_OK) {
+                gr_error_prefix(&err, "%s: frame %d", frames_spec ? "--frames" : "--times", i);
+                goto fail;
+            }
+            times[i] = tw;
+        }
+    }
+    const gr_scene *scene0 = cases ? &cases[0] : scene; /* the frame index.html compares */
     /* Bad settings are bad input (exit 2) before any slow or GL work. */
     for (int k = 0; k < nt; k++)
         if (gr_technique_check(cls[k], gr_technique_scene_settings(cls[k], scene), &err) != GR_OK) goto fail;
@@ -285,7 +347,7 @@ static int run_with(gr_args *args)
     for (int k = 0; k < nt; k++) {
         if (!quiet) fprintf(stderr, "godrays run: rendering %s...\n", cls[k]->name);
         double t = now_s();
-        if (render_technique(cls[k], gl, scene, &test[k], &smeta[k], &err) != GR_OK) goto fail;
+        if (render_technique(cls[k], gl, scene0, &test[k], &smeta[k], &err) != GR_OK) goto fail;
         ts[k].seconds = now_s() - t;
         ts[k].name = cls[k]->name;
         ts[k].description = cls[k]->description;
@@ -293,13 +355,33 @@ static int run_with(gr_args *args)
         ts[k].meta = &smeta[k];
         snprintf(exr_names[k], sizeof exr_names[k], "%s.exr", cls[k]->name);
         ts[k].exr = exr_names[k];
+        for (int i = 1; i < nf; i++) {
+            gr_metadata scratch;
+            gr_meta_init(&scratch);
+            gr_status rst = render_technique(cls[k], gl, &cases[i], &seq_test[k * nf + i], &scratch, &err);
+            gr_meta_free(&scratch);
+            if (rst != GR_OK) {
+                gr_error_prefix(&err, "frame %d (t = %g s)", i, times[i]);
+                goto fail;
+            }
+        }
+        if (nf > 1) seq_test[k * nf] = test[k];
     }
     gr_gl_destroy(gl);
     gl = NULL;
 
     double t = now_s();
-    if (get_reference(scene, use_cache, quiet, &ro, &err) != GR_OK) goto fail;
+    if (nf > 1 && !quiet) fprintf(stderr, "godrays run: frame 1 of %d (t = %g s)\n", nf, times[0]);
+    if (get_reference(scene0, use_cache, quiet, &ro, &err) != GR_OK) goto fail;
     const double t_ref = now_s() - t;
+    for (int i = 1; i < nf; i++) {
+        if (!quiet) fprintf(stderr, "godrays run: frame %d of %d (t = %g s)\n", i + 1, nf, times[i]);
+        if (get_reference(&cases[i], use_cache, quiet, &seq_ref[i], &err) != GR_OK) {
+            gr_error_prefix(&err, "frame %d (t = %g s)", i, times[i]);
+            goto fail;
+        }
+    }
+    const double t_refs = now_s() - t;
 
     if (!quiet) fprintf(stderr, "godrays run: comparing...\n");
     t = now_s();
@@ -314,11 +396,32 @@ static int run_with(gr_args *args)
     /* The report links the EXRs; they are written first so that a finished index.html never
      * points at a missing file. */
     if (!quiet) fprintf(stderr, "godrays run: writing the report...\n");
-    gr_report_input in = {.scene = scene, .ref = ro.img, .ref_meta = &ro.meta, .n_techniques = nt, .techniques = ts,
+    if (nf > 1) {
+        if (!quiet) fprintf(stderr, "godrays run: the sequence (%d frames)...\n", nf);
+        const gr_scene *fs[GR_SEQUENCE_MAX_FRAMES];
+        const gr_image *frefs[GR_SEQUENCE_MAX_FRAMES];
+        const char *names[GR_REPORT_MAX_TECHNIQUES];
+        for (int i = 0; i < nf; i++) {
+            fs[i] = &cases[i];
+            frefs[i] = i ? seq_ref[i].img : ro.img;
+        }
+        for (int k = 0; k < nt; k++) names[k] = cls[k]->name;
+        gr_sequence_input sin = {.n_frames = nf, .times = times, .frame_numbers = frames_spec ? frame_no : NULL,
+                                 .scenes = fs, .refs = frefs, .n_techniques = nt, .names = names,
+                                 .tests = (const gr_image *const *)seq_test, .up_href = "../index.html",
+                                 .command_line = gr_sb_str(&cmdline)};
+        if (snprintf(path, sizeof path, "%s/sequence", outdir) >= (int)sizeof path - 48) {
+            gr_fail(&err, GR_E_USAGE, "%s: output directory name too long", outdir);
+            goto fail;
+        }
+        if (gr_sequence_write(path, &sin, &seq_json, &sres, &err) != GR_OK) goto fail;
+    }
+    gr_report_input in = {.scene = scene0, .ref = ro.img, .ref_meta = &ro.meta, .n_techniques = nt, .techniques = ts,
                           .command_line = gr_sb_str(&cmdline), .scene_words = gr_sb_str(&words),
                           .ref_cached = ro.cached, .ref_cache_path = ro.cache_on ? ro.cache_path : NULL,
                           .ref_cache_note = ro.note[0] ? ro.note : NULL, .ref_seconds = t_ref,
-                          .compare_seconds = t_cmp, .ref_exr = "reference.exr"};
+                          .compare_seconds = t_cmp, .ref_exr = "reference.exr", .sequence_json = seq_json,
+                          .sequence_href = seq_json ? "sequence/index.html" : NULL};
     gr_report_result rres;
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
     if (snprintf(path, sizeof path, "%s/reference.exr", outdir) >= (int)sizeof path - 48) {
@@ -334,7 +437,17 @@ static int run_with(gr_args *args)
     if (!quiet && !rres.labelled)
         fprintf(stderr, "godrays run: note: no font for OpenImageIO's text: summary.png is unlabelled\n");
     if (!quiet && rres.charts == 0) fprintf(stderr, "godrays run: note: charts not drawn (see index.html)\n");
-    print_summary(outdir, scene, ts, nt, rres.order, &ro, t_ref);
+    print_summary(outdir, scene0, ts, nt, rres.order, &ro, t_ref);
+    if (nf > 1) {
+        printf("\nsequence: %d frames, t = %g .. %g s; ground truths %.1f s in all\n", nf, times[0], times[nf - 1],
+               t_refs);
+        printf("  %-24s %10s %14s %12s %14s\n", "technique", "a", "diff. error", "flicker", "drift err deg");
+        for (int k = 0; k < nt; k++)
+            printf("  %-24s %10.4g %14.4g %12.4g %14.3g\n", cls[k]->name, sres.scale[k], sres.rel_diff_rmse[k],
+                   sres.flicker_ratio[k], sres.drift_err_deg[k]);
+        printf("sequence report: %s/sequence/index.html (%d charts, %d animations)\n", outdir, sres.charts,
+               sres.animations);
+    }
     goto done;
 fail:
     rc = gr_cli_report(cmd, &err);
@@ -342,6 +455,16 @@ done:
     gr_gl_destroy(gl);
     gr_image_destroy(ro.img);
     gr_meta_free(&ro.meta);
+    for (int i = 1; seq_ref && i < nf; i++) {
+        gr_image_destroy(seq_ref[i].img);
+        gr_meta_free(&seq_ref[i].meta);
+    }
+    for (int k = 0; seq_test && k < nt; k++)
+        for (int i = 1; i < nf; i++) gr_image_destroy(seq_test[k * nf + i]);
+    free(seq_test);
+    free(seq_ref);
+    free(cases);
+    free(seq_json);
     for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) {
         gr_image_destroy(test[k]);
         gr_meta_free(&smeta[k]);

@@ -421,3 +421,83 @@ extern "C" gr_status gr_oiio_render_text(gr_image *img, int x, int y, const char
         return exception_status(err, text, "drawing text");
     }
 }
+
+// ---- animations for the sequence report (report module) ------------------------------------
+
+extern "C" gr_status gr_oiio_write_animation(const char *path, const gr_image *const *frames, int n, double fps,
+                                             gr_error *err)
+{
+    if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "animation write: no output path");
+    if (!frames || n < 1 || !(fps > 0) || !std::isfinite(fps))
+        return gr_fail(err, GR_E_INPUT, "%s: no frames or a bad frame rate", path);
+    for (int i = 0; i < n; i++)
+        if (!image_ok(frames[i]) || frames[i]->nchannels < 3 || frames[i]->width != frames[0]->width ||
+            frames[i]->height != frames[0]->height)
+            return gr_fail(err, GR_E_INPUT, "%s: frame %d: missing, not RGB, or another size than frame 0", path, i);
+    try {
+        auto out = OIIO::ImageOutput::create(path);
+        if (!out) return fail(err, GR_E_INPUT, path, "no writer for this file type", OIIO::geterror());
+        if (!out->supports("multiimage") || !out->supports("appendsubimage"))
+            return gr_fail(err, GR_E_INPUT, "%s: this format holds no animation", path);
+        const int w = frames[0]->width, h = frames[0]->height;
+        OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
+        // frames per second as a rational of whole hundredths (the GIF delay unit)
+        int delay = static_cast<int>(std::lround(100.0 / fps));
+        if (delay < 1) delay = 1;
+        const int rate[2] = {100, delay};
+        spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
+        spec.attribute("oiio:Movie", 1);
+        spec.attribute("oiio:LoopCount", 0);
+        spec.attribute("gif:LoopCount", 0);
+        std::vector<OIIO::ImageSpec> specs(static_cast<size_t>(n), spec);
+        gr_outfile of;
+        gr_status st = gr_outfile_begin(&of, path, err);
+        if (st != GR_OK) return st;
+        const std::string tmp = of.tmp;
+        const std::string format = out->format_name();
+        std::vector<unsigned char> codes(static_cast<size_t>(w) * static_cast<size_t>(h) * 3);
+        if (!out->open(tmp, n, specs.data())) {
+            st = fail(err, GR_E_IO, path, "cannot create file", out->geterror());
+        } else {
+            for (int i = 0; i < n && st == GR_OK; i++) {
+                if (i > 0 && !out->open(tmp, specs[static_cast<size_t>(i)], OIIO::ImageOutput::AppendSubimage)) {
+                    st = fail(err, GR_E_IO, path, "appending a frame", out->geterror());
+                    break;
+                }
+                const gr_image *f = frames[i];
+                for (size_t p = 0; p < codes.size() / 3; p++)
+                    for (size_t c = 0; c < 3; c++) {
+                        const float x = f->pixels[p * static_cast<size_t>(f->nchannels) + c];
+                        const float v = std::isfinite(x) ? (x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x)) : 0.0f;
+                        codes[p * 3 + c] = static_cast<unsigned char>(std::lround(v * 255.0f));
+                    }
+                if (!out->write_image(OIIO::TypeDesc::UINT8, codes.data()))
+                    st = fail(err, GR_E_IO, path, "writing a frame", out->geterror());
+            }
+            if (!out->close() && st == GR_OK) st = fail(err, GR_E_IO, path, "closing file", out->geterror());
+        }
+        out.reset();
+        if (st == GR_OK) { // read back: every frame must be there
+            StderrCapture quiet;
+            auto in = OIIO::ImageInput::create(format);
+            OIIO::ImageSpec got;
+            int count = 0;
+            if (in && in->open(tmp, got)) {
+                do {
+                    count++;
+                } while (in->seek_subimage(count, 0));
+                in->close();
+            }
+            if (in) (void)in->geterror();
+            (void)OIIO::geterror();
+            if (count != n)
+                st = gr_fail(err, GR_E_IO, "%s: cannot write: %d of %d frames read back (is the disk full?)", path,
+                             count, n);
+        }
+        if (st == GR_OK) return gr_outfile_commit(&of, 1, err);
+        gr_outfile_abort(&of);
+        return st;
+    } catch (...) {
+        return exception_status(err, path, "writing animation");
+    }
+}

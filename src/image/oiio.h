@@ -35,6 +35,13 @@ gr_status gr_oiio_color_map(const gr_image *src, int channel, const char *map, g
 gr_status gr_oiio_render_text(gr_image *img, int x, int y, const char *text, int size_px, const float rgb[3],
                               int align, gr_error *err);
 
+/* (report module) Writes n display-encoded frames (R, G, B in [0, 1], all the same size) as
+ * one animated file, an animated GIF by extension (OpenImageIO's GIF writer: one subimage
+ * per frame, 256 colours per frame, looping forever), at fps frames per second (GIF delays
+ * are whole 1/100 s). Through a temporary name renamed into place; the file is read back and
+ * must hold n subimages. */
+gr_status gr_oiio_write_animation(const char *path, const gr_image *const *frames, int n, double fps, gr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

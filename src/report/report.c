@@ -944,6 +944,14 @@ static gr_status build_json(ctx *c, char **text, gr_error *err)
         }
         jadd(rp, "reference", profile_json(&c->pr.ref, 1), &ok);
     }
+    if (in->sequence_json) { /* godrays run --frames: report/sequence.h */
+        cJSON *sq = cJSON_Parse(in->sequence_json);
+        if (!sq && ok) {
+            cJSON_Delete(root);
+            return gr_fail(err, GR_E_INPUT, "%s/metrics.json: the sequence's JSON does not parse", c->dir);
+        }
+        jadd(root, "sequence", sq, &ok);
+    }
     cJSON *ch = cJSON_CreateObject();
     jadd(root, "charts", ch, &ok);
     jnum(ch, "drawn", c->charts, &ok);
@@ -1243,6 +1251,14 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
         gr_sb_puts(b, "\n</div>\n");
     }
     html_leaderboard(b, c);
+    if (in->sequence_href) {
+        gr_sb_puts(b, "<p class=\"box\">This run rendered a sequence of frames: its report over time (a chart per "
+                      "metric, an animation per technique) is <a href=\"");
+        gr_sb_html(b, in->sequence_href);
+        gr_sb_puts(b, "\">");
+        gr_sb_html(b, in->sequence_href);
+        gr_sb_puts(b, "</a>. This page compares the first frame.</p>\n");
+    }
     {
         gr_viewer_item vi[GR_REPORT_MAX_TECHNIQUES];
         for (int r = 0; r < in->n_techniques; r++) { /* leaderboard order: 1 = the best */

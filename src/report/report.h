@@ -53,6 +53,9 @@ typedef struct gr_report_input {
     const char *ref_exr;            /* name (inside DIR) of the reference's EXR copy; NULL: none */
     const char *scene_words;        /* the scene and its --set/--size options, shell-quoted, for the
                                        commands that make DIR/{sweep,tune,pareto} (NULL: the scene file) */
+    const char *sequence_json;      /* godrays run --frames: the sequence (report/sequence.h) as JSON text,
+                                       carried by metrics.json as "sequence" (NULL: none) */
+    const char *sequence_href;      /* its page inside DIR, linked from index.html (NULL: none) */
 } gr_report_input;
 
 typedef struct gr_report_result {
