@@ -5,14 +5,16 @@
  *                       technique its images beside the reference with false-colour
  *                       differences and colorbars, metrics tables (raw and after the best
  *                       scale fit), charts, timings and counters; the scene and every setting;
- *                       inline CSS, relative links only, no JavaScript
+ *                       inline CSS, relative links only; one script: the interactive
+ *                       comparison (report/viewer.h), its images inside the page
  *   summary.png         labelled contact sheet, one row per technique (reference | technique
  *                       x a | difference + numbers)
  *   metrics.json        every number, one entry per technique (docs/report.md)
  *   reference.png, radial_profile.png (every technique), and per technique T (files named
  *   after T, "rt_T" where T is one of the report's own names): T.png (x the fitted scale,
  *   same exposure as the reference), T_raw.png (own exposure), T_diff.png,
- *   T_diff_signed.png, T_radial_profile_rgb.png, T_error_vs_blur.png
+ *   T_diff_signed.png, T_radial_profile_rgb.png, T_error_vs_blur.png, T_flip.png (report/viewer.h)
+ *   With --frames: DIR/sequence/ (report/sequence.h), linked from index.html (sequence_href).
  * index.html links the pages of `godrays sweep`, `tune` and `pareto` in DIR/sweep, DIR/tune and
  * DIR/pareto that exist when it is written, and gives the command for each one that does not.
  * How to read it: docs/report.md. Library code: writes files, prints nothing. */
