@@ -32,6 +32,10 @@ ck "godrays run --frames exits 0 (rc $rc)" [ "$rc" -eq 0 ]
 ck "sequence/index.html written" [ -s rep/sequence/index.html ]
 ck "index.html links the sequence page" grep -q 'href="sequence/index.html"' rep/index.html
 ck "the summary names the sequence report" grep -q 'sequence report: rep/sequence/index.html' run.txt
+grep -o '<img src="[^"]*"' rep/sequence/index.html | sed 's/<img src="//; s/"$//' >srcs.txt
+ck "the sequence page shows pictures ($(wc -l <srcs.txt))" [ "$(wc -l <srcs.txt)" -ge 4 ]
+while read -r f; do ck "sequence page image $f exists" [ -s "rep/sequence/$f" ]; done <srcs.txt
+ck "the sequence page links back to the run's page" grep -q 'href="../index.html"' rep/sequence/index.html
 for f in rep/*.exr; do
     case $f in rep/reference.exr) continue ;; esac
     t=$(basename "$f" .exr)
