@@ -21,6 +21,8 @@ GODRAYS_PACKAGES=(
   libplplot-dev plplot-driver-qt
   # headless browser for the report's test (tests/cli/test_report_browser.sh)
   chromium
+  # libFuzzer targets (tests/fuzz, scripts/fuzz.sh): clang and its fuzzer runtime
+  clang libclang-rt-14-dev
 )
 
 installed() {
