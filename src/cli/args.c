@@ -179,7 +179,42 @@ int gr_args_take_common(gr_args *a, const char **dir, gr_gl_platform *platform, 
     if (!strcmp(f, "--set")) return gr_args_take_set(a);
     if (!strcmp(f, "--size")) return gr_args_take_size(a);
     if (platform && !strcmp(f, "--gl-platform")) return gr_args_take_gl_platform(a, platform);
+    if (!strcmp(f, "--technique-dir")) return gr_args_take_technique_dir(a);
     *taken = 0;
+    return 0;
+}
+
+int gr_args_take_technique_dir(gr_args *a)
+{
+    const char *d = NULL;
+    int rc = gr_args_dir(a, &d);
+    if (rc) return rc;
+    if (a->n_tech_dirs >= GR_TECH_MAX)
+        return gr_cli_usage_error(a->cmd, "--technique-dir %s: more than %d technique folders", d, GR_TECH_MAX);
+    a->tech_dirs[a->n_tech_dirs++] = d;
+    return 0;
+}
+
+int gr_args_add_technique_dirs(const gr_args *a)
+{
+    gr_error err = {GR_OK, ""};
+    gr_technique_count(); /* the built-in techniques first: theirs are the first sections */
+    for (int i = 0; i < a->n_tech_dirs; i++)
+        if (gr_technique_add_dir(a->tech_dirs[i], &err) != GR_OK) return gr_cli_report(a->cmd, &err);
+    return 0;
+}
+
+int gr_args_find_technique(const gr_args *a, const char *what, const char *name, const gr_technique_class **cls)
+{
+    gr_error err = {GR_OK, ""};
+    const gr_technique_class *one[1];
+    int n = 0;
+    if (strchr(name, ',')) return gr_cli_usage_error(a->cmd, "%s %s: one technique expected", what, name);
+    if (gr_technique_parse_list(what, name, one, 1, &n, &err) != GR_OK || n != 1) {
+        if (err.status == GR_OK) gr_fail(&err, GR_E_USAGE, "%s: no technique given", what);
+        return gr_cli_usage_error(a->cmd, "%s", err.msg);
+    }
+    *cls = one[0];
     return 0;
 }
 

@@ -47,7 +47,8 @@ gr_status gr_cache_key(const gr_scene *s, char *key, gr_error *err)
     /* What the ground truth does not read: the label and the real-time settings; the
      * reference settings are hashed on their own below. */
     cJSON_DeleteItemFromObjectCaseSensitive(root, "name");
-    cJSON_DeleteItemFromObjectCaseSensitive(root, "shafts");
+    for (int i = 0; i < gr_sections_count(); i++)
+        cJSON_DeleteItemFromObjectCaseSensitive(root, gr_sections_table(i)->section);
     cJSON_DeleteItemFromObjectCaseSensitive(root, "reference");
     char *content = cJSON_PrintUnformatted(root);
     cJSON_Delete(root);

@@ -354,7 +354,9 @@ static void set_defaults(gr_scene *s)
     s->has_seabed = 0;
     s->seabed_depth_m = 25.0;
     gr_param_defaults(&gr_reference_param_table, &s->reference);
-    gr_param_defaults(&gr_shafts_param_table, &s->shafts);
+    /* technique sections: every one known now (scene/sections.h), at its defaults */
+    s->n_sections = gr_sections_count();
+    for (int i = 0; i < s->n_sections; i++) gr_param_defaults(gr_sections_table(i), s->sections[i].bytes);
 }
 
 static void wave_defaults(gr_wave *w)
@@ -368,8 +370,9 @@ static void wave_defaults(gr_wave *w)
 }
 
 /* ---- JSON -> struct ------------------------------------------------------------------ */
+/* The format's own top-level keys; technique sections (scene/sections.h) come on top. */
 static const char *const root_keys[] = {"version", "name", "water", "sun", "medium", "camera",
-                                        "occluders", "seabed", "reference", "shafts"};
+                                        "occluders", "seabed", "reference"};
 static const char *const water_keys[] = {"rest_height_m", "time_s", "waves"};
 static const char *const wave_keys[] = {"amplitude_m", "wavelength_m", "direction_deg", "phase_rad",
                                         "angular_frequency_rad_s"};
@@ -381,6 +384,32 @@ static const char *const box_keys[] = {"type", "name", "center_m", "size_m", "ya
 static const char *const sphere_keys[] = {"type", "name", "center_m", "radius_m"};
 static const char *const seabed_keys[] = {"depth_m"};
 #define NKEYS(a) (sizeof(a) / sizeof((a)[0]))
+
+/* The root's keys: the format's own and every technique section known now. An unknown key
+ * may be a user technique's section whose folder was not given: the message says so. */
+static gr_status check_root_keys(vctx *c, const cJSON *root)
+{
+    const char *names[NKEYS(root_keys) + GR_SCENE_MAX_SECTIONS];
+    size_t n = 0;
+    for (size_t i = 0; i < NKEYS(root_keys); i++) names[n++] = root_keys[i];
+    for (int i = 0; i < gr_sections_count(); i++) names[n++] = gr_sections_table(i)->section;
+    gr_status st = check_keys(c, root, "", names, n);
+    if (st == GR_E_INPUT && strstr(c->err->msg, "unknown key"))
+        snprintf(c->err->msg + strlen(c->err->msg), sizeof c->err->msg - strlen(c->err->msg), "%s",
+                 "; a user technique's section needs its --technique-dir");
+    return st;
+}
+
+/* Every technique section's settings against its table (allow_unresolved: NaN accepted
+ * for scene-derived settings). */
+static gr_status validate_sections(const gr_scene *s, int allow_unresolved, gr_error *err)
+{
+    for (int i = 0; i < s->n_sections; i++) {
+        gr_status st = gr_param_validate(gr_sections_table(i), s->sections[i].bytes, allow_unresolved, err);
+        if (st) return st;
+    }
+    return GR_OK;
+}
 
 static gr_status parse_water(vctx *c, const cJSON *w, gr_water *out)
 {
@@ -575,7 +604,7 @@ static gr_status parse_scene(vctx *c, const cJSON *root, gr_scene *s)
     char got[80];
     set_defaults(s);
     if ((st = want_object(c, root, ""))) return st;
-    if ((st = check_keys(c, root, "", root_keys, NKEYS(root_keys)))) return st;
+    if ((st = check_root_keys(c, root))) return st;
     const cJSON *ver = cJSON_GetObjectItemCaseSensitive(root, "version");
     if (ver && (!cJSON_IsNumber(ver) || ver->valuedouble != 1.0))
         return vfail(c, "version", "unsupported scene format version, expected 1, got %s", got_text(ver, got, sizeof got));
@@ -597,9 +626,12 @@ static gr_status parse_scene(vctx *c, const cJSON *root, gr_scene *s)
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "reference")) &&
         (st = parse_section(c, v, &gr_reference_param_table, &s->reference)))
         return st;
-    if ((v = cJSON_GetObjectItemCaseSensitive(root, "shafts")) &&
-        (st = parse_section(c, v, &gr_shafts_param_table, &s->shafts)))
-        return st;
+    for (int i = 0; i < s->n_sections; i++) {
+        const gr_param_table *t = gr_sections_table(i);
+        if ((v = cJSON_GetObjectItemCaseSensitive(root, t->section)) &&
+            (st = parse_section(c, v, t, s->sections[i].bytes)))
+            return st;
+    }
     return GR_OK;
 }
 
@@ -687,7 +719,7 @@ static gr_status validate_fields(vctx *c, const gr_scene *s)
     if (s->has_seabed && (st = range(c, "seabed.depth_m", s->seabed_depth_m, 0, 1e5, LO_X))) return st;
     /* Renderer sections: the descriptor tables hold the ranges. */
     if (gr_param_validate(&gr_reference_param_table, &s->reference, 1, c->err) ||
-        gr_param_validate(&gr_shafts_param_table, &s->shafts, 1, c->err)) {
+        validate_sections(s, 1, c->err)) {
         /* the message starts with "section.key"; use it as the path */
         size_t n = strcspn(c->err->msg, ":");
         snprintf(c->path, sizeof c->path, "%.*s", (int)(n < sizeof c->path ? n : sizeof c->path - 1), c->err->msg);
@@ -788,7 +820,7 @@ static gr_status derive(vctx *c, gr_scene *s)
         cam->right[k] = r[k];
         cam->up[k] = u[k];
     }
-    resolve_from_scene(&gr_shafts_param_table, &s->shafts, s);
+    for (int i = 0; i < s->n_sections; i++) resolve_from_scene(gr_sections_table(i), s->sections[i].bytes, s);
     resolve_from_scene(&gr_reference_param_table, &s->reference, s);
     return GR_OK;
 }
@@ -799,7 +831,7 @@ static gr_status validate_cross(vctx *c, const gr_scene *s)
     char a[40], b[40], d[40];
     /* FROM_SCENE settings now hold scene values: they too must lie in the table's range */
     if (gr_param_validate(&gr_reference_param_table, &s->reference, 0, c->err) ||
-        gr_param_validate(&gr_shafts_param_table, &s->shafts, 0, c->err)) {
+        validate_sections(s, 0, c->err)) {
         size_t n = strcspn(c->err->msg, ":");
         snprintf(c->path, sizeof c->path, "%.*s", (int)(n < sizeof c->path ? n : sizeof c->path - 1), c->err->msg);
         return GR_E_INPUT;
@@ -1055,10 +1087,14 @@ char *gr_scene_to_json(const gr_scene *s)
     sb_puts(&b, "{");
     print_section(&b, &gr_reference_param_table, &s->reference);
     sb_puts(&b, "}");
-    sb_key(&b, "  ", "shafts", 0);
-    sb_puts(&b, "{");
-    print_section(&b, &gr_shafts_param_table, &s->shafts);
-    sb_puts(&b, "}\n}\n");
+    for (int i = 0; i < s->n_sections; i++) {
+        const gr_param_table *t = gr_sections_table(i);
+        sb_key(&b, "  ", t->section, 0);
+        sb_puts(&b, "{");
+        print_section(&b, t, s->sections[i].bytes);
+        sb_puts(&b, "}");
+    }
+    sb_puts(&b, "\n}\n");
     if (b.oom) {
         free(b.p);
         return NULL;
@@ -1425,4 +1461,19 @@ gr_status gr_scene_load_file(const char *path, const char *const *overrides, int
                              gr_error *err)
 {
     return one_line(err, load_file_impl(path, overrides, n_overrides, out, err));
+}
+
+void *gr_scene_section(gr_scene *s, int i)
+{
+    return s && i >= 0 && i < s->n_sections ? s->sections[i].bytes : NULL;
+}
+
+const void *gr_scene_section_const(const gr_scene *s, int i)
+{
+    return s && i >= 0 && i < s->n_sections ? s->sections[i].bytes : NULL;
+}
+
+void gr_scene_resolve_settings(const gr_param_table *t, void *settings, const gr_scene *s)
+{
+    resolve_from_scene(t, settings, s);
 }
