@@ -985,6 +985,7 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, gr_ref_sums *keep, pthre
         if (keep) { /* hand the sums over */
             keep->probe_w = a[0].W;
             keep->probe_h = a[0].H;
+            keep->probe_levels = 2;
             for (int k = 0; k < 2; k++) {
                 free(keep->probe_sum[k]);
                 free(keep->probe_count[k]);
@@ -1048,7 +1049,7 @@ static gr_status finish_result(gr_ref_renderer *r, const ref_accum *acc, const r
     return GR_OK;
 }
 
-gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_w, int probe_h)
+gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_levels, int probe_w, int probe_h)
 {
     gr_ref_sums *s = calloc(1, sizeof *s);
     if (!s) return NULL;
@@ -1059,10 +1060,12 @@ gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_w, int probe_h)
     s->sum = calloc(np * B * 3 + 1, sizeof *s->sum);
     s->count = calloc(np * B + 1, sizeof *s->count);
     int ok = s->sum && s->count;
-    if (nq) {
+    if (probe_levels > GR_REF_PROBE_MAX_LEVELS) ok = 0;
+    if (nq && probe_levels > 0 && ok) {
         s->probe_w = probe_w;
         s->probe_h = probe_h;
-        for (int k = 0; k < 2; k++) {
+        s->probe_levels = probe_levels;
+        for (int k = 0; k < probe_levels; k++) {
             s->probe_sum[k] = calloc(nq * 3, sizeof *s->probe_sum[k]);
             s->probe_count[k] = calloc(nq, sizeof *s->probe_count[k]);
             ok = ok && s->probe_sum[k] && s->probe_count[k];
@@ -1080,7 +1083,7 @@ void gr_ref_sums_destroy(gr_ref_sums *s)
     if (!s) return;
     free(s->sum);
     free(s->count);
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < GR_REF_PROBE_MAX_LEVELS; k++) {
         free(s->probe_sum[k]);
         free(s->probe_count[k]);
     }
@@ -1191,6 +1194,9 @@ gr_status gr_ref_assemble(gr_ref_renderer *r, const gr_ref_sums *sums, double wa
                        sums->W, sums->H, sums->B, r->scene.camera.width, r->scene.camera.height, r->batches);
     ref_accum acc = {sums->W, sums->H, sums->B, sums->sum, sums->count, NULL};
     r->bias_rel = r->flat ? 0.0 : -1.0;
+    if (sums->probe && sums->probe_levels != 2)
+        return gr_fail(err, GR_E_INPUT, "reference: sums with %d probe levels; this integrator's probe has 2",
+                       sums->probe_levels);
     if (sums->probe && !r->flat) {
         r->bias_rel = probe_bias(sums->probe_sum[0], sums->probe_count[0], sums->probe_sum[1], sums->probe_count[1],
                                  (size_t)sums->probe_w * sums->probe_h);

@@ -56,6 +56,7 @@ void gr_ref_destroy(gr_ref_renderer *r); /* accepts NULL */
  * batch the RGB sums of the camera samples and their count, and the surface-bias probe's two
  * sparse accumulators (surface_res and surface_res / 2). gr_ref_assemble turns full sums
  * back into the result a single render gives, bit for bit (src/farm/parts.h merges them). */
+#define GR_REF_PROBE_MAX_LEVELS 4
 typedef struct gr_ref_sums {
     int W, H, B;            /* image size, batches */
     double *sum;            /* [(pixel * B + batch) * 3 + c] */
@@ -63,15 +64,17 @@ typedef struct gr_ref_sums {
     int passes;             /* main passes done (every batch) */
     int probe;              /* 1: the probe ran (the probe_* fields are set) */
     int probe_w, probe_h, probe_stride, probe_off, probe_passes;
-    double *probe_sum[2];   /* [probe pixel * 3 + c] at surface_res and at surface_res / 2 */
-    uint32_t *probe_count[2];
+    int probe_levels;       /* its accumulators: surface_res, surface_res / 2 (, ...) */
+    double *probe_sum[GR_REF_PROBE_MAX_LEVELS];   /* [probe pixel * 3 + c] per level */
+    uint32_t *probe_count[GR_REF_PROBE_MAX_LEVELS];
     double probe_s;         /* probe time */
     double beam_cell_m;     /* the main passes' last beam set (0: none) */
     long long beam_prims;
     double beam_build_s, march_s;
     long long queries, shadows, overflows;
 } gr_ref_sums;
-gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_w, int probe_h); /* zeroed; NULL if no memory */
+/* Zeroed sums; probe_levels accumulators of probe_w x probe_h (0: none). NULL if no memory. */
+gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_levels, int probe_w, int probe_h);
 void gr_ref_sums_destroy(gr_ref_sums *s); /* accepts NULL */
 
 typedef struct gr_ref_result {

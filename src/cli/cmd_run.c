@@ -210,6 +210,9 @@ static void print_summary(const char *dir, const gr_scene *scene, const gr_repor
                w && w->type != GR_META_STRING ? w->num : NAN);
     }
     printf("report: %s/index.html (also summary.png, metrics.json)\n", dir);
+    if (nt > 0 && ts[0].metrics->raw.ch[GR_MCH_Y].ref_mean == 0.0) /* the ground truth is >= 0: zero mean = zero everywhere scored */
+        fprintf(stderr, "godrays run: warning: the ground truth is zero everywhere scored: the metrics say nothing "
+                "(camera inside an occluder, no scattering, or no light reaching the view?)\n");
 }
 
 /* The command after gr_args_create; returns the exit code (gr_args_main frees args). */

@@ -130,10 +130,10 @@ static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune
             snprintf(l0, sizeof l0, "%s (%s): %s of Y%s", s->labels[0], s->base->name, metric,
                      p->fit ? " after the best scale fit" : "");
             snprintf(l1, sizeof l1, "before: %.5g    after: %.5g    (%.1f %% lower)",
-                     gr_tune_metric_value(p->fit ? &mb.fit : &mb.raw, p->metric),
-                     gr_tune_metric_value(p->fit ? &ma.fit : &ma.raw, p->metric),
-                     100.0 * (1.0 - gr_tune_metric_value(p->fit ? &ma.fit : &ma.raw, p->metric) /
-                                        fmax(1e-300, gr_tune_metric_value(p->fit ? &mb.fit : &mb.raw, p->metric))));
+                     gr_tune_value(p, p->fit ? &mb.fit : &mb.raw),
+                     gr_tune_value(p, p->fit ? &ma.fit : &ma.raw),
+                     100.0 * (1.0 - gr_tune_value(p, p->fit ? &ma.fit : &ma.raw) /
+                                        fmax(1e-300, gr_tune_value(p, p->fit ? &mb.fit : &mb.raw))));
             snprintf(l2, sizeof l2, "%s shown x its fitted scale (%.3g, %.3g), same exposure as the reference",
                      p->cls->name, ab, aa);
             const char *lines[3] = {l0, l1, l2};

@@ -74,7 +74,7 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
     if (s->probe) {
         py0 = probe_row(row0, s->probe_stride, s->probe_off, s->probe_h);
         py1 = probe_row(row1, s->probe_stride, s->probe_off, s->probe_h);
-        for (int k = 0; k < 2; k++) {
+        for (int k = 0; k < s->probe_levels; k++) {
             size_t a = (size_t)py0 * s->probe_w, e = (size_t)py1 * s->probe_w;
             put(&pay, s->probe_sum[k] + a * 3, (e - a) * 3 * sizeof(double));
             put(&pay, s->probe_count[k] + a, (e - a) * sizeof(uint32_t));
@@ -107,6 +107,7 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
         cJSON_AddNumberToObject(h, "batch1", b1);
         cJSON_AddNumberToObject(h, "passes", s->passes);
         cJSON_AddNumberToObject(h, "probe", s->probe);
+        cJSON_AddNumberToObject(h, "probe_levels", s->probe_levels);
         cJSON_AddNumberToObject(h, "probe_w", s->probe_w);
         cJSON_AddNumberToObject(h, "probe_h", s->probe_h);
         cJSON_AddNumberToObject(h, "probe_stride", s->probe_stride);
@@ -128,7 +129,8 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
             cJSON_AddNumberToObject(pv, "pid", (double)getpid());
             cJSON_AddStringToObject(pv, "date", date);
             cJSON_AddNumberToObject(pv, "wall_s", res->wall_s);
-            cJSON_AddNumberToObject(pv, "threads", scene->reference.threads);
+            const gr_meta_item *th = gr_meta_get(&res->meta, "godrays:threads");
+            cJSON_AddNumberToObject(pv, "threads", th ? th->num : scene->reference.threads);
             cJSON_AddStringToObject(pv, "version", GR_VERSION);
             cJSON_AddStringToObject(pv, "command", command ? command : "");
         }
@@ -176,7 +178,7 @@ typedef struct part {
     unsigned char *data; /* the whole file */
     const unsigned char *pay;
     size_t pay_n;
-    int W, H, B, row0, row1, b0, b1, passes, probe, pw, ph, pstride, poff, ppasses, py0, py1;
+    int W, H, B, row0, row1, b0, b1, passes, probe, plevels, pw, ph, pstride, poff, ppasses, py0, py1;
 } part;
 
 static double num(const cJSON *h, const char *k, int *ok)
@@ -200,7 +202,7 @@ static void part_free(part *p)
 }
 
 /* Reads and checks one part file (header fields, payload length and checksum). */
-static gr_status part_read(const char *path, int header_only, part *p, gr_error *err)
+static gr_status part_read(const char *path, part *p, gr_error *err)
 {
     memset(p, 0, sizeof *p);
     p->path = path;
@@ -225,7 +227,7 @@ static gr_status part_read(const char *path, int header_only, part *p, gr_error 
         fclose(f);
         return gr_fail(err, GR_E_INPUT, "%s: truncated header", path);
     }
-    size_t want = header_only ? hn : total;
+    size_t want = total;
     p->data = malloc(want + 1);
     if (!p->data) {
         fclose(f);
@@ -260,6 +262,7 @@ static gr_status part_read(const char *path, int header_only, part *p, gr_error 
     p->b1 = (int)num(p->h, "batch1", &ok);
     p->passes = (int)num(p->h, "passes", &ok);
     p->probe = (int)num(p->h, "probe", &ok);
+    p->plevels = (int)num(p->h, "probe_levels", &ok);
     p->pw = (int)num(p->h, "probe_w", &ok);
     p->ph = (int)num(p->h, "probe_h", &ok);
     p->pstride = (int)num(p->h, "probe_stride", &ok);
@@ -271,52 +274,27 @@ static gr_status part_read(const char *path, int header_only, part *p, gr_error 
     const char *fnv = str(p->h, "payload_fnv1a64");
     if (!ok || !fnv || !str(p->h, "cache_key") || !str(p->h, "scene") || p->W < 1 || p->H < 1 || p->B < 2 ||
         p->row0 < 0 || p->row1 > p->H || p->row0 >= p->row1 || p->b0 < 0 || p->b1 > p->B || p->b0 >= p->b1 ||
-        (p->probe && (p->pw < 1 || p->ph < 1 || p->py0 < 0 || p->py1 > p->ph || p->py0 > p->py1))) {
+        (p->probe && (p->plevels < 1 || p->plevels > GR_REF_PROBE_MAX_LEVELS || p->pw < 1 || p->ph < 1 || p->py0 < 0 ||
+                      p->py1 > p->ph || p->py0 > p->py1))) {
         part_free(p);
         return gr_fail(err, GR_E_INPUT, "%s: header fields missing or out of range", path);
     }
     size_t npix = (size_t)(p->row1 - p->row0) * p->W * (p->b1 - p->b0);
     size_t expect = npix * (3 * sizeof(double) + sizeof(uint32_t));
-    if (p->probe) expect += 2 * (size_t)(p->py1 - p->py0) * p->pw * (3 * sizeof(double) + sizeof(uint32_t));
+    if (p->probe) expect += (size_t)p->plevels * (size_t)(p->py1 - p->py0) * p->pw * (3 * sizeof(double) + sizeof(uint32_t));
     if ((double)expect != pn || total - hn != expect) {
         part_free(p);
         return gr_fail(err, GR_E_INPUT, "%s: payload is %zu bytes, the header says %.0f (expected %zu): truncated or damaged",
                        path, total - hn, pn, expect);
     }
     p->pay_n = expect;
-    if (!header_only) {
-        p->pay = p->data + hn;
-        char h[20];
-        snprintf(h, sizeof h, "%016llx", gr_fnv1a64(GR_FNV_BASIS, p->pay, p->pay_n));
-        if (strcmp(h, fnv) != 0) {
-            part_free(p);
-            return gr_fail(err, GR_E_INPUT, "%s: payload checksum %s, the header says %s: damaged", path, h, fnv);
-        }
+    p->pay = p->data + hn;
+    char h[20];
+    snprintf(h, sizeof h, "%016llx", gr_fnv1a64(GR_FNV_BASIS, p->pay, p->pay_n));
+    if (strcmp(h, fnv) != 0) {
+        part_free(p);
+        return gr_fail(err, GR_E_INPUT, "%s: payload checksum %s, the header says %s: damaged", path, h, fnv);
     }
-    return GR_OK;
-}
-
-gr_status gr_part_check(const char *path, gr_part_info *info, gr_error *err)
-{
-    part p;
-    gr_status st = part_read(path, 0, &p, err);
-    if (st != GR_OK) return st;
-    memset(info, 0, sizeof *info);
-    snprintf(info->key, sizeof info->key, "%s", str(p.h, "cache_key"));
-    info->width = p.W;
-    info->height = p.H;
-    info->batches = p.B;
-    info->row0 = p.row0;
-    info->row1 = p.row1;
-    info->batch0 = p.b0;
-    info->batch1 = p.b1;
-    const cJSON *pv = cJSON_GetObjectItemCaseSensitive(p.h, "provenance");
-    int ok = 1;
-    info->wall_s = pv ? num(pv, "wall_s", &ok) : 0.0;
-    info->threads = pv ? (int)num(pv, "threads", &ok) : 0;
-    const char *host = pv ? str(pv, "host") : NULL;
-    snprintf(info->host, sizeof info->host, "%s", host ? host : "");
-    part_free(&p);
     return GR_OK;
 }
 
@@ -331,7 +309,7 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
     int *owner = NULL;
     gr_ref_sums *sums = NULL;
     gr_ref_renderer *r = NULL;
-    for (int i = 0; i < n && st == GR_OK; i++) st = part_read(paths[i], 0, &ps[i], err);
+    for (int i = 0; i < n && st == GR_OK; i++) st = part_read(paths[i], &ps[i], err);
     /* one scene, one set of settings, one image size (the cache key covers the scene's
      * content and every reference setting but threads) */
     const part *p0 = &ps[0];
@@ -372,21 +350,22 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
                 }
     }
     /* the probe: the parts that hold batch 0 carry it, for their rows */
-    int probe = 0, pw = 0, ph = 0;
+    int probe = 0, pw = 0, ph = 0, plevels = 0;
     for (int i = 0; i < n && st == GR_OK; i++)
         if (ps[i].probe) {
             if (!probe) {
                 probe = 1;
                 pw = ps[i].pw;
                 ph = ps[i].ph;
-            } else if (ps[i].pw != pw || ps[i].ph != ph) {
+                plevels = ps[i].plevels;
+            } else if (ps[i].pw != pw || ps[i].ph != ph || ps[i].plevels != plevels) {
                 st = gr_fail(err, GR_E_INPUT, "%s: probe grid %dx%d, other parts %dx%d", ps[i].path, ps[i].pw, ps[i].ph, pw, ph);
             }
         }
     for (int i = 0; i < n && st == GR_OK && probe; i++)
         if (ps[i].b0 == 0 && !ps[i].probe)
             st = gr_fail(err, GR_E_INPUT, "%s: holds batch 0 but no surface-bias probe, other parts do", ps[i].path);
-    if (st == GR_OK && !(sums = gr_ref_sums_create(W, H, B, probe ? pw : 0, probe ? ph : 0)))
+    if (st == GR_OK && !(sums = gr_ref_sums_create(W, H, B, probe ? plevels : 0, probe ? pw : 0, probe ? ph : 0)))
         st = gr_fail(err, GR_E_NOMEM, "merge: out of memory for %dx%d pixels x %d batches", W, H, B);
     double wall = 0.0;
     if (st == GR_OK) {
@@ -409,7 +388,7 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
                 }
             if (p->probe) {
                 size_t a = (size_t)p->py0 * pw, e = (size_t)p->py1 * pw;
-                for (int k = 0; k < 2; k++) {
+                for (int k = 0; k < p->plevels; k++) {
                     memcpy(sums->probe_sum[k] + a * 3, q, (e - a) * 3 * sizeof(double));
                     q += (e - a) * 3 * sizeof(double);
                     memcpy(sums->probe_count[k] + a, q, (e - a) * sizeof(uint32_t));

@@ -11,12 +11,12 @@
  *   line 1  "GODRAYS-PART 1"
  *   line 2  N, the byte length of the header
  *   N bytes a JSON header: format, cache_key, scene (the normalized scene JSON), scene_path,
- *           width, height, batches, row0, row1, batch0, batch1, passes, probe fields, timing
- *           counters, provenance (host, pid, date, wall_s, threads, version), payload_bytes,
- *           payload_fnv1a64
+ *           width, height, batches, row0, row1, batch0, batch1, passes, probe fields
+ *           (levels, grid, its rows), timing counters, provenance (host, pid, date, wall_s,
+ *           threads, version, command), payload_bytes, payload_fnv1a64
  *   payload for rows y in [row0, row1), x in [0, W), batches b in [batch0, batch1):
  *           3 doubles (RGB sums), then the same order again as uint32 sample counts; if the
- *           part ran the probe (it holds batch 0), for each of its two accumulators the
+ *           part ran the probe (it holds batch 0), for each of its probe_levels accumulators the
  *           probe rows inside [row0, row1): 3 doubles per probe pixel, then uint32 counts.
  * Files are written to a temporary name and renamed: never half a part. */
 #ifndef GR_FARM_PARTS_H
@@ -43,17 +43,5 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
  * parts of different scenes or settings: GR_E_INPUT naming the file(s) (exit 2). */
 gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_ref_result *out, char *key,
                          size_t key_n, gr_error *err);
-
-/* Reads only a part's header: its cache key, tile rows and batches, and whether it is
- * complete and intact (the payload's length and checksum). For `farm --status` and the
- * jobs' skip of finished parts. GR_E_INPUT when it is not a valid part. */
-typedef struct gr_part_info {
-    char key[64];
-    int width, height, batches, row0, row1, batch0, batch1;
-    double wall_s;
-    int threads;
-    char host[128];
-} gr_part_info;
-gr_status gr_part_check(const char *path, gr_part_info *info, gr_error *err);
 
 #endif

@@ -5,7 +5,7 @@
  * surface-bias probe's estimate, spp, passes). Two scenes: the default (waves, occluders,
  * seabed, bias probe) and flat water (closed form, no occluders). The parts are rendered
  * with 1 thread and the single run with 2 (the same bytes for any thread count). A missing,
- * a duplicated, a mismatched and a truncated part each exit 2 naming the file. The oracle is
+ * a duplicated, a mismatched, a damaged and a truncated part each exit 2 naming the file. The oracle is
  * the independent single run. Runs the built binary (GODRAYS_BINARY). */
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
@@ -172,6 +172,22 @@ int main(void)
     CHECK(rc == 0);
     rc = run(log, "merge", parts[1], other, "-o", bad, (char *)NULL);
     CHECK_MSG(rc == 2 && log_has(log, "another scene or settings"), "a part of another seed: exit %d", rc);
+    /* a part with one flipped payload byte */
+    char flipped[4300];
+    snprintf(flipped, sizeof flipped, "%s/flipped.part", dir);
+    FILE *in = fopen(parts[5], "rb"), *fo = fopen(flipped, "wb");
+    if (in && fo) {
+        int ch;
+        long pos = 0, len;
+        fseek(in, 0, SEEK_END);
+        len = ftell(in);
+        fseek(in, 0, SEEK_SET);
+        while ((ch = fgetc(in)) != EOF) fputc(pos++ == len - 7 ? ch ^ 0x10 : ch, fo);
+    }
+    if (in) fclose(in);
+    if (fo) fclose(fo);
+    rc = run(log, "merge", flipped, "-o", bad, (char *)NULL);
+    CHECK_MSG(rc == 2 && log_has(log, "checksum"), "a damaged part: exit %d", rc);
     /* a truncated part */
     FILE *f = fopen(other, "r+b");
     if (f) {
