@@ -2,6 +2,7 @@
  * and a real-time frame, possibly captured from another engine), optional mask, reference
  * standard errors, best scale fit; with -o DIR also metrics.json and false-color differences. */
 #include "cli/cli.h"
+#include "common/memlimit.h"
 #include "common/outfile.h"
 #include "cli/args.h"
 
@@ -18,6 +19,7 @@
 #include "compare/diffmap.h"
 #include "compare/flip.h"
 #include "compare/structure.h"
+#include "report/profile.h"
 #include "scene/scene.h"
 #include "compare/metrics.h"
 #include "compare/metrics_io.h"
@@ -53,6 +55,8 @@ static void usage(FILE *f)
             "  --vp X,Y             the beams' vanishing point in image coordinates (pixel centres\n"
             "                       at +0.5; may lie outside) for the structure metrics\n"
             "  --scene FILE         take the vanishing point from FILE's camera and refracted sun\n"
+            "                       (and de-glow by the angle to that sun, not the distance to the\n"
+            "                       point)\n"
             "  --set KEY=VALUE      override a value of that scene, e.g. camera.yaw_deg=120\n"
             "                       (repeatable)\n"
             "  --flip-mode M        ldr or hdr (default: hdr when REF is .exr, .hdr or .pfm, else\n"
@@ -64,6 +68,8 @@ static void usage(FILE *f)
             "                       with -o, DIR/flip.png is the per-pixel FLIP map (magma, 0 black\n"
             "                       .. 1 white-yellow)\n"
             "  --json               print the JSON instead of the table\n"
+            "  --max-memory SIZE    refuse (exit 2) images estimated to need more (e.g. 2G; default\n"
+            "                       $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  -h, --help           this help\n"
             "\n"
             "Exit codes: 0 ok, 1 runtime failure, 2 bad usage, unreadable input or size mismatch.\n",
@@ -109,6 +115,17 @@ static cJSON *image_json(const char *path, const gr_image *img, const int rgb[3]
         return NULL;
     }
     return o;
+}
+
+/* Every compared sample of img is 0: a "perfect" fit (a = 0, RMSE 0, PSNR inf, SSIM 1) that
+ * means nothing. */
+static int all_zero(const gr_image *img, const int rgb[3])
+{
+    const size_t n = (size_t)img->width * (size_t)img->height, nc = (size_t)img->nchannels;
+    for (size_t p = 0; p < n; p++)
+        for (int k = 0; k < 3; k++)
+            if (img->pixels[p * nc + (size_t)rgb[k]] != 0.0f) return 0;
+    return 1;
 }
 
 static double now_s(void)
@@ -212,6 +229,11 @@ int cmd_compare(int argc, char **argv)
                     return gr_cli_usage_error(cmd, "--exposures '%s': need START:STOP:COUNT, START <= STOP, COUNT >= 1", v);
                 fopt.exposures_given = 1, fopt.start_exposure = e0, fopt.stop_exposure = e1, fopt.n_exposures = k;
             }
+        } else if (!strcmp(a, "--max-memory")) {
+            gr_error merr;
+            double bytes;
+            if (gr_memlimit_parse("--max-memory", v, &bytes, &merr) != GR_OK) return gr_cli_usage_error(cmd, "%s", merr.msg);
+            gr_memlimit_set(bytes);
         } else if (!strcmp(a, "--fit-scale")) {
             opt.fit_scale = 1;
         } else if (!strcmp(a, "--json")) {
@@ -239,7 +261,7 @@ int cmd_compare(int argc, char **argv)
     gr_error err = {0};
     gr_image *ref = NULL, *test = NULL, *mask = NULL, *diff[3] = {NULL, NULL, NULL}, *scaled = NULL;
     unsigned char *scored = NULL;
-    float *flipmap = NULL;
+    float *flipmap = NULL, *angles = NULL;
     cJSON *root = NULL;
     char *text = NULL;
     int rc = 0;
@@ -252,6 +274,22 @@ int cmd_compare(int argc, char **argv)
     if (st == GR_OK && mask && (mask->width != ref->width || mask->height != ref->height))
         st = gr_fail(&err, GR_E_INPUT, "size mismatch: mask %s is %d x %d, images are %d x %d", mask_path, mask->width,
                      mask->height, ref->width, ref->height);
+    /* two channels: grey + alpha is compared as grey; anything else (R, G) has no defined
+     * luminance, so it is refused rather than compared as grey with a channel dropped */
+    for (int k = 0; st == GR_OK && k < 2; k++) {
+        const gr_image *im = k ? test : ref;
+        if (im->nchannels == 2 && strcmp(im->names[1], "A"))
+            st = gr_fail(&err, GR_E_INPUT, "%s %s: 2 channels (%s, %s): neither grey (+ alpha A) nor RGB; convert it "
+                         "first, e.g. oiiotool IN --ch R,G,B=0 -o OUT.exr", k ? "test" : "reference", paths[k],
+                         im->names[0], im->names[1]);
+    }
+    if (st == GR_OK) {
+        /* the metrics, blurs and difference images: about 170 bytes per pixel, measured
+         * (2.8 GB for 4096 x 4096; docs/reliability.md) */
+        char detail[96];
+        snprintf(detail, sizeof detail, "%d x %d pixels at about 170 bytes each", ref->width, ref->height);
+        st = gr_memlimit_check("the comparison", 170.0 * ref->width * (double)ref->height, detail, &err);
+    }
     if (st != GR_OK) goto fail;
 
     opt.mask = mask;
@@ -304,6 +342,7 @@ int cmd_compare(int argc, char **argv)
     gr_structure_compare sres;
     double t_struct = 0.0;
     if (do_struct) {
+        gr_structure_options so = {0};
         if (scene_path) {
             gr_scene sc;
             st = gr_scene_load_file(scene_path, sets, n_sets, &sc, &err);
@@ -313,6 +352,17 @@ int cmd_compare(int argc, char **argv)
                 gr_error_prefix(&err, "--scene %s", scene_path);
                 goto fail;
             }
+            /* de-glow by the angle to the refracted sun, rings one pixel wide */
+            sc.camera.width = ref->width, sc.camera.height = ref->height;
+            angles = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
+            if (!angles) {
+                st = gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
+                goto fail;
+            }
+            double dir[3];
+            gr_profile_sun_view_dir(&sc, dir);
+            gr_profile_angles(&sc.camera, dir, angles);
+            so.radial = angles, so.radial_bin = sc.camera.fov_deg / ref->height;
         }
         if (!scored) {
             scored = malloc((size_t)ref->width * (size_t)ref->height);
@@ -323,7 +373,7 @@ int cmd_compare(int argc, char **argv)
             st = gr_metrics_scored_pixels(ref, mask, opt.stderr_bound, scored, NULL, NULL, &err);
             if (st != GR_OK) goto fail;
         }
-        gr_structure_options so = {.vp_x = vp[0], .vp_y = vp[1], .scored = scored};
+        so.vp_x = vp[0], so.vp_y = vp[1], so.scored = scored;
         const double t2 = now_s();
         st = gr_structure_compare_images(ref, test, &so, &sres, &err);
         t_struct = now_s() - t2;
@@ -417,6 +467,10 @@ int cmd_compare(int argc, char **argv)
         }
     }
 
+    if (all_zero(ref, m.ref_rgb))
+        fprintf(stderr, "godrays compare: warning: the reference %s is zero everywhere scored: RMSE, PSNR, SSIM and the "
+                "scale fit say nothing about the test image (is the camera inside an occluder, or the medium "
+                "without scattering?)\n", paths[0]);
     if (json) {
         printf("%s\n", text);
     } else {
@@ -443,5 +497,6 @@ done:
     gr_image_destroy(scaled);
     free(scored);
     free(flipmap);
+    free(angles);
     return rc;
 }

@@ -16,6 +16,7 @@
 
 #include "farm/farm.h"
 #include "report/cache.h"
+#include "realtime/technique.h"
 
 static void usage(FILE *f)
 {
@@ -44,8 +45,8 @@ static void usage(FILE *f)
             "  --max-parallel K     at most K array tasks at once\n"
             "  --retries R          attempts per part before it is reported failed (default 3)\n"
             "  --then tune|run|none the final job on the merged truths (default tune)\n"
-            "  --then-args \"ARGS\"   more arguments for it (tune: default --params\n"
-            "                       shafts.extinction,shafts.K unless ARGS name --params)\n"
+            "  --then-args \"ARGS\"   more arguments for it (tune: default --params with the first\n"
+            "                       technique's first two tunable settings, unless ARGS name --params)\n"
             "  --binary PATH        the godrays the jobs run (default: this one)\n"
             "  --set KEY=VALUE, --size WxH   scene overrides (baked into the scene copy)\n"
             "  --dry-run            write the scripts, do not submit (submit later: DIR/submit.sh)\n");
@@ -195,8 +196,16 @@ static int farm_with(gr_args *args)
     if (strcmp(plan.then, "tune") && strcmp(plan.then, "run") && strcmp(plan.then, "none"))
         return gr_cli_usage_error(cmd, "--then %s: expected tune, run or none", plan.then);
     if (!strcmp(plan.then, "tune") && !strstr(plan.then_args, "--params")) { /* tune needs its parameters */
+        /* the first technique's first tunable settings (`godrays techniques`) */
+        const gr_technique_class *tc = gr_technique_at(0);
+        const gr_param *ex[2];
+        const int nex = gr_technique_tune_example(tc, ex, 2);
+        if (nex == 0) return gr_cli_usage_error(cmd, "--then tune: give --then-args \"--params TECHNIQUE.KEY\"");
         size_t tl = strlen(plan.then_args);
-        snprintf(plan.then_args + tl, sizeof plan.then_args - tl, "%s--params shafts.extinction,shafts.K", tl ? " " : "");
+        snprintf(plan.then_args + tl, sizeof plan.then_args - tl, "%s--params %s.%s%s%s%s", tl ? " " : "", tc->name,
+                 ex[0]->name, nex > 1 ? "," : "", nex > 1 ? tc->name : "", nex > 1 ? "." : "");
+        tl = strlen(plan.then_args);
+        if (nex > 1) snprintf(plan.then_args + tl, sizeof plan.then_args - tl, "%s", ex[1]->name);
     }
     if (!cache) cache = getenv("GODRAYS_CACHE");
     char user_cache[4096];

@@ -2,6 +2,7 @@
  * PNG preview beside it. Quality flags become "reference.*" overrides of the scene, so they
  * are range-checked by the same tables as the file. */
 #include "cli/cli.h"
+#include "common/memlimit.h"
 #include "cli/args.h"
 #include "cli/render.h"
 
@@ -41,8 +42,11 @@ static void usage(FILE *f)
             "  --cutoff T             stop camera rays where their transmittance falls below T\n"
             "  --size WxH             override the image size\n"
             "  --set KEY=VALUE        any scene override, e.g. --set medium.g=0.9 (repeatable)\n"
+            "  --technique-dir DIR    add the user technique in DIR (for a scene with its section)\n"
             "  --aov                  add transmittance and ray_length channels\n"
             "  --no-preview           do not write the PNG preview\n"
+            "  --max-memory SIZE      refuse (exit 2) a render estimated to need more (e.g. 8G;\n"
+            "                         default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  --quiet                no progress bar\n"
             "  --bench                benchmark instead of writing files: hot-loop lookups per second\n"
             "                         with 1 and 2 threads, Embree's raw occlusion-ray throughput\n"
@@ -57,6 +61,19 @@ static void usage(FILE *f)
             "                         (parts take the fixed passes: no --target-error, no --aov)\n"
             "\n"
             "Ctrl-C stops the render and writes what is done, marked godrays:partial = 1 (exit 1).\n");
+}
+
+/* --max-memory SIZE (common/memlimit). */
+static int take_max_memory(gr_args *args)
+{
+    const char *v = NULL;
+    int rc = gr_args_value(args, &v);
+    if (rc) return rc;
+    gr_error err;
+    double bytes;
+    if (gr_memlimit_parse("--max-memory", v, &bytes, &err) != GR_OK) return gr_cli_usage_error(args->cmd, "%s", err.msg);
+    gr_memlimit_set(bytes);
+    return 0;
 }
 
 /* --target-error stops refining at the round cap (gr_ref_result.max_rounds) whether or not the
@@ -123,7 +140,9 @@ static int reference_with(gr_args *args)
             rc = gr_args_value(args, &v);
             if (!rc && gr_tune_parse_view(a, v, &view, &verr) != GR_OK) rc = gr_cli_report(cmd, &verr);
             have_view = 1;
-        } else rc = gr_args_take_scene(args);
+        } else if (!strcmp(a, "--technique-dir")) rc = gr_args_take_technique_dir(args);
+        else if (!strcmp(a, "--max-memory")) rc = take_max_memory(args);
+        else rc = gr_args_take_scene(args);
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
     if (!out_path && !bench) return gr_cli_usage_error(cmd, "no output given (-o OUT.exr)");
@@ -137,6 +156,8 @@ static int reference_with(gr_args *args)
         return gr_cli_usage_error(cmd, "--frame %s: expected a frame number >= 0", frame_s);
     if (fps_s && (sscanf(fps_s, "%lf%c", &fps, &extra) != 1 || !(fps > 0.0) || fps > 1e6))
         return gr_cli_usage_error(cmd, "--fps %s: expected frames per second > 0", fps_s);
+    /* a scene with a user technique's section loads once that technique is known */
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) goto done;
     if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
     if (frame_s || have_view) {
         /* the same scene as tune's case (frame f: water.time_s + f / fps), so the ground truth

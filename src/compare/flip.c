@@ -417,6 +417,11 @@ gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_fl
     gr_metrics_pick_rgb(ref, ch[0]);
     gr_metrics_pick_rgb(test, ch[1]);
     const int nexp = opt->mode == GR_FLIP_HDR ? res->n_exposures : 1;
+    const double tscale = opt->test_scale == 0.0 ? 1.0 : opt->test_scale;
+    if (!isfinite(tscale)) {
+        st = gr_fail(err, GR_E_INPUT, "FLIP: test scale %g is not finite", tscale);
+        goto done;
+    }
     double c[6];
     tm_coeffs(opt->tonemapper, c);
     for (int k = 0; k < nexp; k++) {
@@ -429,12 +434,13 @@ gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_fl
         for (int i = 0; i < 2; i++)
             for (size_t p = 0; p < n; p++)
                 for (int j = 0; j < 3; j++) {
-                    double v = im[i]->pixels[p * (size_t)im[i]->nchannels + (size_t)ch[i][j]];
+                    double v = (i ? tscale : 1.0) * im[i]->pixels[p * (size_t)im[i]->nchannels + (size_t)ch[i][j]];
                     if (opt->mode == GR_FLIP_HDR) {
                         v = gain * (v < 0.0 ? 0.0 : v);
                         /* ACES acts per channel; Reinhard on luminance (colour / (1 + Y)), which
                          * keeps hues (checked against the published tool: per channel it differs) */
-                        v = opt->tonemapper == GR_FLIP_TM_REINHARD ? v / (1.0 + gain * lum_pos(im[i], ch[i], p))
+                        v = opt->tonemapper == GR_FLIP_TM_REINHARD
+                                ? v / (1.0 + gain * (i ? tscale : 1.0) * lum_pos(im[i], ch[i], p))
                                                                    : tonemap(c, v);
                     }
                     rgb[i][3 * p + (size_t)j] = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);

@@ -32,6 +32,7 @@ typedef struct gr_flip_options {
     int exposures_given;           /* HDR: 1 = use start/stop/count below; 0 = from the reference */
     double start_exposure, stop_exposure; /* log2 factors, start <= stop */
     int n_exposures;               /* >= 1 (1: the start exposure only) */
+    double test_scale;             /* the test is multiplied by this first; 0: 1 */
     const unsigned char *scored;   /* per pixel, may be NULL: the pooled statistics use only
                                       pixels with scored[p] != 0 (filters still see every pixel) */
 } gr_flip_options;

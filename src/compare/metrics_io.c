@@ -53,6 +53,17 @@ static cJSON *set_json(const gr_metrics *m, const gr_metrics_set *s)
              (s->have_ssim ? add_num(o, "ssim_y", s->ssim_y) : cJSON_AddNullToObject(o, "ssim_y") != NULL);
     cJSON *chs = ok ? cJSON_AddObjectToObject(o, "channels") : NULL;
     ok = ok && chs;
+    if (ok && s->have_flip) {
+        cJSON *fj = gr_flip_to_json(&s->flip, s->scale);
+        ok = fj && cJSON_AddItemToObject(o, "flip", fj);
+        if (!ok) cJSON_Delete(fj);
+    }
+    if (ok && s->have_structure) {
+        cJSON *sj = cJSON_AddObjectToObject(o, "structure");
+        ok = sj && add_num(sj, "score", s->structure_score) && add_num(sj, "bandpass_correlation", s->structure_corr) &&
+             add_num(sj, "contrast_log_error", s->structure_contrast_err) &&
+             add_num(sj, "log_spectral_distance", s->structure_lsd);
+    }
     for (int c = 0; ok && c < GR_MCH_COUNT; c++) {
         cJSON *cj = channel_json(&s->ch[c], m->have_stderr, s->have_blur);
         ok = cj && cJSON_AddItemToObject(chs, gr_metric_channel_name((gr_metric_channel)c), cj);

@@ -8,53 +8,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
+#include "common/outfile.h"
 #include "core/optics.h"
 #include "core/shaftgeom.h"
+#include "realtime/frame.h"
 #include "realtime/shafts.h"
-
-/* c = a b, column-major 4x4 */
-static void mat_mul(const double a[16], const double b[16], double out[16])
-{
-    double t[16];
-    for (int col = 0; col < 4; col++)
-        for (int r = 0; r < 4; r++) {
-            double acc = 0.0;
-            for (int k = 0; k < 4; k++) acc += a[k * 4 + r] * b[col * 4 + k];
-            t[col * 4 + r] = acc;
-        }
-    memcpy(out, t, sizeof t);
-}
-
-/* Inverse by Gauss-Jordan with partial pivoting; -1 if singular. */
-static int mat_inverse(const double m[16], double out[16])
-{
-    double a[4][8];
-    for (int r = 0; r < 4; r++)
-        for (int k = 0; k < 8; k++) a[r][k] = k < 4 ? m[k * 4 + r] : (k - 4 == r ? 1.0 : 0.0);
-    for (int col = 0; col < 4; col++) {
-        int piv = col;
-        for (int r = col + 1; r < 4; r++)
-            if (fabs(a[r][col]) > fabs(a[piv][col])) piv = r;
-        if (!(fabs(a[piv][col]) > 1e-300)) return -1;
-        for (int k = 0; k < 8; k++) {
-            double t = a[col][k];
-            a[col][k] = a[piv][k];
-            a[piv][k] = t;
-        }
-        double inv = 1.0 / a[col][col];
-        for (int k = 0; k < 8; k++) a[col][k] *= inv;
-        for (int r = 0; r < 4; r++) {
-            if (r == col) continue;
-            double f = a[r][col];
-            for (int k = 0; k < 8; k++) a[r][k] -= f * a[col][k];
-        }
-    }
-    for (int r = 0; r < 4; r++)
-        for (int k = 0; k < 4; k++) out[k * 4 + r] = a[r][k + 4];
-    return 0;
-}
 
 static double wrap_2pi(double x)
 {
@@ -66,9 +25,6 @@ static void set3(double *d, const double *s) { d[0] = s[0], d[1] = s[1], d[2] = 
 
 gr_status gr_constants_compute(const gr_scene *s, gr_shader_constants *c, gr_error *err)
 {
-    /* seed 000's constants use the scene's shafts section, scene-derived defaults resolved */
-    gr_shafts_settings sh;
-    gr_shafts_resolve(s, gr_shafts_scene_settings(s), &sh);
     memset(c, 0, sizeof *c);
     const gr_camera *cam = &s->camera;
     const gr_water *w = &s->water;
@@ -78,6 +34,12 @@ gr_status gr_constants_compute(const gr_scene *s, gr_shader_constants *c, gr_err
     if (!(c->depth_m > 0.0))
         return gr_fail(err, GR_E_INPUT, "camera.position_m: y = %g is not below the water's rest height %g; P and S "
                        "(seed eqs. 5.5.5-5.5.6) need an underwater viewer", cam->position_m[1], w->rest_height_m);
+
+    /* The scene's "shafts" section, its scene-derived defaults (extinction, g) resolved. */
+    const gr_shafts_settings *sec = gr_shafts_scene_settings(s);
+    if (!sec) return gr_fail(err, GR_E_INPUT, "shafts: the scene has no shafts settings");
+    gr_shafts_settings sh;
+    gr_shafts_resolve(s, sec, &sh);
 
     /* Seed eqs. 5.5.5a/b and 5.5.6 (src/core/shaftgeom). */
     gr_dvec3 T;
@@ -91,50 +53,33 @@ gr_status gr_constants_compute(const gr_scene *s, gr_shader_constants *c, gr_err
     if (!(isfinite(P.x) && isfinite(P.z) && T.y < 0.0 && c->S > 0.0 && isfinite(c->S)))
         return gr_fail(err, GR_E_INPUT, "sun.elevation_deg: no finite shaft centre P for this sun and camera");
 
-    /* Seed 000's wave packing (listing in section 5.5.4), eq. 5.5.7's sign of phi0. */
-    c->n_waves = w->n_waves;
-    c->n_groups = (w->n_waves + 3) / 4;
+    /* The frame's shader inputs as every technique gets them (src/realtime/frame.h): GL
+     * matrices, sun, seed 000's packed waves in world coordinates (wt = w t - phi0 mod 2 pi). */
+    gr_frame *fr = malloc(sizeof *fr);
+    if (!fr) return gr_fail(err, GR_E_NOMEM, "out of memory");
+    gr_frame_init(s, fr);
+    memcpy(c->view, fr->view, sizeof c->view);
+    memcpy(c->proj, fr->proj, sizeof c->proj);
+    memcpy(c->view_proj, fr->view_proj, sizeof c->view_proj);
+    memcpy(c->inv_view_proj, fr->inv_view_proj, sizeof c->inv_view_proj);
+    set3(c->sun_dir, fr->sun_dir);
+    set3(c->to_sun, fr->to_sun);
+    set3(c->sun_irradiance, fr->sun_irradiance);
+    c->sun_angular_radius_rad = fr->sun_angular_radius_rad;
+    c->transmittance_flat = fr->transmittance_flat;
+    c->n_waves = fr->n_waves;
+    c->n_groups = fr->n_wave_groups;
+    memcpy(c->waves_world, fr->waves_seed, sizeof c->waves_world);
+    memcpy(c->waves_rel_p, fr->waves_seed, sizeof c->waves_rel_p);
+    free(fr);
+    /* Relative to P (as src/realtime uses them): K.X0 = K.(X0 - P) + K.P, so wt_P = wt - K.P. */
     for (int i = 0; i < w->n_waves; i++) {
         const gr_wave *wv = &w->waves[i];
-        int g = i / 4, lane = i % 4;
         double kx = wv->k * wv->dir[0], kz = wv->k * wv->dir[1];
-        double ainvk = wv->k > 0.0 ? wv->amplitude_m / wv->k : 0.0;
         double wt = wv->omega_rad_s * w->time_s - wv->phase_rad;
-        double rows[5] = {kx, kz, ainvk, wv->amplitude_m, wrap_2pi(wt)};
-        for (int r = 0; r < 5; r++) c->waves_world[g * 5 + r][lane] = c->waves_rel_p[g * 5 + r][lane] = (float)rows[r];
-        c->waves_rel_p[g * 5 + 4][lane] = (float)wrap_2pi(wt - (kx * P.x + kz * P.z));
+        c->waves_rel_p[(i / 4) * 5 + 4][i % 4] = (float)wrap_2pi(wt - (kx * P.x + kz * P.z));
     }
-
-    /* Sun */
-    set3(c->sun_dir, s->sun.dir);
-    set3(c->to_sun, s->sun.to_sun);
-    set3(c->sun_irradiance, s->sun.irradiance);
-    c->sun_angular_radius_rad = 0.5 * s->sun.angular_diameter_deg * GR_PI / 180.0;
-    c->transmittance_flat = 1.0 - gr_fresnel_exact(s->sun.to_sun[1], 1.0, s->medium.ior);
-
-    /* View: rows right, up, -forward, translation -R eye (right-handed, camera looks down -z);
-     * projection as gluPerspective (clip z in [-1, 1]). Column-major: (row r, col k) at [k*4+r].
-     * Same convention as src/realtime/frame.h's gr_frame_init. */
-    const double *R[3] = {cam->right, cam->up, cam->forward};
-    const double sgn[3] = {1.0, 1.0, -1.0};
-    for (int r = 0; r < 3; r++) {
-        double t = 0.0;
-        for (int k = 0; k < 3; k++) {
-            c->view[k * 4 + r] = sgn[r] * R[r][k];
-            t += sgn[r] * R[r][k] * c->eye[k];
-        }
-        c->view[12 + r] = -t;
-    }
-    c->view[15] = 1.0;
-    double aspect = (double)cam->width / (double)cam->height;
-    double tf = 1.0 / tan(0.5 * cam->fov_deg * GR_PI / 180.0), n = GR_CONST_ZNEAR_M, f = GR_CONST_ZFAR_M;
-    c->proj[0] = tf / aspect;
-    c->proj[5] = tf;
-    c->proj[10] = (f + n) / (n - f);
-    c->proj[11] = -1.0;
-    c->proj[14] = 2.0 * f * n / (n - f);
-    mat_mul(c->proj, c->view, c->view_proj);
-    if (mat_inverse(c->view_proj, c->inv_view_proj) != 0)
+    if (gr_mat4_inverse(c->view_proj, c->inv_view_proj) != 0)
         return gr_fail(err, GR_E_INPUT, "camera: singular view-projection matrix");
 
     /* Medium and the shafts' own settings (their defaults are the medium's) */
@@ -160,25 +105,7 @@ gr_status gr_constants_compute(const gr_scene *s, gr_shader_constants *c, gr_err
 
 static gr_status write_text(const char *path, const char *text, gr_error *err)
 {
-    size_t n = strlen(path) + 32;
-    char *tmp = malloc(n);
-    if (!tmp) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
-    snprintf(tmp, n, "%s.tmp-%ld", path, (long)getpid());
-    gr_status st = GR_OK;
-    FILE *f = fopen(tmp, "wb");
-    if (!f) {
-        st = gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    } else {
-        size_t len = strlen(text);
-        int bad = fwrite(text, 1, len, f) != len;
-        if (fclose(f) != 0) bad = 1;
-        if (bad) st = gr_fail(err, GR_E_IO, "%s: write failed: %s", path, strerror(errno));
-        else if (rename(tmp, path) != 0)
-            st = gr_fail(err, GR_E_IO, "%s: cannot rename into place: %s", path, strerror(errno));
-        if (st != GR_OK) remove(tmp);
-    }
-    free(tmp);
-    return st;
+    return gr_outfile_write(path, text, -1, err); /* atomic: common/outfile */
 }
 
 static cJSON *arr(const double *v, int n)

@@ -7,8 +7,10 @@
 
 #include "scene/scene.h"
 
-#define GR_CONST_ZNEAR_M 0.05  /* projection planes: those of src/realtime (shafts.c, frame.h) */
-#define GR_CONST_ZFAR_M 2000.0
+#include "realtime/frame.h"
+
+#define GR_CONST_ZNEAR_M GR_FRAME_NEAR_M  /* projection planes: src/realtime/frame.h's */
+#define GR_CONST_ZFAR_M GR_FRAME_FAR_M
 
 typedef struct gr_shader_constants {
     double time_s;

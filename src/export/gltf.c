@@ -3,15 +3,14 @@
 
 #include <cjson/cJSON.h>
 #include <errno.h>
-#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
+#include "common/outfile.h"
 #include "core/gerstner.h"
 #include "core/optics.h"
 #include "core/shaftgeom.h"
@@ -443,21 +442,25 @@ int gr_gltf_kind(const char *path)
     return 0;
 }
 
-/* a, then b, then nzero (< 4) zero bytes, into tmp */
-static gr_status write_tmp(const char *path, const char *tmp, const void *a, size_t na, const void *b, size_t nb,
-                           size_t nzero, gr_error *err)
+/* a, then b, then nzero (< 4) zero bytes into path, atomically (common/outfile) */
+static gr_status write_file(const char *path, const void *a, size_t na, const void *b, size_t nb, size_t nzero,
+                            gr_error *err)
 {
     static const unsigned char zero[4] = {0, 0, 0, 0};
-    FILE *f = fopen(tmp, "wb");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    int bad = (na && fwrite(a, 1, na, f) != na) || (nb && fwrite(b, 1, nb, f) != nb) ||
-              (nzero && fwrite(zero, 1, nzero, f) != nzero);
-    if (fclose(f) != 0) bad = 1;
-    if (bad) {
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: write failed: %s", path, strerror(errno));
+    gr_outfile o;
+    gr_status st = gr_outfile_open(&o, path, err);
+    if (st != GR_OK) return st;
+    if (!o.f) {
+        gr_outfile_abort(&o);
+        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
     }
-    return GR_OK;
+    if ((na && fwrite(a, 1, na, o.f) != na) || (nb && fwrite(b, 1, nb, o.f) != nb) ||
+        (nzero && fwrite(zero, 1, nzero, o.f) != nzero)) {
+        int e = errno;
+        gr_outfile_abort(&o);
+        return gr_fail(err, GR_E_IO, "%s: write failed: %s", path, strerror(e));
+    }
+    return gr_outfile_commit(&o, (long long)(na + nb + nzero), err);
 }
 
 static void put_u32(unsigned char *p, uint32_t v)
@@ -504,7 +507,7 @@ gr_status gr_gltf_write(const gr_scene *s, const gr_gltf_options *opt, const cha
     ctx c = {0};
     float *pos = NULL, *nrm = NULL, *tp = NULL, *tn = NULL, *wts = NULL, *times = NULL;
     uint32_t *idx = NULL;
-    char *json = NULL, *tmp = NULL, *tmp2 = NULL, *binpath = NULL;
+    char *json = NULL, *binpath = NULL;
 
     /* Patch centre: the point P of seed eq. 5.5.5 (where the refracted sun ray through the eye
      * meets the rest plane), the centre of the surface that lights the viewer's surroundings;
@@ -713,10 +716,8 @@ gr_status gr_gltf_write(const gr_scene *s, const gr_gltf_options *opt, const cha
 
     /* buffer */
     size_t plen = strlen(path);
-    tmp = malloc(plen + 64);
-    tmp2 = malloc(plen + 64);
     binpath = malloc(plen + 8);
-    if (!tmp || !tmp2 || !binpath) goto nomem;
+    if (!binpath) goto nomem;
     size_t binlen = c.n;
     cJSON *buf = cJSON_CreateObject();
     cJSON_AddNumberToObject(buf, "byteLength", (double)binlen);
@@ -735,20 +736,10 @@ gr_status gr_gltf_write(const gr_scene *s, const gr_gltf_options *opt, const cha
     json = cJSON_PrintUnformatted(c.root);
     if (!json) goto nomem;
     size_t jlen = strlen(json);
-    long pid = (long)getpid();
-    snprintf(tmp, plen + 64, "%s.tmp-%ld", path, pid);
     if (kind == 1) {
-        snprintf(tmp2, plen + 64, "%s.tmp-%ld", binpath, pid);
-        if ((st = write_tmp(binpath, tmp2, c.bin, binlen, NULL, 0, 0, err)) != GR_OK) goto done;
-        if ((st = write_tmp(path, tmp, json, jlen, NULL, 0, 0, err)) != GR_OK) {
-            remove(tmp2);
-            goto done;
-        }
-        if (rename(tmp2, binpath) != 0) {
-            st = gr_fail(err, GR_E_IO, "%s: cannot rename into place: %s", binpath, strerror(errno));
-            remove(tmp2), remove(tmp);
-            goto done;
-        }
+        /* the .bin first: a .gltf never names a buffer that is not there */
+        if ((st = write_file(binpath, c.bin, binlen, NULL, 0, 0, err)) != GR_OK) goto done;
+        st = write_file(path, json, jlen, NULL, 0, 0, err);
     } else {
         /* GLB (glTF 2.0 spec, "Binary glTF Layout"): 12-byte header, JSON chunk padded with
          * spaces, BIN chunk padded with zeros, both to 4 bytes */
@@ -770,13 +761,8 @@ gr_status gr_gltf_write(const gr_scene *s, const gr_gltf_options *opt, const cha
         memset(head + 20 + jlen, ' ', jpad - jlen);
         put_u32(head + 20 + jpad, (uint32_t)bpad);
         put_u32(head + 24 + jpad, 0x004E4942u); /* "BIN\0" */
-        st = write_tmp(path, tmp, head, 28u + jpad, c.bin, binlen, bpad - binlen, err);
+        st = write_file(path, head, 28u + jpad, c.bin, binlen, bpad - binlen, err);
         free(head);
-        if (st != GR_OK) goto done;
-    }
-    if (rename(tmp, path) != 0) {
-        st = gr_fail(err, GR_E_IO, "%s: cannot rename into place: %s", path, strerror(errno));
-        remove(tmp);
     }
     goto done;
 
@@ -786,7 +772,7 @@ done:
     cJSON_Delete(scene_nodes);
     cJSON_Delete(c.root);
     free(c.bin);
-    free(json), free(tmp), free(tmp2), free(binpath);
+    free(json), free(binpath);
     free(pos), free(nrm), free(idx), free(tp), free(tn), free(wts), free(times);
     return st;
 }

@@ -3,6 +3,7 @@
 extern "C" {
 #include "common/outfile.h"
 #include "common/status.h"
+#include "image/exr.h"
 }
 #include "image/oiio.h"
 
@@ -53,8 +54,9 @@ float srgb_decode(float c)
 // reads inputs, never while a render runs.
 class StderrCapture {
   public:
-    StderrCapture()
+    explicit StderrCapture(bool on = true)
     {
+        if (!on) return;
         std::fflush(stderr);
         f_ = std::tmpfile();
         if (f_) saved_ = dup(2);
@@ -157,6 +159,22 @@ gr_status exception_status(gr_error *err, const char *path, const char *what)
     }
 }
 
+// The formats the image reader takes, by file extension (docs/images.md): those a renderer or
+// an image tool writes for comparisons. Anything else is refused before it is opened.
+#define READ_EXTS ".exr, .png, .tif/.tiff, .hdr, .jpg/.jpeg, .bmp, .ppm/.pgm/.pnm/.pbm, .tga"
+const char *read_format(const char *path)
+{
+    static const char *const table[][2] = {
+        {"exr", "openexr"}, {"png", "png"}, {"tif", "tiff"}, {"tiff", "tiff"}, {"hdr", "hdr"}, {"jpg", "jpeg"},
+        {"jpeg", "jpeg"}, {"bmp", "bmp"}, {"ppm", "pnm"}, {"pgm", "pnm"}, {"pnm", "pnm"}, {"pbm", "pnm"},
+        {"tga", "targa"}};
+    const char *dot = std::strrchr(path, '.'), *slash = std::strrchr(path, '/');
+    if (!dot || (slash && slash > dot)) return nullptr;
+    for (const auto &e : table)
+        if (OIIO::Strutil::iequals(dot + 1, e[0])) return e[1];
+    return nullptr;
+}
+
 } // namespace
 
 extern "C" const char *gr_oiio_version(void)
@@ -180,9 +198,37 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
     gr_image *img = nullptr;
     gr_status reg = gr_check_regular_input(path, err); // a FIFO blocks, /dev/zero spins
     if (reg != GR_OK) return reg;
-    StderrCapture cap; // libpng prints its own line ("IHDR: CRC error"): kept for the message
+    const char *format = read_format(path);
+    if (!format) {
+        FILE *f = std::fopen(path, "rb"); // a missing file says so first
+        if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
+        std::fclose(f);
+        return gr_fail(err, GR_E_INPUT, "%s: not a supported image file name (the reader takes %s)", path, READ_EXTS);
+    }
+    // EXR files go through the project's own reader (image/exr.c): it checks the data window
+    // and the chunk table against the file before allocating, where OpenEXR's C++ reader
+    // behind OpenImageIO rebuilt a huge offset table for seconds from a 2.5 KB file.
+    if (!std::strcmp(format, "openexr")) return gr_exr_read(path, out, nullptr, err);
+    // libpng prints its own line ("IHDR: CRC error"): kept for the message (PNG only, so
+    // that anything else a reader prints, a sanitizer's report included, stays visible)
+    StderrCapture cap(!std::strcmp(format, "png"));
     try {
-        auto in = OIIO::ImageInput::open(path);
+        // The reader of the extension's format only: OpenImageIO's fallback would try every
+        // reader it has (IFF spun forever on /dev/zero; JPEG-2000 starts threads per try).
+        auto in = OIIO::ImageInput::create(format);
+        OIIO::ImageSpec opened;
+        if (in && !in->open(path, opened)) {
+            std::string why = in->geterror();
+            in.reset();
+            (void)OIIO::geterror();
+            if (why.empty()) why = "not a valid file of this format";
+            FILE *f = std::fopen(path, "rb");
+            if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
+            std::fclose(f);
+            const std::string lib = cap.take();
+            if (!lib.empty()) why += " (" + lib + ")";
+            return fail(err, GR_E_INPUT, path, "cannot read as an image", why);
+        }
         if (!in) {
             std::string why = OIIO::geterror();
             const std::string lib = cap.take();
@@ -214,7 +260,16 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         for (int c = 0; c < nc; c++) cnames[static_cast<size_t>(c)] = names[static_cast<size_t>(c)].c_str();
         img = gr_image_create(spec.width, spec.height, nc, cnames.data());
         if (!img) return gr_fail(err, GR_E_NOMEM, "%s: cannot allocate %d x %d x %d image", path, spec.width, spec.height, nc);
-        if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, img->pixels)) {
+        // Scanline files are read in their own sample type and converted here: read_image
+        // allocates a 64 MB buffer on every call in OpenImageIO 2.4 (tiled files still use it).
+        const bool native = spec.channelformats.empty() && spec.tile_width == 0;
+        std::vector<unsigned char> raw(native ? spec.image_bytes() : 0);
+        bool read_ok = native ? in->read_native_scanlines(0, 0, spec.y, spec.y + spec.height, spec.z, raw.data())
+                              : in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, img->pixels);
+        if (read_ok && native)
+            read_ok = OIIO::convert_pixel_values(spec.format, raw.data(), OIIO::TypeDesc::FLOAT, img->pixels,
+                                                 static_cast<int>(spec.image_pixels() * static_cast<size_t>(nc)));
+        if (!read_ok) {
             std::string why = in->geterror();
             const std::string lib = cap.take();
             if (!lib.empty()) why += " (" + lib + ")";

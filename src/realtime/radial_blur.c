@@ -30,58 +30,58 @@
 #define NONE 0u
 #define LO_X GR_PF_MIN_EXCL
 #define HI_X GR_PF_MAX_EXCL
-#define FROM GR_PF_FROM_SCENE
 #define RB(field) offsetof(gr_radial_blur_settings, field)
 
 static const char *const format_names[] = {"rgba16f", "rgba8", NULL};
-static const char *const intensity_source =
-    "medium, camera and sun (docs/radial-blur.md, Units)";
 
 #define COMMON_PARAMS                                                                                            \
     {.name = "samples", .type = GR_PT_INT, .offset = RB(samples), .min = 1, .max = 1024, .def = SEED_SAMPLES,   \
      .unit = "", .doc = "NUM_SAMPLES: taps marched toward the light (seed 004 / GPU Gems 3 ch. 13)"},            \
     {.name = "decay", .type = GR_PT_DOUBLE, .offset = RB(decay), .min = 0, .max = 1, .flags = LO_X,            \
-     .def = SEED_DECAY, .unit = "", .doc = "per-tap decay: tap i weighs weight decay^(i-1)"},                    \
+     .def = SEED_DECAY, .unit = "", .doc = "per-tap decay: tap i weighs weight decay^(i-1)", .tune_lo = 0.85, .tune_hi = 0.999},                    \
     {.name = "exposure", .type = GR_PT_DOUBLE, .offset = RB(exposure), .min = 0, .max = 1e6, .def = SEED_EXPOSURE, \
-     .unit = "", .doc = "final multiplier of the sum"},                                                          \
+     .unit = "", .doc = "final multiplier of the sum", .tune_lo = 0.02, .tune_hi = 2.0},                                                          \
     {.name = "density", .type = GR_PT_DOUBLE, .offset = RB(density), .min = 0, .max = 2, .flags = LO_X,        \
-     .def = SEED_DENSITY, .unit = "", .doc = "fraction of the way to the light the N taps span"},                \
+     .def = SEED_DENSITY, .unit = "", .doc = "fraction of the way to the light the N taps span", .tune_lo = 0.3, .tune_hi = 1.5},                \
     {.name = "weight", .type = GR_PT_DOUBLE, .offset = RB(weight), .min = 0, .max = 1e6, .def = SEED_WEIGHT,    \
-     .unit = "", .doc = "weight of the marched taps (the centre tap has 1)"},                                   \
+     .unit = "", .doc = "weight of the marched taps (the centre tap has 1)", .tune_lo = 0.1, .tune_hi = 3.0},                                   \
     {.name = "sample_scale", .type = GR_PT_DOUBLE, .offset = RB(sample_scale), .min = 0, .max = 1e6,           \
      .def = SEED_SAMPLE_SCALE, .unit = "", .doc = "seed 004's '* 0.4' on every tap (GPU Gems 3 has 1)"},        \
     {.name = "target_scale", .type = GR_PT_DOUBLE, .offset = RB(target_scale), .min = 0, .max = 1,             \
-     .flags = LO_X, .def = 0.5, .unit = "", .doc = "light pass target size / frame size, per axis"},             \
+     .flags = LO_X, .def = 0.5, .unit = "", .doc = "light pass target size / frame size, per axis", .tune_lo = 0.125, .tune_hi = 1.0},             \
     {.name = "target_format", .type = GR_PT_ENUM, .offset = RB(target_format), .min = 0, .max = 1,             \
      .def = GR_RB_RGBA16F, .enum_names = format_names, .unit = "",                                              \
      .doc = "light pass storage (rgba8 bands; dither adds half-step noise before it)"},                         \
     {.name = "light_radius_deg", .type = GR_PT_DOUBLE, .offset = RB(light_radius_deg), .min = 0, .max = 90,    \
      .flags = LO_X, .def = 4.0, .unit = "deg",                                                                  \
-     .doc = "angular radius in air of the bright region around the sun (kernel (1-(a/a0)^2)^2)"},               \
+     .doc = "angular radius in air of the bright region around the sun (kernel (1-(a/a0)^2)^2)", .tune_lo = 0.5, .tune_hi = 20.0},               \
     {.name = "threshold", .type = GR_PT_DOUBLE, .offset = RB(threshold), .min = 0, .max = 1, .flags = HI_X,    \
-     .def = 0, .unit = "", .doc = "subtracted from the light pass (1 = the flat-water peak)"},                   \
+     .def = 0, .unit = "", .doc = "subtracted from the light pass (1 = the flat-water peak)", .tune_lo = 0.0, .tune_hi = 0.5},                   \
     {.name = "occluders", .type = GR_PT_BOOL, .offset = RB(occluders), .min = 0, .max = 1, .def = 1,           \
      .unit = "", .doc = "draw occluders (and the seabed) black in the light pass"},                              \
-    {.name = "intensity", .type = GR_PT_RGB, .offset = RB(intensity), .min = 0, .max = 1e9, .flags = FROM,     \
-     .def = NAN, .unit = "", .scene_source = intensity_source,                                                   \
-     .doc = "scale to the ground truth's units; default: the single-scattering peak at the sun"},                \
+    {.name = "intensity", .type = GR_PT_RGB, .offset = RB(intensity), .min = 0, .max = 1e9, .def = 1,          \
+     .unit = "", .doc = "factor on the derived scale to the ground truth's units (1: exact at the sun, flat water)", \
+     .tune_lo = 0.05, .tune_hi = 20.0},                                                                           \
     {.name = "dither", .type = GR_PT_BOOL, .offset = RB(dither), .min = 0, .max = 1, .def = 1, .unit = "",     \
-     .doc = "per-pixel jitter of the march start against banding (deterministic noise)"},                       \
-    {.name = "fade_margin", .type = GR_PT_DOUBLE, .offset = RB(fade_margin), .min = 0, .max = 100, .def = 0.5, \
-     .unit = "", .doc = "NDC beyond the screen edge over which the rays fade out (smoothstep)"}
+     .doc = "per-pixel jitter of the march start against banding (deterministic noise)"}
 
-static const gr_param blur_params[] = {COMMON_PARAMS};
+static const gr_param blur_params[] = {
+    COMMON_PARAMS,
+    {.name = "fade_margin", .type = GR_PT_DOUBLE, .offset = RB(fade_margin), .min = 0, .max = 100, .def = 0.5,
+     .unit = "", .doc = "NDC beyond the screen edge over which the rays fade out (smoothstep)", .tune_lo = 0.1, .tune_hi = 3.0},
+};
 
 static const gr_param local_params[] = {
     COMMON_PARAMS,
     {.name = "lights", .type = GR_PT_INT, .offset = RB(lights), .min = 1, .max = MAX_LIGHTS, .def = 16, .unit = "",
      .doc = "at most this many lights: the brightest cells of the light pass"},
     {.name = "quad_size", .type = GR_PT_DOUBLE, .offset = RB(quad_size), .min = 0, .max = 4, .flags = LO_X,
-     .def = 0.3, .unit = "", .doc = "quad half-size as a fraction of the frame height"},
+     .def = 0.3, .unit = "", .doc = "quad half-size as a fraction of the frame height", .tune_lo = 0.05, .tune_hi = 1.0},
     {.name = "falloff", .type = GR_PT_DOUBLE, .offset = RB(falloff), .min = 0, .max = 16, .def = 2, .unit = "",
-     .doc = "(1 - r)^falloff to the quad's edge: 1 linear, 2 quadratic (seed 003)"},
-    {.name = "cell_px", .type = GR_PT_INT, .offset = RB(cell_px), .min = 1, .max = 1024, .def = 8, .unit = "px",
-     .doc = "light-selection cell size, in light-target pixels"},
+     .doc = "(1 - r)^falloff to the quad's edge: 1 linear, 2 quadratic (seed 003)", .tune_lo = 0.5, .tune_hi = 4.0},
+    {.name = "cell_size", .type = GR_PT_DOUBLE, .offset = RB(cell_size), .min = 0, .max = 1, .flags = LO_X,
+     .def = 0.05, .unit = "", .doc = "light-selection cell side as a fraction of the frame height",
+     .tune_lo = 0.01, .tune_hi = 0.2},
     {.name = "min_fraction", .type = GR_PT_DOUBLE, .offset = RB(min_fraction), .min = 0, .max = 1, .def = 0.02,
      .unit = "", .doc = "cells dimmer than this fraction of the brightest one are no light"},
     {.name = "normalize_overlap", .type = GR_PT_BOOL, .offset = RB(normalize_overlap), .min = 0, .max = 1,
@@ -145,23 +145,19 @@ static double sun_path_m(const gr_scene *scene, const gr_frame *f)
     return f->to_refr_sun[1] > 0 ? depth / f->to_refr_sun[1] : 0.0;
 }
 
-static void rb_resolve(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out)
+/* The scale k_c that puts the layer in the ground truth's units: looking straight at the
+ * refracted sun through flat water, with seed 004's defaults, the layer equals the single-
+ * scattering closed form sigma_s p_HG(0) T E D exp(-sigma_t D) (docs, "Units"):
+ * k_c = sigma_s,c p_HG(0; g) D Omega_eff / (n^2 0.2 0.4 G_seed). */
+static void units_scale(const gr_scene *scene, const gr_frame *f, double light_radius_deg, double k[3])
 {
-    (void)cls;
-    gr_radial_blur_settings *s = out;
-    memcpy(s, in, sizeof *s);
-    gr_frame f;
-    gr_frame_init(scene, &f);
-    /* Output at the refracted sun's pixel, flat water, seed defaults, equals the single-
-     * scattering closed form sigma_s p_HG(0) T E D exp(-sigma_t D) (docs, "Units"). */
-    double D = fmax(sun_path_m(scene, &f), 0.0);
-    double omega = gr_radial_blur_kernel_solid_angle(s->light_radius_deg * GR_PI / 180.0);
+    double D = fmax(sun_path_m(scene, f), 0.0);
+    double omega = gr_radial_blur_kernel_solid_angle(light_radius_deg * GR_PI / 180.0);
     double g_seed = gr_radial_blur_gain(SEED_SAMPLES, SEED_DECAY, SEED_WEIGHT);
     double n = scene->medium.ior;
     for (int c = 0; c < 3; c++)
-        if (isnan(s->intensity[c]))
-            s->intensity[c] = scene->medium.scattering[c] * gr_hg_phase(1.0, scene->medium.g) * D * omega /
-                              (n * n * SEED_EXPOSURE * SEED_SAMPLE_SCALE * g_seed);
+        k[c] = scene->medium.scattering[c] * gr_hg_phase(1.0, scene->medium.g) * D * omega /
+               (n * n * SEED_EXPOSURE * SEED_SAMPLE_SCALE * g_seed);
 }
 
 /* ---- state ------------------------------------------------------------------------------- */
@@ -430,10 +426,7 @@ static gr_status read_out(rb_state *r, int w, int h, gr_image *out, const char *
         const float *src = r->readback + (size_t)(h - 1 - y) * (size_t)w * 4;
         for (int x = 0; x < w; x++) {
             float *px = gr_image_pixel(out, x, y);
-            for (int c = 0; c < 3; c++) {
-                float v = src[(size_t)x * 4 + (size_t)c];
-                px[ch[c]] = isfinite(v) ? v : 0.0f; /* never NaN/Inf (counted as a failure below) */
-            }
+            for (int c = 0; c < 3; c++) px[ch[c]] = src[(size_t)x * 4 + (size_t)c]; /* NaN/Inf: checked by the caller */
         }
     }
     return gr_gl_check(what, err);
@@ -454,7 +447,11 @@ static int cell_cmp(const void *a, const void *b)
  * at most s->lights, each placed at its cell's luminance-weighted centroid (docs, "Lights"). */
 static gr_status select_lights(rb_state *r, const gr_radial_blur_settings *s, gr_error *err)
 {
-    int w = r->light_w, h = r->light_h, cp = s->cell_px;
+    int w = r->light_w, h = r->light_h;
+    /* cells relative to the frame, so the lights (and their overlap) do not grow in number
+     * with the resolution */
+    int cp = (int)lround(s->cell_size * h);
+    if (cp < 1) cp = 1;
     int cw = (w + cp - 1) / cp, chh = (h + cp - 1) / cp;
     size_t need = (size_t)w * h * 4;
     if (need > r->readback_cap) {
@@ -540,9 +537,6 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     if (scene->water.n_waves > MAX_WAVE_GROUPS * 4)
         return gr_fail(err, GR_E_INPUT, "water.waves: %d waves, %s takes at most %d", scene->water.n_waves, name,
                        MAX_WAVE_GROUPS * 4);
-    for (int c = 0; c < 3; c++)
-        if (!isfinite(s->intensity[c]))
-            return gr_fail(err, GR_E_INPUT, "%s.intensity: unresolved (resolve the settings first)", name);
     int tw = (int)lround(W * s->target_scale), th = (int)lround(H * s->target_scale);
     if (tw < 1) tw = 1;
     if (th < 1) th = 1;
@@ -618,13 +612,14 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     glDrawArrays(GL_TRIANGLES, 0, 3);
     gr_gl_timer_end(&r->timer);
 
-    /* Output scale: intensity * exposure * sample_scale * peak * fade, where peak = n^2 T_flat
+    /* Output scale: k * intensity * exposure * sample_scale * peak * fade, where peak = n^2 T_flat
      * E / Omega_eff is the flat-water light-pass radiance at the sun (docs, "Units"). */
     double omega = gr_radial_blur_kernel_solid_angle(s->light_radius_deg * GR_PI / 180.0);
     double fade = r->local ? 1.0 : gr_radial_blur_fade(f.sun_ndc, f.sun_clip_w, s->fade_margin);
-    double scale[3];
+    double scale[3], ku[3];
+    units_scale(scene, &f, s->light_radius_deg, ku);
     for (int c = 0; c < 3; c++)
-        scale[c] = s->intensity[c] * s->exposure * s->sample_scale * f.ior * f.ior * f.transmittance_flat *
+        scale[c] = ku[c] * s->intensity[c] * s->exposure * s->sample_scale * f.ior * f.ior * f.transmittance_flat *
                    f.sun_irradiance[c] / omega * fade;
     r->sun_uv[0] = f.sun_uv[0];
     r->sun_uv[1] = f.sun_uv[1];
@@ -768,6 +763,39 @@ int gr_radial_blur_local_lights(void *state, double (*uv)[2], int max)
     return r->n_lights;
 }
 
+/* The light pass of the last render (RGBA float, top row first, as stored: the normalized
+ * light pass s of docs/radial-blur.md). */
+static gr_status rb_read_target(void *state, gr_image **out, gr_error *err)
+{
+    rb_state *r = state;
+    *out = NULL;
+    if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "radial blur: no render yet, no light pass to read");
+    gr_status st = gr_gl_make_current(r->gl, err);
+    if (st != GR_OK) return st;
+    int w = r->light_w, h = r->light_h;
+    gr_image *img = gr_image_create(w, h, 4, NULL);
+    float *tmp = malloc((size_t)w * h * 4 * sizeof *tmp);
+    if (!img || !tmp) {
+        gr_image_destroy(img);
+        free(tmp);
+        return gr_fail(err, GR_E_NOMEM, "radial blur: out of memory for the light pass readback");
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, r->light_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, tmp);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    size_t row = (size_t)w * 4;
+    for (int y = 0; y < h; y++) memcpy(img->pixels + (size_t)y * row, tmp + (size_t)(h - 1 - y) * row, row * sizeof *tmp);
+    free(tmp);
+    if ((st = gr_gl_check("radial blur light pass readback", err)) != GR_OK) {
+        gr_image_destroy(img);
+        return st;
+    }
+    *out = img;
+    return GR_OK;
+}
+
 /* ---- metadata ----------------------------------------------------------------------------- */
 
 static gr_status rb_metadata(void *state, const gr_scene *scene, const void *settings, const gr_technique_stats *stats,
@@ -790,18 +818,29 @@ fail:
     return gr_fail(err, st, "radial blur metadata: cannot add an entry (%s)", gr_status_name(st));
 }
 
+static void rb_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)
+{
+    rb_state *r = state;
+    (void)stats;
+    int k = snprintf(buf, n, "light target %dx%d, refracted sun at uv (%.3f, %.3f), fade %.3g", r->light_w,
+                     r->light_h, r->sun_uv[0], r->sun_uv[1], r->fade);
+    if (r->local && k > 0 && (size_t)k < n) snprintf(buf + k, n - (size_t)k, ", %d light(s)", r->n_lights);
+}
+
 const gr_technique_class gr_radial_blur_class = {
     .name = "radial_blur",
     .description = "seeds 004/GPU Gems 3 ch. 13: radial blur of the refracted sun seen through the surface",
     .params = &gr_radial_blur_param_table,
     .settings_size = sizeof(gr_radial_blur_settings),
     .origin = "built-in",
+    .gain_key = "intensity",
     .check = rb_check,
-    .resolve = rb_resolve,
     .create = rb_create,
     .destroy = rb_destroy,
     .render = rb_render,
     .metadata = rb_metadata,
+    .read_target = rb_read_target,
+    .summary = rb_summary,
 };
 
 const gr_technique_class gr_radial_blur_local_class = {
@@ -810,10 +849,12 @@ const gr_technique_class gr_radial_blur_local_class = {
     .params = &gr_radial_blur_local_param_table,
     .settings_size = sizeof(gr_radial_blur_settings),
     .origin = "built-in",
+    .gain_key = "intensity",
     .check = rb_check,
-    .resolve = rb_resolve,
     .create = rb_create,
     .destroy = rb_destroy,
     .render = rb_render,
     .metadata = rb_metadata,
+    .read_target = rb_read_target,
+    .summary = rb_summary,
 };

@@ -37,14 +37,14 @@ typedef struct gr_radial_blur_settings {
     double threshold;        /* subtracted from the normalized light pass (1 = flat-water peak) */
     int occluders;           /* draw the occluders black in the light pass */
     /* output */
-    double intensity[3];     /* scale to the ground truth's units; NaN: derived from the scene */
+    double intensity[3];     /* factor on the derived scale to the ground truth's units (1) */
     int dither;              /* per-pixel jitter of the march (and of 8-bit storage) vs banding */
     double fade_margin;      /* NDC beyond the screen edge over which the rays fade out */
     /* radial_blur_local */
     int lights;              /* at most this many lights (quads) */
     double quad_size;        /* quad half-size as a fraction of the frame height */
     double falloff;          /* (1 - r)^falloff to the quad's edge: 1 linear, 2 quadratic */
-    int cell_px;             /* light-selection cell size in light-target pixels */
+    double cell_size;        /* light-selection cell side / frame height */
     double min_fraction;     /* cells dimmer than this fraction of the brightest are no light */
     int normalize_overlap;   /* divide by the summed falloff where quads overlap (> 1) */
 } gr_radial_blur_settings;

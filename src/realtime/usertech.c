@@ -104,6 +104,7 @@ typedef struct ut_manifest {
     int allow_black;
     int uses_shadow_map, uses_eye_depth;
     ut_value shadow_size, shadow_half_extent;
+    char source_hash[17]; /* FNV-1a 64 of the manifest and every shader file, hex */
     int n_ladder;
     gr_technique_level ladder[UT_MAX_LADDER];
     char *ladder_text[UT_MAX_LADDER];
@@ -785,7 +786,8 @@ static gr_status parse_ladder(ut_ctx *c, ut_manifest *m, const cJSON *lad)
             gr_error perr;
             if (gr_param_check(&m->table, &m->params[k], v, 0, &perr) != GR_OK) {
                 free(b.s);
-                return vfail(c, r, "%s", perr.msg);
+                const char *why = strstr(perr.msg, ": "); /* drop gr_param_check's "NAME.KEY: " */
+                return vfail(c, r, "%s", why ? why + 2 : perr.msg);
             }
             if (m->settings[k].type == UT_BOOL) snprintf(num, sizeof num, "%s", v != 0 ? "true" : "false");
             else gr_format_double(v, num, sizeof num);
@@ -832,6 +834,9 @@ static gr_status parse_manifest(ut_ctx *c, ut_manifest *m, const cJSON *root)
     const cJSON *set = cJSON_GetObjectItemCaseSensitive(root, "settings");
     m->settings_size = sizeof(double);
     if (set && (st = parse_settings(c, m, set))) return st;
+    m->table.section = m->name;
+    m->table.params = m->params;
+    m->table.count = (size_t)m->n_settings;
 
     const cJSON *gain = cJSON_GetObjectItemCaseSensitive(root, "gain");
     if (gain) {
@@ -937,6 +942,15 @@ void gr_usertech_free(gr_technique_class *cls)
     manifest_free((ut_manifest *)cls->class_data);
 }
 
+static unsigned long long fnv1a(unsigned long long h, const char *s)
+{
+    for (const unsigned char *q = (const unsigned char *)s; *q; q++) {
+        h ^= *q;
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
 /* "LABEL:LINE:COL: malformed JSON near '...'" (as the scene loader words it) */
 static gr_status parse_json(const char *text, const char *label, cJSON **out, gr_error *err)
 {
@@ -993,11 +1007,20 @@ gr_status gr_usertech_load(const char *dir, gr_technique_class **out, gr_error *
     }
     cJSON *root = NULL;
     st = parse_json(text, m->path, &root, err);
-    free(text);
     if (st == GR_OK) {
         ut_ctx c = {err, m->path};
         st = parse_manifest(&c, m, root);
     }
+    if (st == GR_OK) {
+        /* provenance: which version of the technique rendered an image */
+        unsigned long long h = fnv1a(14695981039346656037ULL, text);
+        for (int i = 0; i < m->n_passes; i++) {
+            if (m->passes[i].vertex_src) h = fnv1a(h, m->passes[i].vertex_src);
+            h = fnv1a(h, m->passes[i].fragment_src);
+        }
+        snprintf(m->source_hash, sizeof m->source_hash, "%016llx", h);
+    }
+    free(text);
     cJSON_Delete(root);
     if (st) {
         manifest_free(m);
@@ -1752,7 +1775,7 @@ static gr_status ut_metadata(void *state, const gr_scene *scene, const void *set
     const ut_state *s = state;
     const ut_manifest *m = s->m;
     char key[96], val[64];
-    gr_status st = gr_meta_set_string(meta, "godrays:user_manifest", m->path);
+    gr_status st = gr_meta_set_string(meta, "godrays:user_source_hash", m->source_hash);
     for (int t = 0; st == GR_OK && t < m->n_targets; t++) {
         snprintf(key, sizeof key, "godrays:user_target.%s", m->targets[t].name);
         snprintf(val, sizeof val, "%dx%d %s", s->last_w[t], s->last_h[t], ut_format_names[m->targets[t].format]);

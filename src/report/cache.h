@@ -4,8 +4,9 @@
  *
  * Key = "SCENEHASH-SETTINGSHASH" (16 hex digits each, FNV-1a 64):
  *  - SCENEHASH: the normalized scene JSON (every default filled in, stable key order) without
- *    the "name", "shafts" and "reference" sections: what the ground truth renders. A change of
- *    the real-time settings or of the scene's label does not invalidate the reference.
+ *    the "name" and "reference" sections and every real-time technique's section
+ *    (scene/sections.h): what the ground truth renders. A change of the real-time settings or
+ *    of the scene's label does not invalidate the reference.
  *  - SETTINGSHASH: every reference.* setting except `threads` (the integrator gives the same
  *    bytes for any thread count), plus the cache format and the godrays version (a new build of
  *    the integrator may render differently).

@@ -9,8 +9,12 @@
 
 const char gr_tune_cli_help[] =
     "  -o, --output DIR     report folder (default: out/SCENE_NAME/COMMAND)\n"
-    "  --metric M           rmse (default), relmse, ssim (scored as 1 - SSIM) or msrmse (mean RMSE\n"
-    "                       after blurs at 1, 4, 16 px); all on luminance Y\n"
+    "  --metric M           rmse (default), relmse, ssim (scored as 1 - SSIM), msrmse (mean RMSE\n"
+    "                       after blurs at 1, 4, 16 px), all on luminance Y; flip (mean HDR-FLIP)\n"
+    "                       or structure (beam-structure score in [0, 1]): docs/metrics.md\n"
+    "  --objective W        a weighted sum instead, e.g. rmse=1,structure=1,flip=0.5: each class\n"
+    "                       dimensionless (rmse, msrmse relative to the mean reference Y), the\n"
+    "                       weights normalized to sum 1 (docs/tuning.md)\n"
     "  --technique NAME     the real-time technique (default: the one the parameters name, else\n"
     "                       the first of `godrays techniques`); its settings are NAME.KEY\n"
     "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
@@ -42,7 +46,8 @@ void gr_tune_cli_init(gr_tune_cli *c)
 
 static int needs_value(const char *a)
 {
-    static const char *const with_value[] = {"--metric", "--frames", "--fps", "--times", "--view", "--technique"};
+    static const char *const with_value[] = {"--metric", "--frames",    "--fps",
+                                             "--times",  "--view",      "--technique", "--objective"};
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
         if (!strcmp(a, with_value[k])) return 1;
     return 0;
@@ -76,6 +81,9 @@ int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *
     gr_status st = GR_OK;
     if (!strcmp(a, "--metric")) {
         st = gr_tune_metric_parse(a, v, &c->metric, err);
+    } else if (!strcmp(a, "--objective")) {
+        st = gr_tune_weights_parse(a, v, c->weights, err);
+        if (st == GR_OK) c->metric = GR_TM_WEIGHTED;
     } else if (!strcmp(a, "--technique")) {
         c->technique_name = v; /* looked up in gr_tune_cli_open, after --technique-dir */
     } else if (!strcmp(a, "--frames")) {
@@ -145,6 +153,7 @@ gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_pa
     p->n_params = n_params;
     memcpy(p->params, params, (size_t)n_params * sizeof *params);
     p->metric = c->metric;
+    memcpy(p->weights, c->weights, sizeof p->weights);
     p->fit = c->fit;
     p->normalize = c->normalize;
     return gr_tune_problem_init(p, err);

@@ -1,4 +1,4 @@
-/* Shafts-vs-ground-truth error as a function of settings (objective.h). */
+/* A technique's error against the ground truth as a function of its settings (objective.h). */
 #include "tune/objective.h"
 
 #include <math.h>
@@ -9,17 +9,45 @@
 
 #include <cjson/cJSON.h>
 
-static const char *const metric_names[GR_TM_COUNT] = {"rmse", "relmse", "ssim", "msrmse"};
+#include "report/profile.h"
+
+static const char *const metric_names[GR_TM_COUNT] = {"rmse", "relmse", "ssim", "msrmse", "flip", "structure",
+                                                      "objective"};
 
 gr_status gr_tune_metric_parse(const char *flag, const char *s, gr_tune_metric *m, gr_error *err)
 {
-    for (int i = 0; i < GR_TM_COUNT; i++) {
+    for (int i = 0; i < GR_TM_WEIGHTED; i++) {
         if (!strcmp(s, metric_names[i])) {
             *m = (gr_tune_metric)i;
             return GR_OK;
         }
     }
-    return gr_fail(err, GR_E_USAGE, "%s %s: unknown metric (expected rmse, relmse, ssim or msrmse)", flag, s);
+    return gr_fail(err, GR_E_USAGE, "%s %s: unknown metric (expected rmse, relmse, ssim, msrmse, flip or structure)",
+                   flag, s);
+}
+
+gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_TM_COUNT], gr_error *err)
+{
+    for (int k = 0; k < GR_TM_COUNT; k++) w[k] = 0.0;
+    char buf[512];
+    if (!s || strlen(s) >= sizeof buf) return gr_fail(err, GR_E_USAGE, "%s: missing or too long", flag);
+    strcpy(buf, s);
+    double total = 0.0;
+    for (char *save = NULL, *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+        char *eq = strchr(t, '=');
+        if (!eq) return gr_fail(err, GR_E_USAGE, "%s %s: '%s' is not NAME=WEIGHT", flag, s, t);
+        *eq = '\0';
+        gr_tune_metric m = GR_TM_RMSE;
+        if (gr_tune_metric_parse(flag, t, &m, err) != GR_OK) return err->status;
+        char *end = NULL;
+        const double v = strtod(eq + 1, &end);
+        if (end == eq + 1 || *end || !isfinite(v) || v < 0.0)
+            return gr_fail(err, GR_E_USAGE, "%s %s: weight '%s' of %s is not a number >= 0", flag, s, eq + 1, t);
+        w[m] = v;
+        total += v;
+    }
+    if (!(total > 0.0)) return gr_fail(err, GR_E_USAGE, "%s %s: no weight > 0", flag, s);
+    return GR_OK;
 }
 
 const char *gr_tune_metric_name(gr_tune_metric m)
@@ -39,9 +67,60 @@ double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m)
         for (int k = 0; k < GR_METRICS_NSCALES; k++) v += y->rmse_blur[k];
         v /= GR_METRICS_NSCALES;
         break;
+    case GR_TM_FLIP: v = set->have_flip ? set->flip.mean : 1.0; break;
+    case GR_TM_STRUCTURE: v = set->have_structure ? set->structure_score : 1.0; break;
+    case GR_TM_WEIGHTED: v = 1e300; break;
     default: v = y->rmse; break;
     }
     return isfinite(v) ? v : 1e300;
+}
+
+/* Whether metric k enters the problem's value. */
+static int uses(const gr_tune_problem *p, gr_tune_metric k)
+{
+    return p->metric == k || (p->metric == GR_TM_WEIGHTED && p->weights[k] > 0.0);
+}
+
+double gr_tune_value(const gr_tune_problem *p, const gr_metrics_set *set)
+{
+    const double mean_y = set->ch[GR_MCH_Y].ref_mean;
+    if (p->metric != GR_TM_WEIGHTED) {
+        double v = gr_tune_metric_value(set, p->metric);
+        /* relative error: a bright view (toward the sun) would otherwise outweigh the rest */
+        if (p->normalize && (p->metric == GR_TM_RMSE || p->metric == GR_TM_MSRMSE) && mean_y > 0) v /= mean_y;
+        return v;
+    }
+    /* each class made dimensionless (rmse, msrmse relative to the mean reference Y; relmse,
+     * 1 - SSIM, FLIP and the structure score already are), then weighted (docs/tuning.md) */
+    double sum = 0.0, wsum = 0.0;
+    for (int k = 0; k < GR_TM_WEIGHTED; k++) {
+        if (!(p->weights[k] > 0.0)) continue;
+        double v = gr_tune_metric_value(set, (gr_tune_metric)k);
+        if ((k == GR_TM_RMSE || k == GR_TM_MSRMSE) && mean_y > 0) v /= mean_y;
+        sum += p->weights[k] * v, wsum += p->weights[k];
+    }
+    const double v = wsum > 0 ? sum / wsum : 1e300;
+    return isfinite(v) ? v : 1e300;
+}
+
+/* The metrics options of case i for the problem's metric(s); fo and so are the caller's. */
+static void case_options(const gr_tune_problem *p, int i, gr_metrics_options *opt, gr_flip_options *fo,
+                         gr_structure_options *so)
+{
+    if (uses(p, GR_TM_FLIP)) {
+        memset(fo, 0, sizeof *fo);
+        fo->mode = GR_FLIP_HDR;
+        opt->flip = fo;
+    }
+    if (uses(p, GR_TM_STRUCTURE)) {
+        const gr_camera *c = &p->scenes[i]->camera;
+        memset(so, 0, sizeof *so);
+        so->vp_x = p->vp[i][0], so->vp_y = p->vp[i][1];
+        so->radial = p->angles[i], so->radial_bin = c->fov_deg / c->height;
+        opt->structure = so;
+    }
+    if (uses(p, GR_TM_SSIM)) opt->skip_ssim = 0;
+    if (uses(p, GR_TM_MSRMSE)) opt->skip_blur = 0;
 }
 
 gr_status gr_tune_make_case(const gr_scene *base, double time_s, const gr_tune_view *view, gr_scene *out,
@@ -70,6 +149,7 @@ static double now_s(void)
 gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
 {
     p->scratch = NULL;
+    for (int i = 0; i < GR_TUNE_MAX_CASES; i++) p->angles[i] = NULL;
     if (p->n_cases < 1 || p->n_cases > GR_TUNE_MAX_CASES)
         return gr_fail(err, GR_E_INPUT, "tuning: %d cases (1..%d)", p->n_cases, GR_TUNE_MAX_CASES);
     if (p->n_params < 0 || p->n_params > GR_TUNE_MAX_PARAMS)
@@ -94,6 +174,27 @@ gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
     p->base = r;
     p->scratch = gr_image_create(c0->width, c0->height, 3, NULL);
     if (!p->scratch) return gr_fail(err, GR_E_NOMEM, "tuning: out of memory for a %dx%d frame", c0->width, c0->height);
+    if (uses(p, GR_TM_STRUCTURE)) {
+        /* the structure metrics' geometry per case: the vanishing point of the refracted sun's
+         * rays and the angle to the sun (their de-glow), once */
+        for (int i = 0; i < p->n_cases; i++) {
+            const gr_camera *c = &p->scenes[i]->camera;
+            gr_status st = gr_structure_scene_vp(p->scenes[i], c->width, c->height, &p->vp[i][0], &p->vp[i][1], err);
+            if (st != GR_OK) {
+                gr_error_prefix(err, "tuning: case %d: structure metrics", i);
+                gr_tune_problem_free(p);
+                return st;
+            }
+            p->angles[i] = malloc((size_t)c->width * (size_t)c->height * sizeof(float));
+            if (!p->angles[i]) {
+                gr_tune_problem_free(p);
+                return gr_fail(err, GR_E_NOMEM, "tuning: out of memory");
+            }
+            double dir[3];
+            gr_profile_sun_view_dir(p->scenes[i], dir);
+            gr_profile_angles(c, dir, p->angles[i]);
+        }
+    }
     p->renders = 0;
     p->render_s = p->metrics_s = p->wall_ms_sum = p->gpu_ms_sum = 0.0;
     p->gpu_timed = 0;
@@ -105,6 +206,10 @@ void gr_tune_problem_free(gr_tune_problem *p)
     if (!p) return;
     gr_image_destroy(p->scratch);
     p->scratch = NULL;
+    for (int i = 0; i < GR_TUNE_MAX_CASES; i++) {
+        free(p->angles[i]);
+        p->angles[i] = NULL;
+    }
 }
 
 gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, void *out, gr_error *err)
@@ -147,22 +252,19 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
     gr_status st = gr_tune_settings_at(p, x, s.bytes, err);
     if (st != GR_OK) return st;
     /* Only what the metric needs: the pointwise pass is cheap, SSIM and blurs are not. */
-    gr_metrics_options opt = {0};
-    opt.stderr_bound = p->stderr_bound;
-    opt.fit_scale = p->fit;
-    opt.skip_ssim = p->metric != GR_TM_SSIM;
-    opt.skip_blur = p->metric != GR_TM_MSRMSE;
     double sum = 0.0;
     for (int i = 0; i < p->n_cases; i++) {
+        gr_metrics_options opt = {0};
+        gr_flip_options fo;
+        gr_structure_options so;
+        opt.stderr_bound = p->stderr_bound;
+        opt.fit_scale = p->fit;
+        opt.skip_ssim = opt.skip_blur = 1;
+        case_options(p, i, &opt, &fo, &so);
         gr_metrics m;
         if ((st = render_score(p, i, s.bytes, p->scratch, &opt, &m, err)) != GR_OK) return st;
         const gr_metrics_set *set = p->fit ? &m.fit : &m.raw;
-        double v = gr_tune_metric_value(set, p->metric);
-        if (p->normalize && (p->metric == GR_TM_RMSE || p->metric == GR_TM_MSRMSE)) {
-            /* relative error: a bright view (toward the sun) would otherwise outweigh the rest */
-            double mean_y = set->ch[GR_MCH_Y].ref_mean;
-            v = mean_y > 0 ? v / mean_y : v;
-        }
+        const double v = gr_tune_value(p, set);
         sum += v;
         if (per_case) per_case[i] = v;
         if (scale) scale[i] = p->fit ? m.fit.scale : 1.0;
@@ -176,8 +278,11 @@ gr_status gr_tune_render_case(gr_tune_problem *p, int i, const void *s, gr_image
 {
     if (i < 0 || i >= p->n_cases) return gr_fail(err, GR_E_INPUT, "tuning: no case %d", i);
     gr_metrics_options opt = {0};
+    gr_flip_options fo;
+    gr_structure_options so;
     opt.stderr_bound = p->stderr_bound;
     opt.fit_scale = 1;
+    case_options(p, i, &opt, &fo, &so);
     gr_metrics local;
     return render_score(p, i, s, out, &opt, m ? m : &local, err);
 }

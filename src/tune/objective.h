@@ -19,14 +19,25 @@ typedef enum gr_tune_metric {
     GR_TM_RELMSE = 1, /* relative MSE of Y (docs/metrics.md) */
     GR_TM_SSIM = 2,   /* 1 - SSIM of Y (so that lower is better, 0 = identical) */
     GR_TM_MSRMSE = 3, /* mean of the RMSEs of Y after blurs at sigma 1, 4, 16 px */
+    GR_TM_FLIP = 4,   /* mean HDR-FLIP (compare/flip.h) */
+    GR_TM_STRUCTURE = 5, /* structure score (compare/structure.h via gr_metrics_set), in [0, 1] */
+    GR_TM_WEIGHTED = 6,  /* sum_k w_k v_k / sum_k w_k over the metrics above (problem.weights),
+                            rmse and msrmse relative to the case's mean reference Y */
     GR_TM_COUNT
 } gr_tune_metric;
 
-/* "rmse", "relmse", "ssim", "msrmse". GR_E_USAGE naming flag for anything else. */
+/* "rmse", "relmse", "ssim", "msrmse", "flip", "structure" ("objective" is the weighted sum,
+ * chosen by gr_tune_weights_parse). GR_E_USAGE naming flag for anything else. */
 gr_status gr_tune_metric_parse(const char *flag, const char *s, gr_tune_metric *m, gr_error *err);
 const char *gr_tune_metric_name(gr_tune_metric m);
-/* The metric's value from a computed set (raw or fit): lower is better, always finite. */
+/* The metric's value from a computed set (raw or fit): lower is better, always finite.
+ * GR_TM_FLIP / GR_TM_STRUCTURE need the set computed with them (else 1); GR_TM_WEIGHTED
+ * needs the weights: use gr_tune_value. */
 double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m);
+
+/* "rmse=1,structure=0.5,flip=0.5": weights w[GR_TM_COUNT] (unnamed metrics 0; each >= 0,
+ * finite, at least one > 0). GR_E_USAGE naming flag and the bad part. */
+gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_TM_COUNT], gr_error *err);
 
 /* A camera view for tuning beyond the scene's own: same position and fov, other direction. */
 typedef struct gr_tune_view {
@@ -53,6 +64,11 @@ typedef struct gr_tune_problem {
     int fit;                            /* score the test after the best scale fit */
     int normalize;                      /* rmse/msrmse divided by the case's mean reference Y,
                                            so that every frame and view weighs the same */
+    double weights[GR_TM_COUNT];        /* GR_TM_WEIGHTED: each metric's weight */
+    /* filled by gr_tune_problem_init when FLIP or structure is needed: per case, the beams'
+     * vanishing point and the angle to the sun per pixel (the structure de-glow) */
+    double vp[GR_TUNE_MAX_CASES][2];
+    float *angles[GR_TUNE_MAX_CASES];
     double stderr_bound;                /* passed to the metrics (0: default) */
     /* filled by gr_tune_problem_init */
     gr_image *scratch;                  /* one frame (R, G, B) */
@@ -63,6 +79,10 @@ typedef struct gr_tune_problem {
     double gpu_ms_sum;                  /* sum of per-pass GPU times (-1 entries skipped) */
     int gpu_timed;                      /* 1 if any GPU time was available */
 } gr_tune_problem;
+
+/* The problem's value of one case from its computed set: the metric (normalized as asked),
+ * or the weighted sum. */
+double gr_tune_value(const gr_tune_problem *p, const gr_metrics_set *set);
 
 /* Resolves base (scene-derived defaults from case 0) and allocates the scratch frame. The
  * caller fills renderer, cls, cases, base, params, metric, fit first. GR_E_INPUT if the cases

@@ -28,7 +28,12 @@ void gr_pareto_mark_fronts(gr_pareto_point *pts, int n)
     if (!c || !e || !f || !idx) {
         for (int i = 0; i < n; i++) pts[i].on_front = 0;
     } else {
-        for (int fam = 0; fam < 2; fam++) {
+        /* every family present (the ground truth = 0, technique k = 1 + k) */
+        int max_fam = -1;
+        for (int i = 0; i < n; i++)
+            if (pts[i].family > max_fam) max_fam = pts[i].family;
+        for (int i = 0; i < n; i++) pts[i].on_front = 0;
+        for (int fam = 0; fam <= max_fam; fam++) {
             int m = 0;
             for (int i = 0; i < n; i++)
                 if (pts[i].family == fam) {

@@ -1,4 +1,4 @@
-/* Grid sweeps of the shafts settings and their error surface (sweep.h). */
+/* Grid sweeps of a technique's settings and their error surface (sweep.h). */
 #include "tune/sweep.h"
 #include "common/outfile.h"
 

@@ -27,6 +27,12 @@ grep -qF '"shadow_march"' "$dir/json" || { echo "FAIL: techniques --json lacks s
 rc=$?
 if [ $rc -ne 0 ] || [ ! -s "$dir/x.exr" ]; then echo "FAIL: render exit $rc"; cat "$dir/err"; fail=1; else echo "ok: render"; fi
 
+# the walkthrough's port of GPU Gems 3's radial blur (docs/techniques.md) compiles and renders
+"$bin" render walkthrough_radial "$scene" --technique-dir "$src/tests/techniques/walkthrough_radial" --size 64x36 \
+    --set walkthrough_radial.samples=16 -o "$dir/w.exr" >"$dir/out" 2>"$dir/err"
+rc=$?
+if [ $rc -ne 0 ] || [ ! -s "$dir/w.exr" ]; then echo "FAIL: walkthrough render exit $rc"; cat "$dir/err"; fail=1; else echo "ok: walkthrough render"; fi
+
 # expect CODE TEXT ARGS...: exit CODE, exactly one stderr line containing TEXT, empty stdout, no output file
 expect() {
   want=$1; text=$2; shift 2

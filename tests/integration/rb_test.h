@@ -36,7 +36,7 @@ static inline void rb_test_settings(const gr_technique_class *cls, const gr_scen
 {
     gr_radial_blur_settings d;
     gr_param_defaults(cls->params, &d);
-    cls->resolve(cls, scene, &d, out);
+    gr_technique_resolve(cls, scene, &d, out);
 }
 
 static inline gr_image *rb_test_render(const gr_technique_class *cls, void *state, const gr_scene *scene,

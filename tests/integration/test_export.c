@@ -180,7 +180,9 @@ static void check_constants(const gr_scene *s, gr_shader_constants *c)
     CHECK(dp[1] * -c->refr_dir[1] > 0); /* P lies up the beam from the eye */
     double sin_i = sqrt(1 - s->sun.dir[1] * s->sun.dir[1]), sin_t = sqrt(1 - c->refr_dir[1] * c->refr_dir[1]);
     CHECK_NEAR(sin_t, sin_i / s->medium.ior, 1e-12);
-    CHECK_NEAR(c->S, gr_shafts_scene_settings(s)->K * 2 * c->depth_m * tan(0.5 * cam->fov_deg * GR_PI / 180.0) / gr_shafts_scene_settings(s)->N, 1e-12);
+    const gr_shafts_settings *sh = gr_shafts_scene_settings(s);
+    CHECK(sh != NULL);
+    if (sh) CHECK_NEAR(c->S, sh->K * 2 * c->depth_m * tan(0.5 * cam->fov_deg * GR_PI / 180.0) / sh->N, 1e-12);
     /* packed waves: the seed's formula gives gr_gerstner_position (float-rounded constants) */
     double werr = 0;
     for (int k = 0; k < 5; k++) {

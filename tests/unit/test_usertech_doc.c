@@ -80,7 +80,7 @@ int main(void)
     free(pre);
     /* every manifest key of the parser has a row "| `key` |" */
     static const char *const keys[] = {"version", "name", "description", "settings", "shadow_map", "targets", "passes",
-                                       "output", "allow_black", "type", "default", "min", "max", "min_exclusive",
+                                       "output", "allow_black", "gain", "ladder", "tune", "type", "default", "min", "max", "min_exclusive",
                                        "max_exclusive", "unit", "doc", "scale", "size", "format", "filter", "vertex",
                                        "fragment", "draw", "target", "blend", "clear", "inputs", NULL};
     for (int i = 0; keys[i]; i++) {
