@@ -334,7 +334,9 @@ static void build_html(gr_strbuf *b, const gr_sequence_input *in, const seq_tech
                   "figure{margin:0;background:#fff;border:1px solid #ddd;border-radius:6px;padding:8px}"
                   "figure img{max-width:100%;height:auto;display:block}figcaption{font-size:.85em;color:#444}"
                   ".warn{background:#fff4e0;border:1px solid #e5b567;padding:8px}</style>\n</head>\n<body>\n");
-    gr_sb_htmlf(b, "<h1>God rays over time: %d frames, %d technique%s</h1>\n", n, nt, nt == 1 ? "" : "s");
+    gr_sb_puts(b, "<h1>");
+    gr_sb_htmlf(b, "God rays over time: %d frames, %d technique%s", n, nt, nt == 1 ? "" : "s");
+    gr_sb_puts(b, "</h1>\n");
     gr_sb_puts(b, "<p class=\"sub\">");
     if (in->up_href) {
         gr_sb_puts(b, "<a href=\"");

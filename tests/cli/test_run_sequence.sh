@@ -35,6 +35,7 @@ ck "the summary names the sequence report" grep -q 'sequence report: rep/sequenc
 grep -o '<img src="[^"]*"' rep/sequence/index.html | sed 's/<img src="//; s/"$//' >srcs.txt
 ck "the sequence page shows pictures ($(wc -l <srcs.txt))" [ "$(wc -l <srcs.txt)" -ge 4 ]
 while read -r f; do ck "sequence page image $f exists" [ -s "rep/sequence/$f" ]; done <srcs.txt
+ck "no escaped markup shows on the page" sh -c "! grep -q '&lt;h1&gt;' rep/sequence/index.html"
 ck "the sequence page links back to the run's page" grep -q 'href="../index.html"' rep/sequence/index.html
 for f in rep/*.exr; do
     case $f in rep/reference.exr) continue ;; esac
