@@ -22,7 +22,6 @@
 #include "reference/progress.h"
 #include "scene/settings.h"
 
-#define REF_MAX_HITS 256
 #define REF_DEFAULT_MAX_PRIMS ((size_t)16 * 1024 * 1024)
 #define REF_EXP_LIMIT 700.0 /* exp(-700) ~ 1e-304: below any image value, above denormals */
 
@@ -348,22 +347,38 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
 
 /* Sunlight arriving at the local point x: every beam through it under waves, the closed
  * form on flat water (and outside the lit region, where the waves' mean is used). With
- * `ray` (the beams collected along a camera ray), x must be the ray's march point k. */
-static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray, int k, ref_light *out,
-                    gr_beam_hit *hits, int *overflow)
+ * `ray` (the beams collected along a camera ray), x must be the ray's march point k. The
+ * lists grow as needed (no beam is ever dropped); returns the number of lights in
+ * *lights, or -1 when out of memory. */
+static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray, int k, ref_light **lights,
+                    int *lcap, gr_beam_hits *hits)
 {
+    if (*lcap < 1) {
+        ref_light *nl = realloc(*lights, 64 * sizeof *nl);
+        if (!nl) return -1;
+        *lights = nl;
+        *lcap = 64;
+    }
     if (!r->flat) {
         double u = x.x - r->sx * x.y, w = x.z - r->sz * x.y;
         const gr_beam_region *g = &r->region;
         if (x.y >= g->y_min && u >= g->u0 && u <= g->u1 && w >= g->w0 && w <= g->w1) {
-            int n = ray ? gr_beams_ray_lookup(r->beams, ray, k, x, hits, REF_MAX_HITS, overflow)
-                        : gr_beams_lookup(r->beams, x, hits, REF_MAX_HITS, overflow);
+            int n = ray ? gr_beams_ray_lookup(r->beams, ray, k, x, hits) : gr_beams_lookup(r->beams, x, hits);
+            if (n < 0) return -1;
+            if (n > *lcap) {
+                ref_light *nl = realloc(*lights, (size_t)n * sizeof *nl);
+                if (!nl) return -1;
+                *lights = nl;
+                *lcap = n;
+            }
+            ref_light *out = *lights;
             int m = 0;
             for (int i = 0; i < n; i++) {
-                if (!(hits[i].T.y < 0.0f)) continue;
-                out[m].T = hits[i].T;
-                out[m].eperp = hits[i].e_h / -hits[i].T.y; /* horizontal -> perpendicular to T */
-                out[m].path = hits[i].path_m;
+                const gr_beam_hit *h = &hits->h[i];
+                if (!(h->T.y < 0.0f)) continue;
+                out[m].T = h->T;
+                out[m].eperp = h->e_h / -h->T.y; /* horizontal -> perpendicular to T */
+                out[m].path = h->path_m;
                 m++;
             }
             return m;
@@ -371,6 +386,7 @@ static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray,
     }
     float depth = -x.y;
     if (!(depth > 0.0f)) return 0;
+    ref_light *out = *lights;
     out[0].T = r->Tp;
     out[0].eperp = r->flat_eperp;
     out[0].path = depth / r->mu_t;
@@ -379,22 +395,25 @@ static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray,
 
 double gr_ref_irradiance_h(const gr_ref_renderer *r, gr_dvec3 world)
 {
-    gr_beam_hit hits[REF_MAX_HITS];
-    ref_light l[REF_MAX_HITS];
-    int of = 0;
+    gr_beam_hits hits = {NULL, 0, 0};
+    ref_light *l = NULL;
+    int lcap = 0;
     gr_vec3 x = gr_d3_to_f(gr_d3_sub(world, r->origin));
-    int n = light_at(r, x, NULL, 0, l, hits, &of);
-    double e = 0.0;
+    int n = light_at(r, x, NULL, 0, &l, &lcap, &hits);
+    double e = n < 0 ? NAN : 0.0; /* out of memory: NaN, never a silently smaller value */
     for (int i = 0; i < n; i++) e += (double)l[i].eperp * -(double)l[i].T.y;
+    free(l);
+    gr_beam_hits_free(&hits);
     return e;
 }
 
 int gr_ref_beam_count(const gr_ref_renderer *r, gr_dvec3 world)
 {
     if (r->flat || !r->beams) return 0;
-    gr_beam_hit hits[REF_MAX_HITS];
-    int of = 0;
-    return gr_beams_lookup(r->beams, gr_d3_to_f(gr_d3_sub(world, r->origin)), hits, REF_MAX_HITS, &of);
+    gr_beam_hits hits = {NULL, 0, 0};
+    int n = gr_beams_lookup(r->beams, gr_d3_to_f(gr_d3_sub(world, r->origin)), &hits);
+    gr_beam_hits_free(&hits);
+    return n;
 }
 
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
@@ -433,10 +452,10 @@ typedef struct ref_job {
     atomic_int rows_done;
     atomic_int stop;
     /* per-thread counters, summed after the pass */
-    atomic_llong queries, shadow_rays, overflows;
+    atomic_llong queries, shadow_rays, max_hits; /* max_hits: the most beams at one point */
 } ref_job;
 
-typedef struct ref_counters { long long queries, shadow_rays, overflows; } ref_counters;
+typedef struct ref_counters { long long queries, shadow_rays, max_hits; } ref_counters;
 
 /* Stratum j of n over the pixel: an nx x ny grid of cells (nx the largest divisor of n not
  * above sqrt(n)); the sample is jittered within its cell. */
@@ -454,8 +473,9 @@ static void pixel_stratum(int j, int n, ref_rng *g, double *jx, double *jy)
  * sample is stratum j of the n camera samples its batch takes in this round. */
 /* Per-thread scratch memory of the march. */
 typedef struct ref_scratch {
-    gr_beam_hit *hits;
+    gr_beam_hits hits;   /* grow as needed */
     ref_light *lights;
+    int lcap;
     gr_beam_ray *ray;
     double *t;     /* march points along the ray (m) */
     float *tf;     /* the same in float, as the points are placed */
@@ -463,7 +483,7 @@ typedef struct ref_scratch {
 
 static void scratch_free(ref_scratch *sc)
 {
-    free(sc->hits);
+    gr_beam_hits_free(&sc->hits);
     free(sc->lights);
     gr_beam_ray_destroy(sc->ray);
     free(sc->t);
@@ -472,22 +492,22 @@ static void scratch_free(ref_scratch *sc)
 
 static int scratch_alloc(ref_scratch *sc, int steps)
 {
-    sc->hits = malloc(REF_MAX_HITS * sizeof *sc->hits);
-    sc->lights = malloc(REF_MAX_HITS * sizeof *sc->lights);
+    memset(sc, 0, sizeof *sc);
+    sc->lights = malloc(64 * sizeof *sc->lights);
+    sc->lcap = 64;
     sc->ray = gr_beam_ray_create();
     sc->t = malloc((size_t)steps * sizeof *sc->t);
     sc->tf = malloc((size_t)steps * sizeof *sc->tf);
-    if (sc->hits && sc->lights && sc->ray && sc->t && sc->tf) return 0;
+    if (sc->lights && sc->ray && sc->t && sc->tf) return 0;
     scratch_free(sc);
     memset(sc, 0, sizeof *sc);
     return -1;
 }
 
-static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, ref_rng *g, double L[3],
-                          double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
+/* Returns 0, or -1 when out of memory (a growing hit list). */
+static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, ref_rng *g, double L[3],
+                         double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
 {
-    gr_beam_hit *hits = sc->hits;
-    ref_light *lights = sc->lights;
     const gr_camera *c = &r->scene.camera;
     double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), aspect = (double)c->width / (double)c->height;
     double jx, jy;
@@ -507,7 +527,7 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n
     if (!(D > 0.0f)) D = 0.0f;
     *len = D;
     *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
-    if (D == 0.0f) return;
+    if (D == 0.0f) return 0;
     int n = r->set.steps;
     /* March density ~ exp(-lam t) on [0, D], lam = sig_ref (1 - w_y / mu_t0): the camera
      * ray's extinction times the sunlight's extinction down to the point on flat water, so
@@ -534,12 +554,12 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n
     for (int k = 0; k < n; k++) {
         double t = sc->t[k];
         gr_vec3 x = gr_v3_madd(o, d, sc->tf[k]);
-        int of = 0;
-        int m = light_at(r, x, ray, k, lights, hits, &of);
+        int m = light_at(r, x, ray, k, &sc->lights, &sc->lcap, &sc->hits);
+        if (m < 0) return -1;
         cnt->queries++;
-        cnt->overflows += of;
+        if (m > cnt->max_hits) cnt->max_hits = m;
         for (int i = 0; i < m; i++) {
-            const ref_light *l = &lights[i];
+            const ref_light *l = &sc->lights[i];
             if (r->geom->shadow) {
                 cnt->shadow_rays++;
                 if (gr_ref_shadowed(r->geom, x, gr_v3_scale(l->T, -1.0f), l->path)) continue;
@@ -555,6 +575,7 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n
             }
         }
     }
+    return 0;
 }
 
 static void *worker(void *arg)
@@ -569,6 +590,7 @@ static void *worker(void *arg)
     ref_accum *acc = job->acc;
     ref_scratch sc;
     ref_counters cnt = {0, 0, 0};
+    int oom = 0;
     /* camera samples are stratified over the pixel within a batch (like the passes' strata):
      * this pass is the k-th of its batch in the round */
     int per_batch = r->passes_per_round / r->batches, k_in_batch = (job->pass % r->passes_per_round) / r->batches;
@@ -589,8 +611,11 @@ static void *worker(void *arg)
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
-                render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, &g, L, &tr, &len, &cnt,
-                              &sc);
+                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, &g, L, &tr, &len,
+                                  &cnt, &sc) != 0) {
+                    oom = 1;
+                    break;
+                }
                 sum[0] += L[0];
                 sum[1] += L[1];
                 sum[2] += L[2];
@@ -600,12 +625,18 @@ static void *worker(void *arg)
                     acc->aov[ai * 2 + 1] += len;
                 }
             }
+            if (oom) break;
+        }
+        if (oom) {
+            atomic_store(&job->stop, 2); /* out of memory: the pass fails, nothing is dropped */
+            break;
         }
         atomic_fetch_add(&job->rows_done, 1);
     }
     atomic_fetch_add(&job->queries, cnt.queries);
     atomic_fetch_add(&job->shadow_rays, cnt.shadow_rays);
-    atomic_fetch_add(&job->overflows, cnt.overflows);
+    long long mh = atomic_load(&job->max_hits);
+    while (cnt.max_hits > mh && !atomic_compare_exchange_weak(&job->max_hits, &mh, cnt.max_hits)) {}
     scratch_free(&sc);
     return NULL;
 }
@@ -836,7 +867,7 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     return st;
 }
 
-typedef struct ref_march_totals { double march_s; long long queries, shadows, overflows; } ref_march_totals;
+typedef struct ref_march_totals { double march_s; long long queries, shadows, max_hits; } ref_march_totals;
 
 /* Marches one pass over every row of acc with r->threads workers (thread handles in th),
  * the progress bar going from frac0 to frac0 + span. *complete = 0 when interrupted. */
@@ -857,7 +888,7 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
     atomic_init(&job.stop, 0);
     atomic_init(&job.queries, 0);
     atomic_init(&job.shadow_rays, 0);
-    atomic_init(&job.overflows, 0);
+    atomic_init(&job.max_hits, 0);
     *complete = 0;
     double tm = mono_s();
     int started = 0;
@@ -880,7 +911,7 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
     tot->march_s += mono_s() - tm;
     tot->queries += atomic_load(&job.queries);
     tot->shadows += atomic_load(&job.shadow_rays);
-    tot->overflows += atomic_load(&job.overflows);
+    if (atomic_load(&job.max_hits) > tot->max_hits) tot->max_hits = atomic_load(&job.max_hits);
     if (atomic_load(&job.stop) == 2) return gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
     *complete = atomic_load(&job.rows_done) >= acc->H;
     return GR_OK;
@@ -1040,7 +1071,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for metadata");
         else {
             gr_meta_set_double(&out->meta, "godrays:shadow_rays_per_s", out->shadow_rays_per_s);
-            gr_meta_set_int(&out->meta, "godrays:beam_overflows", tot.overflows);
+            gr_meta_set_int(&out->meta, "godrays:beam_max_hits", tot.max_hits);
         }
     }
     free(acc.sum);
@@ -1068,8 +1099,7 @@ long long gr_ref_surface_triangles(const gr_ref_renderer *r)
 double gr_ref_lookup_rate(const gr_ref_renderer *r, const double box[6], int n)
 {
     if (r->flat || !r->beams || n < 1) return 0.0;
-    gr_beam_hit *hits = malloc(REF_MAX_HITS * sizeof *hits);
-    if (!hits) return 0.0;
+    gr_beam_hits hits = {NULL, 0, 0};
     gr_rng g = gr_rng_make(42, 2, 0);
     long long found = 0;
     double t0 = mono_s();
@@ -1077,11 +1107,10 @@ double gr_ref_lookup_rate(const gr_ref_renderer *r, const double box[6], int n)
         double y = box[4] + (box[5] - box[4]) * gr_rng_double(&g);
         double u = box[0] + (box[1] - box[0]) * gr_rng_double(&g), w = box[2] + (box[3] - box[2]) * gr_rng_double(&g);
         gr_vec3 p = gr_v3((float)(u + r->sx * y), (float)y, (float)(w + r->sz * y));
-        int of = 0;
-        found += gr_beams_lookup(r->beams, p, hits, REF_MAX_HITS, &of);
+        found += gr_beams_lookup(r->beams, p, &hits);
     }
     double dt = mono_s() - t0;
-    free(hits);
+    gr_beam_hits_free(&hits);
     (void)found;
     return dt > 0.0 ? n / dt : 0.0;
 }
