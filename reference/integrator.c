@@ -17,6 +17,7 @@
 #include "core/gerstner.h"
 #include "core/optics.h"
 #include "core/rng.h"
+#include "core/student.h"
 #include "reference/beams.h"
 #include "reference/embree_scene.h"
 #include "reference/progress.h"
@@ -74,6 +75,12 @@ struct gr_ref_renderer {
     int have_main_beams;
     long long bias_probe_pixels;
     int bias_probe_passes;
+    /* per probe pixel (pw x ph, stride PROBE_STRIDE, offset poff), RGB: the signed Richardson
+     * estimate of the surface bias (bias.R/G/B channels; NULL when not estimated) */
+    float *bias_px;
+    int bias_pw, bias_ph, bias_poff;
+    double bias_block_p95;    /* 95th percentile of |block bias| / max(block mean, image mean) */
+    int bias_blocks;
 };
 
 void gr_ref_options_default(gr_ref_options *o)
@@ -270,6 +277,7 @@ void gr_ref_destroy(gr_ref_renderer *r)
 {
     if (!r) return;
     gr_beams_destroy(r->beams);
+    free(r->bias_px);
     gr_ref_geometry_destroy(r->geom);
     gr_rtc_destroy(r->rtc);
     free(r);
@@ -667,6 +675,15 @@ static int cmp_by_value(const void *a, const void *b)
 
 typedef struct ref_errors { double rel_mean, rel_p95, frac_1pct, mean, p95; } ref_errors;
 
+/* --target-error E: the relative standard errors come from B batch means, B - 1 degrees of
+ * freedom; the target is met when their Student-t 95 % half-widths are within those a
+ * known standard error E would give, t_{0.975, B-1} se <= 1.96 E (docs/reference.md). */
+static int target_met(const ref_errors *e, int batches, double target)
+{
+    double k = gr_student_t975(batches - 1) / GR_NORMAL_Q975;
+    return k * e->rel_mean < target && k * e->rel_p95 < target;
+}
+
 /* Image-level error estimates from the batch images (docs/reference.md, "Error bars"). */
 static gr_status image_errors(const ref_accum *acc, ref_errors *e)
 {
@@ -750,11 +767,18 @@ static gr_status image_errors(const ref_accum *acc, ref_errors *e)
     return GR_OK;
 }
 
+static float bias_at(const gr_ref_renderer *r, int x, int y, int c);
+
 static gr_status build_image(const gr_ref_renderer *r, const ref_accum *acc, gr_ref_result *out, gr_error *err)
 {
     static const char *const names[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "transmittance", "ray_length"};
-    int nch = acc->aov ? 8 : 6, B = acc->B;
-    gr_image *img = gr_image_create(acc->W, acc->H, nch, names);
+    static const char *const names_b[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "bias.R", "bias.G", "bias.B"};
+    static const char *const names_ab[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "transmittance", "ray_length",
+                                           "bias.R", "bias.G", "bias.B"};
+    /* bias.R/G/B (the surface-bias probe's signed estimate of the pixel's 5 x 5 block) come last */
+    int bias = r->bias_px != NULL && r->bias_pw > 0 && r->bias_ph > 0;
+    int nch = (acc->aov ? 8 : 6) + (bias ? 3 : 0), B = acc->B;
+    gr_image *img = gr_image_create(acc->W, acc->H, nch, bias ? (acc->aov ? names_ab : names_b) : names);
     if (!img) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for a %dx%d image", acc->W, acc->H);
     uint32_t min_n = UINT32_MAX;
     for (int y = 0; y < acc->H; y++)
@@ -786,10 +810,11 @@ static gr_status build_image(const gr_ref_renderer *r, const ref_accum *acc, gr_
                 px[6] = n ? (float)(acc->aov[p * 2] / n) : 0.0f;
                 px[7] = n ? (float)(acc->aov[p * 2 + 1] / n) : 0.0f;
             }
+            if (bias)
+                for (int c = 0; c < 3; c++) px[nch - 3 + c] = bias_at(r, x, y, c);
         }
     out->image = img;
     out->spp = min_n == UINT32_MAX ? 0 : (int)min_n;
-    (void)r;
     return GR_OK;
 }
 
@@ -855,6 +880,9 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     else
         snprintf(buf, sizeof buf, "not estimated (reference.bias_probe = false or interrupted); -1");
     SET(gr_meta_set_string(m, "godrays:bias_surface_probe", buf));
+    /* per-block bias next to the mean's (bias.R/G/B channels; 10 x 10 pixel blocks) */
+    SET(gr_meta_set_double(m, "godrays:bias_block_p95_rel", r->bias_px ? finite_or(r->bias_block_p95, -1.0) : (r->flat ? 0.0 : -1.0)));
+    SET(gr_meta_set_int(m, "godrays:stderr_dof", r->batches - 1));
     SET(gr_meta_set_string(m, "godrays:bias_note",
                            "bias_surface_rel_est = mean |pixel bias| / image mean from the surface tessellation "
                            "(measured here, see bias_surface_probe; bound = 2x the estimate); march steps: "
@@ -862,7 +890,11 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
                            "below 0.3 % L1 (sun_disc = sample: unbiased); cutoff tail <= transmittance_cutoff * "
                            "S_max / sigma_t (docs/reference.md)"));
     SET(gr_meta_set_string(m, "godrays:error_bars",
-                           "stderr.* channels: batch-mean spread (noise only); discretization bias: docs/reference.md"));
+                           r->bias_px ? "stderr.* channels: batch-mean spread (noise only; Student t with stderr_dof "
+                                        "degrees of freedom); bias.* channels: the surface bias of the pixel's 5x5 block "
+                                        "(signed Richardson estimate from the probe; |bias| + t stderr bounds the error)"
+                                      : "stderr.* channels: batch-mean spread (noise only; Student t with stderr_dof "
+                                        "degrees of freedom); discretization bias: docs/reference.md"));
 #undef SET
     return st;
 }
@@ -930,22 +962,24 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, pthread_t *th, gr_progre
 {
     int W = r->scene.camera.width, H = r->scene.camera.height;
     int off = W > PROBE_STRIDE / 2 && H > PROBE_STRIDE / 2 ? PROBE_STRIDE / 2 : 0;
+    int res = r->set.surface_res, res2 = res / 2 > 2 ? res / 2 : 2;
+    int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
     ref_accum a[2];
     memset(a, 0, sizeof a);
     for (int k = 0; k < 2; k++) {
         a[k].W = (W - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
         a[k].H = (H - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
-        a[k].B = 1;
+        a[k].B = passes; /* one slot per pass: the per-pass differences give the probe's own noise */
     }
     size_t np = (size_t)a[0].W * a[0].H;
-    int res = r->set.surface_res, res2 = res / 2 > 2 ? res / 2 : 2;
-    int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
     gr_status st = GR_OK;
     for (int k = 0; k < 2 && st == GR_OK; k++) {
-        a[k].sum = calloc(np * 3, sizeof *a[k].sum);
-        a[k].count = calloc(np, sizeof *a[k].count);
+        a[k].sum = calloc(np * 3 * (size_t)passes, sizeof *a[k].sum);
+        a[k].count = calloc(np * (size_t)passes, sizeof *a[k].count);
         if (!a[k].sum || !a[k].count) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
     }
+    float *bpx = st == GR_OK ? malloc(np * 3 * sizeof *bpx) : NULL;
+    if (st == GR_OK && !bpx) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
     int complete = 1;
     for (int p = 0; p < passes && st == GR_OK && complete; p++)
         for (int k = 0; k < 2 && st == GR_OK && complete; k++) {
@@ -953,7 +987,7 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, pthread_t *th, gr_progre
             r->beams_pass = -1; /* another resolution: rebuild */
             st = gr_ref_prepare_pass(r, p, err);
             if (st == GR_OK)
-                st = march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, th, prog, frac0 + span * (2 * p + k) / (2.0 * passes),
+                st = march_pass(r, &a[k], p, p, PROBE_STRIDE, off, th, prog, frac0 + span * (2 * p + k) / (2.0 * passes),
                                 span / (2.0 * passes), "surface-bias probe", tot, &complete, err);
         }
     r->set.surface_res = res;
@@ -961,21 +995,88 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, pthread_t *th, gr_progre
     if (st == GR_OK && complete) {
         double d = 0.0, v = 0.0;
         for (size_t i = 0; i < np; i++) {
-            if (!a[0].count[i] || !a[1].count[i]) continue;
-            double lh = (a[0].sum[3 * i] + a[0].sum[3 * i + 1] + a[0].sum[3 * i + 2]) / (3.0 * a[0].count[i]);
-            double l2h = (a[1].sum[3 * i] + a[1].sum[3 * i + 1] + a[1].sum[3 * i + 2]) / (3.0 * a[1].count[i]);
-            d += fabs(l2h - lh) / 3.0; /* Richardson, p = 2: e_h = (L_2h - L_h) / (2^2 - 1) */
+            double lh = 0.0, l2h = 0.0;
+            for (int c = 0; c < 3; c++) {
+                double sh = 0.0, s2h = 0.0;
+                uint32_t nh = 0, n2h = 0;
+                for (int p = 0; p < passes; p++) {
+                    sh += a[0].sum[(i * passes + p) * 3 + c];
+                    s2h += a[1].sum[(i * passes + p) * 3 + c];
+                    nh += a[0].count[i * passes + p];
+                    n2h += a[1].count[i * passes + p];
+                }
+                double mh = nh ? sh / nh : 0.0, m2h = n2h ? s2h / n2h : 0.0;
+                /* Richardson, p = 2: e_h = (L_2h - L_h) / (2^2 - 1), signed, per channel */
+                double e = (m2h - mh) / 3.0;
+                bpx[i * 3 + c] = isfinite(e) ? (float)e : 0.0f;
+                lh += mh / 3.0;
+                l2h += m2h / 3.0;
+            }
+            d += fabs(l2h - lh) / 3.0;
             v += lh;
         }
         r->bias_rel = v > 0.0 && isfinite(d) ? d / v : (d > 0.0 ? -1.0 : 0.0);
         r->bias_probe_pixels = (long long)np;
         r->bias_probe_passes = passes;
+        free(r->bias_px);
+        r->bias_px = bpx;
+        bpx = NULL;
+        r->bias_pw = a[0].W;
+        r->bias_ph = a[0].H;
+        r->bias_poff = off;
     }
+    free(bpx);
     for (int k = 0; k < 2; k++) {
         free(a[k].sum);
         free(a[k].count);
     }
     return st;
+}
+
+/* The surface-bias estimate of image pixel (x, y), channel c: that of its probe pixel (the
+ * PROBE_STRIDE x PROBE_STRIDE block it lies in). */
+static float bias_at(const gr_ref_renderer *r, int x, int y, int c)
+{
+    int i = x / PROBE_STRIDE, j = y / PROBE_STRIDE;
+    if (i >= r->bias_pw) i = r->bias_pw - 1;
+    if (j >= r->bias_ph) j = r->bias_ph - 1;
+    return r->bias_px[((size_t)j * r->bias_pw + (size_t)i) * 3 + c];
+}
+
+/* Block bias: over blocks of 2 x 2 probe pixels (10 x 10 image pixels), the mean of the probe
+ * pixels' signed estimates (RGB mean) relative to max(block mean, image mean) (the same
+ * normalization as the 1 % standard-error figure); the 95th percentile of its magnitude. The
+ * probe's residual noise enters the magnitude: an overestimate, not an underestimate. */
+static void block_bias(gr_ref_renderer *r, const gr_image *img, double image_mean)
+{
+    r->bias_block_p95 = -1.0;
+    r->bias_blocks = 0;
+    if (!r->bias_px || !img) return;
+    int bw = (r->bias_pw + 1) / 2, bh = (r->bias_ph + 1) / 2, bs = 2 * PROBE_STRIDE;
+    double *v = malloc((size_t)bw * bh * sizeof *v);
+    if (!v) return;
+    size_t n = 0;
+    for (int J = 0; J < bh; J++)
+        for (int I = 0; I < bw; I++) {
+            double b = 0.0, m = 0.0;
+            int nb = 0, nm = 0;
+            for (int j = 2 * J; j < 2 * J + 2 && j < r->bias_ph; j++)
+                for (int i = 2 * I; i < 2 * I + 2 && i < r->bias_pw; i++, nb++)
+                    for (int c = 0; c < 3; c++) b += r->bias_px[((size_t)j * r->bias_pw + (size_t)i) * 3 + c] / 3.0;
+            for (int y = J * bs; y < (J + 1) * bs && y < img->height; y++)
+                for (int x = I * bs; x < (I + 1) * bs && x < img->width; x++, nm++) {
+                    const float *px = gr_image_pixel((gr_image *)img, x, y);
+                    m += (px[0] + px[1] + px[2]) / 3.0;
+                }
+            if (!nb || !nm) continue;
+            double den = fmax(m / nm, image_mean);
+            if (den > 0.0) v[n++] = fabs(b / nb) / den;
+        }
+    if (n) {
+        r->bias_block_p95 = percentile(v, n, 0.95);
+        r->bias_blocks = (int)n;
+    }
+    free(v);
 }
 
 gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
@@ -1024,7 +1125,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         if (st != GR_OK || out->partial) break;
         if (rounds > 1) {
             if (image_errors(&acc, &e) != GR_OK) { st = gr_fail(err, GR_E_NOMEM, "reference: out of memory"); break; }
-            if (e.rel_mean < r->set.target_error && e.rel_p95 < r->set.target_error) break;
+            if (target_met(&e, acc.B, r->set.target_error)) break;
         }
     }
     /* the tessellation's bias, measured on this scene (flat water has none: closed form) */
@@ -1042,7 +1143,9 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     gr_progress_destroy(prog);
     free(th);
     if (st == GR_OK && image_errors(&acc, &e) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
+    if (st == GR_OK && (r->flat || out->partial || !probe)) { free(r->bias_px); r->bias_px = NULL; }
     if (st == GR_OK) st = build_image(r, &acc, out, err);
+    if (st == GR_OK) block_bias(r, out->image, e.mean);
     if (st == GR_OK) {
         out->wall_s = mono_s() - t0;
         out->rel_se_mean = e.rel_mean;
@@ -1052,6 +1155,8 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         out->shadow_rays_per_s = tot.march_s > 0.0 ? (double)tot.shadows / tot.march_s : 0.0;
         out->beam_build_s = r->beam_build_s;
         out->bias_surface_rel = r->bias_rel;
+        out->bias_block_p95 = r->bias_block_p95;
+        out->target_met = r->set.target_error > 0.0 ? target_met(&e, acc.B, r->set.target_error) : 1;
         out->rounds = P > 0 ? (out->passes + P - 1) / P : 0;
         out->max_rounds = rounds;
         /* preview: the 99th percentile of the brightest channel maps to 0.8 */

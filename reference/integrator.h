@@ -45,7 +45,8 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
 void gr_ref_destroy(gr_ref_renderer *r); /* accepts NULL */
 
 typedef struct gr_ref_result {
-    gr_image *image;        /* R, G, B, stderr.R, stderr.G, stderr.B [, transmittance, ray_length] */
+    gr_image *image;        /* R, G, B, stderr.R, stderr.G, stderr.B [, transmittance, ray_length]
+                               [, bias.R, bias.G, bias.B] (with the surface-bias probe) */
     gr_metadata meta;       /* "godrays:*" keys: settings, samples, errors, timings */
     int partial;            /* 1 if interrupted: fewer samples than asked */
     int spp;                /* camera samples per pixel actually taken (pixels done last) */
@@ -61,6 +62,9 @@ typedef struct gr_ref_result {
     int rounds, max_rounds; /* rounds of passes done; the cap that --target-error refines up to */
     double bias_surface_rel;/* surface-tessellation bias: mean |pixel bias| / image mean,
                                measured by the probe (0 on flat water, -1 if not estimated) */
+    double bias_block_p95;  /* 95th percentile over 10x10-pixel blocks of |block bias| / max(block
+                               mean, image mean) (-1 if not estimated) */
+    int target_met;         /* --target-error: 1 when met (Student t, batches - 1 dof); 1 if off */
 } gr_ref_result;
 
 /* Renders the image; `progress_label` may be NULL. On interruption returns GR_OK with

@@ -15,6 +15,7 @@
 
 #include "compare/diffmap.h"
 #include "compare/metrics.h"
+#include "image/exr.h"
 #include "compare/metrics_io.h"
 #include "image/oiio.h"
 #include "report/report.h"
@@ -165,6 +166,20 @@ int cmd_compare(int argc, char **argv)
     if (st != GR_OK) goto fail;
 
     opt.mask = mask;
+    /* a ground truth's stderr comes from a few batches: its degrees of freedom, for Student's t */
+    {
+        gr_metadata meta;
+        gr_meta_init(&meta);
+        gr_image *tmp = NULL;
+        gr_error e2 = {0};
+        size_t n = strlen(paths[0]);
+        if (n > 4 && !strcmp(paths[0] + n - 4, ".exr") && gr_exr_read(paths[0], &tmp, &meta, &e2) == GR_OK) {
+            const gr_meta_item *it = gr_meta_get(&meta, "godrays:stderr_dof");
+            if (it && it->type != GR_META_STRING && it->num >= 1.0) opt.stderr_dof = (int)it->num;
+        }
+        gr_image_destroy(tmp);
+        gr_meta_free(&meta);
+    }
     gr_metrics m;
     const double t0 = now_s();
     st = gr_metrics_compute(ref, test, &opt, &m, &err);

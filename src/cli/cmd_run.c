@@ -255,6 +255,8 @@ static int run_with(gr_args *args)
     t = now_s();
     gr_metrics_options mopt = {0};
     mopt.fit_scale = 1; /* the technique's intensity is an arbitrary factor (seed 000) */
+    const gr_meta_item *dof = gr_meta_get(&ro.meta, "godrays:stderr_dof"); /* Student t for significance */
+    if (dof && dof->type != GR_META_STRING && dof->num >= 1.0) mopt.stderr_dof = (int)dof->num;
     gr_metrics m;
     if (gr_metrics_compute(ro.img, test, &mopt, &m, &err) != GR_OK) goto fail;
     const double t_cmp = now_s() - t;
