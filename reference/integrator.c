@@ -71,6 +71,7 @@ struct gr_ref_renderer {
     double beam_build_s;
     /* surface-bias probe: mean |bias| / mean (-1 = not estimated), its cost and size */
     double bias_rel, bias_probe_s;
+    double bias_ratio, bias_order; /* the probe's |L_4h - L_2h| / |L_2h - L_h| and the order p used */
     gr_beam_stats main_beams; /* the main passes' last beam set (the probe builds others) */
     int have_main_beams;
     long long bias_probe_pixels;
@@ -867,6 +868,7 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     /* bias next to the noise (docs/reference.md section 4): the surface tessellation is the
      * only discretization bias; measured on this scene by the probe (surface_bias_probe) */
     SET(gr_meta_set_double(m, "godrays:bias_surface_rel_est", finite_or(r->bias_rel, -1.0)));
+    if (r->bias_rel >= 0.0 && !r->flat) SET(gr_meta_set_double(m, "godrays:bias_surface_order", finite_or(r->bias_order, -1.0)));
     /* the bound: twice the estimate; unit.ref_convergence checks that the probe lies within a
      * factor 2 of the bias measured against a 2x finer tessellation */
     SET(gr_meta_set_double(m, "godrays:bias_surface_rel_bound", r->bias_rel >= 0.0 ? finite_or(2.0 * r->bias_rel, -1.0) : -1.0));
@@ -874,9 +876,11 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
         snprintf(buf, sizeof buf, "none: flat water takes the closed form (no tessellation)");
     else if (r->bias_rel >= 0.0)
         snprintf(buf, sizeof buf,
-                 "Richardson (O(h^2)) from %lld pixels (every %dth) x %d passes at surface_res %d and %d, %.2f s",
+                 "Richardson from %lld pixels (every %dth) x %d passes at surface_res %d, %d and %d: difference ratio "
+                 "%.2f, order %.2f (clamped to [1, 2]), %.2f s",
                  r->bias_probe_pixels, PROBE_STRIDE, r->bias_probe_passes, r->set.surface_res,
-                 r->set.surface_res / 2 > 2 ? r->set.surface_res / 2 : 2, r->bias_probe_s);
+                 r->set.surface_res / 2 > 2 ? r->set.surface_res / 2 : 2, r->set.surface_res / 4 > 2 ? r->set.surface_res / 4 : 2,
+                 r->bias_ratio, r->bias_order, r->bias_probe_s);
     else
         snprintf(buf, sizeof buf, "not estimated (reference.bias_probe = false or interrupted); -1");
     SET(gr_meta_set_string(m, "godrays:bias_surface_probe", buf));
@@ -950,72 +954,86 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
 }
 
 /* Surface-bias probe (docs/reference.md, section 4). Every PROBE_STRIDE-th pixel in x and y
- * is rendered again for the first PROBE_PASSES passes, once with the beam sets of surface_res
- * (cell h) and once with those of surface_res / 2 (2h), from the same random numbers (camera
- * samples, march steps, sun directions, grid offsets in cells). The tessellation's error is
- * O(h^2) (section 2.2), so Richardson's extrapolation gives the bias at h per pixel as
- * (L_2h - L_h) / 3; r->bias_rel = the mean of its absolute value over the probe pixels
- * divided by their mean value: the same figure as the convergence study's table. What noise
- * the common random numbers leave in the difference makes it an overestimate. */
+ * is rendered again for the first PROBE_PASSES passes with the beam sets of surface_res
+ * (cell h), surface_res / 2 (2h) and surface_res / 4 (4h), from the same random numbers
+ * (camera samples, march steps, grid offsets in cells). The tessellation's error is O(h^p),
+ * p = 2 once the cells resolve the waves (section 2.2), less before: the order is measured
+ * from the three levels, r = mean |L_4h - L_2h| / mean |L_2h - L_h|, p = log2 r clamped to
+ * [1, 2] (clamping p at 2 when r > 4 overestimates; noise in the differences flattens r and
+ * also overestimates). Richardson then gives the bias at h per pixel as
+ * (L_2h - L_h) / (2^p - 1); r->bias_rel = the mean of its absolute value over the probe
+ * pixels divided by their mean value: the same figure as the convergence study's table. */
 static gr_status surface_bias_probe(gr_ref_renderer *r, pthread_t *th, gr_progress *prog, double frac0, double span,
                                     ref_march_totals *tot, gr_error *err)
 {
+    enum { NL = 3 }; /* levels h, 2h, 4h */
     int W = r->scene.camera.width, H = r->scene.camera.height;
     int off = W > PROBE_STRIDE / 2 && H > PROBE_STRIDE / 2 ? PROBE_STRIDE / 2 : 0;
-    int res = r->set.surface_res, res2 = res / 2 > 2 ? res / 2 : 2;
+    int res = r->set.surface_res, lres[NL];
+    for (int k = 0; k < NL; k++) lres[k] = (res >> k) > 2 ? res >> k : 2;
     int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
-    ref_accum a[2];
+    ref_accum a[NL];
     memset(a, 0, sizeof a);
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < NL; k++) {
         a[k].W = (W - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
         a[k].H = (H - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
-        a[k].B = passes; /* one slot per pass: the per-pass differences give the probe's own noise */
+        a[k].B = passes;
     }
     size_t np = (size_t)a[0].W * a[0].H;
     gr_status st = GR_OK;
-    for (int k = 0; k < 2 && st == GR_OK; k++) {
+    for (int k = 0; k < NL && st == GR_OK; k++) {
         a[k].sum = calloc(np * 3 * (size_t)passes, sizeof *a[k].sum);
         a[k].count = calloc(np * (size_t)passes, sizeof *a[k].count);
         if (!a[k].sum || !a[k].count) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
     }
     float *bpx = st == GR_OK ? malloc(np * 3 * sizeof *bpx) : NULL;
-    if (st == GR_OK && !bpx) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
+    double *lv = st == GR_OK ? malloc(np * 3 * NL * sizeof *lv) : NULL; /* per pixel, channel, level: the mean */
+    if (st == GR_OK && (!bpx || !lv)) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
     int complete = 1;
     for (int p = 0; p < passes && st == GR_OK && complete; p++)
-        for (int k = 0; k < 2 && st == GR_OK && complete; k++) {
-            r->set.surface_res = k ? res2 : res;
+        for (int k = 0; k < NL && st == GR_OK && complete; k++) {
+            r->set.surface_res = lres[k];
             r->beams_pass = -1; /* another resolution: rebuild */
             st = gr_ref_prepare_pass(r, p, err);
             if (st == GR_OK)
-                st = march_pass(r, &a[k], p, p, PROBE_STRIDE, off, th, prog, frac0 + span * (2 * p + k) / (2.0 * passes),
-                                span / (2.0 * passes), "surface-bias probe", tot, &complete, err);
+                st = march_pass(r, &a[k], p, p, PROBE_STRIDE, off, th, prog,
+                                frac0 + span * (NL * p + k) / (NL * (double)passes), span / (NL * (double)passes),
+                                "surface-bias probe", tot, &complete, err);
         }
     r->set.surface_res = res;
     r->beams_pass = -1;
     if (st == GR_OK && complete) {
-        double d = 0.0, v = 0.0;
+        double d1 = 0.0, d2 = 0.0, v = 0.0;
         for (size_t i = 0; i < np; i++) {
-            double lh = 0.0, l2h = 0.0;
-            for (int c = 0; c < 3; c++) {
-                double sh = 0.0, s2h = 0.0;
-                uint32_t nh = 0, n2h = 0;
-                for (int p = 0; p < passes; p++) {
-                    sh += a[0].sum[(i * passes + p) * 3 + c];
-                    s2h += a[1].sum[(i * passes + p) * 3 + c];
-                    nh += a[0].count[i * passes + p];
-                    n2h += a[1].count[i * passes + p];
+            double l[NL] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < NL; k++)
+                for (int c = 0; c < 3; c++) {
+                    double sm = 0.0;
+                    uint32_t n = 0;
+                    for (int p = 0; p < passes; p++) {
+                        sm += a[k].sum[(i * passes + p) * 3 + c];
+                        n += a[k].count[i * passes + p];
+                    }
+                    lv[(i * 3 + c) * NL + k] = n ? sm / n : 0.0;
+                    l[k] += lv[(i * 3 + c) * NL + k] / 3.0;
                 }
-                double mh = nh ? sh / nh : 0.0, m2h = n2h ? s2h / n2h : 0.0;
-                /* Richardson, p = 2: e_h = (L_2h - L_h) / (2^2 - 1), signed, per channel */
-                double e = (m2h - mh) / 3.0;
-                bpx[i * 3 + c] = isfinite(e) ? (float)e : 0.0f;
-                lh += mh / 3.0;
-                l2h += m2h / 3.0;
-            }
-            d += fabs(l2h - lh) / 3.0;
-            v += lh;
+            d1 += fabs(l[1] - l[0]);
+            d2 += fabs(l[2] - l[1]);
+            v += l[0];
         }
-        r->bias_rel = v > 0.0 && isfinite(d) ? d / v : (d > 0.0 ? -1.0 : 0.0);
+        /* the measured order of convergence, clamped to [1, 2] */
+        double ratio = d1 > 0.0 ? d2 / d1 : 4.0, order = ratio > 0.0 ? log2(ratio) : 2.0;
+        if (!(order <= 2.0)) order = 2.0;
+        if (!(order >= 1.0)) order = 1.0;
+        double div = pow(2.0, order) - 1.0; /* Richardson: e_h = (L_2h - L_h) / (2^p - 1) */
+        for (size_t i = 0; i < np; i++)
+            for (int c = 0; c < 3; c++) {
+                double e = (lv[(i * 3 + c) * NL + 1] - lv[(i * 3 + c) * NL]) / div; /* signed, per channel */
+                bpx[i * 3 + c] = isfinite(e) ? (float)e : 0.0f;
+            }
+        r->bias_rel = v > 0.0 && isfinite(d1) ? d1 / div / v : (d1 > 0.0 ? -1.0 : 0.0);
+        r->bias_ratio = ratio;
+        r->bias_order = order;
         r->bias_probe_pixels = (long long)np;
         r->bias_probe_passes = passes;
         free(r->bias_px);
@@ -1026,7 +1044,8 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, pthread_t *th, gr_progre
         r->bias_poff = off;
     }
     free(bpx);
-    for (int k = 0; k < 2; k++) {
+    free(lv);
+    for (int k = 0; k < NL; k++) {
         free(a[k].sum);
         free(a[k].count);
     }

@@ -7,9 +7,10 @@
  *    (ratio 2 +- 0.5 from spp 1 to 4 per batch), the march and the disc being unbiased
  *    (jittered stratification), so more samples only remove noise;
  *  - the renderer's own bias estimate (godrays:bias_surface_rel_est, the probe that renders
- *    every 5th pixel again at half the surface_res) must agree within a factor of 2 with the
- *    bias measured here against the finer render, Richardson-corrected ((4/3) of the mean
- *    difference at the finest compared resolution).
+ *    every 5th pixel again at 1/2 and 1/4 of the surface_res and measures the order) must be
+ *    at least half the bias measured here against the finer render, Richardson-corrected
+ *    ((4/3) of the mean difference at the finest compared resolution), so that the bound
+ *    (twice the estimate) holds, and at most 4x it.
  * Prints the table of docs/reference.md section 4 and, with PLplot, writes
  * GODRAYS_TEST_OUT/ref_convergence.svg. Slow: reduced variant stops at surface_res 256. */
 #include "check.h"
@@ -81,7 +82,10 @@ int main(void)
     double measured = err[nres - 1] * 4.0 / 3.0, est = probe[nres - 1];
     printf("surface bias at %d: renderer's probe %.3e, measured against %d %.3e (ratio %.2f)\n", resl[nres - 1], est,
            ref_res, measured, est / measured);
-    CHECK_MSG(est > 0.5 * measured && est < 2.0 * measured, "bias probe %g vs measured %g", est, measured);
+    /* the bound written beside it is twice the estimate: it must not fall below the measured
+     * bias (est > measured / 2); the probe measures its order of convergence from three levels
+     * and leans high before the cells resolve the waves, but not wildly (< 4x) */
+    CHECK_MSG(est > 0.5 * measured && est < 4.0 * measured, "bias probe %g vs measured %g", est, measured);
     CHECK_MSG(err[nres - 2] / err[nres - 1] >= 2.5, "surface_res doubling must cut the bias >= 2.5x, got %.2f",
               err[nres - 2] / err[nres - 1]);
 
