@@ -183,7 +183,7 @@ static void print_set(FILE *f, const gr_metrics *m, const gr_metrics_set *s)
     }
     if (m->have_stderr) {
         char label[48];
-        snprintf(label, sizeof label, "not signif. (<=%gse) %%", m->stderr_z);
+        snprintf(label, sizeof label, "not signif. (<=%.4gse%s) %%", m->stderr_z, m->have_bias ? "+|b|" : "");
         ROW(label, ch->n_samples > 0 ? 100.0 * (double)ch->n_not_significant / (double)ch->n_samples : 0.0, 2, 1);
     }
 #undef ROW

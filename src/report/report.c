@@ -527,9 +527,12 @@ static void html_metrics_table(gr_strbuf *b, const gr_metrics *m, const gr_metri
         snprintf(label, sizeof label, "RMSE after blur, sigma %g px", gr_metrics_blur_sigmas[k]);
         ROW(label, cm->rmse_blur[k]);
     }
-    if (m->have_stderr)
-        ROW("not significant (|d| <= 2 stderr), %",
-            cm->n_samples > 0 ? 100.0 * (double)cm->n_not_significant / (double)cm->n_samples : NAN);
+    if (m->have_stderr) {
+        char sl[96]; /* z: Student t with the reference's batches - 1 degrees of freedom, or 2 */
+        snprintf(sl, sizeof sl, "not significant (|d| <= %.3g stderr%s), %%", m->stderr_z,
+                 m->have_bias ? " + |bias|" : "");
+        ROW(sl, cm->n_samples > 0 ? 100.0 * (double)cm->n_not_significant / (double)cm->n_samples : NAN);
+    }
 #undef ROW
     gr_sb_puts(b, "<tr><td class=\"l\">max error at (x, y)</td>");
     for (int c = 0; c < GR_MCH_COUNT; c++) {
