@@ -11,6 +11,7 @@
 #define GR_CLI_ARGS_H
 
 #include "gl/glctx.h"
+#include "realtime/technique.h"
 #include "report/html.h"
 #include "scene/scene.h"
 
@@ -21,9 +22,13 @@ typedef struct gr_args {
     int i;                      /* the argument being read; taking a value advances it */
     char **sets;                /* scene overrides "KEY=VALUE" in command-line order (owned) */
     int n_sets, cap_sets;
+    char **origins;             /* per override: the flag and value that made it ("--threads 4"),
+                                   NULL for --set; messages name what the user typed (owned) */
     int have_size;              /* --size was given */
     const char *size_example;   /* in the --size message; NULL: "640x360" */
     const char *scene_path;     /* the positional SCENE argument (NULL: none yet) */
+    const char *tech_dirs[GR_TECH_MAX]; /* --technique-dir values, in order */
+    int n_tech_dirs;
 } gr_args;
 
 /* Empty overrides, reading argv from argument 1. */
@@ -50,9 +55,19 @@ int gr_args_take_setting(gr_args *a, const char *key);
 /* --gl-platform auto|surfaceless|device. */
 int gr_args_take_gl_platform(gr_args *a, gr_gl_platform *platform);
 /* argv[i] as one of the options of the commands that write a folder from a scene (run,
- * sweep, tune, pareto): -o/--output DIR (into *dir, see gr_args_dir), --set, --size, and
- * --gl-platform when platform is not NULL. *taken = 0 (and 0 returned) when it is none. */
+ * sweep, tune, pareto): -o/--output DIR (into *dir, see gr_args_dir), --set, --size,
+ * --technique-dir, and --gl-platform when platform is not NULL. *taken = 0 (and 0 returned) when it is none. */
 int gr_args_take_common(gr_args *a, const char **dir, gr_gl_platform *platform, int *taken);
+/* --technique-dir DIR: remembers DIR (repeatable; added by gr_args_add_technique_dirs). */
+int gr_args_take_technique_dir(gr_args *a);
+/* Registers the user technique of every --technique-dir (gr_technique_add_dir), in order;
+ * call it once, after the argument loop and BEFORE loading the scene (a user technique's
+ * section is unknown to the loader until then). A bad folder or manifest: its message. */
+int gr_args_add_technique_dirs(const gr_args *a);
+/* The technique called name (for the argument `what`, e.g. "--technique"); a usage error
+ * listing the known ones otherwise. */
+int gr_args_find_technique(const gr_args *a, const char *what, const char *name, const gr_technique_class **cls);
+
 /* An override the command adds itself (printf format, e.g. "camera.width=%d"). */
 int gr_args_add_set(gr_args *a, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

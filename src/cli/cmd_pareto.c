@@ -1,6 +1,6 @@
-/* godrays pareto SCENE: speed against error of both renderers (src/tune/pareto.h): the ground
- * truth at increasing quality against a high-quality one, and the real-time shafts over
- * settings that trade speed for quality (N, target scale, 8-bit vs 16F). */
+/* godrays pareto SCENE: speed against error (src/tune/pareto.h): the ground truth at increasing
+ * quality against a high-quality one, and every chosen real-time technique over the settings
+ * of its class's ladder (gr_technique_class.ladder), one family and one front each. */
 #include "cli/cli.h"
 #include "cli/args.h"
 
@@ -12,14 +12,14 @@
 #include <time.h>
 
 #include "compare/metrics.h"
-#include "realtime/shafts.h"
+#include "realtime/technique.h"
 #include "report/report.h"
 #include "tune/page.h"
 #include "tune/pareto.h"
 #include "tune/session.h"
 #include "tune/truth.h"
 
-#define MAX_POINTS 64
+#define MAX_POINTS 256
 
 static void usage(FILE *f)
 {
@@ -32,21 +32,24 @@ static void usage(FILE *f)
             "  - the ground truth at increasing quality (q0..q3, q3 = the scene's reference settings,\n"
             "    the others fractions of its passes, steps and surface resolution; each timed,\n"
             "    never cached), error against the high-quality one;\n"
-            "  - the real-time shafts for N in {6, 11, 21}, target scale in {0.25, 0.5, 1} and\n"
-            "    rgba8/rgba16f targets (median time of --repeat renders in one context), error after\n"
-            "    the best scale fit.\n"
-            "Error = RMSE of luminance Y / mean Y of the high-quality ground truth. The shafts are\n"
-            "ranked by the wall time of a render with readback on llvmpipe, by the GPU time of\n"
+            "  - each real-time technique over its own speed/quality ladder (settings such as a grid\n"
+            "    or target size; docs/tuning.md), median time of --repeat renders in one context,\n"
+            "    error after the best scale fit.\n"
+            "Error = RMSE of luminance Y / mean Y of the high-quality ground truth. The techniques\n"
+            "are ranked by the wall time of a render with readback on llvmpipe, by the GPU time of\n"
             "their GL passes on a hardware GPU (both are listed). Writes DIR/pareto.csv and\n"
-            "DIR/pareto.png (both families and their Pareto fronts). docs/tuning.md.\n"
+            "DIR/pareto.png (every family and its Pareto front, one colour each). docs/tuning.md.\n"
             "\n"
             "options:\n"
             "  -o, --output DIR   folder (default: out/SCENE_NAME/pareto)\n"
             "  --size WxH         image size (default 320x180: the high-quality ground truth costs\n"
             "                     about 4x a default-quality one)\n"
             "  --set KEY=VALUE    override a scene value (repeatable)\n"
-            "  --quick            fewer points (q0, q1, N in {6, 11}, scale 0.5 and 1), for tests\n"
-            "  --repeat R         shafts renders per setting; time = median (default 5)\n"
+            "  --techniques A,B   the techniques to place (default: every registered one)\n"
+            "  --technique NAME   one technique only (same as --techniques NAME)\n"
+            "  --technique-dir DIR  add the user technique in DIR (repeatable)\n"
+            "  --quick            fewer points (q0, q1, the quick levels of each ladder), for tests\n"
+            "  --repeat R         renders per setting; time = median (default 5)\n"
             "  --no-cache         render the high-quality ground truth even if cached\n"
             "  --gl-platform P    auto, surfaceless or device\n"
             "  -q, --quiet        no progress messages\n"
@@ -118,6 +121,7 @@ static int pareto_with(gr_args *args)
     const int argc = args->argc;
     char **argv = args->argv;
     int quiet = 0, quick = 0, use_cache = 1, rc = 0, taken = 0;
+    const char *tech_list = NULL, *tech_flag = "--techniques";
     long repeat = 5;
     gr_gl_platform platform = GR_GL_AUTO;
     args->size_example = "320x180";
@@ -130,6 +134,11 @@ static int pareto_with(gr_args *args)
             quiet = 1;
         } else if (!strcmp(a, "--quick")) {
             quick = 1;
+        } else if (!strcmp(a, "--techniques") || !strcmp(a, "--technique")) {
+            tech_flag = a;
+            if ((rc = gr_args_value(args, &tech_list)) != 0) break;
+            if (!strcmp(a, "--technique") && strchr(tech_list, ','))
+                rc = gr_cli_usage_error(cmd, "--technique %s: one technique (use --techniques for a list)", tech_list);
         } else if (!strcmp(a, "--no-cache")) {
             use_cache = 0;
         } else if (!strcmp(a, "--repeat")) {
@@ -145,6 +154,14 @@ static int pareto_with(gr_args *args)
         }
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    const gr_technique_class *techs[GR_TECH_MAX];
+    int n_techs = 0;
+    {
+        gr_error lerr = {GR_OK, ""};
+        if (gr_technique_parse_list(tech_flag, tech_list, techs, GR_TECH_MAX, &n_techs, &lerr) != GR_OK)
+            return gr_cli_usage_error(cmd, "%s", lerr.msg);
+    }
     /* the default size after every override, so that it wins over --set camera.width/height */
     if (!args->have_size && (rc = gr_args_add_set(args, "camera.width=320")) != 0) return rc;
     if (!args->have_size && (rc = gr_args_add_set(args, "camera.height=180")) != 0) return rc;
@@ -152,7 +169,8 @@ static int pareto_with(gr_args *args)
     gr_error err = {GR_OK, ""};
     gr_scene *scene = NULL, *work = malloc(sizeof *work);
     gr_image *truth = NULL, *img = NULL;
-    gr_shafts *r = NULL;
+    gr_gl *gl = NULL;
+    gr_technique *r = NULL;
     gr_pareto_point *pts = calloc(MAX_POINTS, sizeof *pts);
     int n = 0;
     char dirbuf[4096], path[4300];
@@ -162,13 +180,14 @@ static int pareto_with(gr_args *args)
         goto fail;
     }
     if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
-    if (gr_shafts_check_settings(&scene->shafts, &err) != GR_OK) goto fail;
+    for (int k = 0; k < n_techs; k++)
+        if (gr_technique_check(techs[k], gr_technique_scene_settings(techs[k], scene), &err) != GR_OK) goto fail;
     /* The ground truths take minutes: a folder that cannot be made is refused before them. */
     if ((rc = gr_args_output_dir(args, scene, outopt, "pareto", dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
-    gr_shafts_options so;
-    memset(&so, 0, sizeof so);
-    so.gl.platform = platform;
-    if (gr_shafts_create(&so, &r, &err) != GR_OK) goto fail;
+    gr_gl_options glo;
+    memset(&glo, 0, sizeof glo);
+    glo.platform = platform;
+    if (gr_gl_create(&glo, &gl, &err) != GR_OK) goto fail;
 
     /* the high-quality ground truth, with its own seed so that no ladder level shares its
      * random numbers (a shared seed would make the lower levels look better than they are) */
@@ -206,6 +225,7 @@ static int pareto_with(gr_args *args)
         if (st != GR_OK) goto fail;
         gr_pareto_point *p = &pts[n++];
         p->family = GR_PARETO_REFERENCE;
+        snprintf(p->family_name, sizeof p->family_name, "reference");
         snprintf(p->label, sizeof p->label, "%s", lv.name);
         snprintf(p->settings, sizeof p->settings, "sun_samples=%d;batches=%d;steps=%d;surface_res=%d;spp=%d",
                  lv.sun_samples, lv.batches, lv.steps, lv.surface_res, lv.spp);
@@ -215,9 +235,7 @@ static int pareto_with(gr_args *args)
         p->error = rel_rmse(&m.raw);
     }
 
-    /* shafts over settings that trade speed for quality */
-    static const int Ns[] = {6, 11, 21};
-    static const double scales[] = {0.25, 0.5, 1.0};
+    /* each technique over the settings of its ladder, which trade speed for quality */
     img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
     double *times = malloc((size_t)repeat * sizeof *times), *gpus = malloc((size_t)repeat * sizeof *gpus);
     if (!img || !times || !gpus) {
@@ -227,68 +245,81 @@ static int pareto_with(gr_args *args)
         goto fail;
     }
     int gpu_any = 0;
-    const int n_N = quick ? 2 : 3;
-    for (int in = 0; in < n_N; in++)
-        for (int is = quick ? 1 : 0; is < 3; is++)
-            for (int fmt = 0; fmt < 2; fmt++) {
-                gr_shafts_settings s = scene->shafts;
-                s.N = Ns[in];
-                s.target_scale = scales[is];
-                s.target_format = fmt ? GR_TARGET_RGBA16F : GR_TARGET_RGBA8;
-                gr_shafts_stats stats;
-                /* warm-up render: buffers rebuilt for a new N or target size, shader JIT */
-                gr_status st = gr_shafts_render(r, scene, &s, img, &stats, &err);
-                for (long k = 0; st == GR_OK && k < repeat; k++) {
-                    st = gr_shafts_render(r, scene, &s, img, &stats, &err);
-                    times[k] = stats.cpu_ms * 1e-3;
-                    double g = 0;
-                    int ok = 1;
-                    for (int q = 0; q < GR_SHAFTS_NPASS; q++) {
-                        if (stats.gpu_ns[q] < 0) ok = 0;
-                        else g += (double)stats.gpu_ns[q] * 1e-9;
-                    }
-                    gpus[k] = ok ? g : -1;
+    for (int k = 0; k < n_techs; k++) {
+        const gr_technique_class *cls = techs[k];
+        gr_technique_destroy(r);
+        r = NULL;
+        if (gr_technique_create(cls, gl, NULL, &r, &err) != GR_OK) {
+            free(times);
+            free(gpus);
+            goto fail;
+        }
+        const int n_lv = cls->n_ladder > 0 ? cls->n_ladder : 1;
+        for (int l = 0; l < n_lv; l++) {
+            const char *lvs = cls->n_ladder > 0 ? cls->ladder[l].settings : "";
+            if (quick && cls->n_ladder > 0 && !cls->ladder[l].quick) continue;
+            if (n >= MAX_POINTS) break;
+            gr_section_store s;
+            memcpy(s.bytes, gr_technique_scene_settings(cls, scene), cls->settings_size);
+            gr_technique_stats stats;
+            /* warm-up render: buffers rebuilt for new sizes, shader JIT */
+            gr_status st = gr_technique_apply_text(cls, s.bytes, lvs, &err);
+            if (st == GR_OK) st = gr_technique_render(r, scene, s.bytes, img, &stats, &err);
+            for (long q = 0; st == GR_OK && q < repeat; q++) {
+                st = gr_technique_render(r, scene, s.bytes, img, &stats, &err);
+                times[q] = stats.wall_ms * 1e-3;
+                double g = 0;
+                int ok = stats.n_passes > 0;
+                for (int pp = 0; pp < stats.n_passes; pp++) {
+                    if (stats.gpu_ns[pp] < 0) ok = 0;
+                    else g += (double)stats.gpu_ns[pp] * 1e-9;
                 }
-                if (st == GR_OK) {
-                    gr_metrics_options fo = mo;
-                    fo.fit_scale = 1;
-                    fo.stderr_bound = INFINITY;
-                    st = gr_metrics_compute(truth, img, &fo, &m, &err);
-                }
-                if (st != GR_OK) {
-                    free(times);
-                    free(gpus);
-                    goto fail;
-                }
-                qsort(times, (size_t)repeat, sizeof *times, cmp_double);
-                qsort(gpus, (size_t)repeat, sizeof *gpus, cmp_double);
-                gr_pareto_point *p = &pts[n++];
-                p->family = GR_PARETO_SHAFTS;
-                snprintf(p->label, sizeof p->label, "N=%d scale=%g %s", s.N, s.target_scale, fmt ? "rgba16f" : "rgba8");
-                snprintf(p->settings, sizeof p->settings, "N=%d;target_scale=%g;target_format=%s", s.N, s.target_scale,
-                         fmt ? "rgba16f" : "rgba8");
-                p->time_s = times[repeat / 2];
-                p->gpu_s = gpus[repeat / 2];
-                if (p->gpu_s >= 0) gpu_any = 1;
-                p->error = rel_rmse(&m.fit);
-                if (!quiet) fprintf(stderr, "godrays pareto: shafts %s: %.2f ms, error %.4g\n", p->label,
-                                    1e3 * p->time_s, p->error);
+                gpus[q] = ok ? g : -1;
             }
+            if (st == GR_OK) {
+                gr_metrics_options fo = mo;
+                fo.fit_scale = 1;
+                fo.stderr_bound = INFINITY;
+                st = gr_metrics_compute(truth, img, &fo, &m, &err);
+            }
+            if (st != GR_OK) {
+                free(times);
+                free(gpus);
+                goto fail;
+            }
+            qsort(times, (size_t)repeat, sizeof *times, cmp_double);
+            qsort(gpus, (size_t)repeat, sizeof *gpus, cmp_double);
+            gr_pareto_point *p = &pts[n++];
+            p->family = 1 + k;
+            snprintf(p->family_name, sizeof p->family_name, "%s", cls->name);
+            snprintf(p->label, sizeof p->label, "%s %s", cls->name, lvs[0] ? lvs : "(scene's settings)");
+            for (char *c = p->label; *c; c++)
+                if (*c == ',') *c = ' ';
+            snprintf(p->settings, sizeof p->settings, "%s", lvs);
+            for (char *c = p->settings; *c; c++)
+                if (*c == ',') *c = ';';
+            p->time_s = times[repeat / 2];
+            p->gpu_s = gpus[repeat / 2];
+            if (p->gpu_s >= 0) gpu_any = 1;
+            p->error = rel_rmse(&m.fit);
+            if (!quiet) fprintf(stderr, "godrays pareto: %s: %.2f ms, error %.4g\n", p->label, 1e3 * p->time_s, p->error);
+        }
+    }
     free(times);
     free(gpus);
-    const char *glr = gr_gl_renderer(gr_shafts_gl(r));
+    const char *glr = gr_gl_renderer(gl);
     int is_llvmpipe = glr && strstr(glr, "llvmpipe") != NULL;
-    /* What the shafts cost: on a hardware GPU the GL pass timers (a render's wall time there
+    /* What the techniques cost: on a hardware GPU the GL pass timers (a render's wall time there
      * is mostly this harness's synchronous float readback: docs/benchmarks.md); on llvmpipe
      * the wall time (its timers see a deferred rasterizer). */
     int by_gpu = !is_llvmpipe && gpu_any;
     for (int i = 0; i < n; i++)
-        if (pts[i].family == GR_PARETO_SHAFTS) pts[i].cost_s = by_gpu && pts[i].gpu_s >= 0 ? pts[i].gpu_s : pts[i].time_s;
+        if (pts[i].family != GR_PARETO_REFERENCE) pts[i].cost_s = by_gpu && pts[i].gpu_s >= 0 ? pts[i].gpu_s : pts[i].time_s;
     gr_pareto_mark_fronts(pts, n);
 
     char tlabel[128], title[256];
     snprintf(tlabel, sizeof tlabel, "%s", is_llvmpipe ? "llvmpipe wall time" : by_gpu ? "GPU time of the GL passes" : "GPU frame wall time");
-    snprintf(title, sizeof title, "speed vs error, scene '%s' %dx%d (shafts on %s)", scene->name, scene->camera.width,
+    snprintf(title, sizeof title, "speed vs error, scene '%s' %dx%d (real time on %s)", scene->name, scene->camera.width,
              scene->camera.height, is_llvmpipe ? "llvmpipe, no GPU" : glr);
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
     snprintf(path, sizeof path, "%s/pareto.csv", outdir);
@@ -299,17 +330,17 @@ static int pareto_with(gr_args *args)
 
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "scene '%s' (%d x %d); high-quality ground truth %.1f s (%s); shafts on %s\n", scene->name,
+    gr_sb_printf(&sum, "scene '%s' (%d x %d); high-quality ground truth %.1f s (%s); real time on %s\n", scene->name,
            scene->camera.width, scene->camera.height, ti.seconds, ti.cached ? "from the cache" : "rendered", glr);
-    gr_sb_printf(&sum, "%-10s %-34s %12s %12s %12s %6s\n", "family", "setting", "time ms", "GL timers ms", "rel. RMSE Y", "front");
+    gr_sb_printf(&sum, "%-16s %-50s %12s %12s %12s %6s\n", "family", "setting", "time ms", "GL timers ms", "rel. RMSE Y", "front");
     for (int i = 0; i < n; i++) {
         char g[32];
         if (pts[i].gpu_s >= 0) snprintf(g, sizeof g, "%.3f", 1e3 * pts[i].gpu_s);
         else snprintf(g, sizeof g, "n/a");
-        gr_sb_printf(&sum, "%-10s %-34s %12.2f %12s %12.4g %6s\n", pts[i].family ? "shafts" : "reference", pts[i].label,
+        gr_sb_printf(&sum, "%-16s %-50s %12.2f %12s %12.4g %6s\n", pts[i].family_name, pts[i].label,
                1e3 * pts[i].time_s, g, pts[i].error, pts[i].on_front ? "*" : "");
     }
-    gr_sb_printf(&sum, "GL pass timers %s; the shafts are ranked by %s\n", gpu_any ? "available" : "unavailable",
+    gr_sb_printf(&sum, "GL pass timers %s; the real-time techniques are ranked by %s\n", gpu_any ? "available" : "unavailable",
            is_llvmpipe ? "llvmpipe (CPU) wall times" : by_gpu ? "the GPU time of their GL passes" : "wall times on the GPU");
     gr_sb_printf(&sum, "written: %s/pareto.csv%s\n", outdir, drawn ? ", pareto.png" : " (no plot: charts need PLplot)");
     fputs(gr_sb_str(&sum), stdout);
@@ -328,7 +359,8 @@ fail:
 done:
     gr_image_destroy(img);
     gr_image_destroy(truth);
-    gr_shafts_destroy(r);
+    gr_technique_destroy(r);
+    gr_gl_destroy(gl);
     free(pts);
     free(work);
     free(scene);

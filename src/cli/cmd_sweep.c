@@ -1,4 +1,4 @@
-/* godrays sweep SCENE --param shafts.K=0.4:1.2:16 [--param ...]: the shafts' error surface over
+/* godrays sweep SCENE --param NAME.KEY=0.4:1.2:16 [--param ...]: a technique's error surface over
  * a grid of one or two settings against the cached ground truth (src/tune/sweep.h). */
 #include "cli/cli.h"
 #include "cli/args.h"
@@ -19,19 +19,20 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays sweep SCENE --param shafts.KEY=LO:HI:COUNT [--param ...] [options]\n"
+            "usage: godrays sweep SCENE --param TECHNIQUE.KEY=LO:HI:COUNT [--param ...] [options]\n"
             "\n"
-            "Renders the real-time shafts over a grid of one or two settings (COUNT values from LO to\n"
+            "Renders a real-time technique (--technique, else the one the parameters name) over a\n"
+            "grid of one or two of its settings (COUNT values from LO to\n"
             "HI inclusive per axis; the grid is COUNT1 x COUNT2 renders per frame and view), scores\n"
             "each render against the ground truth (rendered once and cached), and writes into DIR:\n"
             "sweep.csv (every point), sweep.json (grid, minimum, timings, snippet), sweep.png (heat\n"
             "map with the minimum marked; a line chart for one axis), reference.png and best.png.\n"
-            "RGB settings (shafts.extinction, shafts.intensity) are swept as a SCALE on the scene's\n"
-            "value (shafts.extinction=1 is the medium's sigma_t). Integer settings (shafts.N) take\n"
-            "integer values; booleans and choices are set with --set. docs/tuning.md.\n"
+            "RGB settings are swept as a SCALE on the scene's value (1 = the scene's own). Integer\n"
+            "settings take integer values; booleans and choices are set with --set. `godrays\n"
+            "techniques` lists every setting. docs/tuning.md.\n"
             "\n"
             "options:\n"
-            "  --param SPEC         a sweep axis shafts.KEY=LO:HI:COUNT (one or two)\n"
+            "  --param SPEC         a sweep axis TECHNIQUE.KEY=LO:HI:COUNT (one or two)\n"
             "%s"
             "  -h, --help           this help\n"
             "\n"
@@ -65,6 +66,7 @@ static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, cons
     cJSON *root = cJSON_CreateObject();
     if (!root) return NULL;
     cJSON_AddStringToObject(root, "scene", s->base->name);
+    cJSON_AddStringToObject(root, "technique", p->cls->name);
     cJSON_AddStringToObject(root, "scene_file", s->base->source_path);
     cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
     cJSON_AddStringToObject(root, "channel", "Y");
@@ -120,7 +122,7 @@ static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, cons
         cJSON_AddNumberToObject(t, "other_s", r->wall_s - p->render_s - p->metrics_s);
         cJSON_AddNumberToObject(t, "ms_per_render", p->renders ? 1e3 * r->wall_s / (double)p->renders : 0.0);
         cJSON_AddNumberToObject(t, "gl_pass_timers_ms", p->gpu_timed ? p->gpu_ms_sum : -1.0);
-        cJSON_AddStringToObject(t, "gl_renderer", gr_gl_renderer(gr_shafts_gl(p->renderer)));
+        cJSON_AddStringToObject(t, "gl_renderer", gr_gl_renderer(gr_technique_gl(p->renderer)));
         cJSON_AddNumberToObject(t, "ground_truth_s", s->truth_seconds);
     }
     char *text = cJSON_Print(root);
@@ -132,13 +134,13 @@ static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, cons
 static gr_status write_images(const char *dir, gr_tune_problem *p, const double *x, gr_error *err)
 {
     char path[4300];
-    gr_shafts_settings s;
-    gr_status st = gr_tune_settings_at(p, x, &s, err);
+    gr_section_store s;
+    gr_status st = gr_tune_settings_at(p, x, s.bytes, err);
     if (st != GR_OK) return st;
     gr_metrics m;
     gr_image *img = gr_image_create(p->scratch->width, p->scratch->height, 3, NULL);
     if (!img) return gr_fail(err, GR_E_NOMEM, "out of memory");
-    st = gr_tune_render_case(p, 0, &s, img, &m, err);
+    st = gr_tune_render_case(p, 0, s.bytes, img, &m, err);
     if (st == GR_OK) {
         double e = gr_report_exposure(p->refs[0], 1.0, 0.99, 0.8);
         static const int rgb[3] = {0, 1, 2};
@@ -164,6 +166,7 @@ static int sweep_with(gr_args *args)
     gr_tune_cli c;
     gr_tune_cli_init(&c);
     gr_tune_param params[2];
+    const char *param_specs[2];
     int n_params = 0, rc = 0, taken = 0;
     gr_error err = {GR_OK, ""};
     for (; args->i < argc && !rc; args->i++) {
@@ -176,12 +179,7 @@ static int sweep_with(gr_args *args)
             const char *v = NULL;
             if ((rc = gr_args_value(args, &v)) != 0) return rc;
             if (n_params >= 2) return gr_cli_usage_error(cmd, "--param %s: at most two axes", v);
-            if (gr_tune_param_parse_sweep("--param", v, &params[n_params], &err) != GR_OK)
-                return gr_cli_report(cmd, &err);
-            for (int k = 0; k < n_params; k++)
-                if (!strcmp(params[k].key, params[n_params].key))
-                    return gr_cli_usage_error(cmd, "--param %s: %s swept twice", v, params[k].key);
-            n_params++;
+            param_specs[n_params++] = v; /* parsed after the loop, once --technique-dir is known */
         } else if ((rc = gr_args_take_common(args, &outopt, &c.so.gl_platform, &taken)) == 0 && !taken) {
             int r = gr_tune_cli_option(&c, argc, argv, &args->i, &err);
             if (r < 0) rc = gr_cli_report(cmd, &err);
@@ -189,7 +187,15 @@ static int sweep_with(gr_args *args)
         }
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
-    if (n_params == 0) return gr_cli_usage_error(cmd, "no --param given (e.g. --param shafts.K=0.4:1.2:16)");
+    if (n_params == 0) return gr_cli_usage_error(cmd, "no --param given (e.g. --param TECHNIQUE.KEY=0.4:1.2:16)");
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    for (int j = 0; j < n_params; j++) {
+        if (gr_tune_param_parse_sweep("--param", param_specs[j], &params[j], &err) != GR_OK)
+            return gr_cli_report(cmd, &err);
+        for (int k = 0; k < j; k++)
+            if (!strcmp(params[k].key, params[j].key))
+                return gr_cli_usage_error(cmd, "--param %s: %s swept twice", param_specs[j], params[k].key);
+    }
     if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
     c.so.scene_path = args->scene_path;
     c.so.sets = gr_args_sets(args);
@@ -213,9 +219,9 @@ static int sweep_with(gr_args *args)
     if (gr_tune_cli_open(&c, params, n_params, &s, p, &err) != GR_OK) goto fail;
     /* every grid value must be a valid setting before the first render */
     for (int k = 0; k < n_params; k++) {
-        gr_shafts_settings t = p->base;
+        gr_section_store t = p->base;
         for (int e = 0; e < 2; e++)
-            if (gr_tune_param_apply(&params[k], &p->base, e ? params[k].hi : params[k].lo, &t, &err) != GR_OK) {
+            if (gr_tune_param_apply(&params[k], p->base.bytes, e ? params[k].hi : params[k].lo, t.bytes, &err) != GR_OK) {
                 err.status = GR_E_USAGE;
                 gr_error_prefix(&err, "--param %s", params[k].key);
                 goto fail;
@@ -249,15 +255,15 @@ static int sweep_with(gr_args *args)
 
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", s.base->name, s.base->camera.width,
-           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+    gr_sb_printf(&sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
+           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
            p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "minimum %.6g at %s = %.6g", r.err[r.best], p->params[0].key, xbest[0]);
     if (n_params > 1) gr_sb_printf(&sum, ", %s = %.6g", p->params[1].key, xbest[1]);
     gr_sb_printf(&sum, " (fitted scale %.4g)\n", r.scale[r.best]);
     gr_sb_printf(&sum, "%lld renders in %.2f s (%.1f ms each: render + readback %.2f s, metrics %.2f s, other %.2f s; %s)\n",
            sw_renders, r.wall_s, sw_renders ? 1e3 * r.wall_s / (double)sw_renders : 0.0, sw_render_s, sw_metrics_s,
-           r.wall_s - sw_render_s - sw_metrics_s, gr_gl_renderer(gr_shafts_gl(p->renderer)));
+           r.wall_s - sw_render_s - sw_metrics_s, gr_gl_renderer(gr_technique_gl(p->renderer)));
     gr_sb_printf(&sum, "ground truth: %.1f s (%s)\n", s.truth_seconds, s.truth[0].cached ? "from the cache" : "rendered");
     gr_sb_printf(&sum, "best settings for the scene:\n%s\n", snippet);
     gr_sb_printf(&sum, "written: %s/sweep.csv, sweep.json, %s, reference.png, best.png\n", outdir,
@@ -269,7 +275,7 @@ static int sweep_with(gr_args *args)
         gr_tune_page_begin(&pg, outdir, "godrays sweep: %s", s.base->name);
         if (drawn) gr_tune_page_figure(&pg, "sweep.png", "error surface; the cross marks the minimum");
         gr_tune_page_figure(&pg, "reference.png", "ground truth (case 0)");
-        gr_tune_page_figure(&pg, "best.png", "shafts at the minimum, x the fitted scale, same exposure");
+        gr_tune_page_figure(&pg, "best.png", "the technique at the minimum, x the fitted scale, same exposure");
         gr_status pst = gr_tune_page_write(&pg, gr_sb_str(&sum), "sweep.csv,sweep.json", outdir, &err);
         gr_sb_free(&sum);
         if (pst != GR_OK) goto fail;

@@ -1,4 +1,4 @@
-/* godrays tune SCENE --params shafts.extinction,shafts.K[,...]: the shafts settings that
+/* godrays tune SCENE --params NAME.KEY,NAME.KEY[,...]: the technique's settings that
  * minimize the error against the ground truth over frames and views, found by bounded
  * Nelder-Mead with restarts (src/tune/optimize.h). */
 #include "cli/cli.h"
@@ -21,21 +21,23 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays tune SCENE --params shafts.KEY[,shafts.KEY...] [options]\n"
+            "usage: godrays tune SCENE --params TECHNIQUE.KEY[,TECHNIQUE.KEY...] [options]\n"
             "\n"
-            "Finds the shafts settings that minimize the error against the ground truth (rendered\n"
+            "Finds the settings of a real-time technique (--technique, else the one the parameters\n"
+            "name) that minimize the error against the ground truth (rendered\n"
             "once per frame and view, cached), averaged over the frames (--frames/--times) and views\n"
             "(--view), with bounded Nelder-Mead restarted from several starting points spread over\n"
             "the bounds (the scene's own settings are the first). Prints the best settings as a\n"
-            "snippet for the scene's \"shafts\" section and the error before and after per frame and\n"
+            "snippet for the technique's scene section and the error before and after per frame and\n"
             "view; writes DIR/tune.json, DIR/trace.csv (every evaluation), DIR/compare.png\n"
             "(reference | before | after) and per-case reference/before/after PNGs.\n"
-            "RGB settings (extinction, intensity) are tuned as a SCALE on the scene's value.\n"
+            "RGB settings are tuned as a SCALE on the scene's value.\n"
             "docs/tuning.md.\n"
             "\n"
             "options:\n"
-            "  --params LIST        comma-separated shafts settings to tune (at most %d)\n"
-            "  --bounds KEY=LO:HI   box of one parameter (repeatable; default: docs/tuning.md table)\n"
+            "  --params LIST        comma-separated TECHNIQUE.KEY settings to tune (at most %d)\n"
+            "  --bounds KEY=LO:HI   box of one parameter (repeatable; default: the setting's tuning box,\n"
+            "                       `godrays techniques`)\n"
             "  --start KEY=V        first starting point of a parameter (repeatable; default: the\n"
             "                       scene's value, clamped into the box)\n"
             "  --starts N           starting points (default 4, at most %d)\n"
@@ -95,9 +97,9 @@ static int parse_count(const char *s, int lo, int hi, int *out)
 static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune_problem *p, const double *xb,
                               const double *xa, gr_error *err)
 {
-    gr_shafts_settings sb, sa;
-    gr_status st = gr_tune_settings_at(p, xb, &sb, err);
-    if (st == GR_OK) st = gr_tune_settings_at(p, xa, &sa, err);
+    gr_section_store sb, sa;
+    gr_status st = gr_tune_settings_at(p, xb, sb.bytes, err);
+    if (st == GR_OK) st = gr_tune_settings_at(p, xa, sa.bytes, err);
     if (st != GR_OK) return st;
     int W = p->scratch->width, H = p->scratch->height;
     gr_image *ib = gr_image_create(W, H, 3, NULL), *ia = gr_image_create(W, H, 3, NULL);
@@ -106,8 +108,8 @@ static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune
     if (!ib || !ia) st = gr_fail(err, GR_E_NOMEM, "out of memory");
     for (int i = 0; st == GR_OK && i < s->n_cases; i++) {
         gr_metrics mb, ma;
-        if ((st = gr_tune_render_case(p, i, &sb, ib, &mb, err)) != GR_OK) break;
-        if ((st = gr_tune_render_case(p, i, &sa, ia, &ma, err)) != GR_OK) break;
+        if ((st = gr_tune_render_case(p, i, sb.bytes, ib, &mb, err)) != GR_OK) break;
+        if ((st = gr_tune_render_case(p, i, sa.bytes, ia, &ma, err)) != GR_OK) break;
         double e = gr_report_exposure(p->refs[i], 1.0, 0.99, 0.8);
         double ab = p->fit ? mb.fit.scale : 1.0, aa = p->fit ? ma.fit.scale : 1.0;
         int rr[3];
@@ -128,14 +130,17 @@ static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune
             snprintf(l0, sizeof l0, "%s (%s): %s of Y%s", s->labels[0], s->base->name, metric,
                      p->fit ? " after the best scale fit" : "");
             snprintf(l1, sizeof l1, "before: %.5g    after: %.5g    (%.1f %% lower)",
-                     gr_tune_metric_value(p->fit ? &mb.fit : &mb.raw, p->metric),
-                     gr_tune_metric_value(p->fit ? &ma.fit : &ma.raw, p->metric),
-                     100.0 * (1.0 - gr_tune_metric_value(p->fit ? &ma.fit : &ma.raw, p->metric) /
-                                        fmax(1e-300, gr_tune_metric_value(p->fit ? &mb.fit : &mb.raw, p->metric))));
-            snprintf(l2, sizeof l2, "shafts shown x their fitted scale (%.3g, %.3g), same exposure as the reference", ab,
-                     aa);
+                     gr_tune_value(p, p->fit ? &mb.fit : &mb.raw),
+                     gr_tune_value(p, p->fit ? &ma.fit : &ma.raw),
+                     100.0 * (1.0 - gr_tune_value(p, p->fit ? &ma.fit : &ma.raw) /
+                                        fmax(1e-300, gr_tune_value(p, p->fit ? &mb.fit : &mb.raw))));
+            snprintf(l2, sizeof l2, "%s shown x its fitted scale (%.3g, %.3g), same exposure as the reference",
+                     p->cls->name, ab, aa);
             const char *lines[3] = {l0, l1, l2};
-            const char *titles[3] = {"ground truth", "shafts before", "shafts after tuning"};
+            char t1[64], t2[80];
+            snprintf(t1, sizeof t1, "%s before", p->cls->name);
+            snprintf(t2, sizeof t2, "%s after tuning", p->cls->name);
+            const char *titles[3] = {"ground truth", t1, t2};
             int labelled = 0;
             const gr_image *panels[3] = {disp[0], disp[1], disp[2]};
             if ((st = gr_report_contact_sheet(panels, titles, lines, 3, 320, 640, &sheet, &labelled, err)) != GR_OK)
@@ -161,7 +166,7 @@ static int tune_with(gr_args *args)
     gr_tune_cli_init(&c);
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
     int n_params = 0, n_starts = 4, max_evals = 0, rc = 0;
-    const char *bounds[32], *starts[32];
+    const char *bounds[32], *starts[32], *params_spec = NULL;
     int n_bounds = 0, n_start_specs = 0;
     gr_error err = {GR_OK, ""};
     for (; args->i < argc; args->i++) {
@@ -174,9 +179,8 @@ static int tune_with(gr_args *args)
             !strcmp(a, "--max-evals")) {
             if ((rc = gr_args_value(args, &v)) != 0) return rc;
             if (!strcmp(a, "--params")) {
-                if (n_params) return gr_cli_usage_error(cmd, "--params given twice");
-                if (gr_tune_param_parse_list(a, v, params, GR_TUNE_MAX_PARAMS, &n_params, &err) != GR_OK)
-                    return gr_cli_report(cmd, &err);
+                if (params_spec) return gr_cli_usage_error(cmd, "--params given twice");
+                params_spec = v; /* parsed after the loop, once --technique-dir is known */
             } else if (!strcmp(a, "--bounds")) {
                 if (n_bounds >= 32) return gr_cli_usage_error(cmd, "--bounds: too many");
                 bounds[n_bounds++] = v;
@@ -201,7 +205,10 @@ static int tune_with(gr_args *args)
         if (rc) return rc;
     }
     if ((rc = gr_args_need_scene(args)) != 0) return rc;
-    if (!n_params) return gr_cli_usage_error(cmd, "no --params given (e.g. --params shafts.extinction,shafts.K)");
+    if (!params_spec) return gr_cli_usage_error(cmd, "no --params given (e.g. --params TECHNIQUE.KEY,TECHNIQUE.KEY)");
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    if (gr_tune_param_parse_list("--params", params_spec, params, GR_TUNE_MAX_PARAMS, &n_params, &err) != GR_OK)
+        return gr_cli_report(cmd, &err);
     for (int b = 0; b < n_bounds; b++)
         if (gr_tune_param_parse_bounds("--bounds", bounds[b], params, n_params, &err) != GR_OK)
             return gr_cli_report(cmd, &err);
@@ -215,7 +222,7 @@ static int tune_with(gr_args *args)
         char key[64];
         double v;
         if (parse_kv(starts[b], key, sizeof key, &v))
-            return gr_cli_usage_error(cmd, "--start %s: expected shafts.KEY=VALUE", starts[b]);
+            return gr_cli_usage_error(cmd, "--start %s: expected TECHNIQUE.KEY=VALUE", starts[b]);
         int idx = -1;
         for (int k = 0; k < n_params; k++)
             if (!strcmp(params[k].key, key)) idx = k;
@@ -248,11 +255,11 @@ static int tune_with(gr_args *args)
     for (int k = 0; k < n_params; k++) {
         lo[k] = params[k].lo;
         hi[k] = params[k].hi;
-        xb[k] = gr_tune_param_current(&params[k], &p->base, &p->base); /* the scene's own value */
+        xb[k] = gr_tune_param_current(&params[k], p->base.bytes, p->base.bytes); /* the scene's own value */
         if (!have_x0[k]) x0[k] = fmin(hi[k], fmax(lo[k], xb[k]));
-        gr_shafts_settings t = p->base;
+        gr_section_store t = p->base;
         for (int e = 0; e < 2; e++)
-            if (gr_tune_param_apply(&params[k], &p->base, e ? hi[k] : lo[k], &t, &err) != GR_OK) {
+            if (gr_tune_param_apply(&params[k], p->base.bytes, e ? hi[k] : lo[k], t.bytes, &err) != GR_OK) {
                 err.status = GR_E_USAGE;
                 gr_error_prefix(&err, "bounds of %s", params[k].key);
                 goto fail;
@@ -303,6 +310,7 @@ static int tune_with(gr_args *args)
     root = cJSON_CreateObject();
     if (root) {
         cJSON_AddStringToObject(root, "scene", s.base->name);
+        cJSON_AddStringToObject(root, "technique", p->cls->name);
         cJSON_AddStringToObject(root, "scene_file", s.base->source_path);
         cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
         cJSON_AddStringToObject(root, "channel", "Y");
@@ -362,7 +370,7 @@ static int tune_with(gr_args *args)
             cJSON_AddNumberToObject(tm, "render_readback_s", p->render_s - render_s0);
             cJSON_AddNumberToObject(tm, "metrics_s", p->metrics_s - metrics_s0);
             cJSON_AddNumberToObject(tm, "ground_truth_s", s.truth_seconds);
-            cJSON_AddStringToObject(tm, "gl_renderer", gr_gl_renderer(gr_shafts_gl(p->renderer)));
+            cJSON_AddStringToObject(tm, "gl_renderer", gr_gl_renderer(gr_technique_gl(p->renderer)));
         }
         json = cJSON_Print(root);
     }
@@ -375,8 +383,8 @@ static int tune_with(gr_args *args)
 
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", s.base->name, s.base->camera.width,
-           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+    gr_sb_printf(&sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
+           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
            p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
     for (int k = 0; k < n_params; k++)
@@ -406,7 +414,7 @@ static int tune_with(gr_args *args)
         gr_strbuf pg;
         gr_sb_init(&pg);
         gr_tune_page_begin(&pg, outdir, "godrays tune: %s", s.base->name);
-        gr_tune_page_figure(&pg, "compare.png", "ground truth | shafts before | shafts after tuning (case 0)");
+        gr_tune_page_figure(&pg, "compare.png", "ground truth | the technique before | after tuning (case 0)");
         for (int i = 1; i < s.n_cases && i < 8; i++) {
             char f[64], cap[128];
             snprintf(f, sizeof f, "after_%02d.png", i);

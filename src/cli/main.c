@@ -1,22 +1,39 @@
 /* godrays: entry point and subcommand dispatch. */
 #include "cli/cli.h"
+#include "common/signals.h"
 
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "realtime/technique.h"
 
 static const gr_command commands[] = {
     {"validate", "load and check a scene, print it normalized with defaults filled in", cmd_validate},
     {"info", "print library versions and the GL renderer of a headless EGL context", cmd_info},
     {"compare", "error metrics between two images (any format), with mask, stderr, scale fit", cmd_compare},
-    {"shafts", "render the god-ray layer with seed 000's real-time shafts (OpenGL) to EXR + PNG", cmd_shafts},
+    {"techniques", "list the real-time techniques and their settings (text or --json)", cmd_techniques},
+    {"render", "render the god-ray layer with a real-time technique (OpenGL) to EXR + PNG", cmd_render},
     {"reference", "render the ground-truth god-ray layer (Embree, single scattering) to EXR + PNG", cmd_reference},
-    {"run", "the main job: ground truth (cached) + real-time shafts + comparison + HTML report", cmd_run},
-    {"tune", "find the shafts settings that minimize the error over frames and views (Nelder-Mead)", cmd_tune},
-    {"sweep", "error surface of the shafts over a grid of one or two settings (CSV, JSON, heat map)", cmd_sweep},
-    {"pareto", "speed against error of both renderers: quality ladders, Pareto fronts, CSV + plot", cmd_pareto},
+    {"run", "the main job: ground truth (cached) + every real-time technique + leaderboard report", cmd_run},
+    {"tune", "find a technique's settings that minimize the error over frames and views (Nelder-Mead)", cmd_tune},
+    {"sweep", "error surface of a technique over a grid of one or two settings (CSV, JSON, heat map)", cmd_sweep},
+    {"pareto", "speed against error of the ground truth and each technique: Pareto fronts, CSV + plot", cmd_pareto},
+    {"export", "the scene for other engines: glTF 2.0 (water, camera, sun, occluders), shader constants", cmd_export},
+    {"merge", "assemble the parts of a ground-truth render (reference --tile) into one EXR, bit for bit", cmd_merge},
+    {"farm", "ground truths of frames and views as a Slurm job array of parts, merged into the cache", cmd_farm},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
+
+/* Aliases: NAME ARGS... runs COMMAND ARG ARGS... */
+static const struct {
+    const char *name, *summary, *command, *arg;
+} aliases[] = {
+    {"shafts", "same as `render shafts` (seed 000's shafts)", "render", "shafts"},
+};
+static const int n_aliases = (int)(sizeof aliases / sizeof aliases[0]);
 
 static void print_help(FILE *f)
 {
@@ -27,6 +44,7 @@ static void print_help(FILE *f)
             "\n"
             "commands:\n");
     for (int i = 0; i < n_commands; i++) fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    for (int i = 0; i < n_aliases; i++) fprintf(f, "  %-10s %s\n", aliases[i].name, aliases[i].summary);
     fprintf(f,
             "\n"
             "Run `godrays COMMAND --help` for a command's options.\n"
@@ -64,8 +82,28 @@ int main(int argc, char **argv)
         printf("godrays 0.1.0\n");
         return 0;
     }
+    /* the built-in techniques (and so their scene sections) before any scene is read */
+    gr_technique_count();
+    gr_signals_install(); /* SIGINT, SIGTERM: temporary files removed, renders stopped cleanly */
     for (int i = 0; i < n_commands; i++)
         if (!strcmp(argv[1], commands[i].name)) return commands[i].run(argc - 1, argv + 1);
+    for (int i = 0; i < n_aliases; i++) {
+        if (strcmp(argv[1], aliases[i].name)) continue;
+        /* "NAME ARGS..." -> "COMMAND ARG ARGS..." */
+        char **av = calloc((size_t)argc + 1, sizeof *av);
+        if (!av) {
+            fprintf(stderr, "godrays: out of memory\n");
+            return 1;
+        }
+        av[0] = (char *)(uintptr_t)aliases[i].command;
+        av[1] = (char *)(uintptr_t)aliases[i].arg;
+        for (int k = 2; k < argc; k++) av[k] = argv[k];
+        int rc = 2;
+        for (int j = 0; j < n_commands; j++)
+            if (!strcmp(aliases[i].command, commands[j].name)) rc = commands[j].run(argc, av);
+        free(av);
+        return rc;
+    }
     fprintf(stderr, "godrays: unknown command '%s' (see godrays --help)\n", argv[1]);
     return 2;
 }

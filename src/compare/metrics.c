@@ -282,7 +282,44 @@ static gr_status compute_set(const ctx *cx, const int rr[3], const int tr[3], do
         if (st != GR_OK) return st;
         set->have_blur = 1;
     }
+    if (cx->opt->flip) {
+        gr_flip_options fo = *cx->opt->flip;
+        fo.scored = cx->scored, fo.test_scale = scale;
+        gr_status st = gr_flip_compute(ref, test, &fo, NULL, &set->flip, err);
+        if (st != GR_OK) return st;
+        set->have_flip = 1;
+    }
     return GR_OK;
+}
+
+double gr_structure_score(const gr_structure_compare *c)
+{
+    if (!c) return 1.0;
+    const double v = (0.5 * (1.0 - c->bandpass_corr) + fmin(c->contrast_log_err, 3.0) / 3.0 +
+                      fmin(c->spectrum_log_dist, 3.0) / 3.0) / 3.0;
+    return isfinite(v) ? v : 1.0;
+}
+
+/* The structure comparison (scale-invariant: computed once, copied into each set). */
+static gr_status structure_fill(const ctx *cx, gr_metrics *out, gr_error *err)
+{
+    gr_structure_options so = *cx->opt->structure;
+    so.scored = cx->scored;
+    gr_structure_compare *c = malloc(sizeof *c);
+    if (!c) return gr_fail(err, GR_E_NOMEM, "metrics: out of memory");
+    gr_status st = gr_structure_compare_images(cx->ref, cx->test, &so, c, err);
+    if (st == GR_OK) {
+        gr_metrics_set *sets[2] = {&out->raw, &out->fit};
+        for (int k = 0; k < (out->have_fit ? 2 : 1); k++) {
+            sets[k]->have_structure = 1;
+            sets[k]->structure_corr = c->bandpass_corr;
+            sets[k]->structure_contrast_err = c->contrast_log_err;
+            sets[k]->structure_lsd = c->spectrum_log_dist;
+            sets[k]->structure_score = gr_structure_score(c);
+        }
+    }
+    free(c);
+    return st;
 }
 
 /* Reference stderr channels, or -1s. */
@@ -459,6 +496,7 @@ gr_status gr_metrics_compute(const gr_image *ref, const gr_image *test, const gr
         out->fit_defined = tt_dot > 0.0;
         st = compute_set(&cx, rr, tr, tt_dot > 0.0 ? tr_dot / tt_dot : 1.0, &out->fit, err);
     }
+    if (st == GR_OK && opt->structure) st = structure_fill(&cx, out, err);
     free(scored);
     return st;
 }

@@ -8,6 +8,8 @@
 #define GR_METRICS_H
 
 #include "common/status.h"
+#include "compare/flip.h"
+#include "compare/structure.h"
 #include "image/image.h"
 
 /* Rows of the result. GR_MCH_RGB pools the three channels' values (3 N samples): its MAE,
@@ -62,6 +64,14 @@ typedef struct gr_metrics_set {
     gr_channel_metrics ch[GR_MCH_COUNT];
     double ssim_y;                /* mean SSIM of luminance over scored pixels (1 if none) */
     int have_ssim, have_blur;     /* 0 when skipped through the options */
+    int have_flip;                /* options.flip given: */
+    gr_flip_result flip;          /* FLIP of scale * TEST, pooled over the scored pixels */
+    int have_structure;           /* options.structure given: (scale-invariant: the same in both sets) */
+    double structure_corr;        /* band-pass correlation (compare/structure.h) */
+    double structure_contrast_err;/* |ln(streak contrast ratio)| */
+    double structure_lsd;         /* log-spectral distance */
+    double structure_score;       /* ((1 - corr) / 2 + min(contrast_err, 3) / 3 + min(lsd, 3) / 3) / 3,
+                                     in [0, 1], 0 = the truth's structure (docs/metrics.md) */
 } gr_metrics_set;
 
 typedef struct gr_metrics {
@@ -93,6 +103,10 @@ typedef struct gr_metrics_options {
     int skip_blur;                /* leave the multi-scale RMSE out */
     int stderr_dof;               /* degrees of freedom of REF's stderr (batches - 1; the reference
                                      writes godrays:stderr_dof): z = Student t975; 0: z = 2 */
+    const gr_flip_options *flip;  /* also FLIP with these options (scored and test_scale are
+                                     set here); NULL: no FLIP */
+    const gr_structure_options *structure; /* also the structure comparison (scored is set
+                                     here; vanishing point required); NULL: none */
 } gr_metrics_options;
 
 /* The channels compared in img: "R","G","B" by name; else the first three channels; a 1- or
@@ -115,6 +129,9 @@ gr_status gr_metrics_compute(const gr_image *ref, const gr_image *test, const gr
 gr_status gr_metrics_scored_pixels(const gr_image *ref, const gr_image *mask, double stderr_bound,
                                    unsigned char *scored, long long *n_masked_out, long long *n_stderr_excluded,
                                    gr_error *err);
+
+/* The structure score of a comparison (see gr_metrics_set.structure_score). */
+double gr_structure_score(const gr_structure_compare *c);
 
 /* Short name of a row: "R", "G", "B", "RGB", "Y". */
 const char *gr_metric_channel_name(gr_metric_channel ch);

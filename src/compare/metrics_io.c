@@ -53,6 +53,17 @@ static cJSON *set_json(const gr_metrics *m, const gr_metrics_set *s)
              (s->have_ssim ? add_num(o, "ssim_y", s->ssim_y) : cJSON_AddNullToObject(o, "ssim_y") != NULL);
     cJSON *chs = ok ? cJSON_AddObjectToObject(o, "channels") : NULL;
     ok = ok && chs;
+    if (ok && s->have_flip) {
+        cJSON *fj = gr_flip_to_json(&s->flip, s->scale);
+        ok = fj && cJSON_AddItemToObject(o, "flip", fj);
+        if (!ok) cJSON_Delete(fj);
+    }
+    if (ok && s->have_structure) {
+        cJSON *sj = cJSON_AddObjectToObject(o, "structure");
+        ok = sj && add_num(sj, "score", s->structure_score) && add_num(sj, "bandpass_correlation", s->structure_corr) &&
+             add_num(sj, "contrast_log_error", s->structure_contrast_err) &&
+             add_num(sj, "log_spectral_distance", s->structure_lsd);
+    }
     for (int c = 0; ok && c < GR_MCH_COUNT; c++) {
         cJSON *cj = channel_json(&s->ch[c], m->have_stderr, s->have_blur);
         ok = cj && cJSON_AddItemToObject(chs, gr_metric_channel_name((gr_metric_channel)c), cj);
@@ -215,4 +226,102 @@ void gr_metrics_print_table(FILE *f, const gr_metrics *m)
         else fprintf(f, "\nbest scale fit undefined (the test image is zero over the scored pixels): scale 1\n");
         if (m->fit_defined) print_set(f, m, &m->fit);
     }
+}
+
+cJSON *gr_flip_to_json(const gr_flip_result *r, double scale)
+{
+    if (!r) return NULL;
+    cJSON *o = cJSON_CreateObject();
+    if (!o) return NULL;
+    int ok = cJSON_AddStringToObject(o, "mode", gr_flip_mode_name(r->mode)) && add_num(o, "pixels_per_degree", r->ppd) &&
+             add_num(o, "test_scale", scale) && add_num(o, "pooled_pixels", (double)r->n_pooled) &&
+             add_num(o, "mean", r->mean) && add_num(o, "min", r->min) && add_num(o, "max", r->max) &&
+             add_num(o, "q1", r->q1) && add_num(o, "median", r->median) && add_num(o, "q3", r->q3);
+    if (ok && r->mode == GR_FLIP_HDR) {
+        cJSON *e = cJSON_AddObjectToObject(o, "exposures");
+        ok = e && cJSON_AddStringToObject(o, "tone_mapper", gr_flip_tonemapper_name(r->tonemapper)) &&
+             add_num(e, "start", r->start_exposure) && add_num(e, "stop", r->stop_exposure) &&
+             add_num(e, "count", r->n_exposures);
+    }
+    if (!ok) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
+}
+
+void gr_flip_print(FILE *f, const char *label, const gr_flip_result *r, double scale)
+{
+    if (!f || !r) return;
+    fprintf(f, "  %-24s mean %.6f  median %.6f  q1 %.6f  q3 %.6f  min %.6f  max %.6f\n", label, r->mean, r->median,
+            r->q1, r->q3, r->min, r->max);
+    fprintf(f, "  %-24s %s-FLIP, %.4g px/degree, test x %.6g", "", r->mode == GR_FLIP_HDR ? "HDR" : "LDR", r->ppd, scale);
+    if (r->mode == GR_FLIP_HDR)
+        fprintf(f, ", %s, exposures %.4f .. %.4f (%d)", gr_flip_tonemapper_name(r->tonemapper), r->start_exposure,
+                r->stop_exposure, r->n_exposures);
+    fprintf(f, ", %lld pixels pooled\n", r->n_pooled);
+}
+
+static cJSON *structure_image_json(const gr_structure_image *s)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o) return NULL;
+    cJSON *an = cJSON_AddArrayToObject(o, "annuli");
+    int ok = an && add_num(o, "mean_luminance", s->mean_y) && add_num(o, "streak_contrast", s->streak_contrast) &&
+             add_num(o, "angular_power", s->angular_power) && add_num(o, "peak_m", s->peak_m) &&
+             add_num(o, "usable_annuli", s->n_usable);
+    for (int a = 0; ok && a < s->n_annuli; a++) {
+        cJSON *one = cJSON_CreateObject();
+        ok = one && cJSON_AddItemToArray(an, one);
+        cJSON *sp = ok ? cJSON_AddArrayToObject(one, "spectrum") : NULL;
+        ok = ok && sp && add_num(one, "r0_px", s->r0[a]) && add_num(one, "r1_px", s->r1[a]) &&
+             add_num(one, "arc_deg", s->arc_deg[a]);
+        for (int m = 0; ok && m <= s->m_max; m++) {
+            cJSON *v = cJSON_CreateNumber(s->spectrum[a][m]);
+            ok = v && cJSON_AddItemToArray(sp, v);
+        }
+    }
+    if (!ok) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
+}
+
+cJSON *gr_structure_to_json(const gr_structure_compare *c, double vp_x, double vp_y)
+{
+    if (!c) return NULL;
+    cJSON *o = cJSON_CreateObject();
+    if (!o) return NULL;
+    cJSON *vp = cJSON_AddObjectToObject(o, "vanishing_point");
+    int ok = vp && add_num(vp, "x", vp_x) && add_num(vp, "y", vp_y) &&
+             add_num(o, "bandpass_correlation", c->bandpass_corr) && add_num(o, "contrast_ratio", c->contrast_ratio) &&
+             add_num(o, "contrast_log_error", c->contrast_log_err) &&
+             add_num(o, "log_spectral_distance", c->spectrum_log_dist) && add_num(o, "power_ratio", c->power_ratio) &&
+             cJSON_AddStringToObject(o, "spectrum", "P[m] = 2 |sum w f e^(-i m theta)|^2 / (sum w)^2, m cycles per turn; "
+                                                    "docs/metrics.md, Beam structure") != NULL;
+    cJSON *r = ok ? structure_image_json(&c->ref) : NULL;
+    ok = ok && r && cJSON_AddItemToObject(o, "reference", r);
+    if (!ok) cJSON_Delete(r), r = NULL;
+    cJSON *t = ok ? structure_image_json(&c->test) : NULL;
+    ok = ok && t && cJSON_AddItemToObject(o, "test", t);
+    if (!ok) {
+        if (!r) cJSON_Delete(t);
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
+}
+
+void gr_structure_print(FILE *f, const gr_structure_compare *c, double vp_x, double vp_y)
+{
+    if (!f || !c) return;
+    fprintf(f, "  beam structure around the vanishing point (%.1f, %.1f), luminance over its ring mean:\n", vp_x, vp_y);
+    fprintf(f, "  %-24s %11s %11s\n", "", "ref", "test");
+    fprintf(f, "  %-24s %11.5f %11.5f   |ln ratio| %.4f\n", "streak contrast", c->ref.streak_contrast,
+            c->test.streak_contrast, c->contrast_log_err);
+    fprintf(f, "  %-24s %11.5g %11.5g   usable annuli %d / %d\n", "angular power", c->ref.angular_power,
+            c->test.angular_power, c->ref.n_usable, c->test.n_usable);
+    fprintf(f, "  %-24s %11d %11d\n", "peak m (per 360 deg)", c->ref.peak_m, c->test.peak_m);
+    fprintf(f, "  band-pass correlation %.4f   log-spectral distance %.4f\n", c->bandpass_corr, c->spectrum_log_dist);
 }

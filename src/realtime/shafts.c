@@ -23,6 +23,70 @@
 
 const char *const gr_shafts_pass_names[GR_SHAFTS_NPASS] = {"shadow", "shafts", "final"};
 
+/* ---- the scene section "shafts" ------------------------------------------------------
+ * One row per field: key, type, range, default, unit, doc. docs/scene-format.md lists the
+ * same rows (tests/unit/test_scene_doc.c checks that every key is documented there). */
+#define LO_X GR_PF_MIN_EXCL
+#define HI_X GR_PF_MAX_EXCL
+#define FROM GR_PF_FROM_SCENE
+static const char *const target_format_names[] = {"rgba8", "rgba16f", NULL};
+
+#define SH(field) offsetof(gr_shafts_settings, field)
+static const gr_param shafts_params[] = {
+    {.name = "N", .type = GR_PT_INT, .offset = SH(N), .min = 2, .max = 1024, .def = 11, .unit = "",
+     .doc = "grid vertices along each side of the shaft grid (seed eq. 5.5.6); (N-1)^2 shafts"},
+    {.name = "K", .type = GR_PT_DOUBLE, .offset = SH(K), .min = 0, .max = 10, .flags = LO_X,
+     .def = 0.8, .unit = "", .doc = "spacing adjustment factor K of seed eq. 5.5.6",
+     .tune_lo = 0.2, .tune_hi = 2.0},
+    {.name = "shaft_length_m", .type = GR_PT_DOUBLE, .offset = SH(shaft_length_m), .min = 0,
+     .max = 10000, .flags = LO_X, .def = 30, .unit = "m",
+     .doc = "extrusion length of the bottom vertices along the refracted sun ray",
+     .tune_lo = 5.0, .tune_hi = 100.0},
+    {.name = "shaft_width", .type = GR_PT_DOUBLE, .offset = SH(shaft_width), .min = 0, .max = 1,
+     .flags = LO_X, .def = 1.0, .unit = "", .doc = "shaft width as a fraction of the grid cell",
+     .tune_lo = 0.1, .tune_hi = 1.0},
+    {.name = "caps", .type = GR_PT_BOOL, .offset = SH(caps), .min = 0, .max = 1, .def = 1, .unit = "",
+     .doc = "draw the top and bottom faces of each parallelepiped"},
+    {.name = "target_scale", .type = GR_PT_DOUBLE, .offset = SH(target_scale), .min = 0, .max = 1,
+     .flags = LO_X, .def = 0.5, .unit = "",
+     .doc = "shaft render target size / frame size, per axis (0.5 = a quarter of the area)",
+     .tune_lo = 0.125, .tune_hi = 1.0},
+    {.name = "target_format", .type = GR_PT_ENUM, .offset = SH(target_format), .min = 0, .max = 1,
+     .def = GR_TARGET_RGBA8, .enum_names = target_format_names, .unit = "",
+     .doc = "shaft render target format (the seed uses 8 bits per channel)"},
+    {.name = "extinction", .type = GR_PT_RGB, .offset = SH(extinction), .min = 0, .max = 10000,
+     .flags = FROM, .def = NAN, .unit = "1/m", .scene_source = "medium.extinction",
+     .doc = "extinction c of seed eq. 5.5.3; default: the medium's sigma_t",
+     .tune_lo = 0.1, .tune_hi = 4.0},
+    {.name = "g", .type = GR_PT_DOUBLE, .offset = SH(g), .min = -1, .max = 1,
+     .flags = LO_X | HI_X | FROM, .def = NAN, .unit = "", .scene_source = "medium.g",
+     .doc = "HG eccentricity of the final pass (seed eq. 5.5.4); default: the medium's g",
+     .tune_lo = 0.0, .tune_hi = 0.99},
+    {.name = "bias", .type = GR_PT_DOUBLE, .offset = SH(bias), .min = 0, .max = 10, .def = 0.15,
+     .unit = "", .doc = "constant added to the shaft intensity before the phase (seed, second pass)",
+     .tune_lo = 0.0, .tune_hi = 1.0},
+    {.name = "intensity", .type = GR_PT_RGB, .offset = SH(intensity), .min = 0, .max = 1e6, .def = 1,
+     .unit = "", .doc = "user factor on the shaft intensity in the second pass",
+     .tune_lo = 0.05, .tune_hi = 20.0},
+    {.name = "shadow_map_size", .type = GR_PT_INT, .offset = SH(shadow_map_size), .min = 16,
+     .max = 16384, .def = 1024, .unit = "texels", .doc = "shadow map resolution per side"},
+    {.name = "shadow_bias", .type = GR_PT_DOUBLE, .offset = SH(shadow_bias), .min = 0, .max = 100,
+     .def = 0.05, .unit = "m", .doc = "depth bias of the shadow comparison",
+     .tune_lo = 0.0, .tune_hi = 1.0},
+};
+#undef SH
+
+const gr_param_table gr_shafts_param_table = {
+    "shafts", shafts_params, sizeof shafts_params / sizeof shafts_params[0]};
+#undef LO_X
+#undef HI_X
+#undef FROM
+
+const gr_shafts_settings *gr_shafts_scene_settings(const gr_scene *scene)
+{
+    return gr_technique_scene_settings(&gr_shafts_class, scene);
+}
+
 /* Uniform locations of a program built from shafts.vert.glsl (shaft pass and capture). */
 typedef struct shaft_locs {
     GLint origin, spacing, width, length, extinction, sun_dir, eta, r0;
@@ -31,6 +95,7 @@ typedef struct shaft_locs {
 
 struct gr_shafts {
     gr_gl *gl;
+    int owns_gl;     /* 1: made by gr_shafts_create, destroyed with the renderer */
     char *shader_dir;
     int from_dir;
     GLuint prog_shadow, prog_shafts, prog_final, prog_capture;
@@ -190,41 +255,69 @@ static int has_extension(const char *name)
     return 0;
 }
 
+/* Programs, buffers and queries in r->gl (current). */
+static gr_status setup_gl(gr_shafts *r, gr_error *err);
+
 gr_status gr_shafts_create(const gr_shafts_options *opts, gr_shafts **out, gr_error *err)
 {
     gr_shafts_options defaults;
     gr_status st;
+    gr_gl *gl = NULL;
     *out = NULL;
     if (!opts) {
         memset(&defaults, 0, sizeof defaults);
         opts = &defaults;
     }
     if ((st = gr_shader_check_dir(opts->shader_dir, err)) != GR_OK) return st;
+    if ((st = gr_gl_create(&opts->gl, &gl, err)) != GR_OK) return st;
+    if ((st = gr_shafts_create_in(gl, opts->shader_dir, out, err)) != GR_OK) {
+        gr_gl_destroy(gl);
+        return st;
+    }
+    (*out)->owns_gl = 1;
+    return GR_OK;
+}
+
+gr_status gr_shafts_create_in(gr_gl *gl, const char *shader_dir, gr_shafts **out, gr_error *err)
+{
+    gr_status st;
+    *out = NULL;
+    if ((st = gr_shader_check_dir(shader_dir, err)) != GR_OK) return st;
     gr_shafts *r = calloc(1, sizeof *r);
     if (!r) return gr_fail(err, GR_E_NOMEM, "shafts renderer: out of memory");
-    if (opts->shader_dir) {
-        size_t n = strlen(opts->shader_dir) + 1;
+    if (shader_dir) {
+        size_t n = strlen(shader_dir) + 1;
         r->shader_dir = malloc(n);
         if (!r->shader_dir) {
             free(r);
             return gr_fail(err, GR_E_NOMEM, "shafts renderer: out of memory");
         }
-        memcpy(r->shader_dir, opts->shader_dir, n);
+        memcpy(r->shader_dir, shader_dir, n);
     }
-    if ((st = gr_gl_create(&opts->gl, &r->gl, err)) != GR_OK) goto fail;
+    r->gl = gl;
+    if ((st = setup_gl(r, err)) != GR_OK) {
+        gr_shafts_destroy(r);
+        return st;
+    }
+    *out = r;
+    return GR_OK;
+}
 
+static gr_status setup_gl(gr_shafts *r, gr_error *err)
+{
+    gr_status st;
     int nd = 0;
     if ((st = gr_shader_program(r->shader_dir, "shafts_shadow.vert.glsl", "shafts_shadow.frag.glsl", NULL, 0,
                                 &r->prog_shadow, &nd, err)) != GR_OK)
-        goto fail;
+        return st;
     r->from_dir += nd;
     if ((st = gr_shader_program(r->shader_dir, "shafts.vert.glsl", "shafts.frag.glsl", NULL, 0,
                                 &r->prog_shafts, &nd, err)) != GR_OK)
-        goto fail;
+        return st;
     r->from_dir += nd;
     if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_final.frag.glsl", NULL, 0,
                                 &r->prog_final, &nd, err)) != GR_OK)
-        goto fail;
+        return st;
     r->from_dir += nd;
 
     r->loc_light_vp = glGetUniformLocation(r->prog_shadow, "u_light_view_proj");
@@ -255,12 +348,7 @@ gr_status gr_shafts_create(const gr_shafts_options *opts, gr_shafts **out, gr_er
         glGenQueries(1, &r->q_vs);
         glGenQueries(1, &r->q_fs);
     }
-    if ((st = gr_gl_check("shafts renderer setup", err)) != GR_OK) goto fail;
-    *out = r;
-    return GR_OK;
-fail:
-    gr_shafts_destroy(r);
-    return st;
+    return gr_gl_check("shafts renderer setup", err);
 }
 
 static void delete_tex_fbo(GLuint *tex, GLuint *fbo)
@@ -292,7 +380,7 @@ void gr_shafts_destroy(gr_shafts *r)
         delete_tex_fbo(&r->shadow_tex, &r->shadow_fbo);
         delete_tex_fbo(&r->target_tex, &r->target_fbo);
         delete_tex_fbo(&r->frame_tex, &r->frame_fbo);
-        gr_gl_destroy(r->gl);
+        if (r->owns_gl) gr_gl_destroy(r->gl);
     }
     free(r->grid_cpu);
     free(r->occ_cpu);
@@ -445,7 +533,7 @@ static gr_status ensure_targets(gr_shafts *r, const frame_setup *f, gr_error *er
 static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in, frame_setup *f, gr_error *err)
 {
     memset(f, 0, sizeof *f);
-    gr_shafts_resolve(scene, in ? in : &scene->shafts, &f->s);
+    gr_shafts_resolve(scene, in ? in : gr_shafts_scene_settings(scene), &f->s);
     gr_status st = gr_shafts_check_settings(&f->s, err);
     if (st != GR_OK) return st;
     const gr_shafts_settings *s = &f->s;
@@ -928,10 +1016,11 @@ gr_status gr_shafts_metadata(const gr_shafts *r, const gr_scene *scene, const gr
     gr_shafts_settings rs;
     char key[64], val[256];
     gr_status st = GR_OK;
-    gr_shafts_resolve(scene, s ? s : &scene->shafts, &rs);
+    gr_shafts_resolve(scene, s ? s : gr_shafts_scene_settings(scene), &rs);
 #define CK(call) do { if ((st = (call)) != GR_OK) goto fail; } while (0)
     CK(gr_meta_set_string(meta, "godrays:renderer", "shafts"));
-    CK(gr_meta_set_string(meta, "godrays:technique", "seed 000: Lanza, underwater god rays as extruded shafts"));
+    CK(gr_meta_set_string(meta, "godrays:technique", "shafts"));
+    CK(gr_meta_set_string(meta, "godrays:technique_description", gr_shafts_class.description));
     CK(gr_meta_set_string(meta, "godrays:gl_renderer", gr_gl_renderer(r->gl)));
     CK(gr_meta_set_string(meta, "godrays:gl_version", gr_gl_version(r->gl)));
     CK(gr_meta_set_string(meta, "godrays:gl_platform", gr_gl_platform_name(r->gl)));
@@ -989,3 +1078,136 @@ gr_status gr_shafts_metadata(const gr_shafts *r, const gr_scene *scene, const gr
 fail:
     return gr_fail(err, st, "shafts metadata: cannot add an entry (%s)", gr_status_name(st));
 }
+
+/* ---- the technique class (technique.h) ----------------------------------------------- */
+
+typedef struct shafts_tech {
+    gr_shafts *r;
+    gr_shafts_stats last; /* the renderer's own figures of the last render */
+} shafts_tech;
+
+static gr_status tech_check(const gr_technique_class *cls, const void *settings, gr_error *err)
+{
+    return gr_shafts_check_settings(settings, err);
+}
+
+static void tech_resolve(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out)
+{
+    gr_shafts_resolve(scene, in, out);
+}
+
+static gr_status tech_create(const gr_technique_class *cls, gr_gl *gl, const gr_technique_options *opts,
+                             void **state, gr_error *err)
+{
+    *state = NULL;
+    shafts_tech *t = calloc(1, sizeof *t);
+    if (!t) return gr_fail(err, GR_E_NOMEM, "shafts renderer: out of memory");
+    gr_status st = gr_shafts_create_in(gl, opts ? opts->shader_dir : NULL, &t->r, err);
+    if (st != GR_OK) {
+        free(t);
+        return st;
+    }
+    *state = t;
+    return GR_OK;
+}
+
+static void tech_destroy(void *state)
+{
+    shafts_tech *t = state;
+    if (!t) return;
+    gr_shafts_destroy(t->r);
+    free(t);
+}
+
+static gr_status tech_render(void *state, const gr_scene *scene, const void *settings, gr_image *out,
+                             gr_technique_stats *stats, gr_error *err)
+{
+    shafts_tech *t = state;
+    gr_status st = gr_shafts_render(t->r, scene, settings, out, &t->last, err);
+    if (st != GR_OK || !stats) return st;
+    stats->n_passes = GR_SHAFTS_NPASS;
+    for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
+        snprintf(stats->pass_names[p], sizeof stats->pass_names[p], "%s", gr_shafts_pass_names[p]);
+        stats->gpu_ns[p] = t->last.gpu_ns[p];
+    }
+    stats->wall_ms = t->last.cpu_ms;
+    stats->fragments = t->last.fragments;
+    return GR_OK;
+}
+
+/* The renderer's own figures of the last render, with the (possibly median) timings given. */
+static gr_shafts_stats last_with(const shafts_tech *t, const gr_technique_stats *stats)
+{
+    gr_shafts_stats s = t->last;
+    if (stats) {
+        for (int p = 0; p < GR_SHAFTS_NPASS && p < stats->n_passes; p++) s.gpu_ns[p] = stats->gpu_ns[p];
+        s.cpu_ms = stats->wall_ms;
+    }
+    return s;
+}
+
+static gr_status tech_metadata(void *state, const gr_scene *scene, const void *settings,
+                               const gr_technique_stats *stats, gr_metadata *meta, gr_error *err)
+{
+    shafts_tech *t = state;
+    gr_shafts_stats s = last_with(t, stats);
+    return gr_shafts_metadata(t->r, scene, settings, stats ? &s : NULL, meta, err);
+}
+
+static void tech_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)
+{
+    const shafts_tech *t = state;
+    gr_shafts_stats s = last_with(t, stats);
+    double tpx = (double)s.target_width * (double)s.target_height;
+    snprintf(buf, n, "%d shafts, target %dx%d (%s), fragments blended %lld (overdraw %.2f), vertices %lld "
+             "(VS invocations %lld)", s.n_shafts, s.target_width, s.target_height,
+             t->r->target_fmt == GR_TARGET_RGBA16F ? "rgba16f" : "rgba8", s.fragments,
+             tpx > 0 ? (double)s.fragments / tpx : 0.0, s.vertices_submitted, s.vs_invocations);
+}
+
+static gr_status tech_read_target(void *state, gr_image **out, gr_error *err)
+{
+    shafts_tech *t = state;
+    return gr_shafts_read_target(t->r, out, err);
+}
+
+/* `godrays pareto`: shaft counts, target sizes and formats that trade speed for quality. */
+static const gr_technique_level shafts_ladder[] = {
+    {"N=6,target_scale=0.25,target_format=rgba8", 0},
+    {"N=6,target_scale=0.25,target_format=rgba16f", 0},
+    {"N=6,target_scale=0.5,target_format=rgba8", 1},
+    {"N=6,target_scale=0.5,target_format=rgba16f", 1},
+    {"N=6,target_scale=1,target_format=rgba8", 1},
+    {"N=6,target_scale=1,target_format=rgba16f", 1},
+    {"N=11,target_scale=0.25,target_format=rgba8", 0},
+    {"N=11,target_scale=0.25,target_format=rgba16f", 0},
+    {"N=11,target_scale=0.5,target_format=rgba8", 1},
+    {"N=11,target_scale=0.5,target_format=rgba16f", 1},
+    {"N=11,target_scale=1,target_format=rgba8", 1},
+    {"N=11,target_scale=1,target_format=rgba16f", 1},
+    {"N=21,target_scale=0.25,target_format=rgba8", 0},
+    {"N=21,target_scale=0.25,target_format=rgba16f", 0},
+    {"N=21,target_scale=0.5,target_format=rgba8", 0},
+    {"N=21,target_scale=0.5,target_format=rgba16f", 0},
+    {"N=21,target_scale=1,target_format=rgba8", 0},
+    {"N=21,target_scale=1,target_format=rgba16f", 0},
+};
+
+const gr_technique_class gr_shafts_class = {
+    .name = "shafts",
+    .description = "seed 000 (Lanza, ShaderX^5 5.5): extruded light shafts under the waves, blended into a reduced target",
+    .params = &gr_shafts_param_table,
+    .settings_size = sizeof(gr_shafts_settings),
+    .origin = "built-in",
+    .gain_key = "intensity", /* final pass: (bias + shafts) x intensity x phase (seed, second pass) */
+    .ladder = shafts_ladder,
+    .n_ladder = (int)(sizeof shafts_ladder / sizeof shafts_ladder[0]),
+    .check = tech_check,
+    .resolve = tech_resolve,
+    .create = tech_create,
+    .destroy = tech_destroy,
+    .render = tech_render,
+    .metadata = tech_metadata,
+    .summary = tech_summary,
+    .read_target = tech_read_target,
+};

@@ -13,7 +13,37 @@
 #include "common/status.h"
 #include "gl/glctx.h"
 #include "image/image.h"
+#include "realtime/technique.h"
+#include "scene/params.h"
 #include "scene/scene.h"
+
+/* The shafts as a technique of the harness (technique.h): name and scene section "shafts". */
+extern const gr_technique_class gr_shafts_class;
+
+/* The scene section "shafts": settings and their descriptor table (shafts.c). */
+typedef enum gr_target_format { GR_TARGET_RGBA8 = 0, GR_TARGET_RGBA16F = 1 } gr_target_format;
+
+/* Real-time shafts (seed 000), every undocumented choice exposed. */
+typedef struct gr_shafts_settings {
+    int N;                        /* grid vertices along each side (seed eq. 5.5.6) */
+    double K;                     /* spacing adjustment factor (eq. 5.5.6), ~0.8 */
+    double shaft_length_m;        /* extrusion length of bottom vertices (seed: e.g. 30 m) */
+    double shaft_width;           /* shaft width as a fraction of the grid cell */
+    int caps;                     /* draw top/bottom faces of each parallelepiped */
+    double target_scale;          /* shaft target size / frame size, per axis (0.5 = quarter area) */
+    int target_format;            /* gr_target_format */
+    double extinction[3];         /* c in eq. 5.5.3 (1/m); default: the medium's sigma_t */
+    double g;                     /* HG eccentricity in the final pass; default: the medium's g */
+    double bias;                  /* the 0.15 added before the phase (seed, second pass) */
+    double intensity[3];          /* user factor in the second pass */
+    int shadow_map_size;          /* shadow map resolution (texels per side) */
+    double shadow_bias;           /* depth bias of the shadow comparison (m) */
+} gr_shafts_settings;
+
+extern const gr_param_table gr_shafts_param_table;
+
+/* The scene's shafts section (resolved by the loader). */
+const gr_shafts_settings *gr_shafts_scene_settings(const gr_scene *scene);
 
 typedef struct gr_shafts gr_shafts; /* opaque; used from the thread that created it */
 
@@ -51,6 +81,9 @@ typedef struct gr_shafts_vertex {
 /* Creates the GL context, compiles every program (a compile or link failure is GR_E_GL
  * with the GLSL log; a bad --shader-dir is GR_E_INPUT). opts may be NULL. */
 gr_status gr_shafts_create(const gr_shafts_options *opts, gr_shafts **out, gr_error *err);
+/* The same in an existing context gl (current on this thread), which outlives the renderer
+ * (what the technique class uses). */
+gr_status gr_shafts_create_in(gr_gl *gl, const char *shader_dir, gr_shafts **out, gr_error *err);
 void gr_shafts_destroy(gr_shafts *r); /* accepts NULL */
 const gr_gl *gr_shafts_gl(const gr_shafts *r);
 /* Number of the renderer's shader files that came from --shader-dir. */

@@ -21,11 +21,12 @@
 #include "image/image.h"
 #include "scene/params.h"
 #include "scene/scene.h"
+#include "scene/sections.h"
 
 #define GR_TECH_NAME_MAX 32        /* names: [a-z][a-z0-9_]*, at most 31 characters */
 #define GR_TECH_MAX_PASSES 8       /* GL passes reported per render */
-#define GR_TECH_SETTINGS_MAX 1024  /* bytes of one technique's settings struct, at most */
-#define GR_TECH_MAX 32             /* techniques in one registry (built-in + user) */
+#define GR_TECH_SETTINGS_MAX GR_SCENE_SECTION_BYTES /* bytes of one settings struct (1024), at most */
+#define GR_TECH_MAX GR_SCENE_MAX_SECTIONS           /* techniques in one registry (32, built-in + user) */
 
 /* What one render cost. Filled by the technique; -1 where a figure is unavailable. */
 typedef struct gr_technique_stats {
@@ -43,6 +44,13 @@ typedef struct gr_technique_options {
 
 typedef struct gr_technique_class gr_technique_class;
 
+/* One point of a technique's speed/quality ladder for `godrays pareto`: settings changed from
+ * the scene's, as "KEY=VALUE,KEY=VALUE" (numbers, true/false, choice names). */
+typedef struct gr_technique_level {
+    const char *settings;
+    int quick;            /* 1: also in `godrays pareto --quick` */
+} gr_technique_level;
+
 struct gr_technique_class {
     const char *name;          /* "shafts", "radial_blur", ...: CLI name and scene section */
     const char *description;   /* one line for `godrays techniques` */
@@ -50,6 +58,14 @@ struct gr_technique_class {
     size_t settings_size;      /* <= GR_TECH_SETTINGS_MAX */
     const char *origin;        /* "built-in" or the manifest's path (user techniques) */
     void *class_data;          /* the class's own data (a user technique's parsed manifest) */
+    /* A setting (double or RGB) that scales the whole output linearly ("intensity",
+     * "exposure"): where `godrays tune` puts the fitted scale in its snippet, and the scale
+     * fit is off by default when it is tuned. NULL: none. */
+    const char *gain_key;
+    /* Settings that trade speed for quality, from cheap to costly, for `godrays pareto`
+     * (NULL / 0: the scene's settings only). */
+    const gr_technique_level *ladder;
+    int n_ladder;
 
     /* Checks across settings beyond each one's range (e.g. N >= 2 and a target that fits).
      * May be NULL. Errors name "NAME.KEY" and the reason (GR_E_INPUT). */
@@ -75,6 +91,13 @@ struct gr_technique_class {
      * gr_technique_metadata. */
     gr_status (*metadata)(void *state, const gr_scene *scene, const void *settings,
                           const gr_technique_stats *stats, gr_metadata *meta, gr_error *err);
+    /* Optional (may be NULL), for `godrays render`: one line of the technique's own figures
+     * of the last render (counts, target size, ...) written into buf, without a newline. */
+    void (*summary)(void *state, const gr_technique_stats *stats, char *buf, size_t n);
+    /* Optional (may be NULL), for `godrays render --save-target`: the technique's main
+     * intermediate render target of the last render as an RGBA float image (*out is the
+     * caller's). */
+    gr_status (*read_target)(void *state, gr_image **out, gr_error *err);
 };
 
 /* ---- registry --------------------------------------------------------------------------- */
@@ -98,11 +121,22 @@ gr_status gr_technique_add_dir(const char *dir, gr_error *err);
 gr_status gr_technique_parse_list(const char *flag, const char *list, const gr_technique_class **out,
                                   int max, int *n, gr_error *err);
 
-/* The scene's settings of a technique (as loaded and overridden; scene-derived values
- * unresolved), and the same resolved into out (settings_size bytes). */
+/* The scene's settings of a technique (as loaded and overridden; the loader already resolved
+ * scene-derived defaults by each descriptor's scene_source, a NaN set later stays NaN until
+ * gr_technique_resolve), and the same resolved into out (settings_size bytes). For a class
+ * registered after the scene was loaded, its defaults. */
 const void *gr_technique_scene_settings(const gr_technique_class *cls, const gr_scene *scene);
+/* The same, writable (sweeps and tests change a scene's settings in place; gr_scene_refresh
+ * re-validates). NULL for a class registered after the scene was loaded. */
+void *gr_technique_scene_settings_rw(const gr_technique_class *cls, gr_scene *scene);
 void gr_technique_resolve(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out);
 gr_status gr_technique_check(const gr_technique_class *cls, const void *settings, gr_error *err);
+/* The first (at most max) number or RGB settings of cls that have a tuning box, in table
+ * order: the example parameters commands suggest (`--params NAME.A,NAME.B`). Returns how many. */
+int gr_technique_tune_example(const gr_technique_class *cls, const gr_param **out, int max);
+/* Applies "KEY=VALUE,KEY=VALUE" (a ladder level) to settings through the class's table;
+ * GR_E_INPUT naming "NAME.KEY" for an unknown key or a bad value. */
+gr_status gr_technique_apply_text(const gr_technique_class *cls, void *settings, const char *text, gr_error *err);
 
 /* ---- instances -------------------------------------------------------------------------- */
 
@@ -121,5 +155,16 @@ gr_status gr_technique_metadata(const gr_technique *t, const gr_scene *scene, co
                                 const gr_technique_stats *stats, gr_metadata *meta, gr_error *err);
 /* Sum of the passes' GPU times in ms; -1 if none was timed. */
 double gr_technique_stats_gpu_ms(const gr_technique_stats *s);
+/* Stats with nothing measured (n_passes 0, every figure -1). */
+void gr_technique_stats_clear(gr_technique_stats *s);
+/* Per-figure median of n stats (same passes), so that one warm-up outlier does not count. */
+void gr_technique_stats_median(const gr_technique_stats *all, int n, gr_technique_stats *out);
+/* The class's summary line of the last render ("" if it has none). */
+void gr_technique_summary(const gr_technique *t, const gr_technique_stats *stats, char *buf, size_t n);
+/* The class's intermediate target of the last render; GR_E_USAGE naming the technique if it
+ * has none. */
+gr_status gr_technique_read_target(gr_technique *t, gr_image **out, gr_error *err);
+/* The context the instance renders in. */
+gr_gl *gr_technique_gl(const gr_technique *t);
 
 #endif

@@ -36,6 +36,10 @@ typedef struct gr_param {
     /* GR_PF_FROM_SCENE: the scene quantity the default is taken from, e.g.
      * "medium.extinction" or "medium.g" (resolved by the scene loader). */
     const char *scene_source;
+    /* Default tuning box of `godrays tune` (the descriptor range is a sanity bound, often far
+     * wider than useful): [tune_lo, tune_hi] when tune_hi > tune_lo, else none. For an RGB
+     * setting, tuned as a scale on the scene's value, the box is of that scale. */
+    double tune_lo, tune_hi;
 } gr_param;
 
 typedef struct gr_param_table {

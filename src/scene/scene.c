@@ -7,6 +7,7 @@
  * Every error carries the JSON path it concerns, so an error caused by a --set override
  * can be attributed to that override rather than to the file. */
 #include "scene/scene.h"
+#include "common/outfile.h"
 
 #include <cjson/cJSON.h>
 #include <errno.h>
@@ -291,6 +292,31 @@ static gr_status get_str(vctx *c, const cJSON *obj, const char *parent, const ch
     return GR_OK;
 }
 
+/* Names reach the terminal, JSON and HTML: control characters (C0, DEL, C1) and bytes that are
+ * not well-formed UTF-8 (RFC 3629: no overlongs, no surrogates, at most U+10FFFF) become '?'
+ * in place, so an escape sequence in a name cannot drive a terminal and every output stays
+ * valid UTF-8 for strict parsers. */
+static void sanitize_name(char *s)
+{
+    unsigned char *p = (unsigned char *)s;
+    while (*p) {
+        const unsigned c = p[0];
+        int n = c < 0x80 ? 1 : (c >= 0xc2 && c <= 0xdf) ? 2 : (c >= 0xe0 && c <= 0xef) ? 3 : (c >= 0xf0 && c <= 0xf4) ? 4 : 0;
+        unsigned cp = n == 1 ? c : n == 2 ? (c & 0x1f) : n == 3 ? (c & 0x0f) : (c & 0x07);
+        for (int k = 1; k < n; k++) {
+            if ((p[k] & 0xc0) != 0x80) { n = 0; break; }
+            cp = (cp << 6) | (p[k] & 0x3fu);
+        }
+        if (n == 3 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) n = 0;
+        if (n == 4 && (cp < 0x10000 || cp > 0x10ffff)) n = 0;
+        if (n == 0 || cp < 0x20 || cp == 0x7f || (cp >= 0x80 && cp <= 0x9f)) {
+            if (n == 0) n = 1;
+            for (int k = 0; k < n; k++) p[k] = '?';
+        }
+        p += n;
+    }
+}
+
 /* Range check with the same wording as the settings tables ("must be in (0, 180), got 190"). */
 static gr_status range(vctx *c, const char *path, double v, double lo, double hi, unsigned flags)
 {
@@ -328,7 +354,9 @@ static void set_defaults(gr_scene *s)
     s->has_seabed = 0;
     s->seabed_depth_m = 25.0;
     gr_param_defaults(&gr_reference_param_table, &s->reference);
-    gr_param_defaults(&gr_shafts_param_table, &s->shafts);
+    /* technique sections: every one known now (scene/sections.h), at its defaults */
+    s->n_sections = gr_sections_count();
+    for (int i = 0; i < s->n_sections; i++) gr_param_defaults(gr_sections_table(i), s->sections[i].bytes);
 }
 
 static void wave_defaults(gr_wave *w)
@@ -342,8 +370,9 @@ static void wave_defaults(gr_wave *w)
 }
 
 /* ---- JSON -> struct ------------------------------------------------------------------ */
+/* The format's own top-level keys; technique sections (scene/sections.h) come on top. */
 static const char *const root_keys[] = {"version", "name", "water", "sun", "medium", "camera",
-                                        "occluders", "seabed", "reference", "shafts"};
+                                        "occluders", "seabed", "reference"};
 static const char *const water_keys[] = {"rest_height_m", "time_s", "waves"};
 static const char *const wave_keys[] = {"amplitude_m", "wavelength_m", "direction_deg", "phase_rad",
                                         "angular_frequency_rad_s"};
@@ -355,6 +384,32 @@ static const char *const box_keys[] = {"type", "name", "center_m", "size_m", "ya
 static const char *const sphere_keys[] = {"type", "name", "center_m", "radius_m"};
 static const char *const seabed_keys[] = {"depth_m"};
 #define NKEYS(a) (sizeof(a) / sizeof((a)[0]))
+
+/* The root's keys: the format's own and every technique section known now. An unknown key
+ * may be a user technique's section whose folder was not given: the message says so. */
+static gr_status check_root_keys(vctx *c, const cJSON *root)
+{
+    const char *names[NKEYS(root_keys) + GR_SCENE_MAX_SECTIONS];
+    size_t n = 0;
+    for (size_t i = 0; i < NKEYS(root_keys); i++) names[n++] = root_keys[i];
+    for (int i = 0; i < gr_sections_count(); i++) names[n++] = gr_sections_table(i)->section;
+    gr_status st = check_keys(c, root, "", names, n);
+    if (st == GR_E_INPUT && strstr(c->err->msg, "unknown key"))
+        snprintf(c->err->msg + strlen(c->err->msg), sizeof c->err->msg - strlen(c->err->msg), "%s",
+                 "; a user technique's section needs its --technique-dir");
+    return st;
+}
+
+/* Every technique section's settings against its table (allow_unresolved: NaN accepted
+ * for scene-derived settings). */
+static gr_status validate_sections(const gr_scene *s, int allow_unresolved, gr_error *err)
+{
+    for (int i = 0; i < s->n_sections; i++) {
+        gr_status st = gr_param_validate(gr_sections_table(i), s->sections[i].bytes, allow_unresolved, err);
+        if (st) return st;
+    }
+    return GR_OK;
+}
 
 static gr_status parse_water(vctx *c, const cJSON *w, gr_water *out)
 {
@@ -489,6 +544,7 @@ static gr_status parse_occluders(vctx *c, const cJSON *v, gr_scene *s)
         if ((st = get_str(c, it, p, "name", o->name, sizeof o->name)) ||
             (st = get_vec3(c, it, p, "center_m", o->center_m)))
             return st;
+        sanitize_name(o->name);
     }
     s->n_occluders = n;
     return GR_OK;
@@ -548,11 +604,12 @@ static gr_status parse_scene(vctx *c, const cJSON *root, gr_scene *s)
     char got[80];
     set_defaults(s);
     if ((st = want_object(c, root, ""))) return st;
-    if ((st = check_keys(c, root, "", root_keys, NKEYS(root_keys)))) return st;
+    if ((st = check_root_keys(c, root))) return st;
     const cJSON *ver = cJSON_GetObjectItemCaseSensitive(root, "version");
     if (ver && (!cJSON_IsNumber(ver) || ver->valuedouble != 1.0))
         return vfail(c, "version", "unsupported scene format version, expected 1, got %s", got_text(ver, got, sizeof got));
     if ((st = get_str(c, root, "", "name", s->name, sizeof s->name))) return st;
+    sanitize_name(s->name);
     const cJSON *v;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "water")) && (st = parse_water(c, v, &s->water))) return st;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "sun")) && (st = parse_sun(c, v, &s->sun))) return st;
@@ -569,9 +626,12 @@ static gr_status parse_scene(vctx *c, const cJSON *root, gr_scene *s)
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "reference")) &&
         (st = parse_section(c, v, &gr_reference_param_table, &s->reference)))
         return st;
-    if ((v = cJSON_GetObjectItemCaseSensitive(root, "shafts")) &&
-        (st = parse_section(c, v, &gr_shafts_param_table, &s->shafts)))
-        return st;
+    for (int i = 0; i < s->n_sections; i++) {
+        const gr_param_table *t = gr_sections_table(i);
+        if ((v = cJSON_GetObjectItemCaseSensitive(root, t->section)) &&
+            (st = parse_section(c, v, t, s->sections[i].bytes)))
+            return st;
+    }
     return GR_OK;
 }
 
@@ -659,7 +719,7 @@ static gr_status validate_fields(vctx *c, const gr_scene *s)
     if (s->has_seabed && (st = range(c, "seabed.depth_m", s->seabed_depth_m, 0, 1e5, LO_X))) return st;
     /* Renderer sections: the descriptor tables hold the ranges. */
     if (gr_param_validate(&gr_reference_param_table, &s->reference, 1, c->err) ||
-        gr_param_validate(&gr_shafts_param_table, &s->shafts, 1, c->err)) {
+        validate_sections(s, 1, c->err)) {
         /* the message starts with "section.key"; use it as the path */
         size_t n = strcspn(c->err->msg, ":");
         snprintf(c->path, sizeof c->path, "%.*s", (int)(n < sizeof c->path ? n : sizeof c->path - 1), c->err->msg);
@@ -760,7 +820,7 @@ static gr_status derive(vctx *c, gr_scene *s)
         cam->right[k] = r[k];
         cam->up[k] = u[k];
     }
-    resolve_from_scene(&gr_shafts_param_table, &s->shafts, s);
+    for (int i = 0; i < s->n_sections; i++) resolve_from_scene(gr_sections_table(i), s->sections[i].bytes, s);
     resolve_from_scene(&gr_reference_param_table, &s->reference, s);
     return GR_OK;
 }
@@ -771,7 +831,7 @@ static gr_status validate_cross(vctx *c, const gr_scene *s)
     char a[40], b[40], d[40];
     /* FROM_SCENE settings now hold scene values: they too must lie in the table's range */
     if (gr_param_validate(&gr_reference_param_table, &s->reference, 0, c->err) ||
-        gr_param_validate(&gr_shafts_param_table, &s->shafts, 0, c->err)) {
+        validate_sections(s, 0, c->err)) {
         size_t n = strcspn(c->err->msg, ":");
         snprintf(c->path, sizeof c->path, "%.*s", (int)(n < sizeof c->path ? n : sizeof c->path - 1), c->err->msg);
         return GR_E_INPUT;
@@ -1027,10 +1087,14 @@ char *gr_scene_to_json(const gr_scene *s)
     sb_puts(&b, "{");
     print_section(&b, &gr_reference_param_table, &s->reference);
     sb_puts(&b, "}");
-    sb_key(&b, "  ", "shafts", 0);
-    sb_puts(&b, "{");
-    print_section(&b, &gr_shafts_param_table, &s->shafts);
-    sb_puts(&b, "}\n}\n");
+    for (int i = 0; i < s->n_sections; i++) {
+        const gr_param_table *t = gr_sections_table(i);
+        sb_key(&b, "  ", t->section, 0);
+        sb_puts(&b, "{");
+        print_section(&b, t, s->sections[i].bytes);
+        sb_puts(&b, "}");
+    }
+    sb_puts(&b, "\n}\n");
     if (b.oom) {
         free(b.p);
         return NULL;
@@ -1224,6 +1288,23 @@ static gr_status parse_text(const char *json, const char *label, cJSON **out, gr
         near[k++] = *q;
     }
     near[k] = '\0';
+    /* cJSON stops at CJSON_NESTING_LIMIT open brackets: say so rather than "malformed" */
+    int depth = 0, in_str = 0;
+    for (const char *q = json; q < end && *q; q++) {
+        if (in_str) {
+            if (*q == '\\' && q[1]) q++;
+            else if (*q == '"') in_str = 0;
+        } else if (*q == '"') {
+            in_str = 1;
+        } else if (*q == '[' || *q == '{') {
+            depth++;
+        } else if (*q == ']' || *q == '}') {
+            depth--;
+        }
+    }
+    if (depth >= CJSON_NESTING_LIMIT)
+        return gr_fail(err, GR_E_INPUT, "%s:%d:%d: JSON nested deeper than %d levels", label, line, col,
+                       CJSON_NESTING_LIMIT);
     if (k == 0) return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON at end of input", label, line, col);
     return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON near '%s'", label, line, col, near);
 }
@@ -1316,6 +1397,8 @@ static gr_status load_file_impl(const char *path, const char *const *overrides, 
                                 gr_error *err)
 {
     if (!path) return gr_fail(err, GR_E_RUNTIME, "gr_scene_load_file: no path");
+    gr_status reg = gr_check_regular_input(path, err); /* a FIFO would block the open */
+    if (reg != GR_OK) return reg;
     FILE *f = fopen(path, "rb");
     if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, strerror(errno));
     size_t cap = 1 << 16, len = 0;
@@ -1378,4 +1461,19 @@ gr_status gr_scene_load_file(const char *path, const char *const *overrides, int
                              gr_error *err)
 {
     return one_line(err, load_file_impl(path, overrides, n_overrides, out, err));
+}
+
+void *gr_scene_section(gr_scene *s, int i)
+{
+    return s && i >= 0 && i < s->n_sections ? s->sections[i].bytes : NULL;
+}
+
+const void *gr_scene_section_const(const gr_scene *s, int i)
+{
+    return s && i >= 0 && i < s->n_sections ? s->sections[i].bytes : NULL;
+}
+
+void gr_scene_resolve_settings(const gr_param_table *t, void *settings, const gr_scene *s)
+{
+    resolve_from_scene(t, settings, s);
 }

@@ -7,6 +7,7 @@
 
 #include <stdint.h>
 #include "common/status.h"
+#include "scene/sections.h"
 #include "scene/settings.h"
 
 #define GR_MAX_WAVES 64
@@ -91,7 +92,11 @@ typedef struct gr_scene {
     int has_seabed;
     double seabed_depth_m;    /* seabed plane at y = rest_height - depth */
     gr_reference_settings reference;
-    gr_shafts_settings shafts;
+    /* Settings of every technique section known when the scene was loaded
+     * (scene/sections.h): sections[i] holds table i's struct, n_sections of them. Use
+     * gr_scene_section() or gr_technique_scene_settings() rather than indexing. */
+    int n_sections;
+    gr_section_store sections[GR_SCENE_MAX_SECTIONS];
     /* provenance */
     char source_path[1024];   /* file it was loaded from, "" for a string */
     char hash[17];            /* FNV-1a 64 of the normalized JSON, hex */
@@ -113,9 +118,18 @@ gr_status gr_scene_load_string(const char *json, const char *label,
 char *gr_scene_to_json(const gr_scene *s);
 /* Recomputes derived fields (wave k/dir/omega, sun direction, extinction, camera frame)
  * and the hash after a caller changed fields in place (e.g. a sweep). Re-validates.
- * A wave's omega_rad_s set to NaN is re-derived from w^2 = g k, and shafts.extinction /
- * shafts.g set to NaN are re-taken from the medium (their defaults); otherwise values
+ * A wave's omega_rad_s set to NaN is re-derived from w^2 = g k, and a section's
+ * scene-derived settings (GR_PF_FROM_SCENE, e.g. shafts.extinction) set to NaN are re-taken
+ * from their scene_source (their defaults); otherwise values
  * loaded from a file stay as they are. Errors are prefixed with source_path if set. */
 gr_status gr_scene_refresh(gr_scene *s, gr_error *err);
+
+/* Settings of technique section i (scene/sections.h) in s; NULL if the scene was loaded
+ * before that section was added (or i is out of range). */
+void *gr_scene_section(gr_scene *s, int i);
+const void *gr_scene_section_const(const gr_scene *s, int i);
+/* Sets every GR_PF_FROM_SCENE setting of settings (table t) that is NaN to the scene
+ * quantity its descriptor's scene_source names ("medium.extinction", "medium.g", ...). */
+void gr_scene_resolve_settings(const gr_param_table *t, void *settings, const gr_scene *s);
 
 #endif

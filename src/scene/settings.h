@@ -1,5 +1,7 @@
-/* Settings of the two renderers, as stored in the scene's "reference" and "shafts"
- * sections. Their descriptor tables (keys, ranges, defaults, docs) are in settings.c. */
+/* Settings of the ground-truth renderer, as stored in the scene's "reference" section. Its
+ * descriptor table (keys, ranges, defaults, docs) is in settings.c. The real-time
+ * techniques' settings are declared by each technique (src/realtime/, e.g. shafts.h) and
+ * reach the scene as its sections (scene/sections.h). */
 #ifndef GR_SETTINGS_H
 #define GR_SETTINGS_H
 
@@ -28,26 +30,6 @@ typedef struct gr_reference_settings {
  * (default), or by sampling one direction per pass (brute force, for checks). */
 typedef enum gr_sun_disc_mode { GR_SUN_DISC_CONVOLVE = 0, GR_SUN_DISC_SAMPLE = 1 } gr_sun_disc_mode;
 
-typedef enum gr_target_format { GR_TARGET_RGBA8 = 0, GR_TARGET_RGBA16F = 1 } gr_target_format;
-
-/* Real-time shafts (seed 000), every undocumented choice exposed. */
-typedef struct gr_shafts_settings {
-    int N;                        /* grid vertices along each side (seed eq. 5.5.6) */
-    double K;                     /* spacing adjustment factor (eq. 5.5.6), ~0.8 */
-    double shaft_length_m;        /* extrusion length of bottom vertices (seed: e.g. 30 m) */
-    double shaft_width;           /* shaft width as a fraction of the grid cell */
-    int caps;                     /* draw top/bottom faces of each parallelepiped */
-    double target_scale;          /* shaft target size / frame size, per axis (0.5 = quarter area) */
-    int target_format;            /* gr_target_format */
-    double extinction[3];         /* c in eq. 5.5.3 (1/m); default: the medium's sigma_t */
-    double g;                     /* HG eccentricity in the final pass; default: the medium's g */
-    double bias;                  /* the 0.15 added before the phase (seed, second pass) */
-    double intensity[3];          /* user factor in the second pass */
-    int shadow_map_size;          /* shadow map resolution (texels per side) */
-    double shadow_bias;           /* depth bias of the shadow comparison (m) */
-} gr_shafts_settings;
-
 extern const gr_param_table gr_reference_param_table;
-extern const gr_param_table gr_shafts_param_table;
 
 #endif

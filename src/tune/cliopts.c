@@ -9,14 +9,21 @@
 
 const char gr_tune_cli_help[] =
     "  -o, --output DIR     report folder (default: out/SCENE_NAME/COMMAND)\n"
-    "  --metric M           rmse (default), relmse, ssim (scored as 1 - SSIM) or msrmse (mean RMSE\n"
-    "                       after blurs at 1, 4, 16 px); all on luminance Y\n"
-    "  --fit / --no-fit     score the shafts after the best scale fit a = <t,r>/<t,t> (default:\n"
-    "                       on, unless shafts.intensity is a parameter)\n"
+    "  --metric M           rmse (default), relmse, ssim (scored as 1 - SSIM), msrmse (mean RMSE\n"
+    "                       after blurs at 1, 4, 16 px), all on luminance Y; flip (mean HDR-FLIP)\n"
+    "                       or structure (beam-structure score in [0, 1]): docs/metrics.md\n"
+    "  --objective W        a weighted sum instead, e.g. rmse=1,structure=1,flip=0.5: each class\n"
+    "                       dimensionless (rmse, msrmse relative to the mean reference Y), the\n"
+    "                       weights normalized to sum 1 (docs/tuning.md)\n"
+    "  --technique NAME     the real-time technique (default: the one the parameters name, else\n"
+    "                       the first of `godrays techniques`); its settings are NAME.KEY\n"
+    "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
+    "  --fit / --no-fit     score the technique after the best scale fit a = <t,r>/<t,t>\n"
+    "                       (default: on, unless its gain setting, e.g. intensity, is a parameter)\n"
     "  --normalize          divide rmse/msrmse by each case's mean reference Y, so that every\n"
     "                       frame and view weighs the same in the mean\n"
     "  --set KEY=VALUE      override a scene value before validation (repeatable), e.g.\n"
-    "                       reference.spp=2 or shafts.N=15\n"
+    "                       reference.spp=2 or NAME.KEY=V\n"
     "  --size WxH           image size (camera.width/height)\n"
     "  --frames A:B:S       frames A, A+S, ..., B of the animated waves at water.time_s + frame/fps\n"
     "  --fps F              frames per second for --frames (default 30)\n"
@@ -39,7 +46,8 @@ void gr_tune_cli_init(gr_tune_cli *c)
 
 static int needs_value(const char *a)
 {
-    static const char *const with_value[] = {"--metric", "--frames", "--fps", "--times", "--view"};
+    static const char *const with_value[] = {"--metric", "--frames",    "--fps",
+                                             "--times",  "--view",      "--technique", "--objective"};
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
         if (!strcmp(a, with_value[k])) return 1;
     return 0;
@@ -73,6 +81,11 @@ int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *
     gr_status st = GR_OK;
     if (!strcmp(a, "--metric")) {
         st = gr_tune_metric_parse(a, v, &c->metric, err);
+    } else if (!strcmp(a, "--objective")) {
+        st = gr_tune_weights_parse(a, v, c->weights, err);
+        if (st == GR_OK) c->metric = GR_TM_WEIGHTED;
+    } else if (!strcmp(a, "--technique")) {
+        c->technique_name = v; /* looked up in gr_tune_cli_open, after --technique-dir */
     } else if (!strcmp(a, "--frames")) {
         c->frames_spec = v;
     } else if (!strcmp(a, "--times")) {
@@ -113,10 +126,26 @@ gr_status gr_tune_cli_finish(gr_tune_cli *c, gr_error *err)
 gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_params, gr_tune_session *s,
                            gr_tune_problem *p, gr_error *err)
 {
+    const gr_technique_class *cls = n_params > 0 ? params[0].cls : gr_technique_at(0);
+    if (c->technique_name) {
+        const gr_technique_class *one[1];
+        int n = 0;
+        if (strchr(c->technique_name, ','))
+            return gr_fail(err, GR_E_USAGE, "--technique %s: one technique expected", c->technique_name);
+        gr_status lst = gr_technique_parse_list("--technique", c->technique_name, one, 1, &n, err);
+        if (lst != GR_OK) return lst;
+        if (n != 1) return gr_fail(err, GR_E_USAGE, "--technique: no technique given");
+        cls = one[0];
+    }
+    for (int k = 0; k < n_params; k++)
+        if (params[k].cls != cls)
+            return gr_fail(err, GR_E_USAGE, "%s: not a setting of technique %s (its settings are %s.KEY)", params[k].key,
+                           cls->name, cls->name);
+    c->so.technique = cls;
     if (c->fit < 0) {
         c->fit = 1;
         for (int k = 0; k < n_params; k++)
-            if (!strcmp(params[k].p->name, "intensity")) c->fit = 0;
+            if (cls->gain_key && !strcmp(params[k].p->name, cls->gain_key)) c->fit = 0;
     }
     gr_status st = gr_tune_session_open(&c->so, s, err);
     if (st != GR_OK) return st;
@@ -124,6 +153,7 @@ gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_pa
     p->n_params = n_params;
     memcpy(p->params, params, (size_t)n_params * sizeof *params);
     p->metric = c->metric;
+    memcpy(p->weights, c->weights, sizeof p->weights);
     p->fit = c->fit;
     p->normalize = c->normalize;
     return gr_tune_problem_init(p, err);

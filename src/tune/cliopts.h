@@ -12,12 +12,14 @@
 typedef struct gr_tune_cli {
     gr_tune_session_options so;   /* sets, n_sets, gl_platform, scene_path: the caller's */
     gr_tune_metric metric;
-    int fit;                      /* -1: auto (on unless shafts.intensity is a parameter) */
+    double weights[GR_TM_COUNT];  /* --objective (metric GR_TM_WEIGHTED) */
+    int fit;                      /* -1: auto (on unless the gain_key setting is a parameter) */
     int normalize;                /* --normalize */
     int quiet;
     double fps;
     const char *frames_spec;      /* parsed in gr_tune_cli_finish (needs --fps) */
     const char *times_spec;
+    const char *technique_name;   /* --technique (NULL: from the parameters) */
 } gr_tune_cli;
 
 /* Defaults: metric rmse, fit auto, fps 30, cache on, progress on. */
@@ -30,8 +32,9 @@ int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *
 /* After all arguments: the frames/times lists; progress follows quiet. */
 gr_status gr_tune_cli_finish(gr_tune_cli *c, gr_error *err);
 
-/* After gr_tune_cli_finish and the caller's own checks: the fit default (on, unless
- * shafts.intensity is among params), gr_tune_session_open with c->so (s is the caller's; close
+/* After gr_tune_cli_finish and the caller's own checks: the technique (--technique, else the
+ * one params name, else the first registered; GR_E_USAGE if a parameter belongs to another),
+ * the fit default (on, unless its gain_key is among params), gr_tune_session_open with c->so (s is the caller's; close
  * it even after a failure), and p set up from the session, params, metric, fit and
  * normalization, and initialized (gr_tune_problem_free it). */
 gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_params, gr_tune_session *s,

@@ -1,4 +1,4 @@
-/* Shafts-vs-ground-truth error as a function of settings (objective.h). */
+/* A technique's error against the ground truth as a function of its settings (objective.h). */
 #include "tune/objective.h"
 
 #include <math.h>
@@ -9,17 +9,45 @@
 
 #include <cjson/cJSON.h>
 
-static const char *const metric_names[GR_TM_COUNT] = {"rmse", "relmse", "ssim", "msrmse"};
+#include "report/profile.h"
+
+static const char *const metric_names[GR_TM_COUNT] = {"rmse", "relmse", "ssim", "msrmse", "flip", "structure",
+                                                      "objective"};
 
 gr_status gr_tune_metric_parse(const char *flag, const char *s, gr_tune_metric *m, gr_error *err)
 {
-    for (int i = 0; i < GR_TM_COUNT; i++) {
+    for (int i = 0; i < GR_TM_WEIGHTED; i++) {
         if (!strcmp(s, metric_names[i])) {
             *m = (gr_tune_metric)i;
             return GR_OK;
         }
     }
-    return gr_fail(err, GR_E_USAGE, "%s %s: unknown metric (expected rmse, relmse, ssim or msrmse)", flag, s);
+    return gr_fail(err, GR_E_USAGE, "%s %s: unknown metric (expected rmse, relmse, ssim, msrmse, flip or structure)",
+                   flag, s);
+}
+
+gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_TM_COUNT], gr_error *err)
+{
+    for (int k = 0; k < GR_TM_COUNT; k++) w[k] = 0.0;
+    char buf[512];
+    if (!s || strlen(s) >= sizeof buf) return gr_fail(err, GR_E_USAGE, "%s: missing or too long", flag);
+    strcpy(buf, s);
+    double total = 0.0;
+    for (char *save = NULL, *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+        char *eq = strchr(t, '=');
+        if (!eq) return gr_fail(err, GR_E_USAGE, "%s %s: '%s' is not NAME=WEIGHT", flag, s, t);
+        *eq = '\0';
+        gr_tune_metric m = GR_TM_RMSE;
+        if (gr_tune_metric_parse(flag, t, &m, err) != GR_OK) return err->status;
+        char *end = NULL;
+        const double v = strtod(eq + 1, &end);
+        if (end == eq + 1 || *end || !isfinite(v) || v < 0.0)
+            return gr_fail(err, GR_E_USAGE, "%s %s: weight '%s' of %s is not a number >= 0", flag, s, eq + 1, t);
+        w[m] = v;
+        total += v;
+    }
+    if (!(total > 0.0)) return gr_fail(err, GR_E_USAGE, "%s %s: no weight > 0", flag, s);
+    return GR_OK;
 }
 
 const char *gr_tune_metric_name(gr_tune_metric m)
@@ -39,9 +67,60 @@ double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m)
         for (int k = 0; k < GR_METRICS_NSCALES; k++) v += y->rmse_blur[k];
         v /= GR_METRICS_NSCALES;
         break;
+    case GR_TM_FLIP: v = set->have_flip ? set->flip.mean : 1.0; break;
+    case GR_TM_STRUCTURE: v = set->have_structure ? set->structure_score : 1.0; break;
+    case GR_TM_WEIGHTED: v = 1e300; break;
     default: v = y->rmse; break;
     }
     return isfinite(v) ? v : 1e300;
+}
+
+/* Whether metric k enters the problem's value. */
+static int uses(const gr_tune_problem *p, gr_tune_metric k)
+{
+    return p->metric == k || (p->metric == GR_TM_WEIGHTED && p->weights[k] > 0.0);
+}
+
+double gr_tune_value(const gr_tune_problem *p, const gr_metrics_set *set)
+{
+    const double mean_y = set->ch[GR_MCH_Y].ref_mean;
+    if (p->metric != GR_TM_WEIGHTED) {
+        double v = gr_tune_metric_value(set, p->metric);
+        /* relative error: a bright view (toward the sun) would otherwise outweigh the rest */
+        if (p->normalize && (p->metric == GR_TM_RMSE || p->metric == GR_TM_MSRMSE) && mean_y > 0) v /= mean_y;
+        return v;
+    }
+    /* each class made dimensionless (rmse, msrmse relative to the mean reference Y; relmse,
+     * 1 - SSIM, FLIP and the structure score already are), then weighted (docs/tuning.md) */
+    double sum = 0.0, wsum = 0.0;
+    for (int k = 0; k < GR_TM_WEIGHTED; k++) {
+        if (!(p->weights[k] > 0.0)) continue;
+        double v = gr_tune_metric_value(set, (gr_tune_metric)k);
+        if ((k == GR_TM_RMSE || k == GR_TM_MSRMSE) && mean_y > 0) v /= mean_y;
+        sum += p->weights[k] * v, wsum += p->weights[k];
+    }
+    const double v = wsum > 0 ? sum / wsum : 1e300;
+    return isfinite(v) ? v : 1e300;
+}
+
+/* The metrics options of case i for the problem's metric(s); fo and so are the caller's. */
+static void case_options(const gr_tune_problem *p, int i, gr_metrics_options *opt, gr_flip_options *fo,
+                         gr_structure_options *so)
+{
+    if (uses(p, GR_TM_FLIP)) {
+        memset(fo, 0, sizeof *fo);
+        fo->mode = GR_FLIP_HDR;
+        opt->flip = fo;
+    }
+    if (uses(p, GR_TM_STRUCTURE)) {
+        const gr_camera *c = &p->scenes[i]->camera;
+        memset(so, 0, sizeof *so);
+        so->vp_x = p->vp[i][0], so->vp_y = p->vp[i][1];
+        so->radial = p->angles[i], so->radial_bin = c->fov_deg / c->height;
+        opt->structure = so;
+    }
+    if (uses(p, GR_TM_SSIM)) opt->skip_ssim = 0;
+    if (uses(p, GR_TM_MSRMSE)) opt->skip_blur = 0;
 }
 
 gr_status gr_tune_make_case(const gr_scene *base, double time_s, const gr_tune_view *view, gr_scene *out,
@@ -70,6 +149,7 @@ static double now_s(void)
 gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
 {
     p->scratch = NULL;
+    for (int i = 0; i < GR_TUNE_MAX_CASES; i++) p->angles[i] = NULL;
     if (p->n_cases < 1 || p->n_cases > GR_TUNE_MAX_CASES)
         return gr_fail(err, GR_E_INPUT, "tuning: %d cases (1..%d)", p->n_cases, GR_TUNE_MAX_CASES);
     if (p->n_params < 0 || p->n_params > GR_TUNE_MAX_PARAMS)
@@ -83,13 +163,40 @@ gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
         if (!p->refs[i] || p->refs[i]->width != c->width || p->refs[i]->height != c->height)
             return gr_fail(err, GR_E_INPUT, "tuning: the ground truth of case %d is not %dx%d", i, c->width, c->height);
     }
-    gr_shafts_settings r;
-    gr_shafts_resolve(p->scenes[0], &p->base, &r);
+    if (!p->cls || !p->renderer || gr_technique_class_of(p->renderer) != p->cls)
+        return gr_fail(err, GR_E_INPUT, "tuning: no technique instance of the problem's class");
+    for (int k = 0; k < p->n_params; k++)
+        if (p->params[k].cls != p->cls)
+            return gr_fail(err, GR_E_USAGE, "%s: not a setting of technique %s (choose it with --technique)",
+                           p->params[k].key, p->cls->name);
+    gr_section_store r;
+    gr_technique_resolve(p->cls, p->scenes[0], p->base.bytes, r.bytes);
     p->base = r;
     p->scratch = gr_image_create(c0->width, c0->height, 3, NULL);
     if (!p->scratch) return gr_fail(err, GR_E_NOMEM, "tuning: out of memory for a %dx%d frame", c0->width, c0->height);
+    if (uses(p, GR_TM_STRUCTURE)) {
+        /* the structure metrics' geometry per case: the vanishing point of the refracted sun's
+         * rays and the angle to the sun (their de-glow), once */
+        for (int i = 0; i < p->n_cases; i++) {
+            const gr_camera *c = &p->scenes[i]->camera;
+            gr_status st = gr_structure_scene_vp(p->scenes[i], c->width, c->height, &p->vp[i][0], &p->vp[i][1], err);
+            if (st != GR_OK) {
+                gr_error_prefix(err, "tuning: case %d: structure metrics", i);
+                gr_tune_problem_free(p);
+                return st;
+            }
+            p->angles[i] = malloc((size_t)c->width * (size_t)c->height * sizeof(float));
+            if (!p->angles[i]) {
+                gr_tune_problem_free(p);
+                return gr_fail(err, GR_E_NOMEM, "tuning: out of memory");
+            }
+            double dir[3];
+            gr_profile_sun_view_dir(p->scenes[i], dir);
+            gr_profile_angles(c, dir, p->angles[i]);
+        }
+    }
     p->renders = 0;
-    p->render_s = p->metrics_s = p->shafts_cpu_ms_sum = p->gpu_ms_sum = 0.0;
+    p->render_s = p->metrics_s = p->wall_ms_sum = p->gpu_ms_sum = 0.0;
     p->gpu_timed = 0;
     return GR_OK;
 }
@@ -99,31 +206,35 @@ void gr_tune_problem_free(gr_tune_problem *p)
     if (!p) return;
     gr_image_destroy(p->scratch);
     p->scratch = NULL;
+    for (int i = 0; i < GR_TUNE_MAX_CASES; i++) {
+        free(p->angles[i]);
+        p->angles[i] = NULL;
+    }
 }
 
-gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, gr_shafts_settings *out, gr_error *err)
+gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, void *out, gr_error *err)
 {
-    *out = p->base;
+    memcpy(out, p->base.bytes, p->cls->settings_size);
     for (int k = 0; k < p->n_params; k++) {
-        gr_status st = gr_tune_param_apply(&p->params[k], &p->base, x[k], out, err);
+        gr_status st = gr_tune_param_apply(&p->params[k], p->base.bytes, x[k], out, err);
         if (st != GR_OK) return st;
     }
     return GR_OK;
 }
 
 /* One render + metrics; opt chooses which metrics are computed. */
-static gr_status render_score(gr_tune_problem *p, int i, const gr_shafts_settings *s, gr_image *out,
+static gr_status render_score(gr_tune_problem *p, int i, const void *s, gr_image *out,
                               const gr_metrics_options *opt, gr_metrics *m, gr_error *err)
 {
-    gr_shafts_stats stats;
+    gr_technique_stats stats;
     double t0 = now_s();
-    gr_status st = gr_shafts_render(p->renderer, p->scenes[i], s, out, &stats, err);
+    gr_status st = gr_technique_render(p->renderer, p->scenes[i], s, out, &stats, err);
     double t1 = now_s();
     p->render_s += t1 - t0;
     if (st != GR_OK) return st;
     p->renders++;
-    p->shafts_cpu_ms_sum += stats.cpu_ms;
-    for (int k = 0; k < GR_SHAFTS_NPASS; k++) {
+    p->wall_ms_sum += stats.wall_ms;
+    for (int k = 0; k < stats.n_passes; k++) {
         if (stats.gpu_ns[k] >= 0) {
             p->gpu_ms_sum += (double)stats.gpu_ns[k] * 1e-6;
             p->gpu_timed = 1;
@@ -137,26 +248,23 @@ static gr_status render_score(gr_tune_problem *p, int i, const gr_shafts_setting
 gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, double *per_case, double *scale,
                            gr_error *err)
 {
-    gr_shafts_settings s;
-    gr_status st = gr_tune_settings_at(p, x, &s, err);
+    gr_section_store s;
+    gr_status st = gr_tune_settings_at(p, x, s.bytes, err);
     if (st != GR_OK) return st;
     /* Only what the metric needs: the pointwise pass is cheap, SSIM and blurs are not. */
-    gr_metrics_options opt = {0};
-    opt.stderr_bound = p->stderr_bound;
-    opt.fit_scale = p->fit;
-    opt.skip_ssim = p->metric != GR_TM_SSIM;
-    opt.skip_blur = p->metric != GR_TM_MSRMSE;
     double sum = 0.0;
     for (int i = 0; i < p->n_cases; i++) {
+        gr_metrics_options opt = {0};
+        gr_flip_options fo;
+        gr_structure_options so;
+        opt.stderr_bound = p->stderr_bound;
+        opt.fit_scale = p->fit;
+        opt.skip_ssim = opt.skip_blur = 1;
+        case_options(p, i, &opt, &fo, &so);
         gr_metrics m;
-        if ((st = render_score(p, i, &s, p->scratch, &opt, &m, err)) != GR_OK) return st;
+        if ((st = render_score(p, i, s.bytes, p->scratch, &opt, &m, err)) != GR_OK) return st;
         const gr_metrics_set *set = p->fit ? &m.fit : &m.raw;
-        double v = gr_tune_metric_value(set, p->metric);
-        if (p->normalize && (p->metric == GR_TM_RMSE || p->metric == GR_TM_MSRMSE)) {
-            /* relative error: a bright view (toward the sun) would otherwise outweigh the rest */
-            double mean_y = set->ch[GR_MCH_Y].ref_mean;
-            v = mean_y > 0 ? v / mean_y : v;
-        }
+        const double v = gr_tune_value(p, set);
         sum += v;
         if (per_case) per_case[i] = v;
         if (scale) scale[i] = p->fit ? m.fit.scale : 1.0;
@@ -165,13 +273,16 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
     return GR_OK;
 }
 
-gr_status gr_tune_render_case(gr_tune_problem *p, int i, const gr_shafts_settings *s, gr_image *out, gr_metrics *m,
+gr_status gr_tune_render_case(gr_tune_problem *p, int i, const void *s, gr_image *out, gr_metrics *m,
                               gr_error *err)
 {
     if (i < 0 || i >= p->n_cases) return gr_fail(err, GR_E_INPUT, "tuning: no case %d", i);
     gr_metrics_options opt = {0};
+    gr_flip_options fo;
+    gr_structure_options so;
     opt.stderr_bound = p->stderr_bound;
     opt.fit_scale = 1;
+    case_options(p, i, &opt, &fo, &so);
     gr_metrics local;
     return render_score(p, i, s, out, &opt, m ? m : &local, err);
 }
@@ -198,27 +309,32 @@ static int add_rgb(cJSON *o, const char *name, const double *rgb)
 
 char *gr_tune_snippet(const gr_tune_problem *p, const double *x, double scale)
 {
-    gr_shafts_settings s;
+    gr_section_store s;
     gr_error e;
-    if (gr_tune_settings_at(p, x, &s, &e) != GR_OK) return NULL;
+    if (gr_tune_settings_at(p, x, s.bytes, &e) != GR_OK) return NULL;
     cJSON *root = cJSON_CreateObject();
-    cJSON *sh = root ? cJSON_AddObjectToObject(root, "shafts") : NULL;
-    int ok = sh != NULL, has_intensity = 0;
+    cJSON *sh = root ? cJSON_AddObjectToObject(root, p->cls->name) : NULL;
+    const gr_param *gain = p->cls->gain_key ? gr_param_find(p->cls->params, p->cls->gain_key) : NULL;
+    int ok = sh != NULL, has_gain = 0;
     for (int k = 0; ok && k < p->n_params; k++) {
         const gr_tune_param *tp = &p->params[k];
-        if (!strcmp(tp->p->name, "intensity")) has_intensity = 1;
+        if (tp->p == gain) has_gain = 1;
         if (tp->kind == GR_TK_RGB_SCALE) {
-            const double *rgb = (const double *)((const char *)&s + tp->p->offset);
+            const double *rgb = (const double *)(const void *)(s.bytes + tp->p->offset);
             ok = add_rgb(sh, tp->p->name, rgb);
         } else {
-            double v = gr_param_get_number(tp->p, &s, 0);
+            double v = gr_param_get_number(tp->p, s.bytes, 0);
             ok = cJSON_AddNumberToObject(sh, tp->p->name, tp->kind == GR_TK_INT ? v : round_sig(v, 5)) != NULL;
         }
     }
-    if (ok && !has_intensity && scale > 0 && scale != 1.0) {
-        double in[3];
-        for (int c = 0; c < 3; c++) in[c] = s.intensity[c] * scale;
-        ok = add_rgb(sh, "intensity", in);
+    if (ok && gain && !has_gain && scale > 0 && scale != 1.0) {
+        if (gain->type == GR_PT_RGB) {
+            double in[3];
+            for (int c = 0; c < 3; c++) in[c] = gr_param_get_number(gain, s.bytes, c) * scale;
+            ok = add_rgb(sh, gain->name, in);
+        } else {
+            ok = cJSON_AddNumberToObject(sh, gain->name, round_sig(gr_param_get_number(gain, s.bytes, 0) * scale, 5)) != NULL;
+        }
     }
     char *text = ok ? cJSON_Print(root) : NULL;
     cJSON_Delete(root);

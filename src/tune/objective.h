@@ -1,6 +1,6 @@
-/* The error of the real-time shafts against ground truth images, as a function of a few
- * shafts settings: what `godrays sweep` tabulates and `godrays tune` minimizes. One GL
- * renderer (context, programs, buffers) serves every evaluation; each case is one frame
+/* The error of a real-time technique against ground truth images, as a function of a few of
+ * its settings: what `godrays sweep` tabulates and `godrays tune` minimizes. One technique
+ * instance (context, programs, buffers) serves every evaluation; each case is one frame
  * (water time) and camera view with its own ground truth. docs/tuning.md. */
 #ifndef GR_TUNE_OBJECTIVE_H
 #define GR_TUNE_OBJECTIVE_H
@@ -8,7 +8,7 @@
 #include "common/status.h"
 #include "compare/metrics.h"
 #include "image/image.h"
-#include "realtime/shafts.h"
+#include "realtime/technique.h"
 #include "scene/scene.h"
 #include "tune/paramspec.h"
 
@@ -19,14 +19,25 @@ typedef enum gr_tune_metric {
     GR_TM_RELMSE = 1, /* relative MSE of Y (docs/metrics.md) */
     GR_TM_SSIM = 2,   /* 1 - SSIM of Y (so that lower is better, 0 = identical) */
     GR_TM_MSRMSE = 3, /* mean of the RMSEs of Y after blurs at sigma 1, 4, 16 px */
+    GR_TM_FLIP = 4,   /* mean HDR-FLIP (compare/flip.h) */
+    GR_TM_STRUCTURE = 5, /* structure score (compare/structure.h via gr_metrics_set), in [0, 1] */
+    GR_TM_WEIGHTED = 6,  /* sum_k w_k v_k / sum_k w_k over the metrics above (problem.weights),
+                            rmse and msrmse relative to the case's mean reference Y */
     GR_TM_COUNT
 } gr_tune_metric;
 
-/* "rmse", "relmse", "ssim", "msrmse". GR_E_USAGE naming flag for anything else. */
+/* "rmse", "relmse", "ssim", "msrmse", "flip", "structure" ("objective" is the weighted sum,
+ * chosen by gr_tune_weights_parse). GR_E_USAGE naming flag for anything else. */
 gr_status gr_tune_metric_parse(const char *flag, const char *s, gr_tune_metric *m, gr_error *err);
 const char *gr_tune_metric_name(gr_tune_metric m);
-/* The metric's value from a computed set (raw or fit): lower is better, always finite. */
+/* The metric's value from a computed set (raw or fit): lower is better, always finite.
+ * GR_TM_FLIP / GR_TM_STRUCTURE need the set computed with them (else 1); GR_TM_WEIGHTED
+ * needs the weights: use gr_tune_value. */
 double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m);
+
+/* "rmse=1,structure=0.5,flip=0.5": weights w[GR_TM_COUNT] (unnamed metrics 0; each >= 0,
+ * finite, at least one > 0). GR_E_USAGE naming flag and the bad part. */
+gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_TM_COUNT], gr_error *err);
 
 /* A camera view for tuning beyond the scene's own: same position and fov, other direction. */
 typedef struct gr_tune_view {
@@ -40,36 +51,49 @@ gr_status gr_tune_make_case(const gr_scene *base, double time_s, const gr_tune_v
                             gr_error *err);
 
 typedef struct gr_tune_problem {
-    gr_shafts *renderer;                /* created by the caller, reused for every render */
+    gr_technique *renderer;             /* created by the caller, reused for every render */
+    const gr_technique_class *cls;      /* its class: every parameter is one of its settings */
     int n_cases;                        /* 1..GR_TUNE_MAX_CASES */
     const gr_scene *scenes[GR_TUNE_MAX_CASES];
     const gr_image *refs[GR_TUNE_MAX_CASES]; /* ground truth per case (R, G, B [, stderr]) */
-    gr_shafts_settings base;            /* settings the parameters modify (resolved on init) */
+    gr_section_store base;              /* settings (cls's struct) the parameters modify
+                                           (resolved on init) */
     int n_params;
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
     gr_tune_metric metric;
     int fit;                            /* score the test after the best scale fit */
     int normalize;                      /* rmse/msrmse divided by the case's mean reference Y,
                                            so that every frame and view weighs the same */
+    double weights[GR_TM_COUNT];        /* GR_TM_WEIGHTED: each metric's weight */
+    /* filled by gr_tune_problem_init when FLIP or structure is needed: per case, the beams'
+     * vanishing point and the angle to the sun per pixel (the structure de-glow) */
+    double vp[GR_TUNE_MAX_CASES][2];
+    float *angles[GR_TUNE_MAX_CASES];
     double stderr_bound;                /* passed to the metrics (0: default) */
     /* filled by gr_tune_problem_init */
     gr_image *scratch;                  /* one frame (R, G, B) */
     /* accounting since init */
     long long renders;
-    double render_s, metrics_s;         /* wall time in gr_shafts_render / gr_metrics_compute */
-    double shafts_cpu_ms_sum;           /* sum of the renderer's own cpu_ms */
+    double render_s, metrics_s;         /* wall time in gr_technique_render / gr_metrics_compute */
+    double wall_ms_sum;                 /* sum of the technique's own wall_ms */
     double gpu_ms_sum;                  /* sum of per-pass GPU times (-1 entries skipped) */
     int gpu_timed;                      /* 1 if any GPU time was available */
 } gr_tune_problem;
 
+/* The problem's value of one case from its computed set: the metric (normalized as asked),
+ * or the weighted sum. */
+double gr_tune_value(const gr_tune_problem *p, const gr_metrics_set *set);
+
 /* Resolves base (scene-derived defaults from case 0) and allocates the scratch frame. The
- * caller fills renderer, cases, base, params, metric, fit first. GR_E_INPUT if the cases
- * differ in size from their references; GR_E_NOMEM. */
+ * caller fills renderer, cls, cases, base, params, metric, fit first. GR_E_INPUT if the cases
+ * differ in size from their references; GR_E_USAGE if a parameter is not a setting of cls;
+ * GR_E_NOMEM. */
 gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err);
 void gr_tune_problem_free(gr_tune_problem *p); /* frees what init allocated; accepts NULL */
 
 /* The settings for parameter values x[0..n_params). */
-gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, gr_shafts_settings *out, gr_error *err);
+/* The settings (cls's struct, settings_size bytes) for parameter values x[0..n_params). */
+gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, void *out, gr_error *err);
 
 /* Renders every case at x and scores it: *mean = mean over the cases of the metric;
  * per_case[i] (may be NULL) = each case's value, scale[i] (may be NULL) = the fitted scale
@@ -79,13 +103,13 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
 
 /* Renders case i at settings s into out (frame-sized, R, G, B) and computes all metrics
  * (SSIM and blurs included) into m (may be NULL). */
-gr_status gr_tune_render_case(gr_tune_problem *p, int i, const gr_shafts_settings *s, gr_image *out, gr_metrics *m,
+gr_status gr_tune_render_case(gr_tune_problem *p, int i, const void *s, gr_image *out, gr_metrics *m,
                               gr_error *err);
 
-/* The settings at x as a snippet ready to paste into the scene: {"shafts": {KEY: value, ...}}
+/* The settings at x as a snippet ready to paste into the scene: {"NAME": {KEY: value, ...}}
  * with every parameter (RGB settings as [r, g, b] = base x scale) rounded to 5 significant
- * digits; with scale > 0 and != 1 (the fitted scale) also "intensity" = base intensity x scale,
- * unless intensity is a parameter. malloc'd text (caller frees); NULL on failure. */
+ * digits; with scale > 0 and != 1 (the fitted scale) also the class's gain_key = base x scale,
+ * unless it is a parameter or the class has none. malloc'd text (caller frees); NULL on failure. */
 char *gr_tune_snippet(const gr_tune_problem *p, const double *x, double scale);
 
 /* The objective for gr_opt_minimize: user = gr_tune_problem. */

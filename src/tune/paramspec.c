@@ -7,32 +7,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Useful tuning ranges. The descriptor ranges are sanity bounds (K up to 10, extinction up to
- * 1e4 /m) that would waste an optimizer's evaluations; these bracket what the default scenes
- * need with room on both sides. RGB entries are scales on the scene's value. */
-static const struct {
-    const char *name;
-    double lo, hi;
-} default_bounds[] = {
-    {"K", 0.2, 2.0},
-    {"extinction", 0.1, 4.0},
-    {"intensity", 0.05, 20.0},
-    {"g", 0.0, 0.99},
-    {"bias", 0.0, 1.0},
-    {"shaft_width", 0.1, 1.0},
-    {"shaft_length_m", 5.0, 100.0},
-    {"target_scale", 0.125, 1.0},
-    {"shadow_bias", 0.0, 1.0},
-};
-
 int gr_tune_param_default_bounds(const gr_param *p, gr_tune_kind kind, double *lo, double *hi)
 {
-    for (size_t i = 0; i < sizeof default_bounds / sizeof default_bounds[0]; i++) {
-        if (!strcmp(p->name, default_bounds[i].name)) {
-            *lo = default_bounds[i].lo;
-            *hi = default_bounds[i].hi;
-            return 1;
-        }
+    /* The technique's own tuning box: descriptor ranges are sanity bounds that would waste an
+     * optimizer's evaluations. */
+    if (p->tune_hi > p->tune_lo) {
+        *lo = p->tune_lo;
+        *hi = p->tune_hi;
+        return 1;
     }
     if (kind == GR_TK_RGB_SCALE) {
         *lo = 0.1;
@@ -50,13 +32,22 @@ int gr_tune_param_default_bounds(const gr_param *p, gr_tune_kind kind, double *l
 gr_status gr_tune_param_lookup(const char *flag, const char *key, gr_tune_param *out, gr_error *err)
 {
     memset(out, 0, sizeof *out);
-    const char *prefix = "shafts.";
-    if (strncmp(key, prefix, strlen(prefix)) != 0)
-        return gr_fail(err, GR_E_USAGE, "%s %s: unknown parameter (sweeps and tuning take shafts.KEY, e.g. shafts.K)",
-                       flag, key);
-    const char *name = key + strlen(prefix);
-    const gr_param *p = gr_param_find(&gr_shafts_param_table, name);
-    if (!p) return gr_fail(err, GR_E_USAGE, "%s %s: unknown shafts setting '%s'", flag, key, name);
+    const char *dot = strchr(key, '.');
+    char tech[GR_TECH_NAME_MAX];
+    const gr_technique_class *cls = NULL;
+    if (dot && (size_t)(dot - key) < sizeof tech) {
+        memcpy(tech, key, (size_t)(dot - key));
+        tech[dot - key] = '\0';
+        cls = gr_technique_find(tech);
+    }
+    if (!cls)
+        return gr_fail(err, GR_E_USAGE, "%s %s: unknown parameter (sweeps and tuning take TECHNIQUE.KEY, e.g. %s.%s; "
+                       "`godrays techniques` lists them)", flag, key, gr_technique_at(0)->name,
+                       gr_technique_at(0)->params->count ? gr_technique_at(0)->params->params[0].name : "KEY");
+    const char *name = dot + 1;
+    const gr_param *p = gr_param_find(cls->params, name);
+    if (!p) return gr_fail(err, GR_E_USAGE, "%s %s: unknown %s setting '%s'", flag, key, cls->name, name);
+    out->cls = cls;
     switch (p->type) {
     case GR_PT_DOUBLE: out->kind = GR_TK_SCALAR; break;
     case GR_PT_INT: out->kind = GR_TK_INT; break;
@@ -126,7 +117,7 @@ static gr_status check_range(const char *flag, const char *spec, const gr_tune_p
     for (int e = 0; e < 2; e++) {
         double v = e ? tp->hi : tp->lo;
         gr_error perr;
-        if (gr_param_check(&gr_shafts_param_table, tp->p, v, -1, &perr) != GR_OK)
+        if (gr_param_check(tp->cls->params, tp->p, v, -1, &perr) != GR_OK)
             return gr_fail(err, GR_E_USAGE, "%s %s: %s", flag, spec, perr.msg);
     }
     return GR_OK;
@@ -136,10 +127,10 @@ gr_status gr_tune_param_parse_sweep(const char *flag, const char *spec, gr_tune_
 {
     char key[64], f[3][64];
     int n = split_spec(spec, key, sizeof key, f);
-    if (n < 0) return gr_fail(err, GR_E_USAGE, "%s %s: expected shafts.KEY=LO:HI:COUNT", flag, spec);
+    if (n < 0) return gr_fail(err, GR_E_USAGE, "%s %s: expected TECHNIQUE.KEY=LO:HI:COUNT", flag, spec);
     gr_status st = gr_tune_param_lookup(flag, key, out, err);
     if (st != GR_OK) return st;
-    if (n != 3) return gr_fail(err, GR_E_USAGE, "%s %s: expected shafts.KEY=LO:HI:COUNT", flag, spec);
+    if (n != 3) return gr_fail(err, GR_E_USAGE, "%s %s: expected TECHNIQUE.KEY=LO:HI:COUNT", flag, spec);
     double lo, hi, cnt;
     if (parse_num(f[0], &lo) || parse_num(f[1], &hi))
         return gr_fail(err, GR_E_USAGE, "%s %s: LO and HI must be finite numbers", flag, spec);
@@ -196,11 +187,11 @@ gr_status gr_tune_param_parse_bounds(const char *flag, const char *spec, gr_tune
 {
     char key[64], f[3][64];
     int nf = split_spec(spec, key, sizeof key, f);
-    if (nf < 0) return gr_fail(err, GR_E_USAGE, "%s %s: expected shafts.KEY=LO:HI", flag, spec);
+    if (nf < 0) return gr_fail(err, GR_E_USAGE, "%s %s: expected TECHNIQUE.KEY=LO:HI", flag, spec);
     gr_tune_param probe;
     gr_status st = gr_tune_param_lookup(flag, key, &probe, err);
     if (st != GR_OK) return st;
-    if (nf != 2) return gr_fail(err, GR_E_USAGE, "%s %s: expected shafts.KEY=LO:HI", flag, spec);
+    if (nf != 2) return gr_fail(err, GR_E_USAGE, "%s %s: expected TECHNIQUE.KEY=LO:HI", flag, spec);
     int idx = -1;
     for (int i = 0; i < n; i++)
         if (!strcmp(params[i].key, key)) idx = i;
@@ -223,8 +214,7 @@ double gr_tune_param_value(const gr_tune_param *tp, int i)
     return tp->kind == GR_TK_INT ? floor(v + 0.5) : v;
 }
 
-double gr_tune_param_current(const gr_tune_param *tp, const gr_shafts_settings *base,
-                             const gr_shafts_settings *settings)
+double gr_tune_param_current(const gr_tune_param *tp, const void *base, const void *settings)
 {
     if (tp->kind != GR_TK_RGB_SCALE) return gr_param_get_number(tp->p, settings, 0);
     int cmax = 0;
@@ -240,15 +230,14 @@ double gr_tune_param_current(const gr_tune_param *tp, const gr_shafts_settings *
     return gr_param_get_number(tp->p, settings, cmax) / bmax;
 }
 
-gr_status gr_tune_param_apply(const gr_tune_param *tp, const gr_shafts_settings *base, double v,
-                              gr_shafts_settings *s, gr_error *err)
+gr_status gr_tune_param_apply(const gr_tune_param *tp, const void *base, double v, void *s, gr_error *err)
 {
     if (!isfinite(v)) return gr_fail(err, GR_E_INPUT, "%s: value %g is not finite", tp->key, v);
     if (tp->kind != GR_TK_RGB_SCALE)
-        return gr_param_set_number(&gr_shafts_param_table, s, tp->p->name, -1, v, err);
+        return gr_param_set_number(tp->cls->params, s, tp->p->name, -1, v, err);
     for (int c = 0; c < 3; c++) {
         double b = gr_param_get_number(tp->p, base, c);
-        gr_status st = gr_param_set_number(&gr_shafts_param_table, s, tp->p->name, c, b * v, err);
+        gr_status st = gr_param_set_number(tp->cls->params, s, tp->p->name, c, b * v, err);
         if (st != GR_OK) return st;
     }
     return GR_OK;

@@ -1,5 +1,6 @@
 /* Pareto fronts and the speed/error outputs (pareto.h). */
 #include "tune/pareto.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <math.h>
@@ -27,7 +28,12 @@ void gr_pareto_mark_fronts(gr_pareto_point *pts, int n)
     if (!c || !e || !f || !idx) {
         for (int i = 0; i < n; i++) pts[i].on_front = 0;
     } else {
-        for (int fam = 0; fam < 2; fam++) {
+        /* every family present (the ground truth = 0, technique k = 1 + k) */
+        int max_fam = -1;
+        for (int i = 0; i < n; i++)
+            if (pts[i].family > max_fam) max_fam = pts[i].family;
+        for (int i = 0; i < n; i++) pts[i].on_front = 0;
+        for (int fam = 0; fam <= max_fam; fam++) {
             int m = 0;
             for (int i = 0; i < n; i++)
                 if (pts[i].family == fam) {
@@ -47,23 +53,17 @@ void gr_pareto_mark_fronts(gr_pareto_point *pts, int n)
 
 gr_status gr_pareto_write_csv(const char *path, const gr_pareto_point *pts, int n, gr_error *err)
 {
-    char tmp[4200];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
+    gr_outfile of;
+    gr_status st = gr_outfile_open(&of, path, err);
+    if (st != GR_OK) return st;
+    FILE *f = of.f;
     fprintf(f, "family,label,settings,time_s,gpu_s,cost_s,error,on_front\n");
     for (int i = 0; i < n; i++)
-        fprintf(f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g,%d\n", pts[i].family == GR_PARETO_REFERENCE ? "reference" : "shafts",
+        fprintf(f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g,%d\n",
+                pts[i].family_name[0] ? pts[i].family_name : pts[i].family == GR_PARETO_REFERENCE ? "reference" : "?",
                 pts[i].label, pts[i].settings, pts[i].time_s, pts[i].gpu_s, pts[i].cost_s, pts[i].error,
                 pts[i].on_front);
-    int bad = ferror(f);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    }
-    return GR_OK;
+    return gr_outfile_commit(&of, 0, err);
 }
 
 /* The points of one family as isolated markers (a NaN between points breaks the line, per
@@ -93,33 +93,57 @@ static int family_series(const gr_pareto_point *pts, int n, int fam, double *px,
     return m;
 }
 
+/* Colours per family: red for the ground truth, then the techniques (Tableau 10). */
+static const unsigned char palette[10][3] = {{214, 39, 40},  {31, 119, 180}, {44, 160, 44},   {255, 127, 14},
+                                             {148, 103, 189}, {140, 86, 75},  {227, 119, 194}, {127, 127, 127},
+                                             {188, 189, 34},  {23, 190, 207}};
+
 gr_status gr_pareto_write_plot(const char *path, const gr_pareto_point *pts, int n, const char *title,
                                const char *time_label, int *drawn, gr_error *err)
 {
     *drawn = 0;
     if (!gr_plot_available()) return GR_OK;
+    int fams[GR_PARETO_MAX_FAMILIES], nfam = 0;
+    for (int i = 0; i < n; i++) {
+        int k = 0;
+        while (k < nfam && fams[k] != pts[i].family) k++;
+        if (k == nfam && nfam < GR_PARETO_MAX_FAMILIES) fams[nfam++] = pts[i].family;
+    }
     size_t cap = (size_t)(2 * n + 2);
-    double *buf = malloc(cap * 8 * sizeof *buf);
-    if (!buf) return gr_fail(err, GR_E_NOMEM, "pareto plot: out of memory");
-    double *rx = buf, *ry = rx + cap, *rfx = ry + cap, *rfy = rfx + cap;
-    double *sx = rfy + cap, *sy = sx + cap, *sfx = sy + cap, *sfy = sfx + cap;
-    int nrf = 0, nsf = 0;
-    int nr = family_series(pts, n, GR_PARETO_REFERENCE, rx, ry, rfx, rfy, &nrf);
-    int ns = family_series(pts, n, GR_PARETO_SHAFTS, sx, sy, sfx, sfy, &nsf);
-    char slabel[160];
-    snprintf(slabel, sizeof slabel, "real-time shafts (%s)", time_label ? time_label : "wall time");
-    gr_plot_series s[4] = {
-        {.label = "ground truth at lower quality", .x = rx, .y = ry, .n = nr, .rgb = {214, 39, 40}, .markers = 1},
-        {.label = "", .x = rfx, .y = rfy, .n = nrf, .rgb = {214, 39, 40}, .style = GR_PLOT_DASHED},
-        {.label = slabel, .x = sx, .y = sy, .n = ns, .rgb = {31, 119, 180}, .markers = 1},
-        {.label = "Pareto fronts (dashed)", .x = sfx, .y = sfy, .n = nsf, .rgb = {31, 119, 180},
-         .style = GR_PLOT_DASHED},
-    };
+    double *buf = malloc(cap * 4 * (size_t)(nfam ? nfam : 1) * sizeof *buf);
+    gr_plot_series *s = calloc((size_t)(2 * nfam + 1), sizeof *s);
+    char (*labels)[160] = calloc((size_t)(nfam ? nfam : 1), sizeof *labels);
+    if (!buf || !s || !labels) {
+        free(buf);
+        free(s);
+        free(labels);
+        return gr_fail(err, GR_E_NOMEM, "pareto plot: out of memory");
+    }
+    int ns = 0;
+    for (int k = 0; k < nfam; k++) {
+        double *x = buf + cap * 4 * (size_t)k, *y = x + cap, *fx = y + cap, *fy = fx + cap;
+        int nf = 0, m = family_series(pts, n, fams[k], x, y, fx, fy, &nf);
+        const char *name = "";
+        for (int i = 0; i < n; i++)
+            if (pts[i].family == fams[k]) name = pts[i].family_name;
+        if (fams[k] == GR_PARETO_REFERENCE)
+            snprintf(labels[k], sizeof labels[k], "ground truth at lower quality");
+        else
+            snprintf(labels[k], sizeof labels[k], "%s (%s)", name, time_label ? time_label : "wall time");
+        const unsigned char *rgb = palette[(fams[k] == GR_PARETO_REFERENCE ? 0 : 1 + (fams[k] - 1) % 9)];
+        gr_plot_series a = {.label = labels[k], .x = x, .y = y, .n = m, .rgb = {rgb[0], rgb[1], rgb[2]}, .markers = 1};
+        gr_plot_series b = {.label = k == nfam - 1 ? "Pareto fronts (dashed)" : "", .x = fx, .y = fy, .n = nf,
+                            .rgb = {rgb[0], rgb[1], rgb[2]}, .style = GR_PLOT_DASHED};
+        s[ns++] = a;
+        s[ns++] = b;
+    }
     gr_plot_spec spec = {.width = 900, .height = 560, .title = title, .xlabel = "time per frame (s)",
                          .ylabel = "rel. RMSE of Y vs HQ ground truth", .log_x = 1, .log_y = 1,
-                         .series = s, .n_series = 4, .legend_headroom = 0.0};
+                         .series = s, .n_series = ns, .legend_headroom = 0.0};
     gr_status st = gr_plot_write(path, &spec, err);
     free(buf);
+    free(s);
+    free(labels);
     if (st == GR_OK) *drawn = 1;
     return st;
 }

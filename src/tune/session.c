@@ -1,5 +1,6 @@
 /* Cases, ground truths and renderer shared by sweep and tune (session.h). */
 #include "tune/session.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <math.h>
@@ -80,18 +81,7 @@ void gr_tune_default_dir(const char *name, const char *sub, char *buf, size_t n)
 
 gr_status gr_tune_write_text(const char *path, const char *text, gr_error *err)
 {
-    char tmp[4300];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
-    int ok = fputs(text, f) >= 0;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok || rename(tmp, path) != 0) {
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    }
-    return GR_OK;
+    return gr_outfile_write(path, text, -1, err);
 }
 
 void gr_tune_session_close(gr_tune_session *s)
@@ -101,7 +91,8 @@ void gr_tune_session_close(gr_tune_session *s)
         gr_image_destroy(s->refs[i]);
         s->refs[i] = NULL;
     }
-    gr_shafts_destroy(s->renderer);
+    gr_technique_destroy(s->renderer);
+    gr_gl_destroy(s->gl);
     free(s->cases);
     free(s->base);
     memset(s, 0, sizeof *s);
@@ -118,10 +109,12 @@ gr_status gr_tune_session_open(const gr_tune_session_options *o, gr_tune_session
     s->base = malloc(sizeof *s->base);
     s->cases = malloc((size_t)(n_times * n_views) * sizeof *s->cases);
     if (!s->base || !s->cases) return gr_fail(err, GR_E_NOMEM, "out of memory for the scene");
+    s->cls = o->technique ? o->technique : gr_technique_at(0);
+    if (!s->cls) return gr_fail(err, GR_E_USAGE, "no real-time technique is registered");
     gr_status st = gr_scene_load_file(o->scene_path, o->sets, o->n_sets, s->base, err);
     if (st != GR_OK) return st;
     /* bad settings are bad input (exit 2) before any GL or slow work */
-    if ((st = gr_shafts_check_settings(&s->base->shafts, err)) != GR_OK) return st;
+    if ((st = gr_technique_check(s->cls, gr_technique_scene_settings(s->cls, s->base), err)) != GR_OK) return st;
     for (int t = 0; t < n_times; t++) {
         double time_s = o->n_times > 0 ? o->times[t] + (o->times_relative ? s->base->water.time_s : 0.0)
                                         : s->base->water.time_s;
@@ -133,10 +126,11 @@ gr_status gr_tune_session_open(const gr_tune_session_options *o, gr_tune_session
             s->n_cases = i + 1;
         }
     }
-    gr_shafts_options so;
-    memset(&so, 0, sizeof so);
-    so.gl.platform = o->gl_platform;
-    if ((st = gr_shafts_create(&so, &s->renderer, err)) != GR_OK) return st;
+    gr_gl_options glo;
+    memset(&glo, 0, sizeof glo);
+    glo.platform = o->gl_platform;
+    if ((st = gr_gl_create(&glo, &s->gl, err)) != GR_OK) return st;
+    if ((st = gr_technique_create(s->cls, s->gl, NULL, &s->renderer, err)) != GR_OK) return st;
     for (int i = 0; i < s->n_cases; i++) {
         if (o->progress)
             fprintf(stderr, "%s: ground truth %d/%d (%s, %dx%d)...\n", label, i + 1, s->n_cases, s->labels[i],
@@ -158,5 +152,6 @@ void gr_tune_session_problem(const gr_tune_session *s, gr_tune_problem *p)
         p->scenes[i] = &s->cases[i];
         p->refs[i] = s->refs[i];
     }
-    p->base = s->base->shafts;
+    p->cls = s->cls;
+    memcpy(p->base.bytes, gr_technique_scene_settings(s->cls, s->base), s->cls->settings_size);
 }

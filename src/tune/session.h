@@ -1,12 +1,12 @@
 /* What `godrays sweep` and `godrays tune` share: the scene, the cases (frames of the animated
- * waves x camera views), each case's ground truth (cached) and one shafts renderer; plus the
+ * waves x camera views), each case's ground truth (cached) and one technique instance; plus the
  * parsing of --frames, --times and --view. */
 #ifndef GR_TUNE_SESSION_H
 #define GR_TUNE_SESSION_H
 
 #include "common/status.h"
 #include "image/image.h"
-#include "realtime/shafts.h"
+#include "realtime/technique.h"
 #include "scene/scene.h"
 #include "tune/objective.h"
 #include "tune/truth.h"
@@ -27,6 +27,7 @@ typedef struct gr_tune_session_options {
     int progress;                 /* 1: one line per ground truth on stderr + the progress bar */
     const char *progress_label;   /* "godrays sweep" ... */
     gr_gl_platform gl_platform;
+    const gr_technique_class *technique; /* NULL: the first registered one */
 } gr_tune_session_options;
 
 typedef struct gr_tune_session {
@@ -37,7 +38,9 @@ typedef struct gr_tune_session {
     gr_truth_info truth[GR_TUNE_MAX_CASES];
     char labels[GR_TUNE_MAX_CASES][64]; /* "t=0.5s,view0" */
     double truth_seconds;         /* all ground truths together */
-    gr_shafts *renderer;
+    gr_gl *gl;                    /* the renderer's context */
+    gr_technique *renderer;
+    const gr_technique_class *cls;
 } gr_tune_session;
 
 /* Loads and checks the scene (bad input: GR_E_INPUT before any slow work), builds the cases,
@@ -46,7 +49,8 @@ typedef struct gr_tune_session {
 gr_status gr_tune_session_open(const gr_tune_session_options *o, gr_tune_session *s, gr_error *err);
 void gr_tune_session_close(gr_tune_session *s); /* accepts NULL */
 
-/* Fills a problem's cases, renderer and base settings (the scene's shafts section) from s. */
+/* Fills a problem's cases, renderer, class and base settings (the scene's section of the
+ * technique) from s. */
 void gr_tune_session_problem(const gr_tune_session *s, gr_tune_problem *p);
 
 /* --frames A:B:S (frame numbers, inclusive, at fps) -> times base + frame / fps, appended to

@@ -38,7 +38,9 @@ ck "table states the stderr exclusion" grep -q "768 NOT SCORED: reference relati
 ck "metrics.json written" [ -s res/metrics.json ]
 ck "diff.png written" [ -s res/diff.png ]
 ck "diff_signed.png written" [ -s res/diff_signed.png ]
-ck "no temporary file left" [ -z "$(ls res | grep -v -e '^metrics.json$' -e '^diff.png$' -e '^diff_signed.png$')" ]
+ck "flip.png written" [ -s res/flip.png ]
+ck "no temporary file left" [ -z "$(ls res | grep -v -e '^metrics.json$' -e '^diff.png$' -e '^diff_signed.png$' -e '^flip.png$')" ]
+ck "json: FLIP of a constant pair (ref is .exr: HDR)" grep -q '"mode":[[:space:]]*"hdr"' res/metrics.json
 ck "diff.png is the image plus its colorbar (256 x 88)" sh -c 'iinfo res/diff.png | grep -q "256 x   88"'
 ck "json: 2304 scored" grep -q '"scored_pixels":[[:space:]]*2304,' res/metrics.json
 ck "json: 768 excluded" grep -q '"stderr_excluded_pixels":[[:space:]]*768,' res/metrics.json
@@ -86,5 +88,21 @@ expect_error "size mismatch: mask" ref.exr test.png --mask small.exr
 expect_error "unknown option '--bogus'" ref.exr test.png --bogus
 expect_error "need two images" ref.exr
 expect_error "--stderr-bound" ref.exr test.png --stderr-bound -1
+expect_error "--metric structure needs the vanishing point" ref.exr test.png --metric structure
+expect_error "--metric 'flop'" ref.exr test.png --metric flop
+expect_error "--vp '1'" ref.exr test.png --vp 1
+expect_error "--set needs --scene" ref.exr test.png --set camera.yaw_deg=3
+expect_error "--flip-mode 'x'" ref.exr test.png --flip-mode x
+expect_error "--exposures" ref.exr test.png --exposures 3:1:2
+expect_error "--scene missing.json" ref.exr test.png --scene missing.json
 ck "nothing written on a missing file" [ ! -e bad ]
+
+# 5. FLIP and structure selected alone: identical images give FLIP 0; a flat pair has no
+#    structure (contrast 0, correlation 0).
+"$bin" compare ref.exr ref.exr --metric flip,structure --vp 32,24 --json >fs.json 2>fs.err
+ck "flip+structure: exit 0" [ $? -eq 0 ]
+ck "flip of identical images is 0" sh -c "tr -d ' \t\n' < fs.json | grep -q '\"flip\":{[^}]*\"mean\":0,'"
+ck "structure: correlation 0 for flat images" grep -q '"bandpass_correlation":[[:space:]]*0,' fs.json
+"$bin" compare ref.exr test.png --no-linearize --metric flip --flip-mode ldr >ldr.txt 2>&1
+ck "LDR-FLIP selected: no basic table" sh -c '! grep -q "RMSE" ldr.txt && grep -q "LDR-FLIP" ldr.txt'
 exit $fail

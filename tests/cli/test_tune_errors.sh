@@ -36,7 +36,7 @@ expect 2 "COUNT must be an integer" sweep "$s" -o "$o" --param shafts.K=0.4:1.2:
 expect 2 "COUNT must be in" sweep "$s" -o "$o" --param shafts.K=0.4:1.2:0
 expect 2 "not a numeric setting" sweep "$s" -o "$o" --param shafts.target_format=0:1:2
 expect 2 "not a numeric setting" sweep "$s" -o "$o" --param shafts.caps=0:1:2
-expect 2 "expected shafts.KEY=LO:HI:COUNT" sweep "$s" -o "$o" --param shafts.K
+expect 2 "expected TECHNIQUE.KEY=LO:HI:COUNT" sweep "$s" -o "$o" --param shafts.K
 expect 2 "shafts.K" sweep "$s" -o "$o" --param shafts.K=-1:1:3
 expect 2 "at most two axes" sweep "$s" -o "$o" --param shafts.K=0.4:1:2 --param shafts.g=0:0.5:2 --param shafts.bias=0:1:2
 expect 2 "swept twice" sweep "$s" -o "$o" --param shafts.K=0.4:1:2 --param shafts.K=0.5:1:2
@@ -58,6 +58,11 @@ expect 2 "not among the --params" tune "$s" -o "$o" --params shafts.K --bounds s
 expect 2 "--start" tune "$s" -o "$o" --params shafts.K --start shafts.K=x
 expect 2 "--starts" tune "$s" -o "$o" --params shafts.K --starts 0
 expect 2 "no --params" tune "$s" -o "$o"
+# techniques by name
+expect 2 "--technique no_such_technique: unknown technique 'no_such_technique'" tune "$s" -o "$o" --params shafts.K --technique no_such_technique
+expect 2 "--technique no_such_technique: unknown technique" sweep "$s" -o "$o" --param shafts.K=0.5:1:3 --technique no_such_technique
+expect 2 "--techniques shafts,nope: unknown technique 'nope'" pareto "$s" -o "$o" --techniques shafts,nope
+expect 2 "$dir/no_such_dir" tune "$s" -o "$o" --params shafts.K --technique-dir "$dir/no_such_dir"
 # pareto
 expect 2 "--size" pareto "$s" -o "$o" --size 0x5
 expect 2 "--repeat" pareto "$s" -o "$o" --repeat 0

@@ -15,6 +15,7 @@ static inline gr_scene *shafts_test_scene(const char *json, const char *const *s
     gr_error err;
     gr_scene *s = malloc(sizeof *s);
     if (!s) exit(1);
+    gr_technique_count(); /* the built-in techniques' sections ("shafts") */
     if (gr_scene_load_string(json, "test scene", sets, n_sets, s, &err) != GR_OK) {
         fprintf(stderr, "cannot load the test scene: %s\n", err.msg);
         exit(1);

@@ -15,6 +15,7 @@ static gr_scene *load_default(const char *const *sets, int n)
     snprintf(path, sizeof path, "%s/data/scenes/default.json", src ? src : GR_SOURCE_DIR);
     gr_scene *s = malloc(sizeof *s);
     gr_error err;
+    gr_technique_count(); /* the built-in techniques' sections ("shafts") */
     if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
         fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
         exit(1);

@@ -69,8 +69,9 @@ int main(void)
 
     /* The final layer inherits the clamp: with a saturated 8-bit target the layer cannot
      * exceed (bias + intensity) * peak phase; the float pipeline does. */
-    double g = s8->shafts.g, peak = (1.0 - g * g) / pow(1.0 - g, 3.0);
-    double cap = (s8->shafts.bias + s8->shafts.intensity[0]) * peak;
+    const gr_shafts_settings *sh8 = gr_shafts_scene_settings(s8);
+    double g = sh8->g, peak = (1.0 - g * g) / pow(1.0 - g, 3.0);
+    double cap = (sh8->bias + sh8->intensity[0]) * peak;
     float lmax8 = 0.0f, lmax16 = 0.0f;
     for (size_t i = 0; i < (size_t)img8->width * (size_t)img8->height * 3; i++) {
         if (img8->pixels[i] > lmax8) lmax8 = img8->pixels[i];

@@ -37,7 +37,7 @@ static void check_scene(gr_shafts *r, const gr_scene *s, const char *label)
     int n = 0;
     CHECK_OK(gr_shafts_capture(r, s, NULL, &v, &n, &st, &err), err);
     if (!v) return;
-    const gr_shafts_settings *sh = &s->shafts;
+    const gr_shafts_settings *sh = gr_shafts_scene_settings(s);
     CHECK(n == 8 * (sh->N - 1) * (sh->N - 1));
 
     /* Eq. 5.5.5 and 5.5.6 in closed form: P on the rest plane, P - E parallel to T. */

@@ -9,7 +9,7 @@
 #include "tune/optimize.h"
 #include "tune_test.h"
 
-static void identify(gr_shafts *r, const char *format, double k_true, double s_true, const double *x0)
+static void identify(gr_technique *r, const char *format, double k_true, double s_true, const double *x0)
 {
     char fmt[64];
     snprintf(fmt, sizeof fmt, "shafts.target_format=%s", format);
@@ -21,7 +21,7 @@ static void identify(gr_shafts *r, const char *format, double k_true, double s_t
     p->renderer = r;
     p->n_cases = 1;
     p->scenes[0] = scene;
-    p->base = scene->shafts;
+    tune_test_base(p, scene);
     p->n_params = 2;
     CHECK_OK(gr_tune_param_lookup("--params", "shafts.K", &p->params[0], &err), err);
     CHECK_OK(gr_tune_param_lookup("--params", "shafts.extinction", &p->params[1], &err), err);
@@ -37,7 +37,7 @@ static void identify(gr_shafts *r, const char *format, double k_true, double s_t
     double xt[2] = {k_true, s_true};
     gr_shafts_settings st;
     CHECK_OK(gr_tune_settings_at(p, xt, &st, &err), err);
-    CHECK_OK(gr_shafts_render(r, scene, &st, truth, NULL, &err), err);
+    CHECK_OK(gr_technique_render(r, scene, &st, truth, NULL, &err), err);
 
     double f_true = -1;
     CHECK_OK(gr_tune_evaluate(p, xt, &f_true, NULL, NULL, &err), err);
@@ -62,9 +62,9 @@ static void identify(gr_shafts *r, const char *format, double k_true, double s_t
 
 int main(void)
 {
-    gr_shafts *r = tune_test_renderer();
+    gr_technique *r = tune_test_renderer();
     identify(r, "rgba16f", 0.9, 1.3, (double[]){0.6, 0.7});
     identify(r, "rgba8", 0.9, 1.3, (double[]){1.3, 2.2});
-    gr_shafts_destroy(r);
+    tune_test_renderer_destroy(r);
     CHECK_DONE();
 }

@@ -24,14 +24,14 @@ int main(void)
     CHECK_OK(gr_truth_render(scene, 0, &truth, &secs, &err), err);
     if (!truth) return 1;
     printf("ground truth 160x90 in %.1f s\n", secs);
-    gr_shafts *r = tune_test_renderer();
+    gr_technique *r = tune_test_renderer();
     gr_tune_problem *p = calloc(1, sizeof *p);
     if (!p) return 1;
     p->renderer = r;
     p->n_cases = 1;
     p->scenes[0] = scene;
     p->refs[0] = truth;
-    p->base = scene->shafts;
+    tune_test_base(p, scene);
     p->n_params = 2;
     CHECK_OK(gr_tune_param_lookup("--params", "shafts.K", &p->params[0], &err), err);
     CHECK_OK(gr_tune_param_lookup("--params", "shafts.extinction", &p->params[1], &err), err);
@@ -61,7 +61,7 @@ int main(void)
     printf("scene's own settings: rmse %.6g\n", f0);
     gr_tune_problem_free(p);
     free(p);
-    gr_shafts_destroy(r);
+    tune_test_renderer_destroy(r);
     gr_image_destroy(truth);
     free(scene);
     CHECK_DONE();

@@ -14,7 +14,7 @@
 int main(void)
 {
     gr_scene *scene = tune_test_default_scene(160, 90, NULL, 0);
-    gr_shafts *r = tune_test_renderer();
+    gr_technique *r = tune_test_renderer();
     gr_error err;
     gr_tune_problem *p = calloc(1, sizeof *p);
     gr_image *truth = gr_image_create(160, 90, 3, NULL);
@@ -23,7 +23,7 @@ int main(void)
     p->n_cases = 1;
     p->scenes[0] = scene;
     p->refs[0] = truth;
-    p->base = scene->shafts;
+    tune_test_base(p, scene);
     p->n_params = 2;
     CHECK_OK(gr_tune_param_parse_sweep("--param", "shafts.K=0.5:1.1:4", &p->params[0], &err), err);
     CHECK_OK(gr_tune_param_parse_sweep("--param", "shafts.extinction=0.5:2:4", &p->params[1], &err), err);
@@ -33,7 +33,7 @@ int main(void)
     /* truth = grid point (ix 2, iy 1): K = 0.9, extinction x 1.0 */
     gr_shafts_settings st;
     CHECK_OK(gr_tune_settings_at(p, (double[]){0.9, 1.0}, &st, &err), err);
-    CHECK_OK(gr_shafts_render(r, scene, &st, truth, NULL, &err), err);
+    CHECK_OK(gr_technique_render(r, scene, &st, truth, NULL, &err), err);
 
     gr_sweep_result res;
     CHECK_OK(gr_sweep_run(p, &res, NULL, NULL, &err), err);
@@ -91,12 +91,12 @@ int main(void)
     /* one integer axis: N = 5, 7, 9, 11 against a render at N = 9 */
     p->n_params = 1;
     CHECK_OK(gr_tune_param_parse_sweep("--param", "shafts.N=5:11:4", &p->params[0], &err), err);
-    p->base = scene->shafts;
+    tune_test_base(p, scene);
     gr_tune_problem_free(p);
     CHECK_OK(gr_tune_problem_init(p, &err), err);
     CHECK_OK(gr_tune_settings_at(p, (double[]){9}, &st, &err), err);
     CHECK(st.N == 9);
-    CHECK_OK(gr_shafts_render(r, scene, &st, truth, NULL, &err), err);
+    CHECK_OK(gr_technique_render(r, scene, &st, truth, NULL, &err), err);
     CHECK_OK(gr_sweep_run(p, &res, NULL, NULL, &err), err);
     CHECK(res.nx == 4 && res.ny == 1 && res.best == 2 && res.err[2] == 0.0 && res.err[0] > 0 && res.err[3] > 0);
     gr_sweep_result_free(&res);
@@ -104,7 +104,7 @@ int main(void)
     gr_tune_problem_free(p);
     free(p);
     gr_image_destroy(truth);
-    gr_shafts_destroy(r);
+    tune_test_renderer_destroy(r);
     free(scene);
     CHECK_DONE();
 }

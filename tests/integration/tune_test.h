@@ -24,6 +24,7 @@ static inline gr_scene *tune_test_default_scene(int w, int h, const char *const 
     for (int i = 0; i < n_extra && n < 18; i++) sets[n++] = extra[i];
     gr_scene *s = malloc(sizeof *s);
     gr_error err;
+    gr_technique_count(); /* the built-in techniques' sections ("shafts") */
     if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
         fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
         exit(1);
@@ -31,15 +32,34 @@ static inline gr_scene *tune_test_default_scene(int w, int h, const char *const 
     return s;
 }
 
-static inline gr_shafts *tune_test_renderer(void)
+/* The context of tune_test_renderer's instances (one per test process). */
+static gr_gl *tune_test_gl;
+
+/* The shafts technique in a context of its own; destroy with tune_test_renderer_destroy. */
+static inline gr_technique *tune_test_renderer(void)
 {
     gr_error err;
-    gr_shafts *r = NULL;
-    if (gr_shafts_create(NULL, &r, &err) != GR_OK) {
+    gr_technique *r = NULL;
+    if (gr_gl_create(NULL, &tune_test_gl, &err) != GR_OK ||
+        gr_technique_create(&gr_shafts_class, tune_test_gl, NULL, &r, &err) != GR_OK) {
         fprintf(stderr, "cannot create the shafts renderer: %s\n", err.msg);
         exit(1);
     }
     return r;
+}
+
+static inline void tune_test_renderer_destroy(gr_technique *r)
+{
+    gr_technique_destroy(r);
+    gr_gl_destroy(tune_test_gl);
+    tune_test_gl = NULL;
+}
+
+/* p's class and base settings: the scene's shafts section. */
+static inline void tune_test_base(gr_tune_problem *p, const gr_scene *scene)
+{
+    p->cls = &gr_shafts_class;
+    memcpy(p->base.bytes, gr_shafts_scene_settings(scene), sizeof(gr_shafts_settings));
 }
 
 /* 1 if GODRAYS_TEST_REDUCED is set to a non-empty value other than "0" */

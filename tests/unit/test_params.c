@@ -8,6 +8,7 @@
 #include "check.h"
 #include "scene/params.h"
 #include "scene/settings.h"
+#include "realtime/shafts.h"
 
 static const gr_param_table *tables[2] = {&gr_reference_param_table, &gr_shafts_param_table};
 

@@ -8,7 +8,11 @@
 #include <string.h>
 
 #include "check.h"
+#include "realtime/shafts.h"
 #include "scene/scene.h"
+
+/* The scene's shafts section, writable. */
+#define SHAFTS(s) ((gr_shafts_settings *)gr_technique_scene_settings_rw(&gr_shafts_class, (s)))
 
 static const double PI = 3.14159265358979323846;
 
@@ -44,13 +48,13 @@ static void test_defaults(void)
     CHECK(s->reference.seed == 1ull);
     CHECK(s->reference.threads == 0 && s->reference.target_error == 0.0);
     CHECK(s->reference.transmittance_cutoff == 1e-3);
-    CHECK(s->shafts.caps == 1 && s->shafts.target_format == GR_TARGET_RGBA8);
+    CHECK(SHAFTS(s)->caps == 1 && SHAFTS(s)->target_format == GR_TARGET_RGBA8);
     /* FROM_SCENE defaults resolved to the medium */
     for (int k = 0; k < 3; k++) {
-        CHECK(s->shafts.extinction[k] == s->medium.absorption[k] + s->medium.scattering[k]);
+        CHECK(SHAFTS(s)->extinction[k] == s->medium.absorption[k] + s->medium.scattering[k]);
         CHECK(s->medium.extinction[k] == s->medium.absorption[k] + s->medium.scattering[k]);
     }
-    CHECK(s->shafts.g == s->medium.g);
+    CHECK(SHAFTS(s)->g == s->medium.g);
     CHECK(strlen(s->hash) == 16);
     CHECK(s->source_path[0] == '\0');
     free(s);
@@ -199,7 +203,7 @@ static void test_medium(void)
     /* Pope & Fry 1997 absorption and Morel 1974 scattering at 650/550/450 nm, g = 0 */
     CHECK(s->medium.absorption[0] == 0.340 && s->medium.absorption[1] == 0.0565 && s->medium.absorption[2] == 0.00922);
     CHECK(s->medium.scattering[0] == 0.0009 && s->medium.scattering[1] == 0.0019 && s->medium.scattering[2] == 0.0045);
-    CHECK(s->medium.g == 0.0 && s->shafts.g == 0.0);
+    CHECK(s->medium.g == 0.0 && SHAFTS(s)->g == 0.0);
     CHECK(!strcmp(s->medium.preset, "pure_seawater"));
     free(s);
     /* explicit keys override the preset per key */
@@ -211,7 +215,7 @@ static void test_medium(void)
     free(s);
     /* explicit shafts values win over FROM_SCENE */
     s = load("{\"shafts\": {\"extinction\": [0.1, 0.2, 0.3], \"g\": 0.5}}");
-    CHECK(s->shafts.extinction[0] == 0.1 && s->shafts.extinction[2] == 0.3 && s->shafts.g == 0.5);
+    CHECK(SHAFTS(s)->extinction[0] == 0.1 && SHAFTS(s)->extinction[2] == 0.3 && SHAFTS(s)->g == 0.5);
     free(s);
 }
 
@@ -228,12 +232,12 @@ static void test_refresh(void)
     CHECK(strcmp(s->hash, old_hash) != 0);
     /* NaN asks for re-derivation from the medium */
     s->medium.scattering[0] = 0.5;
-    s->shafts.extinction[0] = NAN;
-    s->shafts.g = NAN;
+    SHAFTS(s)->extinction[0] = NAN;
+    SHAFTS(s)->g = NAN;
     s->medium.g = 0.7;
     CHECK(gr_scene_refresh(s, &err) == GR_OK);
-    CHECK(s->shafts.extinction[0] == s->medium.absorption[0] + 0.5);
-    CHECK(s->shafts.g == 0.7);
+    CHECK(SHAFTS(s)->extinction[0] == s->medium.absorption[0] + 0.5);
+    CHECK(SHAFTS(s)->g == 0.7);
     /* refresh re-validates */
     s->camera.fov_deg = 200.0;
     CHECK(gr_scene_refresh(s, &err) == GR_E_INPUT);
@@ -242,7 +246,7 @@ static void test_refresh(void)
     s->camera.position_m[1] = 1.0;
     CHECK(gr_scene_refresh(s, &err) == GR_E_INPUT);
     s->camera.position_m[1] = -8.0;
-    s->shafts.K = -1.0;
+    SHAFTS(s)->K = -1.0;
     CHECK(gr_scene_refresh(s, &err) == GR_E_INPUT);
     CHECK(strstr(err.msg, "shafts.K:") != NULL);
     CHECK(gr_scene_refresh(NULL, &err) != GR_OK);
@@ -278,6 +282,7 @@ static void test_io_errors(void)
 
 int main(void)
 {
+    gr_technique_count(); /* the built-in techniques' sections ("shafts") before any scene */
     test_defaults();
     test_sun();
     test_camera();

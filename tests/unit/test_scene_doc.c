@@ -7,6 +7,7 @@
 #include "check.h"
 #include "scene/params.h"
 #include "scene/settings.h"
+#include "realtime/technique.h"
 
 static char *read_doc(void)
 {
@@ -41,9 +42,12 @@ int main(void)
 {
     char *doc = read_doc();
     if (!doc) CHECK_DONE();
-    const gr_param_table *tables[2] = {&gr_reference_param_table, &gr_shafts_param_table};
+    /* the ground truth's table and every registered technique's */
+    const gr_param_table *tables[1 + GR_TECH_MAX] = {&gr_reference_param_table};
+    int n_tables = 1;
+    for (int i = 0; i < gr_technique_count(); i++) tables[n_tables++] = gr_technique_at(i)->params;
     char line[1024], head[128];
-    for (int t = 0; t < 2; t++) {
+    for (int t = 0; t < n_tables; t++) {
         snprintf(head, sizeof head, "### `%s`", tables[t]->section);
         const char *sec = strstr(doc, head);
         CHECK_MSG(sec != NULL, "no section %s", head);
@@ -57,7 +61,7 @@ int main(void)
     }
     /* scene keys (src/scene/scene.c key lists) and presets */
     static const char *const keys[] = {
-        "version", "name", "water", "sun", "medium", "camera", "occluders", "seabed", "reference", "shafts",
+        "version", "name", "water", "sun", "medium", "camera", "occluders", "seabed", "reference",
         "rest_height_m", "time_s", "waves", "amplitude_m", "wavelength_m", "direction_deg", "phase_rad",
         "angular_frequency_rad_s", "elevation_deg", "azimuth_deg", "irradiance", "angular_diameter_deg",
         "preset", "absorption_per_m", "scattering_per_m", "g", "ior", "position_m", "look_at_m", "yaw_deg",

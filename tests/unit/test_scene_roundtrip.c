@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "realtime/technique.h"
 #include "scene/scene.h"
 
 /* Reference FNV-1a 64 (Fowler/Noll/Vo): basis 0xcbf29ce484222325, prime 0x100000001b3. */
@@ -145,6 +146,7 @@ static void test_hash(void)
 
 int main(void)
 {
+    gr_technique_count(); /* the built-in techniques' sections ("shafts") before any scene */
     test_fnv_vectors();
     test_shipped_scenes();
     test_awkward_values();

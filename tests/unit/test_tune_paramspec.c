@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "realtime/shafts.h"
 #include "scene/scene.h"
 #include "tune/paramspec.h"
 
@@ -31,6 +32,7 @@ static void bad_list(const char *spec, const char *must_contain)
 
 int main(void)
 {
+    gr_technique_count(); /* the built-in techniques' sections ("shafts") before any scene */
     gr_error err;
     gr_tune_param tp;
 
@@ -51,7 +53,7 @@ int main(void)
                        "[0.3, 0.06, 0.03], \"scattering_per_m\": 0.03, \"g\": 0.8}, \"camera\": {\"position_m\": "
                        "[0, -8, 0], \"yaw_deg\": 0, \"pitch_deg\": 30, \"fov_deg\": 60, \"width\": 16, \"height\": 9}}";
     CHECK_OK(gr_scene_load_string(json, "t", NULL, 0, s, &err), err);
-    gr_shafts_settings base = s->shafts, out;
+    gr_shafts_settings base = *gr_shafts_scene_settings(s), out;
     for (int c = 0; c < 3; c++) base.extinction[c] = s->medium.extinction[c]; /* resolved */
     base.g = s->medium.g;
     CHECK_OK(gr_tune_param_parse_sweep("--param", "shafts.extinction=0.25:2:8", &tp, &err), err);
@@ -73,8 +75,8 @@ int main(void)
     /* bad sweep specs: unknown key, other section, empty range, counts, non-numeric, types */
     bad_sweep("shafts.nope=0:1:4", "unknown shafts setting");
     bad_sweep("medium.g=0:1:4", "unknown parameter");
-    bad_sweep("shafts.K", "expected shafts.KEY=LO:HI:COUNT");
-    bad_sweep("shafts.K=0.4:1.2", "expected shafts.KEY=LO:HI:COUNT");
+    bad_sweep("shafts.K", "expected TECHNIQUE.KEY=LO:HI:COUNT");
+    bad_sweep("shafts.K=0.4:1.2", "expected TECHNIQUE.KEY=LO:HI:COUNT");
     bad_sweep("shafts.K=1.2:0.4:16", "empty range");
     bad_sweep("shafts.K=0.5:0.5:16", "empty range");
     bad_sweep("shafts.K=0.4:1.2:0", "COUNT must be in");

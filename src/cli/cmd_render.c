@@ -1,5 +1,6 @@
-/* godrays shafts: render a scene with seed 000's real-time shafts (src/realtime/shafts.h)
- * into an EXR god-ray layer (linear float, frame resolution) plus a PNG preview. */
+/* godrays render TECHNIQUE SCENE: render a scene with any registered real-time technique
+ * (src/realtime/technique.h) into an EXR god-ray layer (linear float, frame resolution) plus
+ * a PNG preview. (main.c's aliases name a technique; nothing here does.) */
 #include "cli/cli.h"
 #include "cli/args.h"
 
@@ -11,23 +12,25 @@
 
 #include "image/exr.h"
 #include "image/oiio.h"
-#include "realtime/shafts.h"
+#include "realtime/technique.h"
 #include "scene/scene.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays shafts SCENE [-o OUT.exr] [options]\n"
+            "usage: godrays render TECHNIQUE SCENE [-o OUT.exr] [options]\n"
             "\n"
-            "Renders SCENE's god-ray layer with seed 000's real-time shafts (OpenGL through headless\n"
-            "EGL) and writes it as a linear float EXR with timings and settings in its metadata,\n"
-            "plus an sRGB PNG preview beside it (OUT.png).\n"
+            "Renders SCENE's god-ray layer with the real-time TECHNIQUE (OpenGL through headless EGL;\n"
+            "`godrays techniques` lists them and their settings) and writes it as a linear float EXR\n"
+            "with timings and settings in its metadata, plus an sRGB PNG preview beside it (OUT.png).\n"
             "\n"
             "options:\n"
-            "  -o, --output FILE    EXR to write (default: shafts.exr)\n"
-            "  --set KEY=VALUE      override a scene value before validation, e.g. shafts.K=0.7,\n"
-            "                       shafts.target_format=rgba16f, medium.g=0.9 (repeatable)\n"
-            "  --shader-dir DIR     GLSL files in DIR replace the embedded ones of the same name\n"
+            "  -o, --output FILE    EXR to write (default: TECHNIQUE.exr)\n"
+            "  --set KEY=VALUE      override a scene value before validation, e.g. TECHNIQUE.KEY=V,\n"
+            "                       medium.g=0.9 (repeatable)\n"
+            "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"
+            "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
+            "  --shader-dir DIR     GLSL files in DIR replace the technique's embedded ones of the same name\n"
             "  --time T             water time t (s) of eq. 5.5.7 (default: the scene's water.time_s)\n"
             "  --frames A:B:S       render frames A, A+S, ... up to B at time T + frame / fps; the\n"
             "                       frame number goes into the file names (OUT.0007.exr)\n"
@@ -36,14 +39,14 @@ static void usage(FILE *f)
             "                       the median of the renders (default 1)\n"
             "  --exposure E         preview exposure (default: auto, the 99.5th percentile maps to 1)\n"
             "  --no-preview         do not write the PNG preview\n"
-            "  --save-target FILE   also write the shaft render target (RGBA float EXR; in an\n"
-            "                       rgba16f target, A counts the shaft surfaces blended per texel)\n"
+            "  --save-target FILE   also write the technique's intermediate render target (RGBA float\n"
+            "                       EXR), for the techniques that have one\n"
             "  --gl-platform P      auto, surfaceless or device (default auto)\n"
             "  -q, --quiet          print nothing on success\n"
             "  -h, --help           this help\n"
             "\n"
-            "Shaft settings (scene section \"shafts\"): see docs/scene-format.md and\n"
-            "docs/realtime-shafts.md. Exit codes: 0 ok, 1 runtime/GL failure, 2 bad usage or input.\n");
+            "Settings (scene section named after the technique): `godrays techniques`,\n"
+            "docs/scene-format.md. Exit codes: 0 ok, 1 runtime/GL failure, 2 bad usage or input.\n");
 }
 
 static int parse_double(const char *s, double *out)
@@ -83,18 +86,6 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static int cmp_ll(const void *a, const void *b)
-{
-    long long x = *(const long long *)a, y = *(const long long *)b;
-    return (x > y) - (x < y);
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* Exposure that maps the 99.5th percentile of max(R, G, B) to 1 (1 if the image is black). */
 static double auto_exposure(const gr_image *img)
 {
@@ -111,35 +102,12 @@ static double auto_exposure(const gr_image *img)
     return q > 0 ? 1.0 / q : 1.0;
 }
 
-/* Median of each stat over the repeats, so one warm-up outlier does not dominate. */
-static void median_stats(gr_shafts_stats *all, int n, gr_shafts_stats *out)
-{
-    *out = all[n - 1];
-    if (n < 2) return;
-    long long *tmp = malloc((size_t)n * sizeof *tmp);
-    double *dt = malloc((size_t)n * sizeof *dt);
-    if (!tmp || !dt) {
-        free(tmp);
-        free(dt);
-        return;
-    }
-    for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
-        for (int i = 0; i < n; i++) tmp[i] = all[i].gpu_ns[p];
-        qsort(tmp, (size_t)n, sizeof *tmp, cmp_ll);
-        out->gpu_ns[p] = tmp[n / 2];
-    }
-    for (int i = 0; i < n; i++) dt[i] = all[i].cpu_ms;
-    qsort(dt, (size_t)n, sizeof *dt, cmp_double);
-    out->cpu_ms = dt[n / 2];
-    free(tmp);
-    free(dt);
-}
-
 /* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
-static int shafts_with(gr_args *args)
+static int render_with(gr_args *args)
 {
-    const char *cmd = "shafts";
-    const char *out_path = "shafts.exr", *shader_dir = NULL, *target_path = NULL;
+    const char *cmd = "render";
+    const char *out_path = NULL, *shader_dir = NULL, *target_path = NULL, *tech_name = NULL;
+
     const int argc = args->argc;
     char **argv = args->argv;
     int preview = 1, quiet = 0, have_time = 0, have_frames = 0, rc = 0;
@@ -160,6 +128,10 @@ static int shafts_with(gr_args *args)
             if ((rc = gr_args_take_set(args)) != 0) return rc;
         } else if (!strcmp(a, "--gl-platform")) {
             if ((rc = gr_args_take_gl_platform(args, &platform)) != 0) return rc;
+        } else if (!strcmp(a, "--size")) {
+            if ((rc = gr_args_take_size(args)) != 0) return rc;
+        } else if (!strcmp(a, "--technique-dir")) {
+            if ((rc = gr_args_take_technique_dir(args)) != 0) return rc;
         } else if (a[0] == '-' && a[1] != '\0') {
             /* every other option takes a value */
             if ((rc = gr_args_value(args, &val)) != 0) return rc;
@@ -190,32 +162,53 @@ static int shafts_with(gr_args *args)
             } else {
                 return gr_cli_usage_error(cmd, "unknown option %s", a);
             }
+        } else if (!tech_name) {
+            tech_name = a; /* the first positional argument */
         } else if ((rc = gr_args_take_scene(args)) != 0) {
             return rc;
         }
     }
+    if (!tech_name) return gr_cli_usage_error(cmd, "no technique given (`godrays techniques` lists them)");
+    if (!args->scene_path && (strchr(tech_name, '/') || strchr(tech_name, '.')))
+        return gr_cli_usage_error(cmd, "%s: expected TECHNIQUE SCENE, the technique first (`godrays techniques` lists them)",
+                                  tech_name);
     if ((rc = gr_args_need_scene(args)) != 0) return rc;
+    /* user techniques before the scene, whose sections they add */
+    const gr_technique_class *cls = NULL;
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    if ((rc = gr_args_find_technique(args, "TECHNIQUE", tech_name, &cls)) != 0) return rc;
+    char default_out[GR_TECH_NAME_MAX + 8];
+    snprintf(default_out, sizeof default_out, "%s.exr", cls->name);
+    if (!out_path) out_path = default_out;
 
     gr_error err = {GR_OK, ""};
     gr_scene *scene = NULL;
-    gr_shafts *r = NULL;
+    gr_gl *gl = NULL;
+    gr_technique *r = NULL;
     gr_image *img = NULL;
-    gr_shafts_stats *runs = NULL;
+    gr_technique_stats *runs = NULL;
     gr_metadata meta;
     gr_meta_init(&meta);
     if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
     /* Settings are checked before any GL work, so bad input exits 2 even without GL. */
-    if (gr_shafts_check_settings(&scene->shafts, &err) != GR_OK) goto fail;
+    if (gr_technique_check(cls, gr_technique_scene_settings(cls, scene), &err) != GR_OK) goto fail;
     /* So are the outputs (frames and previews go beside OUT). */
     if ((rc = gr_args_check_output_file(args, "-o", out_path)) != 0) goto done;
     if (target_path && (rc = gr_args_check_output_file(args, "--save-target", target_path)) != 0) goto done;
     double t_base = have_time ? time_s : scene->water.time_s;
 
-    gr_shafts_options opts;
+    if (target_path && !cls->read_target) {
+        gr_fail(&err, GR_E_USAGE, "--save-target: technique %s has no intermediate render target to save", cls->name);
+        goto fail;
+    }
+    gr_gl_options glo;
+    memset(&glo, 0, sizeof glo);
+    glo.platform = platform;
+    gr_technique_options opts;
     memset(&opts, 0, sizeof opts);
     opts.shader_dir = shader_dir;
-    opts.gl.platform = platform;
-    if (gr_shafts_create(&opts, &r, &err) != GR_OK) goto fail;
+    if (gr_gl_create(&glo, &gl, &err) != GR_OK) goto fail;
+    if (gr_technique_create(cls, gl, &opts, &r, &err) != GR_OK) goto fail;
     img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
     runs = calloc((size_t)repeat, sizeof *runs);
     if (!img || !runs) {
@@ -230,14 +223,14 @@ static int shafts_with(gr_args *args)
         char path[4096], png[4200];
         scene->water.time_s = have_frames ? t_base + (double)fr / fps : t_base;
         for (long k = 0; k < repeat; k++)
-            if (gr_shafts_render(r, scene, NULL, img, &runs[k], &err) != GR_OK) goto fail;
-        gr_shafts_stats stats;
-        median_stats(runs, (int)repeat, &stats);
+            if (gr_technique_render(r, scene, NULL, img, &runs[k], &err) != GR_OK) goto fail;
+        gr_technique_stats stats;
+        gr_technique_stats_median(runs, (int)repeat, &stats);
         if (have_frames) frame_path(out_path, fr, path, sizeof path);
         else snprintf(path, sizeof path, "%s", out_path);
         gr_meta_free(&meta);
         gr_meta_init(&meta);
-        if (gr_shafts_metadata(r, scene, NULL, &stats, &meta, &err) != GR_OK) goto fail;
+        if (gr_technique_metadata(r, scene, NULL, &stats, &meta, &err) != GR_OK) goto fail;
         if (have_frames && gr_meta_set_int(&meta, "godrays:frame", fr) != GR_OK) {
             gr_fail(&err, GR_E_NOMEM, "out of memory");
             goto fail;
@@ -258,25 +251,28 @@ static int shafts_with(gr_args *args)
             gr_image *timg = NULL;
             if (have_frames) frame_path(target_path, fr, tpath, sizeof tpath);
             else snprintf(tpath, sizeof tpath, "%s", target_path);
-            if (gr_shafts_read_target(r, &timg, &err) != GR_OK) goto fail;
+            if (gr_technique_read_target(r, &timg, &err) != GR_OK) goto fail;
             gr_status tst = gr_exr_write(tpath, timg, &meta, &err);
             gr_image_destroy(timg);
             if (tst != GR_OK) goto fail;
         }
         if (!quiet) {
-            char gpu[GR_SHAFTS_NPASS][32];
-            for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
-                if (stats.gpu_ns[p] >= 0) snprintf(gpu[p], sizeof gpu[p], "%.3f", (double)stats.gpu_ns[p] * 1e-6);
-                else snprintf(gpu[p], sizeof gpu[p], "n/a");
+            gr_strbuf line;
+            char extra[512];
+            gr_sb_init(&line);
+            gr_sb_printf(&line, "%s: %s, t = %.4f s, GPU ms:", path, cls->name, scene->water.time_s);
+            for (int p = 0; p < stats.n_passes; p++) {
+                if (stats.gpu_ns[p] >= 0)
+                    gr_sb_printf(&line, "%s %s %.3f", p ? "," : "", stats.pass_names[p], (double)stats.gpu_ns[p] * 1e-6);
+                else
+                    gr_sb_printf(&line, "%s %s n/a", p ? "," : "", stats.pass_names[p]);
             }
-            double tpx = (double)stats.target_width * (double)stats.target_height;
-            printf("%s: t = %.4f s, %d shafts, target %dx%d (%s), GPU ms: shadow %s, shafts %s, final %s; "
-                   "CPU %.3f ms; fragments %lld (overdraw %.2f); vertices %lld (VS invocations %lld)\n",
-                   path, scene->water.time_s, stats.n_shafts, stats.target_width, stats.target_height,
-                   scene->shafts.target_format == GR_TARGET_RGBA16F ? "rgba16f" : "rgba8",
-                   gpu[0], gpu[1], gpu[2],
-                   stats.cpu_ms, stats.fragments, (double)stats.fragments / tpx, stats.vertices_submitted,
-                   stats.vs_invocations);
+            gr_sb_printf(&line, "; wall %.3f ms", stats.wall_ms);
+            if (stats.fragments >= 0) gr_sb_printf(&line, "; fragments %lld", stats.fragments);
+            gr_technique_summary(r, &stats, extra, sizeof extra);
+            if (extra[0]) gr_sb_printf(&line, "; %s", extra);
+            printf("%s\n", gr_sb_str(&line));
+            gr_sb_free(&line);
         }
     }
     goto done;
@@ -286,12 +282,13 @@ done:
     gr_meta_free(&meta);
     free(runs);
     gr_image_destroy(img);
-    gr_shafts_destroy(r);
+    gr_technique_destroy(r);
+    gr_gl_destroy(gl);
     free(scene);
     return rc;
 }
 
-int cmd_shafts(int argc, char **argv)
+int cmd_render(int argc, char **argv)
 {
-    return gr_args_main("shafts", argc, argv, shafts_with);
+    return gr_args_main("render", argc, argv, render_with);
 }
