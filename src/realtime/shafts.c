@@ -816,7 +816,7 @@ static void set_shaft_uniforms(GLuint prog, const shaft_locs *l, const frame_set
     const gr_shafts_settings *s = &f->s;
     glUseProgram(prog);
     glUniform3fv(l->origin, 1, f->origin_rel);
-    glUniform1f(l->spacing, (float)f->S);
+    glUniform1f(l->spacing, (float)f->lvl_S[0]);
     glUniform1f(l->width, (float)s->shaft_width);
     glUniform1f(l->length, (float)s->shaft_length_m);
     glUniform3f(l->extinction, (float)s->extinction[0], (float)s->extinction[1], (float)s->extinction[2]);
