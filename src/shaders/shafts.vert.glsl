@@ -111,8 +111,9 @@ void main()
     if (u_variant == 2) {
         // Flux (docs: "flux"): the slab's irradiance across the beam is the flux through the
         // shaft's top face, E_sun |A_top . I| T, over its cross-section across T at the slab's
-        // middle, widened by the sun disc's blur radius r = alpha_w s (Minkowski sum of the
-        // section with a disc). Every vertex of a slab computes the same value (constant per slab).
+        // middle, regularized by the sun disc's blur area pi r^2, r = alpha_w s, as a smooth
+        // maximum sqrt(A^2 + (pi r^2)^2): the section where it is wide, the blur disc at a focus.
+        // Every vertex of a slab computes the same value (constant per slab).
         vec3 q[4];
         vec3 m[4];
         float trs = 0.0;
@@ -129,7 +130,8 @@ void main()
         float a_top = 0.5 * abs(dot(cross(q[2] - q[0], q[3] - q[1]), u_sun_dir));
         float a_sec = 0.5 * abs(dot(cross(m[2] - m[0], m[3] - m[1]), u_refr_flat));
         float r = u_sun_radius_w * smid;
-        float a_eff = a_sec + 4.0 * sqrt(a_sec) * r + 3.14159265 * r * r;
+        float a_disc = 3.14159265 * r * r;
+        float a_eff = sqrt(a_sec * a_sec + a_disc * a_disc);
         // each shaft carries its whole cell's flux (width^2 of the cell is drawn)
         v_ratio = a_top * trs / max(a_eff, 1e-12) / (u_width * u_width);
         v_tr = 1.0;
