@@ -109,6 +109,7 @@ typedef struct shaft_locs {
     GLint origin, spacing, width, length, extinction, sun_dir, eta, r0;
     GLint view_proj, shadow_matrix, wave_groups, waves, shadow_map, shadow_bias;
     GLint variant, ratio, refr_flat, sun_radius_w, prescale, depth_test, eye_depth, target_size;
+    GLint half, corner_pos, corner_refr;
 } shaft_locs;
 
 struct gr_shafts {
@@ -125,6 +126,11 @@ struct gr_shafts {
     int grid_N, grid_slabs, grid_nshafts;
     float *grid_cpu; /* GRID_FLOATS floats per vertex: cell.xy, corner.xy, bottom, mid */
     gr_scenegl *scenegl; /* eye depth for depth_test */
+    /* flux pre-pass: one texel per shaft corner (2 (N-1) per side), position + transmittance
+     * and refracted direction (shafts_corner.frag.glsl) */
+    GLuint prog_corner, corner_tex[2], corner_fbo;
+    int corner_size;
+    shaft_locs lk;
 
     GLuint vao_occ, vbo_occ;
     float *occ_cpu;
@@ -279,6 +285,9 @@ static void get_shaft_locs(GLuint prog, shaft_locs *l)
     l->depth_test = glGetUniformLocation(prog, "u_depth_test");
     l->eye_depth = glGetUniformLocation(prog, "u_eye_depth");
     l->target_size = glGetUniformLocation(prog, "u_target_size");
+    l->half = glGetUniformLocation(prog, "u_half");
+    l->corner_pos = glGetUniformLocation(prog, "u_corner_pos");
+    l->corner_refr = glGetUniformLocation(prog, "u_corner_refr");
 }
 
 static int has_extension(const char *name)
@@ -357,6 +366,11 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
         return st;
     r->from_dir += nd;
 
+    if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_corner.frag.glsl", NULL, 0,
+                                &r->prog_corner, &nd, err)) != GR_OK)
+        return st;
+    r->from_dir += nd;
+    get_shaft_locs(r->prog_corner, &r->lk);
     r->loc_light_vp = glGetUniformLocation(r->prog_shadow, "u_light_view_proj");
     get_shaft_locs(r->prog_shafts, &r->ls);
     r->loc_inv_vp = glGetUniformLocation(r->prog_final, "u_inv_view_proj");
@@ -404,6 +418,9 @@ void gr_shafts_destroy(gr_shafts *r)
         if (r->prog_shafts) glDeleteProgram(r->prog_shafts);
         if (r->prog_final) glDeleteProgram(r->prog_final);
         if (r->prog_capture) glDeleteProgram(r->prog_capture);
+        if (r->prog_corner) glDeleteProgram(r->prog_corner);
+        if (r->corner_fbo) glDeleteFramebuffers(1, &r->corner_fbo);
+        if (r->corner_tex[0]) glDeleteTextures(2, r->corner_tex);
         if (r->vao_grid) glDeleteVertexArrays(1, &r->vao_grid);
         if (r->vbo_grid) glDeleteBuffers(1, &r->vbo_grid);
         if (r->ibo_grid) glDeleteBuffers(1, &r->ibo_grid);
@@ -543,6 +560,35 @@ static gr_status make_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h
     if (fs != GL_FRAMEBUFFER_COMPLETE)
         return gr_fail(err, GR_E_GL, "%s (%dx%d): framebuffer incomplete (0x%04x)", what, w, h, (unsigned)fs);
     return gr_gl_check(what, err);
+}
+
+/* The flux pre-pass's two RGBA32F corner textures, 2 (N-1) texels per side. */
+static gr_status ensure_corners(gr_shafts *r, int N, gr_error *err)
+{
+    int n = 2 * (N - 1);
+    if (r->corner_size == n && r->corner_fbo) return GR_OK;
+    if (r->corner_fbo) glDeleteFramebuffers(1, &r->corner_fbo);
+    if (r->corner_tex[0]) glDeleteTextures(2, r->corner_tex);
+    r->corner_size = 0;
+    glGenTextures(2, r->corner_tex);
+    glGenFramebuffers(1, &r->corner_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->corner_fbo);
+    for (int i = 0; i < 2; i++) {
+        glBindTexture(GL_TEXTURE_2D, r->corner_tex[i]);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, n, n);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, r->corner_tex[i], 0);
+    }
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, bufs);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (fs != GL_FRAMEBUFFER_COMPLETE)
+        return gr_fail(err, GR_E_GL, "shafts.N = %d: flux corner target %dx%d incomplete (0x%04x)", N, n, n, (unsigned)fs);
+    r->corner_size = n;
+    return gr_gl_check("shafts.N: flux corner target", err);
 }
 
 static gr_status ensure_targets(gr_shafts *r, const frame_setup *f, gr_error *err)
@@ -837,6 +883,9 @@ static void set_shaft_uniforms(GLuint prog, const shaft_locs *l, const frame_set
     glUniform1i(l->depth_test, s->depth_test);
     glUniform1i(l->eye_depth, 1);
     glUniform2f(l->target_size, (float)f->tw, (float)f->th);
+    glUniform1f(l->half, (float)(0.5 * (double)(f->N - 1)));
+    glUniform1i(l->corner_pos, 2);
+    glUniform1i(l->corner_refr, 3);
 }
 
 static long long query_result(GLuint q)
@@ -863,6 +912,7 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
     if ((st = ensure_grid(r, f->N, f->slabs, err)) != GR_OK) goto done;
     if ((st = ensure_targets(r, f, err)) != GR_OK) goto done;
+    if (f->s.variant == GR_SHAFTS_FLUX && (st = ensure_corners(r, f->N, err)) != GR_OK) goto done;
     GLuint eye_depth_tex = 0;
     if (f->s.depth_test) {
         /* scenegl's eye depth of the occluders and seabed at the target's resolution */
@@ -923,6 +973,28 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glBindVertexArray(r->vao_grid);
     for (int k = 0; k < f->n_levels; k++) {
         if (f->lvl_weight[k] <= 0.0) continue;
+        if (f->s.variant == GR_SHAFTS_FLUX) {
+            /* pre-pass: the level's corners, then back to the shaft pass's state */
+            glDisable(GL_BLEND);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->corner_fbo);
+            glViewport(0, 0, r->corner_size, r->corner_size);
+            set_shaft_uniforms(r->prog_corner, &r->lk, f, scene);
+            glUniform3fv(r->lk.origin, 1, f->lvl_origin[k]);
+            glUniform1f(r->lk.spacing, (float)f->lvl_S[k]);
+            if (f->groups > 0) glUniform4fv(r->lk.waves, f->groups * 5, f->lvl_waves[k]);
+            glBindVertexArray(r->vao_empty);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+            glViewport(0, 0, f->tw, f->th);
+            glEnable(GL_BLEND);
+            set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
+            glActiveTexture(GL_TEXTURE2);
+            glBindTexture(GL_TEXTURE_2D, r->corner_tex[0]);
+            glActiveTexture(GL_TEXTURE3);
+            glBindTexture(GL_TEXTURE_2D, r->corner_tex[1]);
+            glActiveTexture(GL_TEXTURE0);
+            glBindVertexArray(r->vao_grid);
+        }
         /* stable_grid: each level drawn with its weight folded into the prescale */
         glUniform3fv(r->ls.origin, 1, f->lvl_origin[k]);
         glUniform1f(r->ls.spacing, (float)f->lvl_S[k]);
@@ -930,8 +1002,10 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
         glUniform1f(r->ls.prescale, (float)(f->s.target_prescale * f->lvl_weight[k]));
         glDrawElements(GL_TRIANGLES, n_idx, GL_UNSIGNED_INT, (const void *)0);
     }
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, 0);
+    for (GLenum u = GL_TEXTURE1; u <= GL_TEXTURE3; u++) {
+        glActiveTexture(u);
+        glBindTexture(GL_TEXTURE_2D, 0);
+    }
     glActiveTexture(GL_TEXTURE0);
     glDisable(GL_BLEND);
     if (r->have_pipeline_stats) {

@@ -31,6 +31,9 @@ uniform int u_variant;        // 0 seed, 1 path, 2 flux (docs/realtime-shafts.md
 uniform float u_ratio;        // path: irradiance factor cos(theta_i) / cos(theta_t) / width^2 (flat water)
 uniform vec3 u_refr_flat;     // flux: T of the flat surface (cross-sections are taken across it)
 uniform float u_sun_radius_w; // flux: the sun's angular radius under water (rad), the regularizer
+uniform float u_half;         // flux: (N - 1) / 2
+uniform sampler2D u_corner_pos;  // flux: corner positions (viewer-relative) and transmittance
+uniform sampler2D u_corner_refr; // flux: corner refracted directions (shafts_corner.frag.glsl)
 
 out vec3 v_intensity;   // seed: output.intensity (read as input.outScattering by its PS)
 out vec4 v_shadow_pos;  // seed: output.shadowmapPos
@@ -85,6 +88,45 @@ void surface(vec2 rest, out vec3 disp, out vec3 normal)
 
 void main()
 {
+    if (u_variant == 2) {
+        // Flux (docs: "flux"): the slab's irradiance across the beam is the flux through the
+        // shaft's top face, E_sun |A_top . I| T, over its cross-section across T at the slab's
+        // middle, regularized by the sun disc's blur area pi r^2, r = alpha_w s, as a smooth
+        // maximum sqrt(A^2 + (pi r^2)^2): the section where it is wide, the blur disc at a focus.
+        // The 4 corners come from the pre-pass; every vertex of a slab computes the same value.
+        ivec2 cell = ivec2(floor(a_cell + u_half));
+        vec3 q[4];
+        vec3 rd[4];
+        float trs = 0.0;
+        int own = 0;
+        for (int k = 0; k < 4; k++) {
+            ivec2 c = ivec2((k == 1 || k == 2) ? 1 : 0, (k >= 2) ? 1 : 0);
+            vec4 pt = texelFetch(u_corner_pos, 2 * cell + c, 0);
+            q[k] = pt.xyz;
+            trs += 0.25 * pt.w;
+            rd[k] = texelFetch(u_corner_refr, 2 * cell + c, 0).xyz;
+            if ((a_corner.x > 0.0) == (c.x == 1) && (a_corner.y > 0.0) == (c.y == 1)) own = k;
+        }
+        float smid = a_mid * u_length;
+        vec3 m0 = q[0] + rd[0] * smid, m1 = q[1] + rd[1] * smid, m2 = q[2] + rd[2] * smid, m3 = q[3] + rd[3] * smid;
+        float a_top = 0.5 * abs(dot(cross(q[2] - q[0], q[3] - q[1]), u_sun_dir));
+        float a_sec = 0.5 * abs(dot(cross(m2 - m0, m3 - m1), u_refr_flat));
+        float r = u_sun_radius_w * smid;
+        float a_disc = 3.14159265 * r * r;
+        float a_eff = sqrt(a_sec * a_sec + a_disc * a_disc);
+        // each shaft carries its whole cell's flux (width^2 of the cell is drawn)
+        v_ratio = a_top * trs / max(a_eff, 1e-12) / (u_width * u_width);
+        v_tr = 1.0;
+        float lenf = a_bottom * u_length;
+        vec3 posf = q[own] + rd[own] * lenf;
+        v_len = lenf;
+        v_intensity = vec3(0.0);
+        v_shadow_pos = u_shadow_matrix * vec4(posf, 1.0);
+        v_world = posf;
+        gl_Position = u_view_proj * vec4(posf, 1.0);
+        gl_Position.z = 0.01;
+        return;
+    }
     // Scale and translate the vertex on the water surface (rest position, relative to P).
     vec2 rest = (a_cell + a_corner * u_width) * u_spacing;
     vec3 disp, normal;
@@ -107,35 +149,6 @@ void main()
     v_len = len;
     v_tr = tr;
     v_ratio = u_ratio;
-
-    if (u_variant == 2) {
-        // Flux (docs: "flux"): the slab's irradiance across the beam is the flux through the
-        // shaft's top face, E_sun |A_top . I| T, over its cross-section across T at the slab's
-        // middle, regularized by the sun disc's blur area pi r^2, r = alpha_w s, as a smooth
-        // maximum sqrt(A^2 + (pi r^2)^2): the section where it is wide, the blur disc at a focus.
-        // Every vertex of a slab computes the same value (constant per slab).
-        vec3 q[4];
-        vec3 m[4];
-        float trs = 0.0;
-        float smid = a_mid * u_length;
-        for (int k = 0; k < 4; k++) {
-            vec2 c = vec2((k == 1 || k == 2) ? 0.5 : -0.5, (k >= 2) ? 0.5 : -0.5);
-            vec2 rk = (a_cell + c * u_width) * u_spacing;
-            vec3 dk, nk;
-            surface(rk, dk, nk);
-            q[k] = vec3(rk.x, 0.0, rk.y) + dk;
-            m[k] = q[k] + refract(u_sun_dir, nk, u_eta) * smid;
-            trs += 0.25 * (1.0 - fast_fresnel(dot(-u_sun_dir, nk), u_r0));
-        }
-        float a_top = 0.5 * abs(dot(cross(q[2] - q[0], q[3] - q[1]), u_sun_dir));
-        float a_sec = 0.5 * abs(dot(cross(m[2] - m[0], m[3] - m[1]), u_refr_flat));
-        float r = u_sun_radius_w * smid;
-        float a_disc = 3.14159265 * r * r;
-        float a_eff = sqrt(a_sec * a_sec + a_disc * a_disc);
-        // each shaft carries its whole cell's flux (width^2 of the cell is drawn)
-        v_ratio = a_top * trs / max(a_eff, 1e-12) / (u_width * u_width);
-        v_tr = 1.0;
-    }
 
     v_shadow_pos = u_shadow_matrix * vec4(pos, 1.0);
     v_world = pos;
