@@ -262,10 +262,13 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         std::fclose(f);
         return gr_fail(err, GR_E_INPUT, "%s: not a supported image file name (the reader takes %s)", path, READ_EXTS);
     }
-    // EXR files go through the project's own reader (image/exr.c): it checks the data window
-    // and the chunk table against the file before allocating, where OpenEXR's C++ reader
-    // behind OpenImageIO rebuilt a huge offset table for seconds from a 2.5 KB file.
-    if (!std::strcmp(format, "openexr")) return gr_exr_read(path, out, nullptr, err);
+    // EXR files pass the project's checks first (image/exr.c: data window and chunk table
+    // against the file, before anything is allocated): OpenEXR's C++ reader behind
+    // OpenImageIO rebuilt a huge offset table for seconds from a 2.5 KB file.
+    if (!std::strcmp(format, "openexr")) {
+        gr_status est = gr_exr_check(path, err);
+        if (est != GR_OK) return est;
+    }
     // libpng prints its own line ("IHDR: CRC error"): kept for the message (PNG only, so
     // that anything else a reader prints, a sanitizer's report included, stays visible)
     if (!std::strcmp(format, "png")) {
