@@ -118,14 +118,16 @@ static cJSON *image_json(const char *path, const gr_image *img, const int rgb[3]
     return o;
 }
 
-/* Every compared sample of img is 0: a "perfect" fit (a = 0, RMSE 0, PSNR inf, SSIM 1) that
- * means nothing. */
-static int all_zero(const gr_image *img, const int rgb[3])
+/* Every sample of img's channels other than stderr.* is 0: the metrics would give a "perfect"
+ * fit (a = 0, RMSE 0, PSNR inf, SSIM 1) that means nothing. */
+static int all_zero(const gr_image *img)
 {
     const size_t n = (size_t)img->width * (size_t)img->height, nc = (size_t)img->nchannels;
-    for (size_t p = 0; p < n; p++)
-        for (int k = 0; k < 3; k++)
-            if (img->pixels[p * nc + (size_t)rgb[k]] != 0.0f) return 0;
+    for (size_t c = 0; c < nc; c++) {
+        if (!strncmp(img->names[c], "stderr.", 7)) continue;
+        for (size_t p = 0; p < n; p++)
+            if (img->pixels[p * nc + c] != 0.0f) return 0;
+    }
     return 1;
 }
 
@@ -231,6 +233,8 @@ int cmd_compare(int argc, char **argv)
                 fopt.exposures_given = 1, fopt.start_exposure = e0, fopt.stop_exposure = e1, fopt.n_exposures = k;
             }
         } else if (!strcmp(a, "--max-memory")) {
+            const int vrc = gr_args_value(&args, &v);
+            if (vrc) return vrc;
             gr_error merr;
             double bytes;
             if (gr_memlimit_parse("--max-memory", v, &bytes, &merr) != GR_OK) return gr_cli_usage_error(cmd, "%s", merr.msg);
@@ -291,6 +295,10 @@ int cmd_compare(int argc, char **argv)
         snprintf(detail, sizeof detail, "%d x %d pixels at about 170 bytes each", ref->width, ref->height);
         st = gr_memlimit_check("the comparison", 170.0 * ref->width * (double)ref->height, detail, &err);
     }
+    if (st == GR_OK && all_zero(ref))
+        st = gr_fail(&err, GR_E_INPUT, "reference %s is zero everywhere: no metric can say anything about the test "
+                     "image (camera inside an occluder, a medium without scattering, no light reaching the view?)",
+                     paths[0]);
     if (st != GR_OK) goto fail;
 
     opt.mask = mask;
@@ -482,10 +490,6 @@ int cmd_compare(int argc, char **argv)
         }
     }
 
-    if (all_zero(ref, m.ref_rgb))
-        fprintf(stderr, "godrays compare: warning: the reference %s is zero everywhere scored: RMSE, PSNR, SSIM and the "
-                "scale fit say nothing about the test image (is the camera inside an occluder, or the medium "
-                "without scattering?)\n", paths[0]);
     if (json) {
         printf("%s\n", text);
     } else {
