@@ -259,6 +259,34 @@ int cmd_compare(int argc, char **argv)
                      mask->height, ref->width, ref->height);
     if (st != GR_OK) goto fail;
 
+    /* The structure metrics' geometry first: the metric sets carry their summary (as in
+     * `godrays run`), the "structure" object the details. */
+    gr_structure_options so = {0};
+    if (do_struct) {
+        if (scene_path) {
+            gr_scene sc;
+            st = gr_scene_load_file(scene_path, sets, n_sets, &sc, &err);
+            if (st == GR_OK) st = gr_structure_scene_vp(&sc, ref->width, ref->height, &vp[0], &vp[1], &err);
+            if (st != GR_OK) {
+                if (st != GR_E_NOMEM) err.status = GR_E_INPUT;
+                gr_error_prefix(&err, "--scene %s", scene_path);
+                goto fail;
+            }
+            /* de-glow by the angle to the refracted sun, rings one pixel wide */
+            sc.camera.width = ref->width, sc.camera.height = ref->height;
+            angles = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
+            if (!angles) {
+                st = gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
+                goto fail;
+            }
+            double dir[3];
+            gr_profile_sun_view_dir(&sc, dir);
+            gr_profile_angles(&sc.camera, dir, angles);
+            so.radial = angles, so.radial_bin = sc.camera.fov_deg / ref->height;
+        }
+        so.vp_x = vp[0], so.vp_y = vp[1];
+        opt.structure = &so;
+    }
     opt.mask = mask;
     if (!do_basic) opt.skip_ssim = opt.skip_blur = 1;
     gr_metrics m;
@@ -309,28 +337,6 @@ int cmd_compare(int argc, char **argv)
     gr_structure_compare sres;
     double t_struct = 0.0;
     if (do_struct) {
-        gr_structure_options so = {0};
-        if (scene_path) {
-            gr_scene sc;
-            st = gr_scene_load_file(scene_path, sets, n_sets, &sc, &err);
-            if (st == GR_OK) st = gr_structure_scene_vp(&sc, ref->width, ref->height, &vp[0], &vp[1], &err);
-            if (st != GR_OK) {
-                if (st != GR_E_NOMEM) err.status = GR_E_INPUT;
-                gr_error_prefix(&err, "--scene %s", scene_path);
-                goto fail;
-            }
-            /* de-glow by the angle to the refracted sun, rings one pixel wide */
-            sc.camera.width = ref->width, sc.camera.height = ref->height;
-            angles = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
-            if (!angles) {
-                st = gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
-                goto fail;
-            }
-            double dir[3];
-            gr_profile_sun_view_dir(&sc, dir);
-            gr_profile_angles(&sc.camera, dir, angles);
-            so.radial = angles, so.radial_bin = sc.camera.fov_deg / ref->height;
-        }
         if (!scored) {
             scored = malloc((size_t)ref->width * (size_t)ref->height);
             if (!scored) {
@@ -340,7 +346,7 @@ int cmd_compare(int argc, char **argv)
             st = gr_metrics_scored_pixels(ref, mask, opt.stderr_bound, scored, NULL, NULL, &err);
             if (st != GR_OK) goto fail;
         }
-        so.vp_x = vp[0], so.vp_y = vp[1], so.scored = scored;
+        so.scored = scored;
         const double t2 = now_s();
         st = gr_structure_compare_images(ref, test, &so, &sres, &err);
         t_struct = now_s() - t2;

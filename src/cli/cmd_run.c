@@ -12,11 +12,14 @@
 #include <string.h>
 #include <time.h>
 
+#include "compare/flip.h"
 #include "compare/metrics.h"
+#include "compare/structure.h"
 #include "image/exr.h"
 #include "realtime/technique.h"
 #include "reference/integrator.h"
 #include "report/cache.h"
+#include "report/profile.h"
 #include "report/report.h"
 #include "scene/scene.h"
 
@@ -219,6 +222,7 @@ static int run_with(gr_args *args)
     gr_error err = {GR_OK, ""};
     gr_scene *scene = NULL;
     gr_image *test = NULL;
+    float *angles = NULL, *flipmap = NULL;
     gr_metadata smeta;
     gr_meta_init(&smeta);
     ref_out ro;
@@ -260,8 +264,32 @@ static int run_with(gr_args *args)
     t = now_s();
     gr_metrics_options mopt = {0};
     mopt.fit_scale = 1; /* the technique's intensity is an arbitrary factor (seed 000) */
+    /* beam structure around the refracted sun's vanishing point, de-glowed by the angle to
+     * the sun (docs/metrics.md); skipped when the beams have no finite vanishing point */
+    const int W = scene->camera.width, H = scene->camera.height;
+    gr_structure_options so = {.radial_bin = scene->camera.fov_deg / H};
+    angles = malloc((size_t)W * (size_t)H * sizeof(float));
+    flipmap = malloc((size_t)W * (size_t)H * sizeof(float));
+    if (!angles || !flipmap) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory for the metrics");
+        goto fail;
+    }
+    {
+        gr_error e2 = {0};
+        if (gr_structure_scene_vp(scene, W, H, &so.vp_x, &so.vp_y, &e2) == GR_OK) {
+            double dir[3];
+            gr_profile_sun_view_dir(scene, dir);
+            gr_profile_angles(&scene->camera, dir, angles);
+            so.radial = angles;
+            mopt.structure = &so;
+        }
+    }
     gr_metrics m;
     if (gr_metrics_compute(ro.img, test, &mopt, &m, &err) != GR_OK) goto fail;
+    /* HDR-FLIP of the fitted test, with its per-pixel map for the report */
+    gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = m.fit_defined ? m.fit.scale : 1.0};
+    gr_flip_result fres;
+    if (gr_flip_compute(ro.img, test, &fo, flipmap, &fres, &err) != GR_OK) goto fail;
     const double t_cmp = now_s() - t;
 
     /* The report links the EXRs; they are written first so that a finished index.html never
@@ -273,7 +301,7 @@ static int run_with(gr_args *args)
                           .ref_cache_path = ro.cache_on ? ro.cache_path : NULL,
                           .ref_cache_note = ro.note[0] ? ro.note : NULL, .ref_seconds = t_ref,
                           .shafts_seconds = t_shafts, .compare_seconds = t_cmp, .ref_exr = "reference.exr",
-                          .test_exr = "shafts.exr"};
+                          .test_exr = "shafts.exr", .flip_map = flipmap, .flip = &fres};
     gr_report_result rres;
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
     if (snprintf(path, sizeof path, "%s/reference.exr", outdir) >= (int)sizeof path) {
@@ -292,6 +320,8 @@ static int run_with(gr_args *args)
 fail:
     rc = gr_cli_report(cmd, &err);
 done:
+    free(angles);
+    free(flipmap);
     gr_image_destroy(ro.img);
     gr_meta_free(&ro.meta);
     gr_image_destroy(test);

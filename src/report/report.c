@@ -640,7 +640,7 @@ typedef struct ctx {
     const char *dir;
     const gr_report_input *in;
     double a, exposure, exposure_raw, noise_y;
-    gr_image *disp_ref, *disp_fit, *disp_raw, *diff_signed, *diff_abs;
+    gr_image *disp_ref, *disp_fit, *disp_raw, *diff_signed, *diff_abs, *flip_map;
     gr_diffmap_info info_signed, info_abs;
     profiles pr;
     int have_profiles;
@@ -695,6 +695,12 @@ static gr_status build_json(ctx *c, char **text, gr_error *err)
     const gr_report_input *in = c->in;
     cJSON *root = gr_metrics_to_json(in->metrics);
     int ok = root != NULL;
+    if (ok && in->flip_map && in->flip) {
+        cJSON *fj = gr_flip_to_json(in->flip, c->a);
+        ok = fj && cJSON_AddStringToObject(fj, "map", "flip.png (magma, 0 black .. 1 pale yellow)") &&
+             cJSON_AddItemToObject(root, "flip", fj);
+        if (!ok) cJSON_Delete(fj);
+    }
     jstr(root, "godrays_version", GR_VERSION, &ok);
     jstr(root, "command_line", in->command_line, &ok);
     /* the scene as the renderers saw it: normalized, every default filled in */
@@ -927,6 +933,13 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     snprintf(cap, sizeof cap, "Absolute luminance difference |a Y(test) - Y(ref)|, map '%s' on [%s, %s] (99th percentile).",
              c->info_abs.map, fmt(c->info_abs.vmin, t[0], sizeof t[0]), fmt(c->info_abs.vmax, t[1], sizeof t[1]));
     html_figure(b, "diff.png", c->diff_abs, "absolute difference with colorbar", cap);
+    if (c->flip_map && in->flip) {
+        snprintf(cap, sizeof cap,
+                 "HDR-FLIP per pixel of a * test against the reference (Andersson et al. 2020, 2021; docs/metrics.md), "
+                 "magma map from 0 (black, no visible difference) to 1 (pale yellow); mean %.4f, median %.4f.",
+                 in->flip->mean, in->flip->median);
+        html_figure(b, "flip.png", c->flip_map, "FLIP map", cap);
+    }
     snprintf(cap, sizeof cap, "Real-time shafts as rendered (a = 1), own exposure %s.", fmt(c->exposure_raw, t[0], sizeof t[0]));
     html_figure(b, "shafts_raw.png", c->disp_raw, "real-time shafts as rendered", cap);
     gr_sb_puts(b, "</div>\n<p class=\"sub\">The same three panels with the key numbers: "
@@ -1099,14 +1112,18 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
                                k ? &c.info_signed : &c.info_abs, err);
         if (st != GR_OK) goto done;
     }
+    if (in->flip_map && (st = gr_flip_heatmap(in->flip_map, in->ref->width, in->ref->height, &c.flip_map, err)) != GR_OK)
+        goto done;
     if ((st = compute_profiles(in, c.a, &c.pr, err)) != GR_OK) goto done;
     c.have_profiles = 1;
     summary_lines(&c);
 
     /* Files: images first, the pages that link them last. */
-    static const char *const names[5] = {"reference.png", "shafts.png", "shafts_raw.png", "diff_signed.png", "diff.png"};
-    const gr_image *imgs[5] = {c.disp_ref, c.disp_fit, c.disp_raw, c.diff_signed, c.diff_abs};
-    for (int i = 0; i < 5; i++) {
+    static const char *const names[6] = {"reference.png", "shafts.png", "shafts_raw.png", "diff_signed.png", "diff.png",
+                                         "flip.png"};
+    const gr_image *imgs[6] = {c.disp_ref, c.disp_fit, c.disp_raw, c.diff_signed, c.diff_abs, c.flip_map};
+    for (int i = 0; i < 6; i++) {
+        if (!imgs[i]) continue;
         if ((st = join(path, sizeof path, dir, names[i], err)) != GR_OK) goto done;
         if ((st = gr_oiio_write(path, imgs[i], err)) != GR_OK) goto done;
     }
@@ -1154,6 +1171,7 @@ done:
     gr_image_destroy(c.disp_fit);
     gr_image_destroy(c.diff_signed);
     gr_image_destroy(c.diff_abs);
+    gr_image_destroy(c.flip_map);
     free_profiles(&c.pr);
     return st;
 }

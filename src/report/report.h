@@ -15,6 +15,7 @@
 #define GR_REPORT_H
 
 #include "common/status.h"
+#include "compare/flip.h"
 #include "compare/metrics.h"
 #include "image/image.h"
 #include "scene/scene.h"
@@ -37,6 +38,8 @@ typedef struct gr_report_input {
     const char *ref_exr, *test_exr; /* names (inside DIR) of EXR copies written beside; NULL: none */
     const char *scene_words;        /* the scene and its --set/--size options, shell-quoted, for the
                                        commands that make DIR/{sweep,tune,pareto} (NULL: the scene file) */
+    const float *flip_map;          /* per-pixel HDR-FLIP of a * test (NULL: no FLIP picture) */
+    const gr_flip_result *flip;     /* its statistics (with flip_map) */
 } gr_report_input;
 
 typedef struct gr_report_result {

@@ -46,7 +46,7 @@ if command -v iinfo >/dev/null 2>&1 && [ -n "$entry" ]; then
 fi
 
 # 2. the run's metrics are compare's metrics on the EXRs it wrote (same stderr rule, same fit)
-"$bin" compare rep1/reference.exr rep1/shafts.exr --fit-scale --json >cmp.json 2>cmp.err
+"$bin" compare rep1/reference.exr rep1/shafts.exr --fit-scale --scene "$scene" --json >cmp.json 2>cmp.err
 ck "compare on the run's EXRs exits 0" [ $? -eq 0 ]
 block() { sed -n "/^\t\"$2\":/,/^\t}/p" "$1"; }
 block rep1/metrics.json metrics >run_metrics.txt

@@ -16,6 +16,7 @@
 #include <cjson/cJSON.h>
 
 #include "check.h"
+#include "compare/flip.h"
 #include "compare/metrics.h"
 #include "image/oiio.h"
 #include "report/plot.h"
@@ -198,14 +199,19 @@ int main(void)
     snprintf(dir, sizeof dir, "%s/report_write", out ? out : "/tmp");
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     CHECK(system(cmd) == 0);
+    /* the FLIP map and its statistics, as godrays run passes them */
+    float *flipmap = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
+    gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = a};
+    gr_flip_result fres;
+    CHECK_OK(gr_flip_compute(ref, test, &fo, flipmap, &fres, &err), err);
     gr_report_input in = {.scene = scene, .ref = ref, .ref_meta = &rmeta, .test = test, .test_meta = &tmeta,
                           .metrics = &m, .command_line = "godrays run <x>", .ref_seconds = 1.0,
-                          .shafts_seconds = 0.5, .compare_seconds = 0.1};
+                          .shafts_seconds = 0.5, .compare_seconds = 0.1, .flip_map = flipmap, .flip = &fres};
     gr_report_result res;
     CHECK_OK(gr_report_write(dir, &in, &res, &err), err);
     CHECK_NEAR(res.fit_scale, a, 1e-9 * a);
     static const char *const files[] = {"index.html", "summary.png", "metrics.json", "reference.png", "shafts.png",
-                                        "shafts_raw.png", "diff.png", "diff_signed.png"};
+                                        "shafts_raw.png", "diff.png", "diff_signed.png", "flip.png"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) CHECK_MSG(exists(dir, files[i]), "%s missing", files[i]);
     CHECK(res.charts == (gr_plot_available() ? 3 : 0));
 
@@ -213,6 +219,11 @@ int main(void)
     snprintf(path, sizeof path, "%s/metrics.json", dir);
     char *text = slurp(path);
     cJSON *root = text ? cJSON_Parse(text) : NULL;
+    {
+        const cJSON *fj = cJSON_GetObjectItemCaseSensitive(root, "flip");
+        const cJSON *fm = cJSON_GetObjectItemCaseSensitive(fj, "mean");
+        CHECK(cJSON_IsNumber(fm) && fabs(fm->valuedouble - fres.mean) <= 1e-12);
+    }
     CHECK(root != NULL);
     if (root) {
         cJSON *v = get(root, "previews.shafts_scale");
@@ -274,7 +285,7 @@ int main(void)
             CHECK_MSG(exists(dir, name) && !strchr(name, '/'), "<img src=\"%s\"> is not a file in the folder", name);
             nimg++;
         }
-        CHECK_MSG(nimg == 5 + res.charts, "%d images in index.html", nimg);
+        CHECK_MSG(nimg == 6 + res.charts, "%d images in index.html", nimg); /* 6: with flip.png */
         CHECK(strstr(html, "16 pixels NOT SCORED") != NULL);
         CHECK(strstr(html, "2 ms") != NULL); /* the shaft pass's GPU time from the metadata */
     }
@@ -295,6 +306,7 @@ int main(void)
     gr_image_destroy(small);
     gr_image_destroy(ref);
     gr_image_destroy(test);
+    free(flipmap);
     gr_meta_free(&rmeta);
     gr_meta_free(&tmeta);
     free(scene);
