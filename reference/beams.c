@@ -606,6 +606,10 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     gr_dvec3 I = p->sun_dir;
     double eta = 1.0 / p->ior; /* air (n = 1) to water, seed eq. 5.5.1 with eta = n1 / n2 */
     for (int j = 0; j <= b->nw; j++) {
+        if (p->interrupt && *p->interrupt) { /* Ctrl-C: a cheap read per row of vertices */
+            free(pos); free(drift); free(jv); gr_beams_destroy(b);
+            return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
+        }
         for (int i = 0; i <= b->nu; i++) {
             size_t k = (size_t)j * (size_t)(b->nu + 1) + (size_t)i;
             double x0 = p->origin.x + start_u + i * h, z0 = p->origin.z + start_w + j * h;

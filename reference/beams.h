@@ -22,6 +22,7 @@
 #ifndef GR_REF_BEAMS_H
 #define GR_REF_BEAMS_H
 
+#include <signal.h>
 #include <stddef.h>
 #include "reference/embree_scene.h"
 
@@ -51,6 +52,7 @@ typedef struct gr_beam_params {
     double slab_cells;       /* drift of a beam per depth slab, in cells; 0 = 1. Thinner slabs
                                 (0.5) give tighter boxes: fewer candidates per lookup for a
                                 render's march, twice the primitives to build */
+    volatile sig_atomic_t *interrupt; /* nonzero (SIGINT/SIGTERM): the build stops, GR_E_INTERRUPTED */
 } gr_beam_params;
 
 typedef struct gr_beams gr_beams;

@@ -221,6 +221,22 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
         return gr_fail(err, GR_E_INPUT, "reference.batches: %d, need at least 2 for error bars", nb);
     }
     r->batches = st->batches;
+    /* a part of the work (godrays farm): rows [row0, row1), batches [batch0, batch1) */
+    if (!r->opt.row0 && !r->opt.row1) r->opt.row1 = s->camera.height;
+    if (!r->opt.batch0 && !r->opt.batch1) r->opt.batch1 = r->batches;
+    if (r->opt.row0 < 0 || r->opt.row1 > s->camera.height || r->opt.row0 >= r->opt.row1 || r->opt.batch0 < 0 ||
+        r->opt.batch1 > r->batches || r->opt.batch0 >= r->opt.batch1) {
+        gr_status e = gr_fail(err, GR_E_INPUT, "reference: part rows [%d, %d) of %d, batches [%d, %d) of %d: empty or outside",
+                              r->opt.row0, r->opt.row1, s->camera.height, r->opt.batch0, r->opt.batch1, r->batches);
+        free(r);
+        return e;
+    }
+    if ((r->opt.row1 - r->opt.row0 < s->camera.height || r->opt.batch1 - r->opt.batch0 < r->batches) &&
+        st->target_error > 0.0) {
+        free(r);
+        return gr_fail(err, GR_E_INPUT, "reference.target_error: a part of a render (rows or batches) takes the fixed "
+                                        "passes of one round; set it to 0 (docs/farm.md)");
+    }
     int S = st->sun_samples < 1 ? 1 : st->sun_samples;
     /* every batch gets the same number of passes: round the sun samples up */
     r->passes_per_round = ((S + r->batches - 1) / r->batches) * r->batches;
@@ -327,6 +343,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     bp.region = r->region;
     bp.pad_m = r->pad;
     bp.res = r->set.surface_res;
+    bp.interrupt = r->opt.interrupt;
     bp.jitter[0] = jit[0];
     bp.jitter[1] = jit[1];
     bp.max_prims = r->opt.max_prims;
@@ -429,6 +446,7 @@ typedef struct ref_job {
     /* accumulator pixel (x, y) is image pixel (x stride + off, y stride + off): stride 1 for
      * the image, a sparse grid for the surface-bias probe */
     int stride, off, img_w;
+    int y1;             /* accumulator rows [next_row's start, y1) */
     atomic_int next_row;
     atomic_int rows_done;
     atomic_int stop;
@@ -579,13 +597,16 @@ static void *worker(void *arg)
     for (;;) {
         if (atomic_load(&job->stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
         int y = atomic_fetch_add(&job->next_row, 1);
-        if (y >= acc->H) break;
+        if (y >= job->y1) break;
         for (int x = 0; x < acc->W; x++) {
             int px = x * job->stride + job->off, py = y * job->stride + job->off;
             size_t pix = (size_t)py * (size_t)job->img_w + (size_t)px; /* the image pixel: its RNG stream */
             size_t ai = (size_t)y * acc->W + x;
             double *sum = acc->sum + (ai * acc->B + job->batch) * 3;
             for (int s = 0; s < r->spp_pass; s++) {
+                /* Ctrl-C within about a second even at thousands of samples per pixel per pass:
+                 * a volatile read every 16 samples (the row then stays unfinished: partial) */
+                if ((s & 15) == 15 && r->opt.interrupt && *r->opt.interrupt) break;
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
@@ -601,6 +622,7 @@ static void *worker(void *arg)
                 }
             }
         }
+        if (r->opt.interrupt && *r->opt.interrupt) break; /* the row may be unfinished: not counted */
         atomic_fetch_add(&job->rows_done, 1);
     }
     atomic_fetch_add(&job->queries, cnt.queries);
@@ -663,6 +685,7 @@ static gr_status image_errors(const ref_accum *acc, ref_errors *e)
         nb++;
     }
     double mean = 0.0;
+    size_t nr = 0; /* rendered pixels */
     for (size_t p = 0; p < np; p++) {
         double s = 0.0, s2 = 0.0;
         uint32_t n = 0;
@@ -682,13 +705,15 @@ static gr_status image_errors(const ref_accum *acc, ref_errors *e)
         v[p] = n ? tot / (3.0 * n) : 0.0;
         double mm = kb ? s / kb : 0.0;
         se[p] = kb >= 2 ? sqrt(fmax(0.0, (s2 - kb * mm * mm) / (kb - 1)) / kb) : fabs(v[p]);
+        if (!n) se[p] = -1.0; /* not rendered (interrupted): no estimate, not "converged" */
         mean += v[p];
+        nr += n > 0;
     }
-    mean /= (double)np;
+    mean /= (double)(nr ? nr : 1);
     size_t ok = 0;
-    for (size_t p = 0; p < np; p++) ok += se[p] <= 0.01 * fmax(v[p], mean);
+    for (size_t p = 0; p < np; p++) ok += se[p] >= 0.0 && se[p] <= 0.01 * fmax(v[p], mean);
     e->mean = mean;
-    e->frac_1pct = (double)ok / (double)np;
+    e->frac_1pct = (double)ok / (double)np; /* unrendered pixels count as not within 1 % */
     memcpy(tmp, v, np * sizeof *v);
     e->p95 = percentile(tmp, np, 0.95);
     if (nb >= 2) {
@@ -838,10 +863,10 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
 
 typedef struct ref_march_totals { double march_s; long long queries, shadows, overflows; } ref_march_totals;
 
-/* Marches one pass over every row of acc with r->threads workers (thread handles in th),
+/* Marches one pass over the rows [y0, y1) of acc with r->threads workers (thread handles in th),
  * the progress bar going from frac0 to frac0 + span. *complete = 0 when interrupted. */
-static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int batch, int stride, int off,
-                            pthread_t *th, gr_progress *prog, double frac0, double span, const char *note,
+static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int batch, int stride, int off, int y0,
+                            int y1, pthread_t *th, gr_progress *prog, double frac0, double span, const char *note,
                             ref_march_totals *tot, int *complete, gr_error *err)
 {
     ref_job job;
@@ -852,7 +877,8 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
     job.stride = stride;
     job.off = off;
     job.img_w = r->scene.camera.width;
-    atomic_init(&job.next_row, 0);
+    job.y1 = y1;
+    atomic_init(&job.next_row, y0);
     atomic_init(&job.rows_done, 0);
     atomic_init(&job.stop, 0);
     atomic_init(&job.queries, 0);
@@ -869,8 +895,8 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
         return gr_fail(err, GR_E_RUNTIME, "reference: could not start worker threads (reference.threads = %d)", r->threads);
     for (;;) {
         int done = atomic_load(&job.rows_done);
-        gr_progress_update(prog, frac0 + span * (double)done / acc->H, note);
-        if (done >= acc->H || atomic_load(&job.stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
+        gr_progress_update(prog, frac0 + span * (double)done / (y1 - y0), note);
+        if (done >= y1 - y0 || atomic_load(&job.stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
         /* short sleeps first so tiny renders (tests) do not wait on the poll */
         double waited = mono_s() - tm;
         struct timespec ts = {0, waited < 0.05 ? 500 * 1000 : 20 * 1000 * 1000};
@@ -882,7 +908,7 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
     tot->shadows += atomic_load(&job.shadow_rays);
     tot->overflows += atomic_load(&job.overflows);
     if (atomic_load(&job.stop) == 2) return gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
-    *complete = atomic_load(&job.rows_done) >= acc->H;
+    *complete = atomic_load(&job.rows_done) >= y1 - y0;
     return GR_OK;
 }
 
@@ -894,7 +920,29 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
  * (L_2h - L_h) / 3; r->bias_rel = the mean of its absolute value over the probe pixels
  * divided by their mean value: the same figure as the convergence study's table. What noise
  * the common random numbers leave in the difference makes it an overestimate. */
-static gr_status surface_bias_probe(gr_ref_renderer *r, pthread_t *th, gr_progress *prog, double frac0, double span,
+/* The probe's estimate from its two accumulators of np pixels (sums at h and at 2h). */
+static double probe_bias(const double *sum_h, const uint32_t *cnt_h, const double *sum_2h, const uint32_t *cnt_2h,
+                         size_t np)
+{
+    double d = 0.0, v = 0.0;
+    for (size_t i = 0; i < np; i++) {
+        if (!cnt_h[i] || !cnt_2h[i]) continue;
+        double lh = (sum_h[3 * i] + sum_h[3 * i + 1] + sum_h[3 * i + 2]) / (3.0 * cnt_h[i]);
+        double l2h = (sum_2h[3 * i] + sum_2h[3 * i + 1] + sum_2h[3 * i + 2]) / (3.0 * cnt_2h[i]);
+        d += fabs(l2h - lh) / 3.0; /* Richardson, p = 2: e_h = (L_2h - L_h) / (2^2 - 1) */
+        v += lh;
+    }
+    return v > 0.0 && isfinite(d) ? d / v : (d > 0.0 ? -1.0 : 0.0);
+}
+
+/* First probe row at or below image row `row` (rows py = y stride + off). */
+static int probe_row(int row, int stride, int off, int h)
+{
+    int y = row <= off ? 0 : (row - off + stride - 1) / stride;
+    return y < h ? y : h;
+}
+
+static gr_status surface_bias_probe(gr_ref_renderer *r, gr_ref_sums *keep, pthread_t *th, gr_progress *prog, double frac0, double span,
                                     ref_march_totals *tot, gr_error *err)
 {
     int W = r->scene.camera.width, H = r->scene.camera.height;
@@ -916,35 +964,130 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, pthread_t *th, gr_progre
         if (!a[k].sum || !a[k].count) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
     }
     int complete = 1;
+    /* a part probes its own rows' probe pixels */
+    int y0 = probe_row(r->opt.row0, PROBE_STRIDE, off, a[0].H), y1 = probe_row(r->opt.row1, PROBE_STRIDE, off, a[0].H);
     for (int p = 0; p < passes && st == GR_OK && complete; p++)
         for (int k = 0; k < 2 && st == GR_OK && complete; k++) {
             r->set.surface_res = k ? res2 : res;
             r->beams_pass = -1; /* another resolution: rebuild */
             st = gr_ref_prepare_pass(r, p, err);
+            if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; break; }
             if (st == GR_OK)
-                st = march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, th, prog, frac0 + span * (2 * p + k) / (2.0 * passes),
+                st = march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, y0, y1, th, prog, frac0 + span * (2 * p + k) / (2.0 * passes),
                                 span / (2.0 * passes), "surface-bias probe", tot, &complete, err);
         }
     r->set.surface_res = res;
     r->beams_pass = -1;
     if (st == GR_OK && complete) {
-        double d = 0.0, v = 0.0;
-        for (size_t i = 0; i < np; i++) {
-            if (!a[0].count[i] || !a[1].count[i]) continue;
-            double lh = (a[0].sum[3 * i] + a[0].sum[3 * i + 1] + a[0].sum[3 * i + 2]) / (3.0 * a[0].count[i]);
-            double l2h = (a[1].sum[3 * i] + a[1].sum[3 * i + 1] + a[1].sum[3 * i + 2]) / (3.0 * a[1].count[i]);
-            d += fabs(l2h - lh) / 3.0; /* Richardson, p = 2: e_h = (L_2h - L_h) / (2^2 - 1) */
-            v += lh;
-        }
-        r->bias_rel = v > 0.0 && isfinite(d) ? d / v : (d > 0.0 ? -1.0 : 0.0);
+        r->bias_rel = probe_bias(a[0].sum, a[0].count, a[1].sum, a[1].count, np);
         r->bias_probe_pixels = (long long)np;
         r->bias_probe_passes = passes;
+        if (keep) { /* hand the sums over */
+            keep->probe_w = a[0].W;
+            keep->probe_h = a[0].H;
+            keep->probe_levels = 2;
+            for (int k = 0; k < 2; k++) {
+                free(keep->probe_sum[k]);
+                free(keep->probe_count[k]);
+                keep->probe_sum[k] = a[k].sum;
+                keep->probe_count[k] = a[k].count;
+                a[k].sum = NULL;
+                a[k].count = NULL;
+            }
+            keep->probe = 1;
+            keep->probe_stride = PROBE_STRIDE;
+            keep->probe_off = off;
+            keep->probe_passes = passes;
+        }
     }
     for (int k = 0; k < 2; k++) {
         free(a[k].sum);
         free(a[k].count);
     }
     return st;
+}
+
+/* The end of a render from its sums: image, error bars, statistics, metadata (shared by
+ * gr_ref_render and gr_ref_assemble, so merged parts give the same bytes). */
+static gr_status finish_result(gr_ref_renderer *r, const ref_accum *acc, const ref_march_totals *tot, double wall_s,
+                               gr_ref_result *out, gr_error *err)
+{
+    size_t np = (size_t)acc->W * acc->H;
+    int P = r->passes_per_round;
+    ref_errors e;
+    memset(&e, 0, sizeof e);
+    gr_status st = GR_OK;
+    if (image_errors(acc, &e) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
+    if (st == GR_OK) st = build_image(r, acc, out, err);
+    if (st != GR_OK) return st;
+    out->wall_s = wall_s;
+    out->rel_se_mean = e.rel_mean;
+    out->rel_se_p95 = e.rel_p95;
+    out->frac_se_1pct = e.frac_1pct;
+    out->queries_per_s = tot->march_s > 0.0 ? (double)tot->queries / tot->march_s : 0.0;
+    out->shadow_rays_per_s = tot->march_s > 0.0 ? (double)tot->shadows / tot->march_s : 0.0;
+    out->beam_build_s = r->beam_build_s;
+    out->bias_surface_rel = r->bias_rel;
+    out->rounds = P > 0 ? (out->passes + P - 1) / P : 0;
+    out->max_rounds = r->set.target_error > 0.0 ? r->opt.max_rounds : 1;
+    /* preview: the 99th percentile of the brightest channel maps to 0.8 */
+    double *v = malloc(np * sizeof *v);
+    out->preview_exposure = 1.0;
+    if (v) {
+        for (size_t p = 0; p < np; p++) {
+            const float *px = out->image->pixels + p * out->image->nchannels;
+            v[p] = fmax(px[0], fmax(px[1], px[2]));
+        }
+        double p99 = percentile(v, np, 0.99);
+        if (p99 > 0.0 && isfinite(p99)) out->preview_exposure = 0.8 / p99;
+        free(v);
+    }
+    if (fill_metadata(r, out, &e, out->queries_per_s) != GR_OK)
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for metadata");
+    gr_meta_set_double(&out->meta, "godrays:shadow_rays_per_s", out->shadow_rays_per_s);
+    gr_meta_set_int(&out->meta, "godrays:beam_overflows", tot->overflows);
+    return GR_OK;
+}
+
+gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_levels, int probe_w, int probe_h)
+{
+    gr_ref_sums *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    size_t np = (size_t)W * H, nq = (size_t)probe_w * probe_h;
+    s->W = W;
+    s->H = H;
+    s->B = B;
+    s->sum = calloc(np * B * 3 + 1, sizeof *s->sum);
+    s->count = calloc(np * B + 1, sizeof *s->count);
+    int ok = s->sum && s->count;
+    if (probe_levels > GR_REF_PROBE_MAX_LEVELS) ok = 0;
+    if (nq && probe_levels > 0 && ok) {
+        s->probe_w = probe_w;
+        s->probe_h = probe_h;
+        s->probe_levels = probe_levels;
+        for (int k = 0; k < probe_levels; k++) {
+            s->probe_sum[k] = calloc(nq * 3, sizeof *s->probe_sum[k]);
+            s->probe_count[k] = calloc(nq, sizeof *s->probe_count[k]);
+            ok = ok && s->probe_sum[k] && s->probe_count[k];
+        }
+    }
+    if (!ok) {
+        gr_ref_sums_destroy(s);
+        return NULL;
+    }
+    return s;
+}
+
+void gr_ref_sums_destroy(gr_ref_sums *s)
+{
+    if (!s) return;
+    free(s->sum);
+    free(s->count);
+    for (int k = 0; k < GR_REF_PROBE_MAX_LEVELS; k++) {
+        free(s->probe_sum[k]);
+        free(s->probe_count[k]);
+    }
+    free(s);
 }
 
 gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
@@ -962,8 +1105,9 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     acc.aov = r->opt.aovs ? calloc(np * 2, sizeof *acc.aov) : NULL;
     gr_progress *prog = gr_progress_create("reference", r->opt.progress);
     pthread_t *th = calloc((size_t)r->threads, sizeof *th);
-    if (!acc.sum || !acc.count || (r->opt.aovs && !acc.aov) || !prog || !th) {
-        free(acc.sum); free(acc.count); free(acc.aov); free(th); gr_progress_destroy(prog);
+    gr_ref_sums *keep = r->opt.keep_sums ? calloc(1, sizeof *keep) : NULL;
+    if (!acc.sum || !acc.count || (r->opt.aovs && !acc.aov) || !prog || !th || (r->opt.keep_sums && !keep)) {
+        free(acc.sum); free(acc.count); free(acc.aov); free(th); free(keep); gr_progress_destroy(prog);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %dx%d pixels x %d batches", acc.W, acc.H, acc.B);
     }
     int P = r->passes_per_round;
@@ -973,19 +1117,21 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     memset(&e, 0, sizeof e);
     int pass = 0;
     r->rendering = 1;
-    int probe = r->set.bias_probe && !r->flat;
+    int probe = r->set.bias_probe && !r->flat && r->opt.batch0 == 0; /* a part: the one with batch 0 */
     double mainw = probe ? 0.95 : 1.0; /* share of the progress bar for the main passes */
     ref_march_totals tot = {0.0, 0, 0, 0};
     for (int round = 0; round < rounds && st == GR_OK && !out->partial; round++) {
         for (int pp = 0; pp < P && st == GR_OK; pp++, pass++) {
+            if (pass % acc.B < r->opt.batch0 || pass % acc.B >= r->opt.batch1) continue; /* another part's batch */
             if (r->opt.interrupt && *r->opt.interrupt) { out->partial = 1; break; }
             st = gr_ref_prepare_pass(r, pass, err);
+            if (st == GR_E_INTERRUPTED) { st = GR_OK; out->partial = 1; break; }
             if (st != GR_OK) break;
             char note[64];
             snprintf(note, sizeof note, "pass %d/%d%s", pp + 1, P, rounds > 1 ? " (refining)" : "");
             int complete = 0;
-            st = march_pass(r, &acc, pass, pass % acc.B, 1, 0, th, prog, mainw * (rounds > 1 ? pp : pass) / P,
-                            mainw / P, note, &tot, &complete, err);
+            st = march_pass(r, &acc, pass, pass % acc.B, 1, 0, r->opt.row0, r->opt.row1, th, prog,
+                            mainw * (rounds > 1 ? pp : pass) / P, mainw / P, note, &tot, &complete, err);
             if (st != GR_OK) break;
             if (!complete) { out->partial = 1; break; }
             out->passes++;
@@ -1000,52 +1146,72 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     r->bias_rel = r->flat ? 0.0 : -1.0;
     r->have_main_beams = r->beams != NULL;
     if (r->beams) r->main_beams = *gr_beams_stats(r->beams);
+    ref_march_totals ptot = {0.0, 0, 0, 0};
     if (st == GR_OK && probe && !out->partial) {
-        ref_march_totals ptot = {0.0, 0, 0, 0};
         double tp = mono_s();
-        st = surface_bias_probe(r, th, prog, mainw, 1.0 - mainw, &ptot, err);
+        st = surface_bias_probe(r, keep, th, prog, mainw, 1.0 - mainw, &ptot, err);
         r->bias_probe_s = mono_s() - tp;
     }
     r->rendering = 0;
     gr_progress_finish(prog);
     gr_progress_destroy(prog);
     free(th);
-    if (st == GR_OK && image_errors(&acc, &e) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
-    if (st == GR_OK) st = build_image(r, &acc, out, err);
-    if (st == GR_OK) {
-        out->wall_s = mono_s() - t0;
-        out->rel_se_mean = e.rel_mean;
-        out->rel_se_p95 = e.rel_p95;
-        out->frac_se_1pct = e.frac_1pct;
-        out->queries_per_s = tot.march_s > 0.0 ? (double)tot.queries / tot.march_s : 0.0;
-        out->shadow_rays_per_s = tot.march_s > 0.0 ? (double)tot.shadows / tot.march_s : 0.0;
-        out->beam_build_s = r->beam_build_s;
-        out->bias_surface_rel = r->bias_rel;
-        out->rounds = P > 0 ? (out->passes + P - 1) / P : 0;
-        out->max_rounds = rounds;
-        /* preview: the 99th percentile of the brightest channel maps to 0.8 */
-        size_t n = np;
-        double *v = malloc(n * sizeof *v);
-        out->preview_exposure = 1.0;
-        if (v) {
-            for (size_t p = 0; p < n; p++) {
-                const float *px = out->image->pixels + p * out->image->nchannels;
-                v[p] = fmax(px[0], fmax(px[1], px[2]));
-            }
-            double p99 = percentile(v, n, 0.99);
-            if (p99 > 0.0 && isfinite(p99)) out->preview_exposure = 0.8 / p99;
-            free(v);
-        }
-        if (fill_metadata(r, out, &e, out->queries_per_s) != GR_OK)
-            st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for metadata");
-        else {
-            gr_meta_set_double(&out->meta, "godrays:shadow_rays_per_s", out->shadow_rays_per_s);
-            gr_meta_set_int(&out->meta, "godrays:beam_overflows", tot.overflows);
-        }
+    if (st == GR_OK) st = finish_result(r, &acc, &tot, mono_s() - t0, out, err);
+    if (st == GR_OK && keep) { /* the raw sums for a part file (src/farm/parts.h) */
+        keep->W = acc.W;
+        keep->H = acc.H;
+        keep->B = acc.B;
+        keep->sum = acc.sum;
+        keep->count = acc.count;
+        acc.sum = NULL;
+        acc.count = NULL;
+        keep->passes = out->passes;
+        keep->probe_s = r->bias_probe_s;
+        keep->beam_cell_m = r->have_main_beams ? r->main_beams.cell_m : 0.0;
+        keep->beam_prims = r->have_main_beams ? (long long)r->main_beams.prims : 0;
+        keep->beam_build_s = r->beam_build_s;
+        keep->march_s = tot.march_s;
+        keep->queries = tot.queries;
+        keep->shadows = tot.shadows;
+        keep->overflows = tot.overflows;
+        out->sums = keep;
+        keep = NULL;
     }
+    gr_ref_sums_destroy(keep);
     free(acc.sum);
     free(acc.count);
     free(acc.aov);
+    if (st != GR_OK) gr_ref_result_free(out);
+    return st;
+}
+
+gr_status gr_ref_assemble(gr_ref_renderer *r, const gr_ref_sums *sums, double wall_s, gr_ref_result *out, gr_error *err)
+{
+    memset(out, 0, sizeof *out);
+    gr_meta_init(&out->meta);
+    if (sums->W != r->scene.camera.width || sums->H != r->scene.camera.height || sums->B != r->batches)
+        return gr_fail(err, GR_E_INPUT, "reference: sums of %dx%d pixels x %d batches for a %dx%d render with %d batches",
+                       sums->W, sums->H, sums->B, r->scene.camera.width, r->scene.camera.height, r->batches);
+    ref_accum acc = {sums->W, sums->H, sums->B, sums->sum, sums->count, NULL};
+    r->bias_rel = r->flat ? 0.0 : -1.0;
+    if (sums->probe && sums->probe_levels != 2)
+        return gr_fail(err, GR_E_INPUT, "reference: sums with %d probe levels; this integrator's probe has 2",
+                       sums->probe_levels);
+    if (sums->probe && !r->flat) {
+        r->bias_rel = probe_bias(sums->probe_sum[0], sums->probe_count[0], sums->probe_sum[1], sums->probe_count[1],
+                                 (size_t)sums->probe_w * sums->probe_h);
+        r->bias_probe_pixels = (long long)sums->probe_w * sums->probe_h;
+        r->bias_probe_passes = sums->probe_passes;
+        r->bias_probe_s = sums->probe_s;
+    }
+    r->have_main_beams = sums->beam_prims > 0;
+    memset(&r->main_beams, 0, sizeof r->main_beams);
+    r->main_beams.cell_m = sums->beam_cell_m;
+    r->main_beams.prims = (size_t)sums->beam_prims;
+    r->beam_build_s = sums->beam_build_s;
+    out->passes = sums->passes;
+    ref_march_totals tot = {sums->march_s, sums->queries, sums->shadows, sums->overflows};
+    gr_status st = finish_result(r, &acc, &tot, wall_s, out, err);
     if (st != GR_OK) gr_ref_result_free(out);
     return st;
 }
@@ -1055,6 +1221,8 @@ void gr_ref_result_free(gr_ref_result *res)
     if (!res) return;
     gr_image_destroy(res->image);
     res->image = NULL;
+    gr_ref_sums_destroy(res->sums);
+    res->sums = NULL;
     gr_meta_free(&res->meta);
 }
 

@@ -16,6 +16,7 @@
 
 #include <signal.h>
 #include <stddef.h>
+#include <stdint.h>
 #include "common/status.h"
 #include "core/vec.h"
 #include "image/image.h"
@@ -35,6 +36,13 @@ typedef struct gr_ref_options {
      * y_min. Unused when lit_box_valid = 0 (the region then follows the camera frustum). */
     int lit_box_valid;
     double lit_box[5];      /* x0, x1, z0, z1, y_min (world) */
+    /* A part of the work (godrays farm, docs/farm.md): image rows [row0, row1) and batches
+     * [batch0, batch1) only; both 0, 0 = all. Passes of other batches are skipped, the pixel
+     * and pass random numbers stay keyed as in a full render, so a part's sums are the same
+     * bytes as those pixels' and batches' sums in a full render. The surface-bias probe runs
+     * (on its pixels in these rows) only in the part that holds batch 0. */
+    int row0, row1, batch0, batch1;
+    int keep_sums;          /* 1: gr_ref_result.sums holds the raw per-batch sums (parts) */
 } gr_ref_options;
 
 void gr_ref_options_default(gr_ref_options *o);
@@ -43,6 +51,31 @@ typedef struct gr_ref_renderer gr_ref_renderer;
 
 gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_renderer **out, gr_error *err);
 void gr_ref_destroy(gr_ref_renderer *r); /* accepts NULL */
+
+/* The raw sums a render's image, error bars and statistics are computed from: per pixel and
+ * batch the RGB sums of the camera samples and their count, and the surface-bias probe's two
+ * sparse accumulators (surface_res and surface_res / 2). gr_ref_assemble turns full sums
+ * back into the result a single render gives, bit for bit (src/farm/parts.h merges them). */
+#define GR_REF_PROBE_MAX_LEVELS 4
+typedef struct gr_ref_sums {
+    int W, H, B;            /* image size, batches */
+    double *sum;            /* [(pixel * B + batch) * 3 + c] */
+    uint32_t *count;        /* [pixel * B + batch] */
+    int passes;             /* main passes done (every batch) */
+    int probe;              /* 1: the probe ran (the probe_* fields are set) */
+    int probe_w, probe_h, probe_stride, probe_off, probe_passes;
+    int probe_levels;       /* its accumulators: surface_res, surface_res / 2 (, ...) */
+    double *probe_sum[GR_REF_PROBE_MAX_LEVELS];   /* [probe pixel * 3 + c] per level */
+    uint32_t *probe_count[GR_REF_PROBE_MAX_LEVELS];
+    double probe_s;         /* probe time */
+    double beam_cell_m;     /* the main passes' last beam set (0: none) */
+    long long beam_prims;
+    double beam_build_s, march_s;
+    long long queries, shadows, overflows;
+} gr_ref_sums;
+/* Zeroed sums; probe_levels accumulators of probe_w x probe_h (0: none). NULL if no memory. */
+gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_levels, int probe_w, int probe_h);
+void gr_ref_sums_destroy(gr_ref_sums *s); /* accepts NULL */
 
 typedef struct gr_ref_result {
     gr_image *image;        /* R, G, B, stderr.R, stderr.G, stderr.B [, transmittance, ray_length] */
@@ -61,12 +94,18 @@ typedef struct gr_ref_result {
     int rounds, max_rounds; /* rounds of passes done; the cap that --target-error refines up to */
     double bias_surface_rel;/* surface-tessellation bias: mean |pixel bias| / image mean,
                                measured by the probe (0 on flat water, -1 if not estimated) */
+    gr_ref_sums *sums;      /* with gr_ref_options.keep_sums: the raw sums (freed with the result) */
 } gr_ref_result;
 
 /* Renders the image; `progress_label` may be NULL. On interruption returns GR_OK with
  * out->partial = 1 (the caller writes what is there). */
 gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err);
 void gr_ref_result_free(gr_ref_result *res); /* accepts NULL */
+/* The result of a render from its full sums (every row and batch, e.g. merged parts): the
+ * same code as the end of gr_ref_render, so pixels, error channels and statistics are the
+ * bytes a single render writes. Needs r's scene and settings (no pass is rendered);
+ * wall_s is the caller's. Timings and counters come from the sums. */
+gr_status gr_ref_assemble(gr_ref_renderer *r, const gr_ref_sums *sums, double wall_s, gr_ref_result *out, gr_error *err);
 
 /* ---- probes for the oracles and the second estimator ---- */
 /* Builds the beam set of pass `pass` (sun direction and grid jitter of that pass). */

@@ -11,7 +11,7 @@ scene=$here/data/scenes/default.json
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$bin" info 2>/dev/null | grep -i -E '^ *(OpenGL|GL)' || true
-echo "| variant | shafts | target | shadow ms | shafts ms | final ms | CPU ms / render | fragments (overdraw) | VS invocations |"
+echo "| variant | shafts | target | shadow ms | shafts ms | final ms | wall ms / render | fragments (overdraw) | VS invocations |"
 echo "|---|---|---|---|---|---|---|---|---|"
 row() {
     name=$1
@@ -24,12 +24,12 @@ row() {
             if ($i == "shadow") sh = $(i+1)
             if ($i == "shafts" && $(i+1) ~ /^[0-9.]+,?$/) sf = $(i+1)
             if ($i == "final") fi_ = $(i+1)
-            if ($i == "CPU") cpu = $(i+1)
-            if ($i == "fragments") fr = $(i+1)
+            if ($i == "CPU" || $i == "wall") cpu = $(i+1)
+            if ($i == "fragments" && $(i+1) ~ /^[0-9]/) fr = $(i+1)
             if ($i == "(overdraw") od = $(i+1)
             if ($i == "(VS") vs = $(i+2)
         }
-        gsub(/[,;)]/, "", sh); gsub(/[,;)]/, "", sf); gsub(/[,;)]/, "", fi_); gsub(/[,;)]/, "", od); gsub(/[,;)]/, "", vs)
+        gsub(/[,;)]/, "", fr); gsub(/[,;)]/, "", sh); gsub(/[,;)]/, "", sf); gsub(/[,;)]/, "", fi_); gsub(/[,;)]/, "", od); gsub(/[,;)]/, "", vs)
         printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s |\n", name, n, tgt, sh, sf, fi_, cpu, fr, od, vs
     }'
 }

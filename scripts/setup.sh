@@ -21,11 +21,39 @@ GODRAYS_PACKAGES=(
   libplplot-dev plplot-driver-qt
   # headless browser for the report's test (tests/cli/test_report_browser.sh)
   chromium
+  # Node.js for the test tools installed from npm below (npm_tools)
+  nodejs
+  # Blender round trip of the glTF export (tests/cli/test_export_blender.sh); its glTF
+  # importer needs NumPy, only a Recommends of blender
+  blender python3-numpy
+  # a single-node Slurm cluster for the farm test (tests/farm/test_slurm.sh, docs/farm.md)
+  slurm-wlm munge
 )
 
 installed() {
   # "install ok installed" is the only state in which a package's files are all present
   [ "$(dpkg-query -W -f '${Status}' "$1" 2>/dev/null)" = "install ok installed" ]
+}
+
+# ---- test tools from npm (tests only; into build-tools/, ignored by git) -----------------
+# Khronos' glTF-Validator for tests/cli/test_export_gltf.sh, pinned, installed only when missing.
+GLTF_VALIDATOR_VERSION=2.0.0-dev.3.10
+npm_tools() {
+  local dir
+  dir="$(cd "$(dirname "$0")/.." && pwd)/build-tools"
+  local pj="$dir/node_modules/gltf-validator/package.json"
+  if [ -f "$pj" ] && [ "$(node -p "require('$pj').version" 2>/dev/null)" = "$GLTF_VALIDATOR_VERSION" ]; then
+    echo "setup: gltf-validator $GLTF_VALIDATOR_VERSION is in build-tools/"
+    return 0
+  fi
+  if ! command -v npm >/dev/null 2>&1; then
+    # Debian's nodejs has no npm; NodeSource's has it built in
+    [ "$(id -u)" -eq 0 ] || { echo "setup: npm missing: run as root (or: sudo apt-get install npm)" >&2; exit 2; }
+    apt-get install -y -q --no-install-recommends npm
+  fi
+  echo "setup: npm install gltf-validator@$GLTF_VALIDATOR_VERSION into build-tools/"
+  mkdir -p "$dir"
+  npm install --no-audit --no-fund --silent --prefix "$dir" "gltf-validator@$GLTF_VALIDATOR_VERSION"
 }
 
 missing=()
@@ -35,6 +63,7 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#GODRAYS_PACKAGES[@]} packages are installed"
+  npm_tools
   exit 0
 fi
 
@@ -59,3 +88,4 @@ if [ ${#still[@]} -ne 0 ]; then
   exit 1
 fi
 echo "setup: installed ${#missing[@]} package(s)"
+npm_tools

@@ -1,5 +1,6 @@
 /* Shared argument handling of the godrays commands (args.h). */
 #include "cli/args.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -25,9 +26,14 @@ void gr_args_create(gr_args *a, const char *cmd, int argc, char **argv)
 void gr_args_free(gr_args *a)
 {
     if (!a) return;
-    for (int k = 0; k < a->n_sets; k++) free(a->sets[k]);
+    for (int k = 0; k < a->n_sets; k++) {
+        free(a->sets[k]);
+        free(a->origins[k]);
+    }
     free(a->sets);
+    free(a->origins);
     a->sets = NULL;
+    a->origins = NULL;
     a->n_sets = a->cap_sets = 0;
 }
 
@@ -58,14 +64,30 @@ static int push_set(gr_args *a, char *s)
     if (a->n_sets == a->cap_sets) {
         int cap = a->cap_sets ? 2 * a->cap_sets : 16;
         char **p = realloc(a->sets, (size_t)cap * sizeof *p);
-        if (!p) {
+        if (p) a->sets = p;
+        char **o = p ? realloc(a->origins, (size_t)cap * sizeof *o) : NULL;
+        if (!o) {
             free(s);
             return out_of_memory(a);
         }
-        a->sets = p;
+        a->origins = o;
         a->cap_sets = cap;
     }
+    a->origins[a->n_sets] = NULL;
     a->sets[a->n_sets++] = s;
+    return 0;
+}
+
+/* The last override came from the flag before argv[i] and its value argv[i]. */
+static int set_origin(gr_args *a)
+{
+    const char *flag = a->argv[a->i - 1], *v = a->argv[a->i];
+    size_t n = strlen(flag) + strlen(v) + 2;
+    char *o = malloc(n);
+    if (!o) return out_of_memory(a);
+    snprintf(o, n, "%s %s", flag, v);
+    free(a->origins[a->n_sets - 1]);
+    a->origins[a->n_sets - 1] = o;
     return 0;
 }
 
@@ -115,14 +137,17 @@ int gr_args_take_size(gr_args *a)
     const char *v = NULL;
     int rc = gr_args_value(a, &v);
     if (rc) return rc;
-    int w = 0, h = 0;
-    char extra;
-    if (sscanf(v, "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1)
+    /* digits only, any length: the scene's range check then names the limit (an int
+     * parse wrapped 99999999999 around to 1215752191) */
+    const size_t nw = strspn(v, "0123456789");
+    const size_t nh = v[nw] == 'x' ? strspn(v + nw + 1, "0123456789") : 0;
+    if (!nw || !nh || v[nw + 1 + nh] || strtod(v, NULL) < 1 || strtod(v + nw + 1, NULL) < 1)
         return gr_cli_usage_error(a->cmd, "--size %s: expected WxH, e.g. %s", v,
                                   a->size_example ? a->size_example : "640x360");
     a->have_size = 1;
-    if ((rc = gr_args_add_set(a, "camera.width=%d", w)) != 0) return rc;
-    return gr_args_add_set(a, "camera.height=%d", h);
+    if ((rc = gr_args_add_set(a, "camera.width=%.*s", (int)nw, v)) != 0 || (rc = set_origin(a)) != 0) return rc;
+    if ((rc = gr_args_add_set(a, "camera.height=%s", v + nw + 1)) != 0) return rc;
+    return set_origin(a);
 }
 
 int gr_args_take_setting(gr_args *a, const char *key)
@@ -130,7 +155,8 @@ int gr_args_take_setting(gr_args *a, const char *key)
     const char *v = NULL;
     int rc = gr_args_value(a, &v);
     if (rc) return rc;
-    return gr_args_add_set(a, "%s=%s", key, v);
+    if ((rc = gr_args_add_set(a, "%s=%s", key, v)) != 0) return rc;
+    return set_origin(a);
 }
 
 int gr_args_take_gl_platform(gr_args *a, gr_gl_platform *platform)
@@ -217,6 +243,16 @@ int gr_args_load_scene(const gr_args *a, gr_scene **scene)
     if (gr_scene_load_file(a->scene_path, gr_args_sets(a), a->n_sets, *scene, &err) != GR_OK) {
         free(*scene);
         *scene = NULL;
+        /* "--set KEY=V: ..." for an override that a flag made: name the flag as typed */
+        for (int k = 0; k < a->n_sets; k++) {
+            char typed[GR_ERROR_MSG_MAX];
+            const int n = snprintf(typed, sizeof typed, "--set %s", a->sets[k]);
+            if (!a->origins[k] || n < 0 || n >= (int)sizeof typed || strncmp(err.msg, typed, (size_t)n)) continue;
+            char rest[GR_ERROR_MSG_MAX];
+            snprintf(rest, sizeof rest, "%s", err.msg + n);
+            snprintf(err.msg, sizeof err.msg, "%s%s", a->origins[k], rest);
+            break;
+        }
         return gr_cli_report(a->cmd, &err);
     }
     return 0;
@@ -270,6 +306,13 @@ int gr_args_check_output_file(const gr_args *a, const char *flag, const char *pa
     if (strlen(path) >= sizeof dir) return output_error(a, flag, path, "cannot write", "", ENAMETOOLONG);
     if (path[strlen(path) - 1] == '/' || (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)))
         return output_error(a, flag, path, "cannot write", "", EISDIR);
+    gr_outfile probe; /* an existing device node, FIFO or socket is refused (common/outfile) */
+    gr_error perr;
+    if (gr_outfile_begin(&probe, path, &perr) != GR_OK) {
+        gr_error_prefix(&perr, "%s", flag);
+        return gr_cli_report(a->cmd, &perr);
+    }
+    gr_outfile_abort(&probe); /* nothing was created */
     parent_of(path, dir, sizeof dir);
     const int e = writable_dir(dir);
     return e ? output_error(a, flag, path, "cannot write into ", dir, e) : 0;

@@ -22,6 +22,8 @@ typedef struct gr_args {
     int i;                      /* the argument being read; taking a value advances it */
     char **sets;                /* scene overrides "KEY=VALUE" in command-line order (owned) */
     int n_sets, cap_sets;
+    char **origins;             /* per override: the flag and value that made it ("--threads 4"),
+                                   NULL for --set; messages name what the user typed (owned) */
     int have_size;              /* --size was given */
     const char *size_example;   /* in the --size message; NULL: "640x360" */
     const char *scene_path;     /* the positional SCENE argument (NULL: none yet) */

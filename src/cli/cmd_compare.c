@@ -2,6 +2,8 @@
  * and a real-time frame, possibly captured from another engine), optional mask, reference
  * standard errors, best scale fit; with -o DIR also metrics.json and false-color differences. */
 #include "cli/cli.h"
+#include "common/memlimit.h"
+#include "common/outfile.h"
 #include "cli/args.h"
 
 #include <errno.h>
@@ -66,27 +68,26 @@ static void usage(FILE *f)
             "                       with -o, DIR/flip.png is the per-pixel FLIP map (magma, 0 black\n"
             "                       .. 1 white-yellow)\n"
             "  --json               print the JSON instead of the table\n"
+            "  --max-memory SIZE    refuse (exit 2) images estimated to need more (e.g. 2G; default\n"
+            "                       $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  -h, --help           this help\n"
             "\n"
             "Exit codes: 0 ok, 1 runtime failure, 2 bad usage, unreadable input or size mismatch.\n",
             GR_METRICS_STDERR_BOUND);
 }
 
-/* Writes text to path through a temporary file renamed into place. */
+/* Writes text and a newline to path atomically (common/outfile). */
 static gr_status write_text(const char *path, const char *text, gr_error *err)
 {
-    char tmp[4300];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
-    int ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok || rename(tmp, path) != 0) {
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    }
-    return GR_OK;
+    size_t n = strlen(text);
+    char *t = malloc(n + 2);
+    if (!t) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
+    memcpy(t, text, n);
+    t[n] = '\n';
+    t[n + 1] = '\0';
+    gr_status st = gr_outfile_write(path, t, (long long)n + 1, err);
+    free(t);
+    return st;
 }
 
 /* Reads one input; any failure is bad input (exit 2) naming the role and the file. */
@@ -114,6 +115,17 @@ static cJSON *image_json(const char *path, const gr_image *img, const int rgb[3]
         return NULL;
     }
     return o;
+}
+
+/* Every compared sample of img is 0: a "perfect" fit (a = 0, RMSE 0, PSNR inf, SSIM 1) that
+ * means nothing. */
+static int all_zero(const gr_image *img, const int rgb[3])
+{
+    const size_t n = (size_t)img->width * (size_t)img->height, nc = (size_t)img->nchannels;
+    for (size_t p = 0; p < n; p++)
+        for (int k = 0; k < 3; k++)
+            if (img->pixels[p * nc + (size_t)rgb[k]] != 0.0f) return 0;
+    return 1;
 }
 
 static double now_s(void)
@@ -217,6 +229,11 @@ int cmd_compare(int argc, char **argv)
                     return gr_cli_usage_error(cmd, "--exposures '%s': need START:STOP:COUNT, START <= STOP, COUNT >= 1", v);
                 fopt.exposures_given = 1, fopt.start_exposure = e0, fopt.stop_exposure = e1, fopt.n_exposures = k;
             }
+        } else if (!strcmp(a, "--max-memory")) {
+            gr_error merr;
+            double bytes;
+            if (gr_memlimit_parse("--max-memory", v, &bytes, &merr) != GR_OK) return gr_cli_usage_error(cmd, "%s", merr.msg);
+            gr_memlimit_set(bytes);
         } else if (!strcmp(a, "--fit-scale")) {
             opt.fit_scale = 1;
         } else if (!strcmp(a, "--json")) {
@@ -257,6 +274,22 @@ int cmd_compare(int argc, char **argv)
     if (st == GR_OK && mask && (mask->width != ref->width || mask->height != ref->height))
         st = gr_fail(&err, GR_E_INPUT, "size mismatch: mask %s is %d x %d, images are %d x %d", mask_path, mask->width,
                      mask->height, ref->width, ref->height);
+    /* two channels: grey + alpha is compared as grey; anything else (R, G) has no defined
+     * luminance, so it is refused rather than compared as grey with a channel dropped */
+    for (int k = 0; st == GR_OK && k < 2; k++) {
+        const gr_image *im = k ? test : ref;
+        if (im->nchannels == 2 && strcmp(im->names[1], "A"))
+            st = gr_fail(&err, GR_E_INPUT, "%s %s: 2 channels (%s, %s): neither grey (+ alpha A) nor RGB; convert it "
+                         "first, e.g. oiiotool IN --ch R,G,B=0 -o OUT.exr", k ? "test" : "reference", paths[k],
+                         im->names[0], im->names[1]);
+    }
+    if (st == GR_OK) {
+        /* the metrics, blurs and difference images: about 170 bytes per pixel, measured
+         * (2.8 GB for 4096 x 4096; docs/reliability.md) */
+        char detail[96];
+        snprintf(detail, sizeof detail, "%d x %d pixels at about 170 bytes each", ref->width, ref->height);
+        st = gr_memlimit_check("the comparison", 170.0 * ref->width * (double)ref->height, detail, &err);
+    }
     if (st != GR_OK) goto fail;
 
     /* The structure metrics' geometry first: the metric sets carry their summary (as in
@@ -440,6 +473,10 @@ int cmd_compare(int argc, char **argv)
         }
     }
 
+    if (all_zero(ref, m.ref_rgb))
+        fprintf(stderr, "godrays compare: warning: the reference %s is zero everywhere scored: RMSE, PSNR, SSIM and the "
+                "scale fit say nothing about the test image (is the camera inside an occluder, or the medium "
+                "without scattering?)\n", paths[0]);
     if (json) {
         printf("%s\n", text);
     } else {

@@ -309,7 +309,7 @@ static int pareto_with(gr_args *args)
     free(gpus);
     const char *glr = gr_gl_renderer(gl);
     int is_llvmpipe = glr && strstr(glr, "llvmpipe") != NULL;
-    /* What the shafts cost: on a hardware GPU the GL pass timers (a render's wall time there
+    /* What the techniques cost: on a hardware GPU the GL pass timers (a render's wall time there
      * is mostly this harness's synchronous float readback: docs/benchmarks.md); on llvmpipe
      * the wall time (its timers see a deferred rasterizer). */
     int by_gpu = !is_llvmpipe && gpu_any;

@@ -2,6 +2,7 @@
  * PNG preview beside it. Quality flags become "reference.*" overrides of the scene, so they
  * are range-checked by the same tables as the file. */
 #include "cli/cli.h"
+#include "common/memlimit.h"
 #include "cli/args.h"
 #include "cli/render.h"
 
@@ -9,11 +10,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "farm/parts.h"
 #include "image/exr.h"
 #include "image/oiio.h"
 #include "reference/bench.h"
 #include "reference/integrator.h"
 #include "scene/scene.h"
+#include "tune/objective.h"
+#include "tune/session.h"
 
 static void usage(FILE *f)
 {
@@ -38,13 +42,38 @@ static void usage(FILE *f)
             "  --cutoff T             stop camera rays where their transmittance falls below T\n"
             "  --size WxH             override the image size\n"
             "  --set KEY=VALUE        any scene override, e.g. --set medium.g=0.9 (repeatable)\n"
+            "  --technique-dir DIR    add the user technique in DIR (for a scene with its section)\n"
             "  --aov                  add transmittance and ray_length channels\n"
             "  --no-preview           do not write the PNG preview\n"
+            "  --max-memory SIZE      refuse (exit 2) a render estimated to need more (e.g. 8G;\n"
+            "                         default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  --quiet                no progress bar\n"
             "  --bench                benchmark instead of writing files: hot-loop lookups per second\n"
             "                         with 1 and 2 threads, Embree's raw occlusion-ray throughput\n"
             "\n"
+            "frames, views and parts of the work (godrays farm, docs/farm.md):\n"
+            "  --frame F              frame F of the animated waves: water.time_s + F / fps (as tune)\n"
+            "  --fps F                frames per second for --frame (default 30)\n"
+            "  --view YAW,PITCH       the camera turned to this view (degrees, as tune's --view)\n"
+            "  --tile I/N             rows of tile I of N (0 <= I < N): writes a part file (-o), not\n"
+            "                         an EXR; `godrays merge` assembles the parts bit for bit\n"
+            "  --batch-part J/M       batches of group J of M (0 <= J < M <= batches): a part file\n"
+            "                         (parts take the fixed passes: no --target-error, no --aov)\n"
+            "\n"
             "Ctrl-C stops the render and writes what is done, marked godrays:partial = 1 (exit 1).\n");
+}
+
+/* --max-memory SIZE (common/memlimit). */
+static int take_max_memory(gr_args *args)
+{
+    const char *v = NULL;
+    int rc = gr_args_value(args, &v);
+    if (rc) return rc;
+    gr_error err;
+    double bytes;
+    if (gr_memlimit_parse("--max-memory", v, &bytes, &err) != GR_OK) return gr_cli_usage_error(args->cmd, "%s", err.msg);
+    gr_memlimit_set(bytes);
+    return 0;
 }
 
 /* --target-error stops refining at the round cap (gr_ref_result.max_rounds) whether or not the
@@ -61,6 +90,15 @@ static void warn_target(const gr_scene *scene, int passes_per_round, const gr_re
             target, res->passes, rounds, passes_per_round, res->rel_se_mean, res->rel_se_p95);
 }
 
+/* "I/N" with 0 <= I < N: 0, else the exit code of the usage error. */
+static int parse_part(const char *flag, const char *v, int *i, int *n)
+{
+    char extra;
+    if (sscanf(v, "%d/%d%c", i, n, &extra) != 2 || *n < 1 || *i < 0 || *i >= *n)
+        return gr_cli_usage_error("reference", "%s %s: expected I/N with 0 <= I < N", flag, v);
+    return 0;
+}
+
 /* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
 static int reference_with(gr_args *args)
 {
@@ -74,6 +112,9 @@ static int reference_with(gr_args *args)
     const char *cmd = "reference", *out_path = NULL;
     gr_scene *scene = NULL;
     int quiet = 0, aov = 0, preview = 1, bench = 0, rc = 0;
+    int tile_i = 0, tile_n = 0, bp_j = 0, bp_m = 0, have_view = 0;
+    const char *frame_s = NULL, *fps_s = NULL, *v = NULL;
+    gr_tune_view view = {0.0, 0.0};
     for (; args->i < argc && !rc; args->i++) {
         const char *a = argv[args->i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -90,11 +131,48 @@ static int reference_with(gr_args *args)
         else if (!strcmp(a, "-o") || !strcmp(a, "--output")) rc = gr_args_value(args, &out_path);
         else if (!strcmp(a, "--set")) rc = gr_args_take_set(args);
         else if (!strcmp(a, "--size")) rc = gr_args_take_size(args);
+        else if (!strcmp(a, "--tile")) rc = gr_args_value(args, &v) ? 2 : parse_part(a, v, &tile_i, &tile_n);
+        else if (!strcmp(a, "--batch-part")) rc = gr_args_value(args, &v) ? 2 : parse_part(a, v, &bp_j, &bp_m);
+        else if (!strcmp(a, "--frame")) rc = gr_args_value(args, &frame_s);
+        else if (!strcmp(a, "--fps")) rc = gr_args_value(args, &fps_s);
+        else if (!strcmp(a, "--view")) {
+            gr_error verr = {GR_OK, ""};
+            rc = gr_args_value(args, &v);
+            if (!rc && gr_tune_parse_view(a, v, &view, &verr) != GR_OK) rc = gr_cli_report(cmd, &verr);
+            have_view = 1;
+        } else if (!strcmp(a, "--technique-dir")) rc = gr_args_take_technique_dir(args);
+        else if (!strcmp(a, "--max-memory")) rc = take_max_memory(args);
         else rc = gr_args_take_scene(args);
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
     if (!out_path && !bench) return gr_cli_usage_error(cmd, "no output given (-o OUT.exr)");
+    const int part = tile_n > 0 || bp_m > 0;
+    if (part && bench) return gr_cli_usage_error(cmd, "--tile/--batch-part and --bench: give one of them");
+    if (part && aov) return gr_cli_usage_error(cmd, "--aov with --tile/--batch-part: parts carry no AOVs (docs/farm.md)");
+    long frame = 0;
+    double fps = 30.0;
+    char extra;
+    if (frame_s && (sscanf(frame_s, "%ld%c", &frame, &extra) != 1 || frame < 0))
+        return gr_cli_usage_error(cmd, "--frame %s: expected a frame number >= 0", frame_s);
+    if (fps_s && (sscanf(fps_s, "%lf%c", &fps, &extra) != 1 || !(fps > 0.0) || fps > 1e6))
+        return gr_cli_usage_error(cmd, "--fps %s: expected frames per second > 0", fps_s);
+    /* a scene with a user technique's section loads once that technique is known */
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) goto done;
     if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
+    if (frame_s || have_view) {
+        /* the same scene as tune's case (frame f: water.time_s + f / fps), so the ground truth
+         * lands under the key tune and run look up */
+        gr_error cerr = {GR_OK, ""};
+        double t = frame_s ? (double)frame / fps + scene->water.time_s : scene->water.time_s;
+        if (gr_tune_make_case(scene, t, have_view ? &view : NULL, scene, &cerr) != GR_OK) {
+            rc = gr_cli_report(cmd, &cerr);
+            goto done;
+        }
+    }
+    if (bp_m > scene->reference.batches) {
+        rc = gr_cli_usage_error(cmd, "--batch-part %d/%d: more groups than the %d batches", bp_j, bp_m, scene->reference.batches);
+        goto done;
+    }
     /* A render takes minutes: an output that cannot be written is refused before it. */
     if (!bench && (rc = gr_args_check_output_file(args, "-o", out_path)) != 0) goto done;
 
@@ -118,10 +196,40 @@ static int reference_with(gr_args *args)
     gr_ref_options_default(&opt);
     opt.progress = !quiet;
     opt.aovs = aov;
+    if (part) {
+        opt.keep_sums = 1;
+        if (tile_n > scene->camera.height) {
+            rc = gr_cli_usage_error(cmd, "--tile %d/%d: more tiles than the %d rows", tile_i, tile_n, scene->camera.height);
+            goto done;
+        }
+        gr_part_rows(tile_n ? tile_i : 0, tile_n ? tile_n : 1, scene->camera.height, &opt.row0, &opt.row1);
+        gr_part_rows(bp_m ? bp_j : 0, bp_m ? bp_m : 1, scene->reference.batches, &opt.batch0, &opt.batch1);
+    }
     gr_ref_result res;
     int per_round = 0;
     st = gr_cli_render_reference(scene, &opt, &res, &per_round, &err);
     if (st != GR_OK) { rc = gr_cli_report(cmd, &err); goto done; }
+    if (part) {
+        if (res.partial) {
+            fprintf(stderr, "godrays reference: interrupted; no part written (%s)\n", out_path);
+            gr_ref_result_free(&res);
+            rc = 1;
+            goto done;
+        }
+        char command[2048] = "godrays";
+        for (int k = 0; k < argc; k++) {
+            size_t l = strlen(command);
+            snprintf(command + l, sizeof command - l, " %s", argv[k]);
+        }
+        st = gr_part_write(out_path, scene, &opt, &res, command, &err);
+        if (st == GR_OK && !quiet)
+            fprintf(stderr, "godrays reference: wrote part %s (rows [%d, %d) of %d, batches [%d, %d) of %d, %d passes, %.1f s)\n",
+                    out_path, opt.row0, opt.row1, scene->camera.height, opt.batch0, opt.batch1, scene->reference.batches,
+                    res.passes, res.wall_s);
+        rc = st == GR_OK ? 0 : gr_cli_report(cmd, &err);
+        gr_ref_result_free(&res);
+        goto done;
+    }
     st = gr_exr_write(out_path, res.image, &res.meta, &err);
     if (st == GR_OK && preview) {
         char pp[4096];

@@ -1,6 +1,6 @@
 /* godrays render TECHNIQUE SCENE: render a scene with any registered real-time technique
  * (src/realtime/technique.h) into an EXR god-ray layer (linear float, frame resolution) plus
- * a PNG preview. (`godrays shafts` is main.c's alias of `render shafts`.) */
+ * a PNG preview. (main.c's aliases name a technique; nothing here does.) */
 #include "cli/cli.h"
 #include "cli/args.h"
 
@@ -169,6 +169,9 @@ static int render_with(gr_args *args)
         }
     }
     if (!tech_name) return gr_cli_usage_error(cmd, "no technique given (`godrays techniques` lists them)");
+    if (!args->scene_path && (strchr(tech_name, '/') || strchr(tech_name, '.')))
+        return gr_cli_usage_error(cmd, "%s: expected TECHNIQUE SCENE, the technique first (`godrays techniques` lists them)",
+                                  tech_name);
     if ((rc = gr_args_need_scene(args)) != 0) return rc;
     /* user techniques before the scene, whose sections they add */
     const gr_technique_class *cls = NULL;

@@ -1,6 +1,7 @@
-/* godrays run SCENE [-o DIR]: the main job. Renders the real-time shafts and the ground truth
- * (or reuses a cached one), compares them (reference-stderr aware, raw and after the best
- * scale fit) and writes the report folder (src/report/report.h), then prints a short table. */
+/* godrays run SCENE [-o DIR] [--techniques a,b]: the main job. Renders every chosen real-time
+ * technique (default: every registered one) and the ground truth (or reuses a cached one),
+ * compares each against it (reference-stderr aware, raw and after the best scale fit), writes
+ * the report folder with its leaderboard (src/report/report.h) and prints a short table. */
 #include "cli/cli.h"
 #include "cli/args.h"
 #include "cli/render.h"
@@ -12,7 +13,6 @@
 #include <string.h>
 #include <time.h>
 
-#include "compare/flip.h"
 #include "compare/metrics.h"
 #include "compare/structure.h"
 #include "image/exr.h"
@@ -26,27 +26,33 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays run SCENE [-o DIR] [options]\n"
+            "usage: godrays run SCENE [-o DIR] [--techniques A,B] [options]\n"
             "\n"
-            "The main job: renders SCENE with seed 000's real-time shafts (OpenGL) and as ground truth\n"
-            "(Embree single scattering, with error bars), compares them and writes a report:\n"
-            "  DIR/index.html    images side by side, metrics, charts, timings, scene and settings\n"
-            "  DIR/summary.png   labelled contact sheet;  DIR/metrics.json  every number\n"
-            "  DIR/reference.exr, DIR/shafts.exr  the two linear images (for godrays compare)\n"
+            "The main job: renders SCENE with every real-time technique (OpenGL; `godrays techniques`\n"
+            "lists them) and as ground truth (Embree single scattering, with error bars), compares\n"
+            "each technique against the one ground truth and writes a report with a leaderboard:\n"
+            "  DIR/index.html    the leaderboard (image, errors with and without the scale fit, GPU\n"
+            "                    and wall time per technique), then each technique's images beside the\n"
+            "                    reference, metrics, charts, timings; the scene and settings\n"
+            "  DIR/summary.png   labelled contact sheet, one row per technique\n"
+            "  DIR/metrics.json  every number, one entry per technique\n"
+            "  DIR/reference.exr, DIR/TECHNIQUE.exr  the linear images (for godrays compare)\n"
             "index.html links DIR/sweep, DIR/tune and DIR/pareto (godrays sweep, tune, pareto) when\n"
             "they exist, and gives the command that makes each one that does not.\n"
             "The ground truth is cached (key: the scene's content and the reference settings) and\n"
             "reused by later runs. How to read the report: docs/report.md.\n"
             "\n"
             "options:\n"
-            "  -o, --output DIR   report folder (default: out/SCENE_NAME)\n"
-            "  --set KEY=VALUE    override a scene value before validation, e.g. shafts.K=0.7,\n"
-            "                     reference.spp=4, medium.g=0.9 (repeatable)\n"
-            "  --size WxH         image size (same as --set camera.width=W --set camera.height=H)\n"
-            "  --no-cache         render the ground truth even if a cached one exists, and do not\n"
-            "                     store it\n"
-            "  -q, --quiet        no progress bar or step messages (the summary table is printed)\n"
-            "  -h, --help         this help\n"
+            "  -o, --output DIR     report folder (default: out/SCENE_NAME)\n"
+            "  --techniques A,B     the techniques to compare (default: every registered one)\n"
+            "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
+            "  --set KEY=VALUE      override a scene value before validation, e.g. TECHNIQUE.KEY=V,\n"
+            "                       reference.spp=4, medium.g=0.9 (repeatable)\n"
+            "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"
+            "  --no-cache           render the ground truth even if a cached one exists, and do not\n"
+            "                       store it\n"
+            "  -q, --quiet          no progress bar or step messages (the summary table is printed)\n"
+            "  -h, --help           this help\n"
             "\n"
             "Cache directory: $GODRAYS_CACHE, else $XDG_CACHE_HOME/godrays or ~/.cache/godrays, else\n"
             "./.godrays-cache. Ctrl-C stops the ground truth; nothing is cached or reported (exit 1).\n"
@@ -107,7 +113,7 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
         gr_error cerr = {GR_OK, ""};
         if (gr_cache_dir(dir, sizeof dir, &cerr) != GR_OK) {
             snprintf(ro->note, sizeof ro->note, "cache off: %.1000s", cerr.msg);
-            if (!quiet) fprintf(stderr, "godrays run: warning: %s\n", ro->note);
+            fprintf(stderr, "godrays run: warning: %s\n", ro->note); /* warnings even with -q */
         } else {
             if ((st = gr_cache_key(scene, key, err)) != GR_OK) return st;
             if ((st = gr_cache_path(dir, key, ro->cache_path, sizeof ro->cache_path, err)) != GR_OK) return st;
@@ -122,7 +128,7 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
             }
             if (strstr(why, "ignored")) {
                 snprintf(ro->note, sizeof ro->note, "%s", why);
-                if (!quiet) fprintf(stderr, "godrays run: warning: cache entry %s\n", why);
+                fprintf(stderr, "godrays run: warning: cache entry %s\n", why); /* even with -q */
             }
         }
     }
@@ -151,49 +157,64 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
         if (gr_cache_store(dir, key, ro->img, &ro->meta, &serr) != GR_OK) {
             /* A cache that cannot be written costs time later, not correctness now. */
             snprintf(ro->note, sizeof ro->note, "not cached: %.1200s", serr.msg);
-            if (!quiet) fprintf(stderr, "godrays run: warning: %s\n", ro->note);
+            fprintf(stderr, "godrays run: warning: %s\n", ro->note); /* warnings even with -q */
             ro->cache_on = 0;
         }
     }
     return GR_OK;
 }
 
-static void print_summary(const char *dir, const gr_scene *scene, const gr_metrics *m, const ref_out *ro,
-                          double t_ref, double t_shafts, const gr_metadata *smeta)
+static double rel(const gr_channel_metrics *y) { return y->ref_mean != 0 ? y->rmse / fabs(y->ref_mean) : NAN; }
+
+static void print_summary(const char *dir, const gr_scene *scene, const gr_report_technique *ts, int nt,
+                          const int *order, const ref_out *ro, double t_ref)
 {
-    const gr_metrics_set *raw = &m->raw, *fit = m->have_fit ? &m->fit : &m->raw;
-    const gr_channel_metrics *yr = &raw->ch[GR_MCH_Y], *yf = &fit->ch[GR_MCH_Y];
-    double gpu = 0.0;
-    int any = 0;
-    const gr_meta_item *g = gr_meta_get(smeta, "godrays:gpu_ms");
-    if (g && g->type != GR_META_STRING && g->num >= 0) {
-        gpu = g->num;
-        any = 1;
-    }
-    const gr_meta_item *cpu = gr_meta_get(smeta, "godrays:wall_ms");
-    printf("scene '%s' (%d x %d): ground truth %.1f s (%s), real time %.2f s (GPU ",
-           scene->name, scene->camera.width, scene->camera.height, t_ref, ro->cached ? "from the cache" : "rendered",
-           t_shafts);
-    if (any) printf("%.2f ms", gpu);
-    else printf("n/a");
-    printf(", CPU %.2f ms)\n", cpu && cpu->type != GR_META_STRING ? cpu->num : NAN);
-    printf("luminance Y                  as rendered   x a (a = %.4g)\n", fit->scale);
+    printf("scene '%s' (%d x %d): ground truth %.1f s (%s), %d real-time technique%s\n", scene->name,
+           scene->camera.width, scene->camera.height, t_ref, ro->cached ? "from the cache" : "rendered", nt,
+           nt == 1 ? "" : "s");
+    for (int r = 0; r < nt; r++) {
+        const gr_report_technique *t = &ts[order[r]];
+        const gr_metrics *m = t->metrics;
+        const gr_metrics_set *raw = &m->raw, *fit = m->have_fit ? &m->fit : &m->raw;
+        const gr_channel_metrics *yr = &raw->ch[GR_MCH_Y], *yf = &fit->ch[GR_MCH_Y];
+        const gr_meta_item *g = gr_meta_get(t->meta, "godrays:gpu_ms"), *w = gr_meta_get(t->meta, "godrays:wall_ms");
+        printf("\n#%d %s: %.2f s in this run (GPU ", r + 1, t->name, t->seconds);
+        if (g && g->type != GR_META_STRING && g->num >= 0) printf("%.2f ms", g->num);
+        else printf("n/a");
+        printf(", wall %.2f ms per render)\n", w && w->type != GR_META_STRING ? w->num : NAN);
+        printf("luminance Y                  as rendered   x a (a = %.4g)\n", fit->scale);
 #define ROW(label, a, b) printf("  %-24s %12.4g %12.4g\n", label, (double)(a), (double)(b))
-    ROW("bias (mean a t - r)", yr->bias, yf->bias);
-    ROW("RMSE", yr->rmse, yf->rmse);
-    ROW("RMSE / mean reference", yr->ref_mean != 0 ? yr->rmse / fabs(yr->ref_mean) : NAN,
-        yf->ref_mean != 0 ? yf->rmse / fabs(yf->ref_mean) : NAN);
-    ROW("relative MSE", yr->rel_mse, yf->rel_mse);
-    ROW("PSNR dB (ref peak)", yr->psnr_ref_db, yf->psnr_ref_db);
-    ROW("SSIM", raw->ssim_y, fit->ssim_y);
-    ROW("RMSE, blur sigma 16 px", yr->rmse_blur[GR_METRICS_NSCALES - 1], yf->rmse_blur[GR_METRICS_NSCALES - 1]);
+        ROW("bias (mean a t - r)", yr->bias, yf->bias);
+        ROW("RMSE", yr->rmse, yf->rmse);
+        ROW("RMSE / mean reference", rel(yr), rel(yf));
+        ROW("relative MSE", yr->rel_mse, yf->rel_mse);
+        ROW("PSNR dB (ref peak)", yr->psnr_ref_db, yf->psnr_ref_db);
+        ROW("SSIM", raw->ssim_y, fit->ssim_y);
+        ROW("RMSE, blur sigma 16 px", yr->rmse_blur[GR_METRICS_NSCALES - 1], yf->rmse_blur[GR_METRICS_NSCALES - 1]);
 #undef ROW
-    printf("scored %lld of %lld pixels (%lld not scored: reference rel. std. error > %g)", m->n_scored, m->n_pixels,
-           m->n_stderr_excluded, m->stderr_bound);
-    if (m->have_stderr && yf->n_samples > 0)
-        printf("; after the fit %.1f %% of Y differences are within 2 std. errors",
-               100.0 * (double)yf->n_not_significant / (double)yf->n_samples);
-    printf("\nreport: %s/index.html (also summary.png, metrics.json)\n", dir);
+        printf("scored %lld of %lld pixels (%lld not scored: reference rel. std. error > %g)", m->n_scored,
+               m->n_pixels, m->n_stderr_excluded, m->stderr_bound);
+        if (m->have_stderr && yf->n_samples > 0)
+            printf("; after the fit %.1f %% of Y differences are within 2 std. errors",
+                   100.0 * (double)yf->n_not_significant / (double)yf->n_samples);
+        printf("\n");
+    }
+    printf("\nleaderboard (rel. RMSE of Y after the scale fit):\n");
+    printf("  %-4s %-24s %12s %12s %10s %10s %10s\n", "rank", "technique", "rel. RMSE", "after fit", "SSIM fit",
+           "GPU ms", "wall ms");
+    for (int r = 0; r < nt; r++) {
+        const gr_report_technique *t = &ts[order[r]];
+        const gr_metrics *m = t->metrics;
+        const gr_metrics_set *fit = m->have_fit ? &m->fit : &m->raw;
+        const gr_meta_item *g = gr_meta_get(t->meta, "godrays:gpu_ms"), *w = gr_meta_get(t->meta, "godrays:wall_ms");
+        printf("  %-4d %-24s %12.4g %12.4g %10.4f %10.3f %10.3f\n", r + 1, t->name, rel(&m->raw.ch[GR_MCH_Y]),
+               rel(&fit->ch[GR_MCH_Y]), fit->ssim_y, g && g->type != GR_META_STRING && g->num >= 0 ? g->num : NAN,
+               w && w->type != GR_META_STRING ? w->num : NAN);
+    }
+    printf("report: %s/index.html (also summary.png, metrics.json)\n", dir);
+    if (nt > 0 && ts[0].metrics->raw.ch[GR_MCH_Y].ref_mean == 0.0) /* the ground truth is >= 0: zero mean = zero everywhere scored */
+        fprintf(stderr, "godrays run: warning: the ground truth is zero everywhere scored: the metrics say nothing "
+                "(camera inside an occluder, no scattering, or no light reaching the view?)\n");
 }
 
 /* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
@@ -202,7 +223,7 @@ static int run_with(gr_args *args)
     const int argc = args->argc;
     char **argv = args->argv;
     const char *cmd = "run";
-    const char *outdir = NULL;
+    const char *outdir = NULL, *tech_list = NULL;
     int quiet = 0, use_cache = 1, rc = 0, taken = 0;
     for (; args->i < argc && !rc; args->i++) {
         const char *a = argv[args->i];
@@ -213,18 +234,32 @@ static int run_with(gr_args *args)
             quiet = 1;
         } else if (!strcmp(a, "--no-cache")) {
             use_cache = 0;
+        } else if (!strcmp(a, "--techniques")) {
+            rc = gr_args_value(args, &tech_list);
         } else if ((rc = gr_args_take_common(args, &outdir, NULL, &taken)) == 0 && !taken) {
             rc = gr_args_take_scene(args);
         }
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
-
+    /* user techniques before the scene, whose sections they add */
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    const gr_technique_class *cls[GR_REPORT_MAX_TECHNIQUES];
+    int nt = 0;
     gr_error err = {GR_OK, ""};
+    if (gr_technique_parse_list("--techniques", tech_list, cls, GR_REPORT_MAX_TECHNIQUES, &nt, &err) != GR_OK)
+        return gr_cli_usage_error(cmd, "%s", err.msg);
+    if (nt == 0) return gr_cli_usage_error(cmd, "no real-time technique to compare");
+
     gr_scene *scene = NULL;
-    gr_image *test = NULL;
-    float *angles = NULL, *flipmap = NULL;
-    gr_metadata smeta;
-    gr_meta_init(&smeta);
+    float *angles = NULL;
+    gr_gl *gl = NULL;
+    gr_image *test[GR_REPORT_MAX_TECHNIQUES] = {NULL};
+    gr_metadata smeta[GR_REPORT_MAX_TECHNIQUES];
+    gr_metrics *mets = calloc((size_t)nt, sizeof *mets);
+    gr_report_technique ts[GR_REPORT_MAX_TECHNIQUES];
+    char exr_names[GR_REPORT_MAX_TECHNIQUES][48];
+    memset(ts, 0, sizeof ts);
+    for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) gr_meta_init(&smeta[k]);
     ref_out ro;
     memset(&ro, 0, sizeof ro);
     gr_meta_init(&ro.meta);
@@ -232,10 +267,14 @@ static int run_with(gr_args *args)
     gr_sb_init(&cmdline);
     gr_sb_init(&words);
     char dirbuf[4096], path[4300];
+    if (!mets) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        goto fail;
+    }
     if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
     /* Bad settings are bad input (exit 2) before any slow or GL work. */
-    const gr_technique_class *cls = gr_technique_at(0);
-    if (gr_technique_check(cls, gr_technique_scene_settings(cls, scene), &err) != GR_OK) goto fail;
+    for (int k = 0; k < nt; k++)
+        if (gr_technique_check(cls[k], gr_technique_scene_settings(cls[k], scene), &err) != GR_OK) goto fail;
     /* The ground truth takes minutes: a folder that cannot be made is refused before it. */
     if ((rc = gr_args_output_dir(args, scene, outdir, NULL, dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
     command_line(argc, argv, &cmdline);
@@ -243,89 +282,96 @@ static int run_with(gr_args *args)
     if (gr_sb_status(&cmdline, "the command line", &err) != GR_OK || gr_sb_status(&words, "the command line", &err) != GR_OK)
         goto fail;
 
-    /* The real-time side first: it takes a second, and a GL failure should not cost the user
-     * a two-minute ground truth first. */
-    if (!quiet) fprintf(stderr, "godrays run: rendering the real-time shafts...\n");
-    double t = now_s();
-    {
-        gr_gl *gl = NULL;
-        if (gr_gl_create(NULL, &gl, &err) != GR_OK) goto fail;
-        gr_status rst = render_technique(cls, gl, scene, &test, &smeta, &err);
-        gr_gl_destroy(gl);
-        if (rst != GR_OK) goto fail;
+    /* The real-time side first: it takes seconds, and a GL failure should not cost the user
+     * a two-minute ground truth first. One context, one instance per technique. */
+    if (gr_gl_create(NULL, &gl, &err) != GR_OK) goto fail;
+    for (int k = 0; k < nt; k++) {
+        if (!quiet) fprintf(stderr, "godrays run: rendering %s...\n", cls[k]->name);
+        double t = now_s();
+        if (render_technique(cls[k], gl, scene, &test[k], &smeta[k], &err) != GR_OK) goto fail;
+        ts[k].seconds = now_s() - t;
+        ts[k].name = cls[k]->name;
+        ts[k].description = cls[k]->description;
+        ts[k].test = test[k];
+        ts[k].meta = &smeta[k];
+        snprintf(exr_names[k], sizeof exr_names[k], "%s.exr", cls[k]->name);
+        ts[k].exr = exr_names[k];
     }
-    const double t_shafts = now_s() - t;
+    gr_gl_destroy(gl);
+    gl = NULL;
 
-    t = now_s();
+    double t = now_s();
     if (get_reference(scene, use_cache, quiet, &ro, &err) != GR_OK) goto fail;
     const double t_ref = now_s() - t;
 
     if (!quiet) fprintf(stderr, "godrays run: comparing...\n");
     t = now_s();
-    gr_metrics_options mopt = {0};
-    mopt.fit_scale = 1; /* the technique's intensity is an arbitrary factor (seed 000) */
     /* beam structure around the refracted sun's vanishing point, de-glowed by the angle to
-     * the sun (docs/metrics.md); skipped when the beams have no finite vanishing point */
-    const int W = scene->camera.width, H = scene->camera.height;
-    gr_structure_options so = {.radial_bin = scene->camera.fov_deg / H};
-    angles = malloc((size_t)W * (size_t)H * sizeof(float));
-    flipmap = malloc((size_t)W * (size_t)H * sizeof(float));
-    if (!angles || !flipmap) {
-        gr_fail(&err, GR_E_NOMEM, "out of memory for the metrics");
-        goto fail;
-    }
+     * the sun (docs/metrics.md), in every technique's metric sets; skipped when the beams have
+     * no finite vanishing point (parallel to the image plane) */
+    gr_structure_options so = {.radial_bin = scene->camera.fov_deg / scene->camera.height};
+    int with_structure = 0;
     {
-        gr_error e2 = {0};
-        if (gr_structure_scene_vp(scene, W, H, &so.vp_x, &so.vp_y, &e2) == GR_OK) {
+        gr_error e2 = {GR_OK, ""};
+        angles = malloc((size_t)scene->camera.width * (size_t)scene->camera.height * sizeof(float));
+        if (!angles) {
+            gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
+            goto fail;
+        }
+        if (gr_structure_scene_vp(scene, scene->camera.width, scene->camera.height, &so.vp_x, &so.vp_y, &e2) == GR_OK) {
             double dir[3];
             gr_profile_sun_view_dir(scene, dir);
             gr_profile_angles(&scene->camera, dir, angles);
             so.radial = angles;
-            mopt.structure = &so;
+            with_structure = 1;
         }
     }
-    gr_metrics m;
-    if (gr_metrics_compute(ro.img, test, &mopt, &m, &err) != GR_OK) goto fail;
-    /* HDR-FLIP of the fitted test, with its per-pixel map for the report */
-    gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = m.fit_defined ? m.fit.scale : 1.0};
-    gr_flip_result fres;
-    if (gr_flip_compute(ro.img, test, &fo, flipmap, &fres, &err) != GR_OK) goto fail;
+    for (int k = 0; k < nt; k++) {
+        gr_metrics_options mopt = {0};
+        mopt.fit_scale = 1; /* a technique's intensity is an arbitrary factor (seed 000) */
+        if (with_structure) mopt.structure = &so;
+        if (gr_metrics_compute(ro.img, test[k], &mopt, &mets[k], &err) != GR_OK) goto fail;
+        ts[k].metrics = &mets[k];
+    }
     const double t_cmp = now_s() - t;
 
     /* The report links the EXRs; they are written first so that a finished index.html never
      * points at a missing file. */
     if (!quiet) fprintf(stderr, "godrays run: writing the report...\n");
-    gr_report_input in = {.scene = scene, .ref = ro.img, .ref_meta = &ro.meta, .test = test, .test_meta = &smeta,
-                          .metrics = &m, .command_line = gr_sb_str(&cmdline),
-                          .scene_words = gr_sb_str(&words), .ref_cached = ro.cached,
-                          .ref_cache_path = ro.cache_on ? ro.cache_path : NULL,
+    gr_report_input in = {.scene = scene, .ref = ro.img, .ref_meta = &ro.meta, .n_techniques = nt, .techniques = ts,
+                          .command_line = gr_sb_str(&cmdline), .scene_words = gr_sb_str(&words),
+                          .ref_cached = ro.cached, .ref_cache_path = ro.cache_on ? ro.cache_path : NULL,
                           .ref_cache_note = ro.note[0] ? ro.note : NULL, .ref_seconds = t_ref,
-                          .shafts_seconds = t_shafts, .compare_seconds = t_cmp, .ref_exr = "reference.exr",
-                          .test_exr = "shafts.exr", .flip_map = flipmap, .flip = &fres};
+                          .compare_seconds = t_cmp, .ref_exr = "reference.exr"};
     gr_report_result rres;
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
-    if (snprintf(path, sizeof path, "%s/reference.exr", outdir) >= (int)sizeof path) {
+    if (snprintf(path, sizeof path, "%s/reference.exr", outdir) >= (int)sizeof path - 48) {
         gr_fail(&err, GR_E_USAGE, "%s: output directory name too long", outdir);
         goto fail;
     }
     if (gr_exr_write(path, ro.img, &ro.meta, &err) != GR_OK) goto fail;
-    snprintf(path, sizeof path, "%s/shafts.exr", outdir); /* no longer than reference.exr */
-    if (gr_exr_write(path, test, &smeta, &err) != GR_OK) goto fail;
+    for (int k = 0; k < nt; k++) {
+        snprintf(path, sizeof path, "%s/%s", outdir, exr_names[k]);
+        if (gr_exr_write(path, test[k], &smeta[k], &err) != GR_OK) goto fail;
+    }
     if (gr_report_write(outdir, &in, &rres, &err) != GR_OK) goto fail;
     if (!quiet && !rres.labelled)
         fprintf(stderr, "godrays run: note: no font for OpenImageIO's text: summary.png is unlabelled\n");
     if (!quiet && rres.charts == 0) fprintf(stderr, "godrays run: note: charts not drawn (see index.html)\n");
-    print_summary(outdir, scene, &m, &ro, t_ref, t_shafts, &smeta);
+    print_summary(outdir, scene, ts, nt, rres.order, &ro, t_ref);
     goto done;
 fail:
     rc = gr_cli_report(cmd, &err);
 done:
     free(angles);
-    free(flipmap);
+    gr_gl_destroy(gl);
     gr_image_destroy(ro.img);
     gr_meta_free(&ro.meta);
-    gr_image_destroy(test);
-    gr_meta_free(&smeta);
+    for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) {
+        gr_image_destroy(test[k]);
+        gr_meta_free(&smeta[k]);
+    }
+    free(mets);
     free(scene);
     gr_sb_free(&cmdline);
     gr_sb_free(&words);

@@ -1,4 +1,4 @@
-/* godrays sweep SCENE --param shafts.K=0.4:1.2:16 [--param ...]: the shafts' error surface over
+/* godrays sweep SCENE --param NAME.KEY=0.4:1.2:16 [--param ...]: a technique's error surface over
  * a grid of one or two settings against the cached ground truth (src/tune/sweep.h). */
 #include "cli/cli.h"
 #include "cli/args.h"
@@ -19,19 +19,20 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays sweep SCENE --param shafts.KEY=LO:HI:COUNT [--param ...] [options]\n"
+            "usage: godrays sweep SCENE --param TECHNIQUE.KEY=LO:HI:COUNT [--param ...] [options]\n"
             "\n"
-            "Renders the real-time shafts over a grid of one or two settings (COUNT values from LO to\n"
+            "Renders a real-time technique (--technique, else the one the parameters name) over a\n"
+            "grid of one or two of its settings (COUNT values from LO to\n"
             "HI inclusive per axis; the grid is COUNT1 x COUNT2 renders per frame and view), scores\n"
             "each render against the ground truth (rendered once and cached), and writes into DIR:\n"
             "sweep.csv (every point), sweep.json (grid, minimum, timings, snippet), sweep.png (heat\n"
             "map with the minimum marked; a line chart for one axis), reference.png and best.png.\n"
-            "RGB settings (shafts.extinction, shafts.intensity) are swept as a SCALE on the scene's\n"
-            "value (shafts.extinction=1 is the medium's sigma_t). Integer settings (shafts.N) take\n"
-            "integer values; booleans and choices are set with --set. docs/tuning.md.\n"
+            "RGB settings are swept as a SCALE on the scene's value (1 = the scene's own). Integer\n"
+            "settings take integer values; booleans and choices are set with --set. `godrays\n"
+            "techniques` lists every setting. docs/tuning.md.\n"
             "\n"
             "options:\n"
-            "  --param SPEC         a sweep axis shafts.KEY=LO:HI:COUNT (one or two)\n"
+            "  --param SPEC         a sweep axis TECHNIQUE.KEY=LO:HI:COUNT (one or two)\n"
             "%s"
             "  -h, --help           this help\n"
             "\n"
@@ -65,6 +66,7 @@ static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, cons
     cJSON *root = cJSON_CreateObject();
     if (!root) return NULL;
     cJSON_AddStringToObject(root, "scene", s->base->name);
+    cJSON_AddStringToObject(root, "technique", p->cls->name);
     cJSON_AddStringToObject(root, "scene_file", s->base->source_path);
     cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
     cJSON_AddStringToObject(root, "channel", "Y");
@@ -253,8 +255,8 @@ static int sweep_with(gr_args *args)
 
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", s.base->name, s.base->camera.width,
-           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+    gr_sb_printf(&sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
+           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
            p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "minimum %.6g at %s = %.6g", r.err[r.best], p->params[0].key, xbest[0]);
     if (n_params > 1) gr_sb_printf(&sum, ", %s = %.6g", p->params[1].key, xbest[1]);

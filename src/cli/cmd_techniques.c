@@ -136,7 +136,12 @@ static void print_text(void)
         const gr_technique_class *c = gr_technique_at(i);
         printf("%s%s  (%s)\n  %s\n", i ? "\n" : "", c->name, c->origin ? c->origin : "built-in",
                c->description ? c->description : "");
-        printf("  %-24s %-9s %-18s %-22s %-7s %s\n", "setting", "type", "range", "default", "unit", "doc");
+        int kw = 24; /* the key column fits the longest NAME.KEY */
+        for (size_t k = 0; k < c->params->count; k++) {
+            int w = (int)(strlen(c->name) + 1 + strlen(c->params->params[k].name));
+            if (w > kw) kw = w;
+        }
+        printf("  %-*s %-9s %-18s %-22s %-7s %s\n", kw, "setting", "type", "range", "default", "unit", "doc");
         for (size_t k = 0; k < c->params->count; k++) {
             const gr_param *p = &c->params->params[k];
             char key[96], range[160], def[96], doc[512];
@@ -150,7 +155,7 @@ static void print_text(void)
             } else {
                 snprintf(doc, sizeof doc, "%s", p->doc ? p->doc : "");
             }
-            printf("  %-24s %-9s %-18s %-22s %-7s %s\n", key, type_name(p->type), range, def,
+            printf("  %-*s %-9s %-18s %-22s %-7s %s\n", kw, key, type_name(p->type), range, def,
                    p->unit && p->unit[0] ? p->unit : "-", doc);
         }
     }

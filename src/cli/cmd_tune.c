@@ -1,4 +1,4 @@
-/* godrays tune SCENE --params shafts.extinction,shafts.K[,...]: the shafts settings that
+/* godrays tune SCENE --params NAME.KEY,NAME.KEY[,...]: the technique's settings that
  * minimize the error against the ground truth over frames and views, found by bounded
  * Nelder-Mead with restarts (src/tune/optimize.h). */
 #include "cli/cli.h"
@@ -21,21 +21,23 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays tune SCENE --params shafts.KEY[,shafts.KEY...] [options]\n"
+            "usage: godrays tune SCENE --params TECHNIQUE.KEY[,TECHNIQUE.KEY...] [options]\n"
             "\n"
-            "Finds the shafts settings that minimize the error against the ground truth (rendered\n"
+            "Finds the settings of a real-time technique (--technique, else the one the parameters\n"
+            "name) that minimize the error against the ground truth (rendered\n"
             "once per frame and view, cached), averaged over the frames (--frames/--times) and views\n"
             "(--view), with bounded Nelder-Mead restarted from several starting points spread over\n"
             "the bounds (the scene's own settings are the first). Prints the best settings as a\n"
-            "snippet for the scene's \"shafts\" section and the error before and after per frame and\n"
+            "snippet for the technique's scene section and the error before and after per frame and\n"
             "view; writes DIR/tune.json, DIR/trace.csv (every evaluation), DIR/compare.png\n"
             "(reference | before | after) and per-case reference/before/after PNGs.\n"
-            "RGB settings (extinction, intensity) are tuned as a SCALE on the scene's value.\n"
+            "RGB settings are tuned as a SCALE on the scene's value.\n"
             "docs/tuning.md.\n"
             "\n"
             "options:\n"
-            "  --params LIST        comma-separated shafts settings to tune (at most %d)\n"
-            "  --bounds KEY=LO:HI   box of one parameter (repeatable; default: docs/tuning.md table)\n"
+            "  --params LIST        comma-separated TECHNIQUE.KEY settings to tune (at most %d)\n"
+            "  --bounds KEY=LO:HI   box of one parameter (repeatable; default: the setting's tuning box,\n"
+            "                       `godrays techniques`)\n"
             "  --start KEY=V        first starting point of a parameter (repeatable; default: the\n"
             "                       scene's value, clamped into the box)\n"
             "  --starts N           starting points (default 4, at most %d)\n"
@@ -308,6 +310,7 @@ static int tune_with(gr_args *args)
     root = cJSON_CreateObject();
     if (root) {
         cJSON_AddStringToObject(root, "scene", s.base->name);
+        cJSON_AddStringToObject(root, "technique", p->cls->name);
         cJSON_AddStringToObject(root, "scene_file", s.base->source_path);
         cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
         cJSON_AddStringToObject(root, "channel", "Y");
@@ -380,8 +383,8 @@ static int tune_with(gr_args *args)
 
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", s.base->name, s.base->camera.width,
-           s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+    gr_sb_printf(&sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
+           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
            p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
     for (int k = 0; k < n_params; k++)
@@ -411,7 +414,7 @@ static int tune_with(gr_args *args)
         gr_strbuf pg;
         gr_sb_init(&pg);
         gr_tune_page_begin(&pg, outdir, "godrays tune: %s", s.base->name);
-        gr_tune_page_figure(&pg, "compare.png", "ground truth | shafts before | shafts after tuning (case 0)");
+        gr_tune_page_figure(&pg, "compare.png", "ground truth | the technique before | after tuning (case 0)");
         for (int i = 1; i < s.n_cases && i < 8; i++) {
             char f[64], cap[128];
             snprintf(f, sizeof f, "after_%02d.png", i);

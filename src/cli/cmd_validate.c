@@ -5,12 +5,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "realtime/technique.h"
 #include "scene/scene.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays validate [--set json.path=value]... SCENE.json\n"
+            "usage: godrays validate [--set json.path=value]... [--technique-dir DIR]... SCENE.json\n"
             "\n"
             "Loads SCENE.json (scene format v1, docs/scene-format.md), applies the overrides,\n"
             "checks every value and prints the normalized scene (all defaults filled in) to stdout.\n"
@@ -19,7 +20,8 @@ static void usage(FILE *f)
             "  --set PATH=VALUE  override one value before validation; VALUE is JSON (a number,\n"
             "                    array, true/false, \"string\") or a bare word taken as a string.\n"
             "                    Examples: --set camera.fov_deg=50  --set sun.irradiance=[1,0.9,0.8]\n"
-            "                    --set water.waves[0].amplitude_m=0.2  --set shafts.target_format=rgba16f\n"
+            "                    --set water.waves[0].amplitude_m=0.2  --set TECHNIQUE.KEY=V\n"
+            "  --technique-dir DIR  add the user technique in DIR first (its section is then known)\n"
             "  -h, --help        this help\n"
             "\n"
             "Exit codes: 0 valid; 2 bad usage or invalid scene; 1 file cannot be read.\n");
@@ -57,6 +59,17 @@ int cmd_validate(int argc, char **argv)
             sets[n_sets++] = argv[++i];
         } else if (!only_args && !strncmp(a, "--set=", 6)) {
             sets[n_sets++] = a + 6;
+        } else if (!only_args && !strcmp(a, "--technique-dir")) {
+            /* a user technique's section is known once its folder is loaded: before the scene */
+            gr_error e = {GR_OK, ""};
+            if (i + 1 >= argc || !argv[i + 1][0]) {
+                free(sets);
+                return gr_cli_usage_error(cmd, "--technique-dir needs a folder");
+            }
+            if (gr_technique_add_dir(argv[++i], &e) != GR_OK) {
+                free(sets);
+                return gr_cli_report(cmd, &e);
+            }
         } else if (!only_args && a[0] == '-' && a[1] != '\0') {
             free(sets);
             return gr_cli_usage_error(cmd, "unknown option '%s'", a);

@@ -1,5 +1,6 @@
 /* godrays: entry point and subcommand dispatch. */
 #include "cli/cli.h"
+#include "common/signals.h"
 
 #include <stdarg.h>
 #include <stdint.h>
@@ -20,6 +21,9 @@ static const gr_command commands[] = {
     {"tune", "find a technique's settings that minimize the error over frames and views (Nelder-Mead)", cmd_tune},
     {"sweep", "error surface of a technique over a grid of one or two settings (CSV, JSON, heat map)", cmd_sweep},
     {"pareto", "speed against error of the ground truth and each technique: Pareto fronts, CSV + plot", cmd_pareto},
+    {"export", "the scene for other engines: glTF 2.0 (water, camera, sun, occluders), shader constants", cmd_export},
+    {"merge", "assemble the parts of a ground-truth render (reference --tile) into one EXR, bit for bit", cmd_merge},
+    {"farm", "ground truths of frames and views as a Slurm job array of parts, merged into the cache", cmd_farm},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
 
@@ -80,6 +84,7 @@ int main(int argc, char **argv)
     }
     /* the built-in techniques (and so their scene sections) before any scene is read */
     gr_technique_count();
+    gr_signals_install(); /* SIGINT, SIGTERM: temporary files removed, renders stopped cleanly */
     for (int i = 0; i < n_commands; i++)
         if (!strcmp(argv[1], commands[i].name)) return commands[i].run(argc - 1, argv + 1);
     for (int i = 0; i < n_aliases; i++) {

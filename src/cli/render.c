@@ -1,24 +1,34 @@
 /* Ground-truth render with Ctrl-C handling (render.h). */
 #include "cli/render.h"
 
-#include <signal.h>
-#include <string.h>
+#include "common/memlimit.h"
+#include "common/signals.h"
 
-static volatile sig_atomic_t g_interrupt = 0;
-
-static void on_sigint(int sig)
-{
-    (void)sig;
-    g_interrupt = 1;
-    signal(SIGINT, SIG_DFL); /* a second Ctrl-C ends the process at once */
-}
+#include <math.h>
+#include <stdio.h>
 
 gr_status gr_cli_render_reference(const gr_scene *scene, const gr_ref_options *opt, gr_ref_result *res,
                                   int *passes_per_round, gr_error *err)
 {
     gr_ref_options o = *opt;
-    o.interrupt = &g_interrupt;
+    o.interrupt = gr_signals_flag(); /* SIGINT and SIGTERM (common/signals, installed by main) */
+    /* What the render allocates, estimated before anything is (docs/reliability.md): per
+     * pixel the batch sums (3 doubles) and counts (uint32) of every batch, the two AOVs and
+     * the 8-channel float image; per surface cell two beam triangles (64 B + 4 B drift each),
+     * a vertex (24 B position, 40 B beam vertex, 16 B Jacobian) and up to two beam
+     * primitives with their Embree BVH (about 128 B each, at most REF's budget of 2^24). */
+    const double px = (double)scene->camera.width * (double)scene->camera.height;
+    const double B = scene->reference.batches, sr = scene->reference.surface_res;
+    const double cells = sr * sr, prims = fmin(2.0 * cells, 16777216.0);
+    const double need = px * (28.0 * B + 16.0 + 32.0) + cells * 216.0 + prims * 128.0;
+    char detail[160];
+    snprintf(detail, sizeof detail, "%d x %d pixels x %d batches, surface_res %d", scene->camera.width,
+             scene->camera.height, scene->reference.batches, scene->reference.surface_res);
+    gr_status mst = gr_memlimit_check("the ground truth", need, detail, err);
+    if (mst != GR_OK) return mst;
     gr_ref_renderer *r = NULL;
+    /* Building the scene and the beams renders nothing yet: a signal there ends the process
+     * at once (nothing to keep, no temporary file open). */
     gr_status st = gr_ref_create(scene, &o, &r, err);
     if (st != GR_OK) return st;
     if (passes_per_round) {
@@ -26,13 +36,9 @@ gr_status gr_cli_render_reference(const gr_scene *scene, const gr_ref_options *o
         gr_ref_get_info(r, &info);
         *passes_per_round = info.passes_per_round;
     }
-    struct sigaction sa, old;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_sigint;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old);
+    gr_signals_hold_begin(); /* the first signal only sets the flag; the renderer stops at its next check */
     st = gr_ref_render(r, res, err);
-    sigaction(SIGINT, &old, NULL);
+    gr_signals_hold_end();
     gr_ref_destroy(r);
     return st;
 }

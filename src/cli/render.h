@@ -1,6 +1,7 @@
 /* The ground-truth render as `godrays reference` and `godrays run` start it: Ctrl-C (SIGINT)
- * stops the render at the next row instead of ending the process, so that what is done can be
- * kept or dropped by the command; a second Ctrl-C ends the process at once. */
+ * or SIGTERM stops the render at the renderer's next check instead of ending the process, so
+ * that what is done can be kept or dropped by the command; a second signal ends the process
+ * at once (common/signals). */
 #ifndef GR_CLI_RENDER_H
 #define GR_CLI_RENDER_H
 

@@ -2,15 +2,40 @@
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+/* src (n bytes) into dst (cap bytes): whole when it fits, else its head, "...", and its tail,
+ * so that the reason at the end of a message survives a long path in the middle. */
+static void fit_middle(char *dst, size_t cap, const char *src, size_t n)
+{
+    if (n < cap) {
+        memmove(dst, src, n);
+        dst[n] = '\0';
+        return;
+    }
+    const size_t head = (cap - 4) / 3, tail = cap - 4 - head;
+    memmove(dst, src, head);
+    memcpy(dst + head, "...", 3);
+    memmove(dst + head + 3, src + n - tail, tail);
+    dst[cap - 1] = '\0';
+}
 
 gr_status gr_fail(gr_error *err, gr_status st, const char *fmt, ...)
 {
     if (err) {
         va_list ap;
         va_start(ap, fmt);
-        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        char *big = NULL;
+        int n = vsnprintf(err->msg, sizeof err->msg, fmt, ap);
         va_end(ap);
+        if (n >= (int)sizeof err->msg && (big = malloc((size_t)n + 1)) != NULL) {
+            va_start(ap, fmt);
+            vsnprintf(big, (size_t)n + 1, fmt, ap);
+            va_end(ap);
+            fit_middle(err->msg, sizeof err->msg, big, (size_t)n);
+            free(big);
+        }
         err->status = st;
     }
     return st;
@@ -25,15 +50,10 @@ gr_status gr_error_prefix(gr_error *err, const char *fmt, ...)
     vsnprintf(prefix, sizeof prefix, fmt, ap);
     va_end(ap);
     memcpy(old, err->msg, sizeof old);
-    /* "prefix: old", truncated to fit */
-    size_t np = strlen(prefix), no = strlen(old), cap = sizeof err->msg - 1;
-    if (np > cap) np = cap;
-    memcpy(err->msg, prefix, np);
-    size_t n = np;
-    if (n + 2 <= cap) { err->msg[n++] = ':'; err->msg[n++] = ' '; }
-    if (no > cap - n) no = cap - n;
-    memcpy(err->msg + n, old, no);
-    err->msg[n + no] = '\0';
+    /* "prefix: old", its middle cut to fit (fit_middle) */
+    char both[2 * GR_ERROR_MSG_MAX + 2];
+    const int n = snprintf(both, sizeof both, "%s: %s", prefix, old);
+    fit_middle(err->msg, sizeof err->msg, both, n < 0 ? 0 : (size_t)n < sizeof both ? (size_t)n : sizeof both - 1);
     return err->status;
 }
 

@@ -1,6 +1,7 @@
 /* EXR files through OpenEXR's C API (OpenEXRCore 3.1). See docs/images.md for the layout,
  * the attribute mapping and the "nothing half-written" rule. */
 #include "image/exr.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -8,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <openexr.h>
@@ -161,11 +163,12 @@ gr_status gr_exr_write(const char *path, const gr_image *img, const gr_metadata 
     gr_status st = check_image(path, img, err);
     if (st != GR_OK) return st;
 
-    /* Written to PATH.tmp-PID and renamed: a reader never sees a half-written file. */
-    size_t tlen = strlen(path) + 32;
-    char *tmp = malloc(tlen);
-    if (!tmp) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
-    snprintf(tmp, tlen, "%s.tmp-%ld", path, (long)getpid());
+    /* Written to a temporary name and renamed (common/outfile): a reader never sees a
+     * half-written file, a device node or symlink at path is refused or followed. */
+    gr_outfile of;
+    st = gr_outfile_begin(&of, path, err);
+    if (st != GR_OK) return st;
+    const char *tmp = of.tmp;
 
     g_exr_msg[0] = '\0';
     exr_context_initializer_t init = exr_init_for(0);
@@ -210,10 +213,9 @@ done:
         rv = exr_finish(&ctx);
         if (st == GR_OK && rv != EXR_ERR_SUCCESS) st = exr_fail(err, path, rv, GR_E_IO, "finishing file");
     }
-    if (st == GR_OK && rename(tmp, path) != 0)
-        st = gr_fail(err, GR_E_IO, "%s: cannot rename %s into place: %s", path, tmp, strerror(errno));
-    if (st != GR_OK) remove(tmp); /* may not exist; nothing half-written stays behind */
-    free(tmp);
+    /* an EXR holds at least its magic number, version and header */
+    if (st == GR_OK) return gr_outfile_commit(&of, 8, err);
+    gr_outfile_abort(&of); /* nothing half-written stays behind */
     return st;
 }
 
@@ -335,6 +337,60 @@ static gr_status read_pixels(exr_const_context_t ctx, exr_storage_t storage, gr_
     return st;
 }
 
+/* The chunk table against the file, before the image is allocated: every chunk must lie
+ * inside the file, and an uncompressed chunk must hold exactly the bytes its pixels need
+ * (a shrunken chunk was decoded as invented samples). */
+static gr_status check_one_chunk(const exr_chunk_info_t *c, long long file_size, const char *path, gr_error *err)
+{
+    if (file_size >= 0 && (c->data_offset > (uint64_t)file_size || c->packed_size > (uint64_t)file_size - c->data_offset))
+        return gr_fail(err, GR_E_INPUT, "%s: chunk at line %d claims %llu bytes at offset %llu, past the end of the "
+                       "%lld-byte file", path, c->start_y, (unsigned long long)c->packed_size,
+                       (unsigned long long)c->data_offset, file_size);
+    if (c->compression == EXR_COMPRESSION_NONE && c->packed_size != c->unpacked_size)
+        return gr_fail(err, GR_E_INPUT, "%s: uncompressed chunk at line %d holds %llu bytes, its pixels need %llu", path,
+                       c->start_y, (unsigned long long)c->packed_size, (unsigned long long)c->unpacked_size);
+    return GR_OK;
+}
+
+static gr_status check_chunks(exr_const_context_t ctx, exr_storage_t storage, const exr_attr_box2i_t *dw,
+                              long long file_size, const char *path, gr_error *err)
+{
+    int32_t count = 0;
+    exr_result_t rv = exr_get_chunk_count(ctx, 0, &count);
+    if (rv != EXR_ERR_SUCCESS || count <= 0) return exr_fail(err, path, rv, GR_E_INPUT, "chunk count");
+    if (file_size >= 0 && (long long)count * 8 > file_size)
+        return gr_fail(err, GR_E_INPUT, "%s: %d chunks need a %lld-byte offset table, the file has %lld bytes", path,
+                       count, (long long)count * 8, file_size);
+    gr_status st = GR_OK;
+    if (storage == EXR_STORAGE_SCANLINE) {
+        int32_t lines = 0;
+        rv = exr_get_scanlines_per_chunk(ctx, 0, &lines);
+        if (rv != EXR_ERR_SUCCESS || lines <= 0) return exr_fail(err, path, rv, GR_E_INPUT, "scanlines per chunk");
+        for (int64_t y = dw->min.y; y <= dw->max.y && st == GR_OK; y += lines) {
+            exr_chunk_info_t c;
+            rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &c);
+            if (rv != EXR_ERR_SUCCESS) return exr_fail(err, path, rv, GR_E_INPUT, "chunk table");
+            st = check_one_chunk(&c, file_size, path, err);
+        }
+    } else {
+        uint32_t tw = 0, th = 0;
+        exr_tile_level_mode_t lm;
+        exr_tile_round_mode_t rm;
+        rv = exr_get_tile_descriptor(ctx, 0, &tw, &th, &lm, &rm);
+        if (rv != EXR_ERR_SUCCESS || tw == 0 || th == 0) return exr_fail(err, path, rv, GR_E_INPUT, "tile description");
+        const int64_t W = (int64_t)dw->max.x - dw->min.x + 1, H = (int64_t)dw->max.y - dw->min.y + 1;
+        const int ntx = (int)((W + tw - 1) / tw), nty = (int)((H + th - 1) / th);
+        for (int ty = 0; ty < nty && st == GR_OK; ty++)
+            for (int tx = 0; tx < ntx && st == GR_OK; tx++) {
+                exr_chunk_info_t c;
+                rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &c);
+                if (rv != EXR_ERR_SUCCESS) return exr_fail(err, path, rv, GR_E_INPUT, "tile table");
+                st = check_one_chunk(&c, file_size, path, err);
+            }
+    }
+    return st;
+}
+
 /* Collects string/float/double/int attributes that are not file structure. */
 static gr_status read_attrs(exr_const_context_t ctx, gr_metadata *meta, const char *path, gr_error *err)
 {
@@ -391,8 +447,11 @@ gr_status gr_exr_read(const char *path, gr_image **out, gr_metadata *meta, gr_er
 {
     if (out) *out = NULL;
     if (!path || !path[0] || !out) return gr_fail(err, GR_E_USAGE, "EXR read: no input path or output");
-    gr_status st = probe_file(path, err);
+    gr_status st = gr_check_regular_input(path, err); /* a FIFO would block the open */
+    if (st == GR_OK) st = probe_file(path, err);
     if (st != GR_OK) return st;
+    struct stat fsb;
+    const long long file_size = stat(path, &fsb) == 0 ? (long long)fsb.st_size : -1;
 
     g_exr_msg[0] = '\0';
     exr_context_initializer_t init = exr_init_for(1);
@@ -422,6 +481,12 @@ gr_status gr_exr_read(const char *path, gr_image **out, gr_metadata *meta, gr_er
         st = gr_fail(err, GR_E_INPUT, "%s: bad data window (%d, %d) - (%d, %d)", path, dw.min.x, dw.min.y, dw.max.x, dw.max.y);
         goto done;
     }
+    /* Bounded before anything is allocated (image.h), then the chunk table checked against
+     * the file: a header of a few bytes may not claim gigabytes. */
+    st = gr_image_check_size(path, w, h, 1, err);
+    if (st != GR_OK) goto done;
+    st = check_chunks(ctx, storage, &dw, file_size, path, err);
+    if (st != GR_OK) goto done;
 
     const exr_attr_chlist_t *chl = NULL;
     rv = exr_get_channels(ctx, 0, &chl);

@@ -58,6 +58,17 @@ int gr_image_channel(const gr_image *img, const char *name)
     return -1;
 }
 
+gr_status gr_image_check_size(const char *path, long long width, long long height, int nchannels, gr_error *err)
+{
+    if (width <= 0 || height <= 0 || nchannels <= 0)
+        return gr_fail(err, GR_E_INPUT, "%s: declares %lld x %lld pixels and %d channels: not an image", path, width,
+                       height, nchannels);
+    if (width > GR_IMAGE_READ_MAX_SIDE || height > GR_IMAGE_READ_MAX_SIDE || width * height > GR_IMAGE_READ_MAX_PIXELS)
+        return gr_fail(err, GR_E_INPUT, "%s: declares %lld x %lld pixels, over the reader's limit (%d per side, %lld "
+                       "in all)", path, width, height, GR_IMAGE_READ_MAX_SIDE, GR_IMAGE_READ_MAX_PIXELS);
+    return GR_OK;
+}
+
 gr_status gr_image_check_finite(const gr_image *img, const char *what, gr_error *err)
 {
     if (!what) what = "image";

@@ -37,6 +37,15 @@ static inline float *gr_image_pixel(gr_image *img, int x, int y)
  * rule "no NaN or Inf reaches an image" is enforced with it by every image writer. */
 gr_status gr_image_check_finite(const gr_image *img, const char *what, gr_error *err);
 
+/* Images read from files (EXR, PNG, any format compare reads) are bounded before anything is
+ * allocated: at most GR_IMAGE_READ_MAX_SIDE pixels per side and GR_IMAGE_READ_MAX_PIXELS
+ * pixels (8192 x 8192), so that a crafted header of a few bytes cannot make a reader allocate
+ * gigabytes (docs/reliability.md). GR_E_INPUT "PATH: declares W x H pixels, over ..." when
+ * width x height x nchannels is over them or not positive. */
+#define GR_IMAGE_READ_MAX_SIDE 16384
+#define GR_IMAGE_READ_MAX_PIXELS (8192LL * 8192LL)
+gr_status gr_image_check_size(const char *path, long long width, long long height, int nchannels, gr_error *err);
+
 /* Metadata: ordered key -> value pairs, each a string or a double (EXR attributes). */
 typedef enum gr_meta_type { GR_META_STRING = 0, GR_META_DOUBLE = 1, GR_META_INT = 2 } gr_meta_type;
 typedef struct gr_meta_item {

@@ -1,7 +1,9 @@
 // OpenImageIO 2.4 behind the C interface of oiio.h: the only C++ in the project.
 // Every extern "C" body is wrapped in try/catch(...) so that no exception reaches C code.
 extern "C" {
+#include "common/outfile.h"
 #include "common/status.h"
+#include "image/exr.h"
 }
 #include "image/oiio.h"
 
@@ -46,20 +48,69 @@ float srgb_decode(float c)
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
-std::string temp_name(const char *path)
-{
-    return std::string(path) + ".tmp-" + std::to_string(static_cast<long>(getpid()));
-}
+// Redirects stderr (fd 2) into a temporary file while it lives: libpng's default handlers
+// print a line of their own ("libpng error: IHDR: CRC error") where the CLI promises one. The
+// text is taken into the error message; the capture is used by the CLI's single thread that
+// reads inputs, never while a render runs.
+class StderrCapture {
+  public:
+    explicit StderrCapture(bool on = true)
+    {
+        if (!on) return;
+        std::fflush(stderr);
+        f_ = std::tmpfile();
+        if (f_) saved_ = dup(2);
+        if (saved_ < 0 || dup2(fileno(f_), 2) < 0) restore();
+    }
+    ~StderrCapture() { restore(); }
+    // Restores stderr; returns what was captured as one line (libpng's "libpng error: " dropped).
+    std::string take()
+    {
+        if (!f_ || saved_ < 0) return std::string();
+        std::fflush(stderr);
+        std::string text;
+        std::rewind(f_);
+        char buf[512];
+        size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, f_)) > 0 && text.size() < 2048) text.append(buf, n);
+        restore();
+        text = text.empty() ? text : one_line(text);
+        const std::string pre = "libpng error: ";
+        if (text.compare(0, pre.size(), pre) == 0) text = "libpng: " + text.substr(pre.size());
+        return text;
+    }
 
-// Writes w x h x nc pixels of type `type` to a temporary file in the format that `path`'s
-// extension names, then renames it over `path`: nothing half-written is ever visible.
+  private:
+    void restore()
+    {
+        if (saved_ >= 0) {
+            std::fflush(stderr);
+            dup2(saved_, 2);
+            close(saved_);
+            saved_ = -1;
+        }
+        if (f_) {
+            std::fclose(f_);
+            f_ = nullptr;
+        }
+    }
+    FILE *f_ = nullptr;
+    int saved_ = -1;
+};
+
+// Writes w x h x nc pixels of type `type` to a temporary file (common/outfile) in the format
+// that `path`'s extension names, reads it back (OpenImageIO's PNG writer does not report a
+// failed write: a full disk left a 0-byte or truncated file), then renames it over `path`.
 gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::TypeDesc type,
                          const void *data, gr_error *err)
 {
     auto out = OIIO::ImageOutput::create(path);
     if (!out) return fail(err, GR_E_INPUT, path, "no writer for this file type", OIIO::geterror());
-    const std::string tmp = temp_name(path);
-    gr_status st = GR_OK;
+    gr_outfile of;
+    gr_status st = gr_outfile_begin(&of, path, err);
+    if (st != GR_OK) return st;
+    const std::string tmp = of.tmp;
+    const std::string format = out->format_name();
     if (!out->open(tmp, spec)) {
         st = fail(err, GR_E_IO, path, "cannot create file", out->geterror());
     } else {
@@ -69,9 +120,23 @@ gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::Ty
             st = fail(err, GR_E_IO, path, "closing file", out->geterror());
     }
     out.reset();
-    if (st == GR_OK && std::rename(tmp.c_str(), path) != 0)
-        st = gr_fail(err, GR_E_IO, "%s: cannot rename %s into place: %s", path, tmp.c_str(), std::strerror(errno));
-    if (st != GR_OK) std::remove(tmp.c_str());
+    if (st == GR_OK) {
+        StderrCapture quiet; // libpng's own line about the truncated file: the message says it
+        auto in = OIIO::ImageInput::create(format);
+        std::vector<unsigned char> back(spec.image_bytes());
+        OIIO::ImageSpec got;
+        if (!in || !in->open(tmp, got) || got.width != spec.width || got.height != spec.height ||
+            !in->read_image(0, 0, 0, spec.nchannels, spec.format, back.data()))
+            st = gr_fail(err, GR_E_IO, "%s: cannot write: the file written does not read back whole (is the disk full?)",
+                         path);
+        if (in) {
+            in->close();
+            (void)in->geterror();
+        }
+        (void)OIIO::geterror();
+    }
+    if (st == GR_OK) return gr_outfile_commit(&of, 1, err);
+    gr_outfile_abort(&of);
     return st;
 }
 
@@ -92,6 +157,22 @@ gr_status exception_status(gr_error *err, const char *path, const char *what)
     } catch (...) {
         return gr_fail(err, GR_E_RUNTIME, "%s: %s: unknown exception", path ? path : "(null)", what);
     }
+}
+
+// The formats the image reader takes, by file extension (docs/images.md): those a renderer or
+// an image tool writes for comparisons. Anything else is refused before it is opened.
+#define READ_EXTS ".exr, .png, .tif/.tiff, .hdr, .jpg/.jpeg, .bmp, .ppm/.pgm/.pnm/.pbm, .tga"
+const char *read_format(const char *path)
+{
+    static const char *const table[][2] = {
+        {"exr", "openexr"}, {"png", "png"}, {"tif", "tiff"}, {"tiff", "tiff"}, {"hdr", "hdr"}, {"jpg", "jpeg"},
+        {"jpeg", "jpeg"}, {"bmp", "bmp"}, {"ppm", "pnm"}, {"pgm", "pnm"}, {"pnm", "pnm"}, {"pbm", "pnm"},
+        {"tga", "targa"}};
+    const char *dot = std::strrchr(path, '.'), *slash = std::strrchr(path, '/');
+    if (!dot || (slash && slash > dot)) return nullptr;
+    for (const auto &e : table)
+        if (OIIO::Strutil::iequals(dot + 1, e[0])) return e[1];
+    return nullptr;
 }
 
 } // namespace
@@ -115,10 +196,43 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
     if (out) *out = nullptr;
     if (!path || !path[0] || !out) return gr_fail(err, GR_E_USAGE, "image read: no input path or output");
     gr_image *img = nullptr;
+    gr_status reg = gr_check_regular_input(path, err); // a FIFO blocks, /dev/zero spins
+    if (reg != GR_OK) return reg;
+    const char *format = read_format(path);
+    if (!format) {
+        FILE *f = std::fopen(path, "rb"); // a missing file says so first
+        if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
+        std::fclose(f);
+        return gr_fail(err, GR_E_INPUT, "%s: not a supported image file name (the reader takes %s)", path, READ_EXTS);
+    }
+    // EXR files go through the project's own reader (image/exr.c): it checks the data window
+    // and the chunk table against the file before allocating, where OpenEXR's C++ reader
+    // behind OpenImageIO rebuilt a huge offset table for seconds from a 2.5 KB file.
+    if (!std::strcmp(format, "openexr")) return gr_exr_read(path, out, nullptr, err);
+    // libpng prints its own line ("IHDR: CRC error"): kept for the message (PNG only, so
+    // that anything else a reader prints, a sanitizer's report included, stays visible)
+    StderrCapture cap(!std::strcmp(format, "png"));
     try {
-        auto in = OIIO::ImageInput::open(path);
+        // The reader of the extension's format only: OpenImageIO's fallback would try every
+        // reader it has (IFF spun forever on /dev/zero; JPEG-2000 starts threads per try).
+        auto in = OIIO::ImageInput::create(format);
+        OIIO::ImageSpec opened;
+        if (in && !in->open(path, opened)) {
+            std::string why = in->geterror();
+            in.reset();
+            (void)OIIO::geterror();
+            if (why.empty()) why = "not a valid file of this format";
+            FILE *f = std::fopen(path, "rb");
+            if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
+            std::fclose(f);
+            const std::string lib = cap.take();
+            if (!lib.empty()) why += " (" + lib + ")";
+            return fail(err, GR_E_INPUT, path, "cannot read as an image", why);
+        }
         if (!in) {
             std::string why = OIIO::geterror();
+            const std::string lib = cap.take();
+            if (!lib.empty()) why += " (" + lib + ")";
             // A missing or unreadable file is an I/O error; anything else is bad input.
             FILE *f = std::fopen(path, "rb");
             if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
@@ -129,6 +243,8 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         if (spec.deep) return gr_fail(err, GR_E_INPUT, "%s: deep images are not supported", path);
         if (spec.depth > 1) return gr_fail(err, GR_E_INPUT, "%s: volume images are not supported", path);
         const int nc = spec.nchannels;
+        gr_status cst = gr_image_check_size(path, spec.width, spec.height, nc, err);
+        if (cst != GR_OK) return cst;
         if (nc <= 0 || nc > GR_IMAGE_MAX_CHANNELS)
             return gr_fail(err, GR_E_INPUT, "%s: %d channels (1 to %d supported)", path, nc, GR_IMAGE_MAX_CHANNELS);
         static const char *const rgba[4] = {"R", "G", "B", "A"};
@@ -144,8 +260,20 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         for (int c = 0; c < nc; c++) cnames[static_cast<size_t>(c)] = names[static_cast<size_t>(c)].c_str();
         img = gr_image_create(spec.width, spec.height, nc, cnames.data());
         if (!img) return gr_fail(err, GR_E_NOMEM, "%s: cannot allocate %d x %d x %d image", path, spec.width, spec.height, nc);
-        if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, img->pixels)) {
-            gr_status st = fail(err, GR_E_INPUT, path, "reading pixels", in->geterror());
+        // Scanline files are read in their own sample type and converted here: read_image
+        // allocates a 64 MB buffer on every call in OpenImageIO 2.4 (tiled files still use it).
+        const bool native = spec.channelformats.empty() && spec.tile_width == 0;
+        std::vector<unsigned char> raw(native ? spec.image_bytes() : 0);
+        bool read_ok = native ? in->read_native_scanlines(0, 0, spec.y, spec.y + spec.height, spec.z, raw.data())
+                              : in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, img->pixels);
+        if (read_ok && native)
+            read_ok = OIIO::convert_pixel_values(spec.format, raw.data(), OIIO::TypeDesc::FLOAT, img->pixels,
+                                                 static_cast<int>(spec.image_pixels() * static_cast<size_t>(nc)));
+        if (!read_ok) {
+            std::string why = in->geterror();
+            const std::string lib = cap.take();
+            if (!lib.empty()) why += " (" + lib + ")";
+            gr_status st = fail(err, GR_E_INPUT, path, "reading pixels", why);
             gr_image_destroy(img);
             return st;
         }

@@ -32,16 +32,26 @@ typedef struct gr_frame {
      * (x right, y UP as in GL textures), and w of its clip position: > 0 in front of the
      * camera, <= 0 behind (no mirrored image then: techniques fade it out) */
     double sun_ndc[2], sun_uv[2], sun_clip_w;
+    /* (behind the camera, w <= 0, sun_ndc = clip.xy / max(|w|, 1e-9): the side of the screen
+     * toward which the sun lies, NOT a projection; uv follows from it. Clip is computed for
+     * the point at infinity (to_refr_sun, 0), so w = sun_cos_view.) */
     double sun_cos_view;            /* dot(forward, to_refr_sun) */
     /* Snell's window: cone half-angle asin(1/ior) about +y seen from below */
     double snell_half_angle_rad;
     /* water */
     double rest_height_m;
     int n_waves;
-    /* seed 000's packing (listing 5.5.1): per wave vec4(dir.x, dir.z, k, omega) and
-     * vec4(amplitude, phase, 0, 0); groups of 4 waves as in the seed's uniform arrays */
+    /* per wave i: waves_a[i] = (dir.x, dir.z, k, omega), waves_b[i] = (amplitude, phase0, 0, 0)
+     * (seed eq. 5.5.7: phase = k dir . X0 - omega t + phase0); unused slots are zero */
     float waves_a[GR_MAX_WAVES][4];
     float waves_b[GR_MAX_WAVES][4];
+    /* seed 000's packing (CalculateWaterNormal's `float4 waves[NUM_WAVES/4 * 5]`): group j of
+     * 4 waves (lanes) is waves_seed[5j .. 5j+4] = kx, kz, A/|k|, A, wt, with the seed's
+     * phase = kx x0 + kz z0 - wt, i.e. wt = omega t - phase0 folded into [0, 2 pi) in double
+     * (the seed's comment says "wt + phi0": a sign slip, docs/radial-blur.md). Lanes past
+     * n_waves are zero (A = 0: no contribution). */
+    int n_wave_groups;              /* ceil(n_waves / 4) */
+    float waves_seed[GR_MAX_WAVES / 4 * 5][4];
     /* medium */
     double absorption[3], scattering[3], extinction[3];
     double g, ior;
@@ -52,5 +62,14 @@ typedef struct gr_frame {
 void gr_frame_init(const gr_scene *scene, gr_frame *f);
 /* Same matrices as float (for glUniformMatrix4fv). */
 void gr_frame_matf(const double m[16], float out[16]);
+
+/* Column-major 4x4 helpers (m[col * 4 + row], as GL stores them). */
+void gr_mat4_mul(const double a[16], const double b[16], double out[16]); /* out = a b; may alias */
+int gr_mat4_inverse(const double m[16], double out[16]);                  /* -1 if singular */
+/* out = m (x, y, z, w) */
+void gr_mat4_apply(const double m[16], const double in[4], double out[4]);
+/* The view-projection without the eye translation (world directions / eye-relative
+ * positions -> clip): what shaders need for geometry far from the origin in float. */
+void gr_frame_view_proj_rot(const gr_frame *f, double out[16]);
 
 #endif

@@ -12,12 +12,23 @@
 
 typedef struct gr_scenegl gr_scenegl; /* opaque; current context only */
 
+/* Compiles the shared programs in the current context gl (embedded shaders; shader_dir, may
+ * be NULL, overrides them file by file as for the shafts). Textures returned below belong to
+ * s and stay valid until the next call that makes the same kind of texture, or destroy.
+ * The calls leave framebuffer 0 and program 0 bound, blending, depth test and depth clamp
+ * off. */
 gr_status gr_scenegl_create(gr_gl *gl, gr_scenegl **out, gr_error *err);
+gr_status gr_scenegl_create_dir(gr_gl *gl, const char *shader_dir, gr_scenegl **out, gr_error *err);
 void gr_scenegl_destroy(gr_scenegl *s); /* accepts NULL */
 
 /* Shadow map of the occluders along f->refr_dir: size x size, depth texture (GL_DEPTH_COMPONENT32F,
  * compare mode off), covering a square of half_extent_m around center. *light_vp receives
- * the light's view-projection (column-major) mapping world -> clip. Returns the texture. */
+ * the light's view-projection (column-major) mapping world -> clip. Returns the texture.
+ * Orthographic: x, y across the beam (a frame e1, e2 perpendicular to refr_dir), z along
+ * refr_dir; the depth range spans the occluders' extent along refr_dir with 1 m margins, so
+ * stored depth 0.5 (z + 1) is < 1 where a caster is; points deeper than every caster map to
+ * depth > 1 (shadowed where a caster is stored), shallower ones to < 0 (lit). Border and
+ * empty texels read 1 (lit). GL_NEAREST filtering. */
 gr_status gr_scenegl_shadow_map(gr_scenegl *s, const gr_scene *scene, const gr_frame *f, int size,
                                 const double center[3], double half_extent_m, unsigned *texture,
                                 double light_vp[16], gr_error *err);
@@ -30,11 +41,14 @@ gr_status gr_scenegl_eye_depth(gr_scenegl *s, const gr_scene *scene, const gr_fr
 typedef struct gr_gl_timer {
     unsigned queries[8];
     int n, have_timer;
+    unsigned used;      /* bit p: pass p was timed in this frame */
 } gr_gl_timer;
 void gr_gl_timer_init(gr_gl_timer *t);            /* needs a current context */
 void gr_gl_timer_begin(gr_gl_timer *t, int pass); /* pass < 8 */
 void gr_gl_timer_end(gr_gl_timer *t);
-long long gr_gl_timer_ns(gr_gl_timer *t, int pass); /* -1 if no timer */
+/* -1 if no timer or the pass was not timed. Waits for the result. On llvmpipe the first query
+ * of a context may read ~1e12 ns: callers drop a figure longer than the frame's wall time. */
+long long gr_gl_timer_ns(gr_gl_timer *t, int pass);
 void gr_gl_timer_free(gr_gl_timer *t);
 
 #endif

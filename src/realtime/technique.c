@@ -10,9 +10,12 @@
 
 /* ---- the built-in techniques: ONE LINE EACH (their header declares the class) -------- */
 #include "realtime/shafts.h"
+#include "realtime/radial_blur.h"
 
 static const gr_technique_class *const builtins[] = {
     &gr_shafts_class,
+    &gr_radial_blur_class,
+    &gr_radial_blur_local_class,
 };
 
 /* ---- registry ------------------------------------------------------------------------- */
@@ -189,6 +192,16 @@ gr_status gr_technique_check(const gr_technique_class *cls, const void *settings
     gr_status st = gr_param_validate(cls->params, settings, 1, err);
     if (st != GR_OK) return st;
     return cls->check ? cls->check(cls, settings, err) : GR_OK;
+}
+
+int gr_technique_tune_example(const gr_technique_class *cls, const gr_param **out, int max)
+{
+    int n = 0;
+    for (size_t i = 0; cls && i < cls->params->count && n < max; i++) {
+        const gr_param *p = &cls->params->params[i];
+        if (p->tune_hi > p->tune_lo && (p->type == GR_PT_DOUBLE || p->type == GR_PT_RGB)) out[n++] = p;
+    }
+    return n;
 }
 
 gr_status gr_technique_apply_text(const gr_technique_class *cls, void *settings, const char *text, gr_error *err)

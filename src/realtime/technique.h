@@ -131,6 +131,9 @@ const void *gr_technique_scene_settings(const gr_technique_class *cls, const gr_
 void *gr_technique_scene_settings_rw(const gr_technique_class *cls, gr_scene *scene);
 void gr_technique_resolve(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out);
 gr_status gr_technique_check(const gr_technique_class *cls, const void *settings, gr_error *err);
+/* The first (at most max) number or RGB settings of cls that have a tuning box, in table
+ * order: the example parameters commands suggest (`--params NAME.A,NAME.B`). Returns how many. */
+int gr_technique_tune_example(const gr_technique_class *cls, const gr_param **out, int max);
 /* Applies "KEY=VALUE,KEY=VALUE" (a ladder level) to settings through the class's table;
  * GR_E_INPUT naming "NAME.KEY" for an unknown key or a bad value. */
 gr_status gr_technique_apply_text(const gr_technique_class *cls, void *settings, const char *text, gr_error *err);

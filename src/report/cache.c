@@ -1,7 +1,9 @@
 /* The ground-truth cache (see cache.h for the key and the checks). */
 #include "report/cache.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <signal.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -142,6 +144,51 @@ gr_status gr_cache_path(const char *dir, const char *key, char *buf, size_t n, g
     return GR_OK;
 }
 
+/* FNV-1a 64 of the pixels' bytes as 16 hex digits: stored in the entry and checked on read,
+ * since a float flipped inside a chunk that OpenEXR stored raw reads back without any error. */
+static void pixel_checksum(const gr_image *img, char out[17])
+{
+    /* channel by channel in name order (a read may order channels differently from the
+     * image that was stored), each channel's name then its samples */
+    const size_t np = (size_t)img->width * (size_t)img->height, nc = (size_t)img->nchannels;
+    int order[GR_IMAGE_MAX_CHANNELS];
+    for (int c = 0; c < img->nchannels; c++) {
+        int j = c;
+        while (j > 0 && strcmp(img->names[c], img->names[order[j - 1]]) < 0) {
+            order[j] = order[j - 1];
+            j--;
+        }
+        order[j] = c;
+    }
+    unsigned long long h = GR_FNV_BASIS;
+    for (int k = 0; k < img->nchannels; k++) {
+        const int c = order[k];
+        h = hash_str(h, img->names[c]);
+        for (size_t p = 0; p < np; p++) h = gr_fnv1a64(h, img->pixels + p * nc + (size_t)c, sizeof(float));
+    }
+    snprintf(out, 17, "%016llx", h);
+}
+
+/* Removes the temporary files that a process killed while storing an entry left behind
+ * (reference-KEY.exr.tmp-PID[-N]): those whose process no longer runs. */
+static void remove_stale_temps(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d) return;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        const char *t = strstr(e->d_name, ".exr.tmp-");
+        if (strncmp(e->d_name, "reference-", 10) != 0 || !t) continue;
+        char *end = NULL;
+        long pid = strtol(t + 9, &end, 10);
+        if (pid <= 0 || end == t + 9 || (*end != '\0' && *end != '-')) continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue; /* alive (or not ours to judge) */
+        char path[4400];
+        if (snprintf(path, sizeof path, "%s/%s", dir, e->d_name) < (int)sizeof path) unlink(path);
+    }
+    closedir(d);
+}
+
 /* why = "PATH: what" (why may be NULL). */
 static void set_why(char *why, size_t n, const char *path, const char *what)
 {
@@ -156,6 +203,12 @@ gr_status gr_cache_load(const char *dir, const char *key, int width, int height,
     char path[4200];
     gr_status st = gr_cache_path(dir, key, path, sizeof path, err);
     if (st != GR_OK) return st;
+    remove_stale_temps(dir);
+    struct stat psb;
+    if (stat(path, &psb) == 0 && !S_ISREG(psb.st_mode)) {
+        set_why(why, why_n, path, "ignored: not a regular file");
+        return GR_OK;
+    }
     if (access(path, F_OK) != 0) {
         set_why(why, why_n, path, "not cached yet");
         return GR_OK;
@@ -177,6 +230,9 @@ gr_status gr_cache_load(const char *dir, const char *key, int width, int height,
     } else {
         const gr_meta_item *k = gr_meta_get(&m, GR_CACHE_META_KEY);
         const gr_meta_item *partial = gr_meta_get(&m, "godrays:partial");
+        const gr_meta_item *sum = gr_meta_get(&m, GR_CACHE_META_CHECKSUM);
+        char want[17];
+        pixel_checksum(im, want);
         static const char *const need[6] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B"};
         if (!k || k->type != GR_META_STRING || strcmp(k->str, key)) {
             bad = "its " GR_CACHE_META_KEY " attribute does not match the file name";
@@ -185,6 +241,9 @@ gr_status gr_cache_load(const char *dir, const char *key, int width, int height,
             bad = detail;
         } else if (partial && partial->type != GR_META_STRING && partial->num != 0) {
             bad = "it holds an interrupted (partial) render";
+        } else if (!sum || sum->type != GR_META_STRING || strcmp(sum->str, want)) {
+            bad = "its pixels do not match their " GR_CACHE_META_CHECKSUM " (a corrupted or older entry); rendering "
+                  "it again";
         } else {
             for (int c = 0; c < 6 && !bad; c++)
                 if (gr_image_channel(im, need[c]) < 0) {
@@ -225,7 +284,10 @@ gr_status gr_cache_store(const char *dir, const char *key, const gr_image *img, 
     if (st != GR_OK) return st;
     gr_metadata m;
     gr_meta_init(&m);
-    if ((meta && gr_meta_copy(&m, meta) != GR_OK) || gr_meta_set_string(&m, GR_CACHE_META_KEY, key) != GR_OK) {
+    char sum[17];
+    pixel_checksum(img, sum);
+    if ((meta && gr_meta_copy(&m, meta) != GR_OK) || gr_meta_set_string(&m, GR_CACHE_META_KEY, key) != GR_OK ||
+        gr_meta_set_string(&m, GR_CACHE_META_CHECKSUM, sum) != GR_OK) {
         gr_meta_free(&m);
         return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
     }

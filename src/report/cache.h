@@ -4,14 +4,16 @@
  *
  * Key = "SCENEHASH-SETTINGSHASH" (16 hex digits each, FNV-1a 64):
  *  - SCENEHASH: the normalized scene JSON (every default filled in, stable key order) without
- *    the "name", "shafts" and "reference" sections: what the ground truth renders. A change of
- *    the real-time settings or of the scene's label does not invalidate the reference.
+ *    the "name" and "reference" sections and every real-time technique's section
+ *    (scene/sections.h): what the ground truth renders. A change of the real-time settings or
+ *    of the scene's label does not invalidate the reference.
  *  - SETTINGSHASH: every reference.* setting except `threads` (the integrator gives the same
  *    bytes for any thread count), plus the cache format and the godrays version (a new build of
  *    the integrator may render differently).
  * The file is CACHEDIR/reference-KEY.exr and carries the key in its "godrays:cache_key"
- * attribute; a read checks that key, the size, the channels and that the render was complete,
- * and treats any mismatch as a miss (with the reason). */
+ * attribute; a read checks that key, the size, the channels, that the render was complete and
+ * the checksum of the pixels (GR_CACHE_META_CHECKSUM), and treats any mismatch as a miss (with
+ * the reason). A read also removes temporary files of killed processes from the folder. */
 #ifndef GR_CACHE_H
 #define GR_CACHE_H
 
@@ -23,6 +25,8 @@
 #define GR_CACHE_KEY_LEN 33          /* 16 + 1 + 16 hex characters */
 #define GR_CACHE_META_KEY "godrays:cache_key"
 #define GR_CACHE_FORMAT "godrays-reference-cache-1"
+/* FNV-1a 64 of the pixel bytes (16 hex digits), checked on every read (docs/reliability.md) */
+#define GR_CACHE_META_CHECKSUM "godrays:pixel_fnv1a64"
 
 /* FNV-1a 64 (Fowler, Noll, Vo) of n bytes, continuing from h (start: GR_FNV_BASIS). */
 #define GR_FNV_BASIS 14695981039346656037ull

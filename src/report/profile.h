@@ -3,7 +3,7 @@
  * the sun's rays refracted by the flat rest surface, seed eq. 5.5.1). Under the forward-
  * peaked phase function (HG, g ~ 0.9) most of the layer's shape is this angular falloff, so
  * one chart of both renderers shows whether the real-time technique gets it right even where
- * individual shafts do not line up. docs/report.md. */
+ * individual rays of light do not line up. docs/report.md. */
 #ifndef GR_PROFILE_H
 #define GR_PROFILE_H
 

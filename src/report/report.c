@@ -1,5 +1,6 @@
 /* The report of `godrays run` (see report.h; how to read it: docs/report.md). */
 #include "report/report.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <math.h>
@@ -19,6 +20,7 @@
 #include "report/plot.h"
 #include "report/profile.h"
 #include "scene/params.h"
+#include "scene/sections.h"
 #include "scene/settings.h"
 
 #ifndef GR_VERSION
@@ -64,22 +66,10 @@ static gr_status join(char *buf, size_t n, const char *dir, const char *name, gr
     return GR_OK;
 }
 
-/* Writes text to path through PATH.tmp-PID renamed into place. */
+/* Writes text to path atomically (common/outfile). */
 static gr_status write_text(const char *path, const char *text, gr_error *err)
 {
-    char tmp[4400];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()) >= (int)sizeof tmp)
-        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
-    int ok = fputs(text, f) >= 0;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok || rename(tmp, path) != 0) {
-        const int e = errno;
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(e));
-    }
-    return GR_OK;
+    return gr_outfile_write(path, text, -1, err);
 }
 
 static const gr_meta_item *meta_get(const gr_metadata *m, const char *key)
@@ -260,10 +250,13 @@ gr_status gr_report_contact_sheet(const gr_image *const panels[3], const char *c
 typedef struct profiles {
     double dir[3];
     double max_deg;
-    gr_radial_profile ref, fit, raw;
+    gr_radial_profile ref;
+    gr_radial_profile fit[GR_REPORT_MAX_TECHNIQUES], raw[GR_REPORT_MAX_TECHNIQUES];
+    int n; /* techniques computed */
 } profiles;
 
-static gr_status compute_profiles(const gr_report_input *in, double a, profiles *pr, gr_error *err)
+/* as[k]: technique k's fitted scale. */
+static gr_status compute_profiles(const gr_report_input *in, const double *as, profiles *pr, gr_error *err)
 {
     memset(pr, 0, sizeof *pr);
     const gr_camera *cam = &in->scene->camera;
@@ -281,8 +274,12 @@ static gr_status compute_profiles(const gr_report_input *in, double a, profiles 
     const double bin = gr_profile_bin_width(mx, PROFILE_TARGET_BINS);
     const int nbins = (int)floor(mx / bin) + 1; /* the last bin holds the maximum itself */
     gr_status st = gr_radial_profile_compute(in->ref, ang, NULL, nbins, bin, 1.0, &pr->ref, err);
-    if (st == GR_OK) st = gr_radial_profile_compute(in->test, ang, NULL, nbins, bin, a, &pr->fit, err);
-    if (st == GR_OK) st = gr_radial_profile_compute(in->test, ang, NULL, nbins, bin, 1.0, &pr->raw, err);
+    for (int k = 0; st == GR_OK && k < in->n_techniques; k++) {
+        const gr_image *test = in->techniques[k].test;
+        st = gr_radial_profile_compute(test, ang, NULL, nbins, bin, as[k], &pr->fit[k], err);
+        if (st == GR_OK) st = gr_radial_profile_compute(test, ang, NULL, nbins, bin, 1.0, &pr->raw[k], err);
+        if (st == GR_OK) pr->n = k + 1;
+    }
     free(ang);
     return st;
 }
@@ -290,8 +287,10 @@ static gr_status compute_profiles(const gr_report_input *in, double a, profiles 
 static void free_profiles(profiles *pr)
 {
     gr_radial_profile_free(&pr->ref);
-    gr_radial_profile_free(&pr->fit);
-    gr_radial_profile_free(&pr->raw);
+    for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) {
+        gr_radial_profile_free(&pr->fit[k]);
+        gr_radial_profile_free(&pr->raw[k]);
+    }
 }
 
 /* RMS over the image of the reference's luminance standard error (linear sum over channels,
@@ -312,57 +311,89 @@ static double ref_noise_rms_y(const gr_image *ref)
     return sqrt(sum / (double)n);
 }
 
-static gr_status draw_charts(const char *dir, const gr_report_input *in, double a, const profiles *pr,
-                             double noise_y, int *n_charts, char *note, size_t note_n, gr_error *err)
+/* Colours of the techniques in the shared charts (Tableau 10 without its red, which the
+ * reference's differences use). */
+static const unsigned char tech_rgb[9][3] = {{31, 119, 180}, {44, 160, 44},   {255, 127, 14},
+                                              {148, 103, 189}, {140, 86, 75},  {227, 119, 194},
+                                              {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
+
+/* The report's own file stems: a technique with one of these names gets "rt_" in front. */
+static void tech_stem(const char *name, char *buf, size_t n)
 {
-    *n_charts = 0;
-    char path[4200], title[256], lab[2][128];
-    gr_status st;
-    const gr_metrics *m = in->metrics;
-    if (!gr_plot_available()) {
-        snprintf(note, note_n, "charts not drawn: this build has no PLplot (install libplplot-dev and rebuild)");
-        return GR_OK;
+    static const char *const own[] = {"reference", "summary", "metrics", "index", "radial_profile"};
+    for (size_t i = 0; i < sizeof own / sizeof own[0]; i++)
+        if (!strcmp(name, own[i])) {
+            snprintf(buf, n, "rt_%s", name);
+            return;
+        }
+    snprintf(buf, n, "%s", name);
+}
+
+/* The shared luminance profile (reference + every technique x its a). */
+static gr_status draw_profile_all(const char *dir, const gr_report_input *in, const double *as, const profiles *pr,
+                                  gr_error *err)
+{
+    char path[4200], title[256];
+    char (*lab)[128] = calloc((size_t)in->n_techniques, sizeof *lab);
+    gr_plot_series *sr = calloc((size_t)in->n_techniques + 1, sizeof *sr);
+    if (!lab || !sr) {
+        free(lab);
+        free(sr);
+        return gr_fail(err, GR_E_NOMEM, "report: out of memory for the charts");
     }
-    /* 1. Radial profile, luminance. */
-    snprintf(lab[0], sizeof lab[0], "real-time shafts x a (a = %.4g)", a);
-    const gr_plot_series prof_y[2] = {
-        {"ground truth (reference)", pr->ref.center_deg, pr->ref.mean[GR_PROFILE_Y], pr->ref.nbins, {0, 0, 0},
-         GR_PLOT_SOLID, 0},
-        {lab[0], pr->fit.center_deg, pr->fit.mean[GR_PROFILE_Y], pr->fit.nbins, {30, 100, 220}, GR_PLOT_DASHED, 1},
-    };
+    sr[0] = (gr_plot_series){"ground truth (reference)", pr->ref.center_deg, pr->ref.mean[GR_PROFILE_Y], pr->ref.nbins,
+                             {0, 0, 0}, GR_PLOT_SOLID, 0};
+    for (int k = 0; k < in->n_techniques; k++) {
+        const unsigned char *c = tech_rgb[k % 9];
+        snprintf(lab[k], sizeof lab[k], "%s x a (a = %.4g)", in->techniques[k].name, as[k]);
+        sr[k + 1] = (gr_plot_series){lab[k], pr->fit[k].center_deg, pr->fit[k].mean[GR_PROFILE_Y], pr->fit[k].nbins,
+                                     {c[0], c[1], c[2]}, GR_PLOT_DASHED, 1};
+    }
     snprintf(title, sizeof title, "Radial profile of '%s': luminance vs angle from the refracted sun", in->scene->name);
     gr_plot_spec spec = {.width = 800, .height = 450, .title = title,
                          .xlabel = "angle between view ray and refracted sun direction (deg)",
-                         .ylabel = "mean luminance Y", .log_y = 1, .series = prof_y, .n_series = 2,
-                         .legend_headroom = 0.25};
-    if ((st = join(path, sizeof path, dir, "radial_profile.png", err)) != GR_OK) return st;
-    if ((st = gr_plot_write(path, &spec, err)) != GR_OK) return st;
-    (*n_charts)++;
+                         .ylabel = "mean luminance Y", .log_y = 1, .series = sr, .n_series = in->n_techniques + 1,
+                         .legend_headroom = 0.25 + 0.1 * (double)(in->n_techniques - 1)};
+    gr_status st = join(path, sizeof path, dir, "radial_profile.png", err);
+    if (st == GR_OK) st = gr_plot_write(path, &spec, err);
+    free(lab);
+    free(sr);
+    return st;
+}
 
-    /* 2. Radial profile per channel. */
+/* Technique k's own charts: per-channel profile, error against blur. */
+static gr_status draw_tech_charts(const char *dir, const gr_report_input *in, int k, double a, const profiles *pr,
+                                  double noise_y, int *n_charts, gr_error *err)
+{
+    char path[4200], title[256], lab[2][128], stem[48], file[96];
+    gr_status st;
+    const gr_report_technique *t = &in->techniques[k];
+    const gr_metrics *m = t->metrics;
+    tech_stem(t->name, stem, sizeof stem);
+    /* 1. Radial profile per channel. */
     static const unsigned char col[3][3] = {{215, 40, 40}, {30, 150, 50}, {40, 80, 220}};
     static const char *const cn[3] = {"R", "G", "B"};
     char labs[6][64];
     gr_plot_series prof_c[6];
     for (int c = 0; c < 3; c++) {
         snprintf(labs[2 * c], sizeof labs[0], "%s reference", cn[c]);
-        snprintf(labs[2 * c + 1], sizeof labs[0], "%s shafts x a", cn[c]);
+        snprintf(labs[2 * c + 1], sizeof labs[0], "%s %.40s x a", cn[c], t->name);
         prof_c[2 * c] = (gr_plot_series){labs[2 * c], pr->ref.center_deg, pr->ref.mean[c], pr->ref.nbins,
                                          {col[c][0], col[c][1], col[c][2]}, GR_PLOT_SOLID, 0};
-        prof_c[2 * c + 1] = (gr_plot_series){labs[2 * c + 1], pr->fit.center_deg, pr->fit.mean[c], pr->fit.nbins,
-                                             {col[c][0], col[c][1], col[c][2]}, GR_PLOT_DASHED, 0};
+        prof_c[2 * c + 1] = (gr_plot_series){labs[2 * c + 1], pr->fit[k].center_deg, pr->fit[k].mean[c],
+                                             pr->fit[k].nbins, {col[c][0], col[c][1], col[c][2]}, GR_PLOT_DASHED, 0};
     }
-    snprintf(title, sizeof title, "Radial profile per channel (shafts x a, a = %.4g)", a);
-    spec.title = title;
-    spec.ylabel = "mean radiance per channel";
-    spec.legend_headroom = 0.6;
-    spec.series = prof_c;
-    spec.n_series = 6;
-    if ((st = join(path, sizeof path, dir, "radial_profile_rgb.png", err)) != GR_OK) return st;
+    snprintf(title, sizeof title, "Radial profile per channel (%s x a, a = %.4g)", t->name, a);
+    gr_plot_spec spec = {.width = 800, .height = 450, .title = title,
+                         .xlabel = "angle between view ray and refracted sun direction (deg)",
+                         .ylabel = "mean radiance per channel", .log_y = 1, .series = prof_c, .n_series = 6,
+                         .legend_headroom = 0.6};
+    snprintf(file, sizeof file, "%s_radial_profile_rgb.png", stem);
+    if ((st = join(path, sizeof path, dir, file, err)) != GR_OK) return st;
     if ((st = gr_plot_write(path, &spec, err)) != GR_OK) return st;
     (*n_charts)++;
 
-    /* 3. Error against blur scale: unblurred, then sigma 1, 4, 16 px. */
+    /* 2. Error against blur scale: unblurred, then sigma 1, 4, 16 px. */
     static const char *const cats[1 + GR_METRICS_NSCALES] = {"none", "1", "4", "16"};
     double xs[1 + GR_METRICS_NSCALES], fy[1 + GR_METRICS_NSCALES], frgb[1 + GR_METRICS_NSCALES],
         ry[1 + GR_METRICS_NSCALES], nz[1 + GR_METRICS_NSCALES];
@@ -378,21 +409,41 @@ static gr_status draw_charts(const char *dir, const gr_report_input *in, double 
         ry[s + 1] = m->raw.have_blur ? m->raw.ch[GR_MCH_Y].rmse_blur[s] : NAN;
     }
     for (int s = 0; s <= GR_METRICS_NSCALES; s++) nz[s] = noise_y;
-    snprintf(lab[0], sizeof lab[0], "Y, shafts x a (a = %.4g)", fs->scale);
-    snprintf(lab[1], sizeof lab[1], "RGB pooled, shafts x a");
+    char lab2[128];
+    snprintf(lab[0], sizeof lab[0], "Y, %.40s x a (a = %.4g)", t->name, fs->scale);
+    snprintf(lab[1], sizeof lab[1], "RGB pooled, %.40s x a", t->name);
+    snprintf(lab2, sizeof lab2, "Y, %.40s as rendered (a = 1)", t->name);
     gr_plot_series blur[4] = {
         {lab[0], xs, fy, 1 + GR_METRICS_NSCALES, {30, 100, 220}, GR_PLOT_SOLID, 1},
         {lab[1], xs, frgb, 1 + GR_METRICS_NSCALES, {120, 60, 170}, GR_PLOT_DASHED, 1},
-        {"Y, shafts as rendered (a = 1)", xs, ry, 1 + GR_METRICS_NSCALES, {215, 40, 40}, GR_PLOT_LONG_DASHED, 1},
+        {lab2, xs, ry, 1 + GR_METRICS_NSCALES, {215, 40, 40}, GR_PLOT_LONG_DASHED, 1},
         {"reference noise (RMS std. error of Y)", xs, nz, 1 + GR_METRICS_NSCALES, {120, 120, 120}, GR_PLOT_DASHED, 0},
     };
-    spec = (gr_plot_spec){.width = 800, .height = 450, .title = "RMSE after Gaussian blur of the difference",
+    snprintf(title, sizeof title, "%s: RMSE after Gaussian blur of the difference", t->name);
+    spec = (gr_plot_spec){.width = 800, .height = 450, .title = title,
                           .xlabel = "blur sigma (px)", .ylabel = "RMSE", .log_y = 1, .series = blur,
                           .n_series = isfinite(noise_y) && noise_y > 0 ? 4 : 3, .legend_headroom = 0.8, .x_categories = cats,
                           .n_categories = 1 + GR_METRICS_NSCALES};
-    if ((st = join(path, sizeof path, dir, "error_vs_blur.png", err)) != GR_OK) return st;
+    snprintf(file, sizeof file, "%s_error_vs_blur.png", stem);
+    if ((st = join(path, sizeof path, dir, file, err)) != GR_OK) return st;
     if ((st = gr_plot_write(path, &spec, err)) != GR_OK) return st;
     (*n_charts)++;
+    return GR_OK;
+}
+
+static gr_status draw_charts(const char *dir, const gr_report_input *in, const double *as, const profiles *pr,
+                             double noise_y, int *n_charts, char *note, size_t note_n, gr_error *err)
+{
+    *n_charts = 0;
+    if (!gr_plot_available()) {
+        snprintf(note, note_n, "charts not drawn: this build has no PLplot (install libplplot-dev and rebuild)");
+        return GR_OK;
+    }
+    gr_status st = draw_profile_all(dir, in, as, pr, err);
+    if (st != GR_OK) return st;
+    (*n_charts)++;
+    for (int k = 0; k < in->n_techniques; k++)
+        if ((st = draw_tech_charts(dir, in, k, as[k], pr, noise_y, n_charts, err)) != GR_OK) return st;
     return GR_OK;
 }
 
@@ -489,7 +540,8 @@ static const char *const CSS =
     "td,th{border:1px solid #ddd;padding:3px 8px;text-align:right;vertical-align:top}"
     "th{background:#f0f2f5}td.l,th.l{text-align:left}pre{background:#fff;border:1px solid #ddd;padding:10px;"
     "overflow:auto;font-size:.85em;max-height:520px}details{margin:8px 0}summary{cursor:pointer;font-weight:bold}"
-    "code{background:#eef0f3;padding:0 3px}";
+    "code{background:#eef0f3;padding:0 3px}"
+    "table.lb td{vertical-align:middle}img.thumb{width:200px;height:auto;image-rendering:pixelated;display:block}";
 
 static void html_metrics_table(gr_strbuf *b, const gr_metrics *m, const gr_metrics_set *s, const char *caption)
 {
@@ -636,71 +688,190 @@ static void html_figure(gr_strbuf *b, const char *file, const gr_image *img, con
 
 /* ---- the writer ----------------------------------------------------------------------------- */
 
+/* What the report computes for one technique. */
+typedef struct tctx {
+    const gr_report_technique *t;
+    char stem[48];                 /* file-name stem (tech_stem) */
+    double a, exposure_raw;
+    double gpu_ms, wall_ms;        /* from its metadata (NaN: unknown) */
+    gr_image *disp_fit, *disp_raw, *diff_signed, *diff_abs;
+    gr_diffmap_info info_signed, info_abs;
+    char lines[3][512];            /* its summary lines */
+} tctx;
+
 typedef struct ctx {
     const char *dir;
     const gr_report_input *in;
-    double a, exposure, exposure_raw, noise_y;
-    gr_image *disp_ref, *disp_fit, *disp_raw, *diff_signed, *diff_abs, *flip_map;
-    gr_diffmap_info info_signed, info_abs;
+    double exposure, noise_y;
+    gr_image *disp_ref;
+    tctx t[GR_REPORT_MAX_TECHNIQUES];
+    int order[GR_REPORT_MAX_TECHNIQUES];
     profiles pr;
     int have_profiles;
     int charts;
     char chart_note[512];
     int labelled;
-    char lines[5][512];
+    char lines[2][512];            /* scene, reference */
 } ctx;
+
+static double rel_rmse_y(const gr_metrics_set *s)
+{
+    const gr_channel_metrics *y = &s->ch[GR_MCH_Y];
+    return y->ref_mean != 0 ? y->rmse / fabs(y->ref_mean) : NAN;
+}
+
+static const gr_metrics_set *fit_set(const gr_metrics *m) { return m->have_fit ? &m->fit : &m->raw; }
+
+void gr_report_rank(const gr_report_technique *techniques, int n, int *order)
+{
+    for (int i = 0; i < n; i++) order[i] = i;
+    /* insertion sort: stable, n is small */
+    for (int i = 1; i < n; i++) {
+        int v = order[i], j = i;
+        double ev = rel_rmse_y(fit_set(techniques[v].metrics));
+        while (j > 0) {
+            double eu = rel_rmse_y(fit_set(techniques[order[j - 1]].metrics));
+            int before = isfinite(ev) && (!isfinite(eu) || ev < eu);
+            if (!before) break;
+            order[j] = order[j - 1];
+            j--;
+        }
+        order[j] = v;
+    }
+}
 
 static void summary_lines(ctx *c)
 {
     const gr_report_input *in = c->in;
-    const gr_metrics *m = in->metrics;
-    const gr_metrics_set *fs = m->have_fit ? &m->fit : &m->raw;
-    const gr_channel_metrics *y = &fs->ch[GR_MCH_Y];
     char t[8][48];
-    snprintf(c->lines[0], sizeof c->lines[0], "scene '%s' (hash %s), %d x %d; godrays %s", in->scene->name,
-             in->scene->hash, in->ref->width, in->ref->height, GR_VERSION);
+    snprintf(c->lines[0], sizeof c->lines[0], "scene '%s' (hash %s), %d x %d; godrays %s; %d real-time technique%s",
+             in->scene->name, in->scene->hash, in->ref->width, in->ref->height, GR_VERSION, in->n_techniques,
+             in->n_techniques == 1 ? "" : "s");
     const double wall = meta_num(in->ref_meta, "godrays:wall_s");
     snprintf(c->lines[1], sizeof c->lines[1],
              "reference: %s s render%s, %s spp, rel. std. error of the image mean %s %%",
              fmt(wall, t[0], sizeof t[0]), in->ref_cached ? " (read from the cache)" : "",
              fmt(meta_num(in->ref_meta, "godrays:spp"), t[1], sizeof t[1]),
              fmt(100.0 * meta_num(in->ref_meta, "godrays:rel_stderr_mean"), t[2], sizeof t[2]));
-    double gpu = 0.0;
-    int any = 0;
-    static const char *const passes[3] = {"godrays:gpu_ns.shadow", "godrays:gpu_ns.shafts", "godrays:gpu_ns.final"};
-    for (int p = 0; p < 3; p++) {
-        const double v = meta_num(in->test_meta, passes[p]);
-        if (v >= 0) {
-            gpu += v * 1e-6;
-            any = 1;
-        }
+    for (int k = 0; k < in->n_techniques; k++) {
+        tctx *tc = &c->t[k];
+        const gr_metrics *m = tc->t->metrics;
+        const gr_metrics_set *fs = fit_set(m);
+        const gr_channel_metrics *y = &fs->ch[GR_MCH_Y];
+        snprintf(tc->lines[0], sizeof tc->lines[0], "%s: GPU %s ms (timed passes), wall %s ms per render, %s fragments",
+                 tc->t->name, fmt(tc->gpu_ms, t[0], sizeof t[0]), fmt(tc->wall_ms, t[1], sizeof t[1]),
+                 fmt(meta_num(tc->t->meta, "godrays:fragments"), t[2], sizeof t[2]));
+        snprintf(tc->lines[1], sizeof tc->lines[1],
+                 "best scale a = %s; luminance after fit: RMSE %s (%s of the mean), bias %s, SSIM %s, RMSE at sigma 16 px %s",
+                 fmt(fs->scale, t[0], sizeof t[0]), fmt(y->rmse, t[1], sizeof t[1]), fmt(rel_rmse_y(fs), t[2], sizeof t[2]),
+                 fmt(y->bias, t[3], sizeof t[3]), fs->have_ssim ? fmt(fs->ssim_y, t[4], sizeof t[4]) : "n/a",
+                 fs->have_blur ? fmt(y->rmse_blur[GR_METRICS_NSCALES - 1], t[5], sizeof t[5]) : "n/a");
+        snprintf(tc->lines[2], sizeof tc->lines[2],
+                 "scored pixels %lld of %lld; not scored: %lld (reference rel. std. error > %s)", m->n_scored,
+                 m->n_pixels, m->n_stderr_excluded, fmt(m->stderr_bound, t[0], sizeof t[0]));
     }
-    snprintf(c->lines[2], sizeof c->lines[2], "real-time shafts: GPU %s ms (timed passes), CPU %s ms, %s shafts, %s fragments",
-             any ? fmt(gpu, t[0], sizeof t[0]) : "n/a", fmt(meta_num(in->test_meta, "godrays:cpu_ms"), t[1], sizeof t[1]),
-             fmt(meta_num(in->test_meta, "godrays:shafts_count"), t[2], sizeof t[2]),
-             fmt(meta_num(in->test_meta, "godrays:fragments_blended"), t[3], sizeof t[3]));
-    snprintf(c->lines[3], sizeof c->lines[3],
-             "best scale a = %s; luminance after fit: RMSE %s (%s of the mean), bias %s, SSIM %s, RMSE at sigma 16 px %s",
-             fmt(fs->scale, t[0], sizeof t[0]), fmt(y->rmse, t[1], sizeof t[1]),
-             y->ref_mean != 0 ? fmt(y->rmse / fabs(y->ref_mean), t[2], sizeof t[2]) : "n/a",
-             fmt(y->bias, t[3], sizeof t[3]), fs->have_ssim ? fmt(fs->ssim_y, t[4], sizeof t[4]) : "n/a",
-             fs->have_blur ? fmt(y->rmse_blur[GR_METRICS_NSCALES - 1], t[5], sizeof t[5]) : "n/a");
-    snprintf(c->lines[4], sizeof c->lines[4],
-             "scored pixels %lld of %lld; not scored: %lld (reference rel. std. error > %s)", m->n_scored,
-             m->n_pixels, m->n_stderr_excluded, fmt(m->stderr_bound, t[0], sizeof t[0]));
+}
+
+/* One technique's entry of metrics.json. */
+static cJSON *technique_json(const ctx *c, int k, int rank)
+{
+    const tctx *tc = &c->t[k];
+    const gr_report_technique *t = tc->t;
+    const gr_metrics *m = t->metrics;
+    char file[96];
+    cJSON *o = cJSON_CreateObject();
+    int ok = o != NULL;
+    jstr(o, "name", t->name, &ok);
+    jstr(o, "description", t->description, &ok);
+    jnum(o, "rank", rank, &ok);
+    jstr(o, "file", t->exr, &ok);
+    jnum(o, "seconds_this_run", t->seconds >= 0 ? t->seconds : NAN, &ok);
+    jnum(o, "gpu_ms", tc->gpu_ms, &ok);
+    jnum(o, "wall_ms", tc->wall_ms, &ok);
+    jnum(o, "fit_scale", tc->a, &ok);
+    /* the headline errors (luminance), raw and after the fit */
+    cJSON *e = cJSON_CreateObject();
+    jadd(o, "errors_y", e, &ok);
+    jnum(e, "rmse", m->raw.ch[GR_MCH_Y].rmse, &ok);
+    jnum(e, "rmse_fit", fit_set(m)->ch[GR_MCH_Y].rmse, &ok);
+    jnum(e, "rel_rmse", rel_rmse_y(&m->raw), &ok);
+    jnum(e, "rel_rmse_fit", rel_rmse_y(fit_set(m)), &ok);
+    jnum(e, "ssim", m->raw.have_ssim ? m->raw.ssim_y : NAN, &ok);
+    jnum(e, "ssim_fit", fit_set(m)->have_ssim ? fit_set(m)->ssim_y : NAN, &ok);
+    jnum(e, "bias_fit", fit_set(m)->ch[GR_MCH_Y].bias, &ok);
+    /* every metric, as `godrays compare --json` writes it */
+    jadd(o, "compare", gr_metrics_to_json(m), &ok);
+    cJSON *pv = cJSON_CreateObject();
+    jadd(o, "previews", pv, &ok);
+    snprintf(file, sizeof file, "%s.png", tc->stem);
+    jstr(pv, "fitted", file, &ok);
+    snprintf(file, sizeof file, "%s_raw.png", tc->stem);
+    jstr(pv, "raw", file, &ok);
+    jnum(pv, "scale", tc->a, &ok);
+    jnum(pv, "raw_exposure", tc->exposure_raw, &ok);
+    cJSON *dj = cJSON_CreateObject();
+    jadd(o, "difference_images", dj, &ok);
+    for (int s = 0; ok && s < 2; s++) {
+        const gr_diffmap_info *info = s ? &tc->info_signed : &tc->info_abs;
+        cJSON *one = cJSON_CreateObject();
+        snprintf(file, sizeof file, "%s_%s.png", tc->stem, s ? "diff_signed" : "diff");
+        jadd(dj, file, one, &ok);
+        jstr(one, "quantity", s ? "scale * Y(test) - Y(ref)" : "|scale * Y(test) - Y(ref)|", &ok);
+        jnum(one, "scale", tc->a, &ok);
+        jstr(one, "color_map", info->map, &ok);
+        jnum(one, "min", info->vmin, &ok);
+        jnum(one, "max", info->vmax, &ok);
+        jnum(one, "unscored_pixels_gray", (double)info->n_unscored, &ok);
+    }
+    if (c->have_profiles) {
+        cJSON *rp = cJSON_CreateObject();
+        jadd(o, "radial_profile", rp, &ok);
+        jadd(rp, "fitted", profile_json(&c->pr.fit[k], 0), &ok);
+        jadd(rp, "raw", profile_json(&c->pr.raw[k], 0), &ok);
+    }
+    {
+        const gr_metrics_set *fs = fit_set(m);
+        double sig[1 + GR_METRICS_NSCALES], fy[1 + GR_METRICS_NSCALES], ry[1 + GR_METRICS_NSCALES];
+        sig[0] = 0;
+        fy[0] = fs->ch[GR_MCH_Y].rmse;
+        ry[0] = m->raw.ch[GR_MCH_Y].rmse;
+        for (int s = 0; s < GR_METRICS_NSCALES; s++) {
+            sig[s + 1] = gr_metrics_blur_sigmas[s];
+            fy[s + 1] = fs->have_blur ? fs->ch[GR_MCH_Y].rmse_blur[s] : NAN;
+            ry[s + 1] = m->raw.have_blur ? m->raw.ch[GR_MCH_Y].rmse_blur[s] : NAN;
+        }
+        cJSON *eb = cJSON_CreateObject();
+        jadd(o, "error_vs_blur", eb, &ok);
+        jadd(eb, "sigma_px", jarr(sig, 1 + GR_METRICS_NSCALES), &ok);
+        jadd(eb, "rmse_y_fitted", jarr(fy, 1 + GR_METRICS_NSCALES), &ok);
+        jadd(eb, "rmse_y_raw", jarr(ry, 1 + GR_METRICS_NSCALES), &ok);
+    }
+    jadd(o, "metadata", meta_json(t->meta), &ok);
+    if (ok) {
+        cJSON *sl = cJSON_CreateArray();
+        for (int i = 0; sl && i < 3; i++) {
+            cJSON *x = cJSON_CreateString(tc->lines[i]);
+            if (!x || !cJSON_AddItemToArray(sl, x)) {
+                cJSON_Delete(x);
+                cJSON_Delete(sl);
+                sl = NULL;
+            }
+        }
+        jadd(o, "summary", sl, &ok);
+    }
+    if (!ok) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
 }
 
 static gr_status build_json(ctx *c, char **text, gr_error *err)
 {
     const gr_report_input *in = c->in;
-    cJSON *root = gr_metrics_to_json(in->metrics);
+    cJSON *root = cJSON_CreateObject();
     int ok = root != NULL;
-    if (ok && in->flip_map && in->flip) {
-        cJSON *fj = gr_flip_to_json(in->flip, c->a);
-        ok = fj && cJSON_AddStringToObject(fj, "map", "flip.png (magma, 0 black .. 1 pale yellow)") &&
-             cJSON_AddItemToObject(root, "flip", fj);
-        if (!ok) cJSON_Delete(fj);
-    }
+    jnum(root, "schema", 2, &ok);
     jstr(root, "godrays_version", GR_VERSION, &ok);
     jstr(root, "command_line", in->command_line, &ok);
     /* the scene as the renderers saw it: normalized, every default filled in */
@@ -720,35 +891,35 @@ static gr_status build_json(ctx *c, char **text, gr_error *err)
         jstr(ref, "cache_file", in->ref_cache_path, &ok);
         jstr(ref, "cache_note", in->ref_cache_note, &ok);
         jnum(ref, "noise_rms_stderr_y", c->noise_y, &ok);
+        jnum(ref, "preview_exposure", c->exposure, &ok);
+        jstr(ref, "preview_exposure_rule", "reference 99th percentile of max(R, G, B) -> 0.8, then sRGB", &ok);
         jadd(ref, "metadata", meta_json(in->ref_meta), &ok);
     }
-    cJSON *test = cJSON_CreateObject();
-    jadd(root, "test", test, &ok);
-    if (ok) {
-        jstr(test, "file", in->test_exr, &ok);
-        jnum(test, "seconds_this_run", in->shafts_seconds >= 0 ? in->shafts_seconds : NAN, &ok);
-        jadd(test, "metadata", meta_json(in->test_meta), &ok);
+    /* the leaderboard: technique names, best first */
+    cJSON *lb = ok ? cJSON_CreateArray() : NULL;
+    for (int r = 0; lb && r < in->n_techniques; r++) {
+        cJSON *x = cJSON_CreateString(in->techniques[c->order[r]].name);
+        if (!x || !cJSON_AddItemToArray(lb, x)) {
+            cJSON_Delete(x);
+            cJSON_Delete(lb);
+            lb = NULL;
+        }
     }
-    cJSON *pv = cJSON_CreateObject();
-    jadd(root, "previews", pv, &ok);
-    jnum(pv, "exposure", c->exposure, &ok);
-    jstr(pv, "exposure_rule", "reference 99th percentile of max(R, G, B) -> 0.8, then sRGB", &ok);
-    jnum(pv, "shafts_scale", c->a, &ok);
-    jnum(pv, "shafts_raw_exposure", c->exposure_raw, &ok);
-
-    cJSON *dj = cJSON_CreateObject();
-    jadd(root, "difference_images", dj, &ok);
-    for (int k = 0; ok && k < 2; k++) {
-        const gr_diffmap_info *info = k ? &c->info_signed : &c->info_abs;
-        cJSON *one = cJSON_CreateObject();
-        jadd(dj, k ? "diff_signed.png" : "diff.png", one, &ok);
-        jstr(one, "quantity", k ? "scale * Y(test) - Y(ref)" : "|scale * Y(test) - Y(ref)|", &ok);
-        jnum(one, "scale", c->a, &ok);
-        jstr(one, "color_map", info->map, &ok);
-        jnum(one, "min", info->vmin, &ok);
-        jnum(one, "max", info->vmax, &ok);
-        jnum(one, "unscored_pixels_gray", (double)info->n_unscored, &ok);
+    jadd(root, "leaderboard", lb, &ok);
+    jstr(root, "leaderboard_rule", "relative RMSE of luminance Y after the best scale fit, lower first", &ok);
+    cJSON *ts = ok ? cJSON_CreateArray() : NULL;
+    for (int k = 0; ts && k < in->n_techniques; k++) {
+        int rank = 0;
+        for (int r = 0; r < in->n_techniques; r++)
+            if (c->order[r] == k) rank = r + 1;
+        cJSON *x = technique_json(c, k, rank);
+        if (!x || !cJSON_AddItemToArray(ts, x)) {
+            cJSON_Delete(x);
+            cJSON_Delete(ts);
+            ts = NULL;
+        }
     }
+    jadd(root, "techniques", ts, &ok);
 
     if (c->have_profiles) {
         cJSON *rp = cJSON_CreateObject();
@@ -771,27 +942,6 @@ static gr_status build_json(ctx *c, char **text, gr_error *err)
             jadd(rp, "pixels", cnt, &ok);
         }
         jadd(rp, "reference", profile_json(&c->pr.ref, 1), &ok);
-        jadd(rp, "test_fitted", profile_json(&c->pr.fit, 0), &ok);
-        jadd(rp, "test_raw", profile_json(&c->pr.raw, 0), &ok);
-    }
-    {
-        const gr_metrics *m = in->metrics;
-        const gr_metrics_set *fs = m->have_fit ? &m->fit : &m->raw;
-        double sig[1 + GR_METRICS_NSCALES], fy[1 + GR_METRICS_NSCALES], ry[1 + GR_METRICS_NSCALES];
-        sig[0] = 0;
-        fy[0] = fs->ch[GR_MCH_Y].rmse;
-        ry[0] = m->raw.ch[GR_MCH_Y].rmse;
-        for (int s = 0; s < GR_METRICS_NSCALES; s++) {
-            sig[s + 1] = gr_metrics_blur_sigmas[s];
-            fy[s + 1] = fs->have_blur ? fs->ch[GR_MCH_Y].rmse_blur[s] : NAN;
-            ry[s + 1] = m->raw.have_blur ? m->raw.ch[GR_MCH_Y].rmse_blur[s] : NAN;
-        }
-        cJSON *eb = cJSON_CreateObject();
-        jadd(root, "error_vs_blur", eb, &ok);
-        jadd(eb, "sigma_px", jarr(sig, 1 + GR_METRICS_NSCALES), &ok);
-        jadd(eb, "rmse_y_fitted", jarr(fy, 1 + GR_METRICS_NSCALES), &ok);
-        jadd(eb, "rmse_y_raw", jarr(ry, 1 + GR_METRICS_NSCALES), &ok);
-        jnum(eb, "reference_noise_rms_stderr_y", c->noise_y, &ok);
     }
     cJSON *ch = cJSON_CreateObject();
     jadd(root, "charts", ch, &ok);
@@ -800,11 +950,12 @@ static gr_status build_json(ctx *c, char **text, gr_error *err)
     cJSON *tm = cJSON_CreateObject();
     jadd(root, "timings_s", tm, &ok);
     jnum(tm, "reference", in->ref_seconds >= 0 ? in->ref_seconds : NAN, &ok);
-    jnum(tm, "shafts", in->shafts_seconds >= 0 ? in->shafts_seconds : NAN, &ok);
+    for (int k = 0; k < in->n_techniques; k++)
+        jnum(tm, in->techniques[k].name, in->techniques[k].seconds >= 0 ? in->techniques[k].seconds : NAN, &ok);
     jnum(tm, "compare", in->compare_seconds >= 0 ? in->compare_seconds : NAN, &ok);
     if (ok) {
         cJSON *sl = cJSON_CreateArray();
-        for (int i = 0; sl && i < 5; i++) {
+        for (int i = 0; sl && i < 2; i++) {
             cJSON *x = cJSON_CreateString(c->lines[i]);
             if (!x || !cJSON_AddItemToArray(sl, x)) {
                 cJSON_Delete(x);
@@ -821,15 +972,27 @@ static gr_status build_json(ctx *c, char **text, gr_error *err)
 }
 
 /* The pages of `godrays sweep`, `tune` and `pareto` in their folders inside the report's
- * (docs/tuning.md): a link to each one that exists now, else the command that makes it. */
+ * (docs/tuning.md): a link to each one that exists now, else the command that makes it. The
+ * example parameters are the leader's first two tunable settings. */
 static void html_tuning_pages(gr_strbuf *b, const ctx *c)
 {
-    static const struct { const char *sub, *what, *args; } pages[3] = {
-        {"sweep", "the error over a grid of one or two shaft settings",
-         " --param shafts.K=0.2:2:16 --param shafts.extinction=0.1:4:16"},
-        {"tune", "the shaft settings with the least error over frames and views", " --params shafts.K,shafts.extinction"},
-        {"pareto", "speed against error of both renderers", ""},
+    static const struct { const char *sub, *what; } pages[3] = {
+        {"sweep", "the error over a grid of one or two settings of a technique"},
+        {"tune", "a technique's settings with the least error over frames and views"},
+        {"pareto", "speed against error of the ground truth and of every technique"},
     };
+    /* example: the first technique's first two settings with a tuning box */
+    const char *tname = c->in->techniques[0].name;
+    const gr_param *ex[2] = {NULL, NULL};
+    int sec = gr_sections_find(tname);
+    const gr_param_table *tab = gr_sections_table(sec);
+    for (size_t i = 0; tab && i < tab->count && !ex[1]; i++) {
+        const gr_param *p = &tab->params[i];
+        if (p->tune_hi > p->tune_lo && (p->type == GR_PT_DOUBLE || p->type == GR_PT_RGB)) {
+            if (!ex[0]) ex[0] = p;
+            else ex[1] = p;
+        }
+    }
     gr_sb_puts(b, "<h2>Sweep, tuning, speed against error</h2>\n<ul>\n");
     for (int k = 0; k < 3; k++) {
         char path[4300];
@@ -845,7 +1008,18 @@ static void html_tuning_pages(gr_strbuf *b, const ctx *c)
             gr_sb_printf(&cmd, "godrays %s ", pages[k].sub);
             if (c->in->scene_words) gr_sb_puts(&cmd, c->in->scene_words);
             else gr_sb_shell_word(&cmd, c->in->scene->source_path);
-            gr_sb_printf(&cmd, "%s -o ", pages[k].args);
+            for (int e = 0; k == 0 && e < 2; e++)
+                if (ex[e]) {
+                    char lo[32], hi[32];
+                    gr_sb_printf(&cmd, " --param %s.%s=%s:%s:16", tname, ex[e]->name,
+                                 gr_format_double(ex[e]->tune_lo, lo, sizeof lo),
+                                 gr_format_double(ex[e]->tune_hi, hi, sizeof hi));
+                }
+            if (k == 1 && ex[0]) {
+                gr_sb_printf(&cmd, " --params %s.%s", tname, ex[0]->name);
+                if (ex[1]) gr_sb_printf(&cmd, ",%s.%s", tname, ex[1]->name);
+            }
+            gr_sb_puts(&cmd, " -o ");
             snprintf(path, sizeof path, "%s/%s", c->dir, pages[k].sub);
             gr_sb_shell_word(&cmd, path);
             gr_sb_printf(b, "%s/: ", pages[k].sub);
@@ -863,17 +1037,176 @@ static void html_tuning_pages(gr_strbuf *b, const ctx *c)
                   "The commands run from the folder <code>godrays run</code> was started in; docs/tuning.md.</p>\n");
 }
 
+/* The leaderboard table: one row per technique, best first. */
+static void html_leaderboard(gr_strbuf *b, const ctx *c)
+{
+    const gr_report_input *in = c->in;
+    char t[10][48];
+    gr_sb_puts(b, "<h2 id=\"leaderboard\">Leaderboard</h2>\n<table class=\"lb\"><tr><th>rank</th><th class=\"l\">"
+                  "technique</th><th class=\"l\">image (x a)</th><th>RMSE Y</th><th>RMSE Y<br>after fit</th>"
+                  "<th>rel. RMSE Y</th><th>rel. RMSE Y<br>after fit</th><th>SSIM</th><th>SSIM<br>after fit</th>"
+                  "<th>scale a</th><th>GPU ms<br>(passes)</th><th>wall ms<br>(render)</th><th>s in<br>this run</th></tr>\n");
+    for (int r = 0; r < in->n_techniques; r++) {
+        const tctx *tc = &c->t[c->order[r]];
+        const gr_metrics *m = tc->t->metrics;
+        const gr_metrics_set *fs = fit_set(m);
+        gr_sb_printf(b, "<tr><td>%d</td><td class=\"l\"><a href=\"#t-", r + 1);
+        gr_sb_html(b, tc->t->name);
+        gr_sb_puts(b, "\"><b>");
+        gr_sb_html(b, tc->t->name);
+        gr_sb_puts(b, "</b></a><br><span class=\"sub\">");
+        gr_sb_html(b, tc->t->description ? tc->t->description : "");
+        gr_sb_puts(b, "</span></td><td class=\"l\"><img src=\"");
+        gr_sb_htmlf(b, "%s.png", tc->stem);
+        gr_sb_puts(b, "\" class=\"thumb\" alt=\"");
+        gr_sb_html(b, tc->t->name);
+        gr_sb_printf(b, "\" width=\"%d\" height=\"%d\"></td>", tc->disp_fit->width, tc->disp_fit->height);
+        const double v[10] = {m->raw.ch[GR_MCH_Y].rmse, fs->ch[GR_MCH_Y].rmse, rel_rmse_y(&m->raw), rel_rmse_y(fs),
+                              m->raw.have_ssim ? m->raw.ssim_y : NAN, fs->have_ssim ? fs->ssim_y : NAN, tc->a,
+                              tc->gpu_ms, tc->wall_ms, tc->t->seconds >= 0 ? tc->t->seconds : NAN};
+        for (int i = 0; i < 10; i++) gr_sb_printf(b, "<td>%s</td>", fmt(v[i], t[i], sizeof t[i]));
+        gr_sb_puts(b, "</tr>\n");
+    }
+    gr_sb_puts(b, "</table>\n<p class=\"sub\">Ranked by the relative RMSE of luminance after the best scale fit "
+                  "(RMSE / mean reference Y; each technique's intensity is an arbitrary factor, so shapes are "
+                  "compared at the best-fitting level a = &lt;t, r&gt; / &lt;t, t&gt;). GPU ms: the sum of the "
+                  "technique's GL pass timers (GL_TIME_ELAPSED; on llvmpipe they measure the CPU rasterizer); "
+                  "wall ms: its render call, readback included. Details per technique below.</p>\n");
+}
+
+static void html_technique(ctx *c, gr_strbuf *b, int k)
+{
+    const gr_report_input *in = c->in;
+    tctx *tc = &c->t[k];
+    const gr_report_technique *t = tc->t;
+    const gr_metrics *m = t->metrics;
+    const gr_metadata *tmeta = t->meta;
+    char cap[1024], f[4][96], tt[4][64];
+    gr_sb_puts(b, "<h2 id=\"t-");
+    gr_sb_html(b, t->name);
+    gr_sb_puts(b, "\">Technique <code>");
+    gr_sb_html(b, t->name);
+    gr_sb_puts(b, "</code></h2>\n<p class=\"sub\">");
+    gr_sb_html(b, t->description ? t->description : "");
+    gr_sb_puts(b, "</p>\n<div class=\"box\">\n");
+    for (int i = 0; i < 3; i++) {
+        gr_sb_html(b, tc->lines[i]);
+        gr_sb_puts(b, "<br>\n");
+    }
+    gr_sb_puts(b, "</div>\n");
+    if (m->n_stderr_excluded > 0)
+        gr_sb_htmlf(b, "<p class=\"box warn\">%lld pixels NOT SCORED: the reference's relative standard error of "
+                       "luminance exceeds %g there (drawn mid gray in the difference images).</p>\n",
+                    m->n_stderr_excluded, m->stderr_bound);
+    snprintf(f[0], sizeof f[0], "%s.png", tc->stem);
+    snprintf(f[1], sizeof f[1], "%s_diff_signed.png", tc->stem);
+    snprintf(f[2], sizeof f[2], "%s_diff.png", tc->stem);
+    snprintf(f[3], sizeof f[3], "%s_raw.png", tc->stem);
+    gr_sb_puts(b, "<div class=\"grid\">\n");
+    snprintf(cap, sizeof cap, "Ground truth, exposure %s (its 99th percentile -> 0.8), sRGB.%s",
+             fmt(c->exposure, tt[0], sizeof tt[0]), in->ref_cached ? " Read from the cache." : "");
+    html_figure(b, "reference.png", c->disp_ref, "reference (ground truth)", cap);
+    snprintf(cap, sizeof cap,
+             "%s times the best scale a = %s, same exposure as the reference: the technique's intensity is an "
+             "arbitrary factor, so shapes are compared at the best-fitting level.",
+             t->name, fmt(tc->a, tt[0], sizeof tt[0]));
+    html_figure(b, f[0], tc->disp_fit, "technique times a", cap);
+    snprintf(cap, sizeof cap,
+             "Signed luminance difference a Y(test) - Y(ref), OpenImageIO map '%s' on [%s, %s]: blue = real-time "
+             "too dark, red = too bright; gray = not scored.",
+             tc->info_signed.map, fmt(tc->info_signed.vmin, tt[0], sizeof tt[0]),
+             fmt(tc->info_signed.vmax, tt[1], sizeof tt[1]));
+    html_figure(b, f[1], tc->diff_signed, "signed difference with colorbar", cap);
+    snprintf(cap, sizeof cap, "Absolute luminance difference |a Y(test) - Y(ref)|, map '%s' on [%s, %s] (99th percentile).",
+             tc->info_abs.map, fmt(tc->info_abs.vmin, tt[0], sizeof tt[0]), fmt(tc->info_abs.vmax, tt[1], sizeof tt[1]));
+    html_figure(b, f[2], tc->diff_abs, "absolute difference with colorbar", cap);
+    snprintf(cap, sizeof cap, "%s as rendered (a = 1), own exposure %s.", t->name,
+             fmt(tc->exposure_raw, tt[0], sizeof tt[0]));
+    html_figure(b, f[3], tc->disp_raw, "technique as rendered", cap);
+    gr_sb_puts(b, "</div>\n");
+    if (t->exr && in->ref_exr) {
+        gr_sb_puts(b, "<p class=\"sub\">The linear images: <a href=\"");
+        gr_sb_html(b, in->ref_exr);
+        gr_sb_puts(b, "\">");
+        gr_sb_html(b, in->ref_exr);
+        gr_sb_puts(b, "</a>, <a href=\"");
+        gr_sb_html(b, t->exr);
+        gr_sb_puts(b, "\">");
+        gr_sb_html(b, t->exr);
+        gr_sb_puts(b, "</a>.</p>\n");
+    }
+    /* metrics */
+    gr_sb_puts(b, "<h3>Metrics</h3>\n<p class=\"sub\">");
+    gr_sb_htmlf(b, "%lld of %lld pixels scored (%lld masked out, %lld not scored because the reference's relative "
+                   "standard error of luminance exceeds %s). Y = 0.2126 R + 0.7152 G + 0.0722 B; RGB pools the "
+                   "three channels as OpenImageIO idiff does. Formulas and conventions: docs/metrics.md.",
+                m->n_scored, m->n_pixels, m->n_masked_out, m->n_stderr_excluded, fmt(m->stderr_bound, tt[0], sizeof tt[0]));
+    gr_sb_puts(b, "</p>\n<div class=\"grid\">\n<div>\n");
+    if (m->have_fit) {
+        char capt[160];
+        snprintf(capt, sizeof capt, "After the best scale fit: test x a, a = <t, r> / <t, t> = %.6g%s", m->fit.scale,
+                 m->fit_defined ? "" : " (undefined: test is black; a = 1)");
+        html_metrics_table(b, m, &m->fit, capt);
+        gr_sb_puts(b, "</div>\n<div>\n");
+    }
+    html_metrics_table(b, m, &m->raw, "As rendered (a = 1): the real-time technique's own, arbitrary, intensity scale");
+    gr_sb_puts(b, "</div>\n</div>\n");
+    gr_sb_htmlf(b, "SSIM: Wang et al. 2004 on luminance, L = %.4g (reference luminance peak), C1 = %.3g, C2 = %.3g.",
+                m->ssim_L, m->ssim_c1, m->ssim_c2);
+    if (c->charts > 0) {
+        char alt[160];
+        gr_sb_puts(b, "\n<div class=\"grid\">\n");
+        snprintf(f[0], sizeof f[0], "%s_radial_profile_rgb.png", tc->stem);
+        snprintf(alt, sizeof alt, "%s: radial profile per channel", t->name);
+        html_figure(b, f[0], NULL, alt, "Mean radiance per RGB channel against the angle from the refracted sun: "
+                                        "solid = reference, dashed = the technique x a.");
+        snprintf(f[1], sizeof f[1], "%s_error_vs_blur.png", tc->stem);
+        snprintf(alt, sizeof alt, "%s: error against blur scale", t->name);
+        html_figure(b, f[1], NULL, alt,
+                    "RMSE of the difference after a Gaussian blur of sigma 1, 4, 16 px: where it falls with blur, "
+                    "the large-scale light distribution is right even if details do not line up. The gray line is "
+                    "the reference's own noise (RMS standard error), below which differences mean nothing.");
+        gr_sb_puts(b, "</div>\n");
+    }
+    /* timings and counters */
+    gr_sb_puts(b, "<h3>Timings and counters</h3>\n<table>\n");
+    kv_num(b, "time in this run (instance, render, readback)", t->seconds >= 0 ? t->seconds : NAN, 1.0, "s");
+    const char *passes = meta_str(tmeta, "godrays:passes");
+    if (passes && passes[0]) {
+        char pname[64], key[96], label[128];
+        const char *p = passes;
+        while (*p) {
+            size_t n = strcspn(p, " ");
+            snprintf(pname, sizeof pname, "%.*s", (int)(n < sizeof pname - 1 ? n : sizeof pname - 1), p);
+            snprintf(key, sizeof key, "godrays:gpu_ns.%s", pname);
+            snprintf(label, sizeof label, "GPU time, pass '%s'", pname);
+            const double v = meta_num(tmeta, key);
+            kv_num(b, label, v >= 0 ? v : NAN, 1e-6, "ms");
+            p += n;
+            while (*p == ' ') p++;
+        }
+    }
+    kv_num(b, "GPU time, all passes", tc->gpu_ms, 1.0, "ms");
+    kv_num(b, "wall time of the render call", tc->wall_ms, 1.0, "ms");
+    const double fr = meta_num(tmeta, "godrays:fragments");
+    kv_num(b, "fragments (main passes)", fr >= 0 ? fr : NAN, 1.0, "");
+    const char *gl = meta_str(tmeta, "godrays:gl_renderer");
+    kv_row(b, "GL renderer", gl ? gl : "n/a");
+    gr_sb_puts(b, "</table>\n<details><summary>Its EXR metadata (every figure the technique reports)</summary>\n");
+    html_meta_table(b, tmeta);
+    gr_sb_puts(b, "</details>\n");
+}
+
 static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
 {
     const gr_report_input *in = c->in;
-    const gr_metrics *m = in->metrics;
     const gr_scene *s = in->scene;
-    char t[8][64];
     gr_sb_puts(b, "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
                   "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>");
     gr_sb_htmlf(b, "godrays report: %s", s->name);
     gr_sb_printf(b, "</title>\n<style>%s</style>\n</head>\n<body>\n<h1>", CSS);
-    gr_sb_htmlf(b, "God rays: ground truth vs real-time shafts, scene '%s'", s->name);
+    gr_sb_htmlf(b, "God rays: ground truth vs %d real-time technique%s, scene '%s'", in->n_techniques,
+                in->n_techniques == 1 ? "" : "s", s->name);
     gr_sb_puts(b, "</h1>\n<p class=\"sub\">");
     {
         char when[64] = "";
@@ -890,20 +1223,16 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
         gr_sb_puts(b, "</code>");
     }
     gr_sb_puts(b, "</p>\n<div class=\"box\">\n");
-    for (int i = 0; i < 5; i++) {
+    for (int i = 0; i < 2; i++) {
         gr_sb_html(b, c->lines[i]);
         gr_sb_puts(b, "<br>\n");
     }
     gr_sb_puts(b, "</div>\n");
     /* Warnings a reader must not miss. */
-    if (m->n_stderr_excluded > 0 || m->n_masked_out > 0 || !m->have_stderr || in->ref_cache_note ||
-        meta_num(in->ref_meta, "godrays:partial") > 0) {
+    const gr_metrics *m0 = in->techniques[0].metrics;
+    if (!m0->have_stderr || in->ref_cache_note || meta_num(in->ref_meta, "godrays:partial") > 0) {
         gr_sb_puts(b, "<div class=\"box warn\">\n");
-        if (m->n_stderr_excluded > 0)
-            gr_sb_htmlf(b, "%lld pixels NOT SCORED: the reference's relative standard error of luminance exceeds %g "
-                           "there (drawn mid gray in the difference images).",
-                        m->n_stderr_excluded, m->stderr_bound);
-        if (!m->have_stderr) gr_sb_html(b, " The reference carries no standard-error channels: no significance test.");
+        if (!m0->have_stderr) gr_sb_html(b, " The reference carries no standard-error channels: no significance test.");
         if (meta_num(in->ref_meta, "godrays:partial") > 0)
             gr_sb_html(b, " The reference is a PARTIAL (interrupted) render.");
         if (in->ref_cache_note) {
@@ -912,84 +1241,14 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
         }
         gr_sb_puts(b, "\n</div>\n");
     }
-
-    /* Images */
-    char cap[1024];
-    gr_sb_puts(b, "<h2>Images</h2>\n<div class=\"grid\">\n");
-    snprintf(cap, sizeof cap,
-             "Ground truth (Embree single scattering), exposure %s (its 99th percentile -> 0.8), sRGB.%s",
-             fmt(c->exposure, t[0], sizeof t[0]), in->ref_cached ? " Read from the cache." : "");
-    html_figure(b, "reference.png", c->disp_ref, "reference (ground truth)", cap);
-    snprintf(cap, sizeof cap,
-             "Real-time shafts (seed 000) times the best scale a = %s, same exposure as the reference: the "
-             "technique's intensity is an arbitrary factor, so shapes are compared at the best-fitting level.",
-             fmt(c->a, t[0], sizeof t[0]));
-    html_figure(b, "shafts.png", c->disp_fit, "real-time shafts times a", cap);
-    snprintf(cap, sizeof cap,
-             "Signed luminance difference a Y(test) - Y(ref), OpenImageIO map '%s' on [%s, %s]: blue = real-time "
-             "too dark, red = too bright; gray = not scored.",
-             c->info_signed.map, fmt(c->info_signed.vmin, t[0], sizeof t[0]), fmt(c->info_signed.vmax, t[1], sizeof t[1]));
-    html_figure(b, "diff_signed.png", c->diff_signed, "signed difference with colorbar", cap);
-    snprintf(cap, sizeof cap, "Absolute luminance difference |a Y(test) - Y(ref)|, map '%s' on [%s, %s] (99th percentile).",
-             c->info_abs.map, fmt(c->info_abs.vmin, t[0], sizeof t[0]), fmt(c->info_abs.vmax, t[1], sizeof t[1]));
-    html_figure(b, "diff.png", c->diff_abs, "absolute difference with colorbar", cap);
-    if (c->flip_map && in->flip) {
-        snprintf(cap, sizeof cap,
-                 "HDR-FLIP per pixel of a * test against the reference (Andersson et al. 2020, 2021; docs/metrics.md), "
-                 "magma map from 0 (black, no visible difference) to 1 (pale yellow); mean %.4f, median %.4f.",
-                 in->flip->mean, in->flip->median);
-        html_figure(b, "flip.png", c->flip_map, "FLIP map", cap);
-    }
-    snprintf(cap, sizeof cap, "Real-time shafts as rendered (a = 1), own exposure %s.", fmt(c->exposure_raw, t[0], sizeof t[0]));
-    html_figure(b, "shafts_raw.png", c->disp_raw, "real-time shafts as rendered", cap);
-    gr_sb_puts(b, "</div>\n<p class=\"sub\">The same three panels with the key numbers: "
-                  "<a href=\"summary.png\">summary.png</a>; every number: <a href=\"metrics.json\">metrics.json</a>");
-    if (in->ref_exr && in->test_exr) {
-        gr_sb_puts(b, "; the linear images: <a href=\"");
-        gr_sb_html(b, in->ref_exr);
-        gr_sb_puts(b, "\">");
-        gr_sb_html(b, in->ref_exr);
-        gr_sb_puts(b, "</a>, <a href=\"");
-        gr_sb_html(b, in->test_exr);
-        gr_sb_puts(b, "\">");
-        gr_sb_html(b, in->test_exr);
-        gr_sb_puts(b, "</a>");
-    }
-    gr_sb_puts(b, ".</p>\n");
-
-    /* Metrics */
-    gr_sb_puts(b, "<h2>Metrics</h2>\n<p class=\"sub\">");
-    gr_sb_htmlf(b, "%lld of %lld pixels scored (%lld masked out, %lld not scored because the reference's relative "
-                   "standard error of luminance exceeds %s). Y = 0.2126 R + 0.7152 G + 0.0722 B; RGB pools the "
-                   "three channels as OpenImageIO idiff does. Formulas and conventions: docs/metrics.md.",
-                m->n_scored, m->n_pixels, m->n_masked_out, m->n_stderr_excluded, fmt(m->stderr_bound, t[0], sizeof t[0]));
-    gr_sb_puts(b, "</p>\n");
-    gr_sb_puts(b, "<div class=\"grid\">\n<div>\n");
-    if (m->have_fit) {
-        char capt[160];
-        snprintf(capt, sizeof capt, "After the best scale fit: test x a, a = <t, r> / <t, t> = %.6g%s", m->fit.scale,
-                 m->fit_defined ? "" : " (undefined: test is black; a = 1)");
-        html_metrics_table(b, m, &m->fit, capt);
-        gr_sb_puts(b, "</div>\n<div>\n");
-    }
-    html_metrics_table(b, m, &m->raw, "As rendered (a = 1): the real-time technique's own, arbitrary, intensity scale");
-    gr_sb_puts(b, "</div>\n</div>\n");
-    gr_sb_htmlf(b, "SSIM: Wang et al. 2004 on luminance, L = %.4g (reference luminance peak), C1 = %.3g, C2 = %.3g.",
-                m->ssim_L, m->ssim_c1, m->ssim_c2);
-
-    /* Charts */
-    gr_sb_puts(b, "\n<h2>Charts</h2>\n");
+    html_leaderboard(b, c);
+    gr_sb_puts(b, "<p class=\"sub\">Every technique beside the reference with the key numbers: "
+                  "<a href=\"summary.png\">summary.png</a>; every number: <a href=\"metrics.json\">metrics.json</a>.</p>\n");
     if (c->charts > 0) {
         gr_sb_puts(b, "<div class=\"grid\">\n");
-        html_figure(b, "radial_profile.png", NULL, "radial profile, luminance",
+        html_figure(b, "radial_profile.png", NULL, "radial profile, luminance, every technique",
                     "Mean luminance against the angle between each pixel's ray and the direction in which the "
-                    "refracted sun is seen (log scale). Both renderers on one chart; the real-time one times a.");
-        html_figure(b, "radial_profile_rgb.png", NULL, "radial profile per channel",
-                    "The same per RGB channel: solid = reference, dashed = real-time x a.");
-        html_figure(b, "error_vs_blur.png", NULL, "error against blur scale",
-                    "RMSE of the difference after a Gaussian blur of sigma 1, 4, 16 px: where it falls with blur, "
-                    "the large-scale light distribution is right even if shafts do not line up. The gray line is "
-                    "the reference's own noise (RMS standard error), below which differences mean nothing.");
+                    "refracted sun is seen (log scale): the reference and every technique times its a.");
         gr_sb_puts(b, "</div>\n");
     }
     if (c->chart_note[0]) {
@@ -997,11 +1256,11 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
         gr_sb_html(b, c->chart_note);
         gr_sb_puts(b, "</p>\n");
     }
+    for (int r = 0; r < in->n_techniques; r++) html_technique(c, b, c->order[r]);
 
-    /* Timings */
-    gr_sb_puts(b, "<h2>Timings and counters</h2>\n<div class=\"grid\">\n<div>\n<table><caption class=\"sub\">"
-                  "ground truth (reference/)</caption>\n");
-    const gr_metadata *rm = in->ref_meta, *tmeta = in->test_meta;
+    /* The ground truth */
+    gr_sb_puts(b, "<h2>Ground truth</h2>\n<table><caption class=\"sub\">ground truth (reference/)</caption>\n");
+    const gr_metadata *rm = in->ref_meta;
     kv_row(b, "source", in->ref_cached ? "cache" : "rendered in this run");
     kv_num(b, "time in this run", in->ref_seconds >= 0 ? in->ref_seconds : NAN, 1.0, "s");
     kv_num(b, "render wall time", meta_num(rm, "godrays:wall_s"), 1.0, "s");
@@ -1016,28 +1275,8 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     kv_num(b, "beam build time", meta_num(rm, "godrays:beam_build_s"), 1.0, "s");
     kv_num(b, "beam primitives", meta_num(rm, "godrays:beam_prims"), 1.0, "");
     if (in->ref_cache_path) kv_row(b, "cache file", in->ref_cache_path);
-    gr_sb_puts(b, "</table>\n</div>\n<div>\n<table><caption class=\"sub\">real-time shafts (src/realtime/)</caption>\n");
-    kv_num(b, "time in this run (context, render, readback)", in->shafts_seconds >= 0 ? in->shafts_seconds : NAN, 1.0, "s");
-    static const char *const pass_keys[3] = {"godrays:gpu_ns.shadow", "godrays:gpu_ns.shafts", "godrays:gpu_ns.final"};
-    static const char *const pass_names[3] = {"GPU time, shadow pass", "GPU time, shaft pass", "GPU time, final pass"};
-    for (int p = 0; p < 3; p++) {
-        const double v = meta_num(tmeta, pass_keys[p]);
-        kv_num(b, pass_names[p], v >= 0 ? v : NAN, 1e-6, "ms");
-    }
-    kv_num(b, "CPU time of the render call", meta_num(tmeta, "godrays:cpu_ms"), 1.0, "ms");
-    kv_num(b, "shafts", meta_num(tmeta, "godrays:shafts_count"), 1.0, "");
-    kv_num(b, "vertices submitted", meta_num(tmeta, "godrays:vertices_submitted"), 1.0, "");
-    kv_num(b, "vertex shader invocations", meta_num(tmeta, "godrays:vertex_shader_invocations"), 1.0, "");
-    kv_num(b, "fragment shader invocations", meta_num(tmeta, "godrays:fragment_shader_invocations"), 1.0, "");
-    kv_num(b, "fragments blended", meta_num(tmeta, "godrays:fragments_blended"), 1.0, "");
-    kv_num(b, "overdraw (fragments / target texel)", meta_num(tmeta, "godrays:overdraw"), 1.0, "");
-    const char *ts = meta_str(tmeta, "godrays:shafts_target_size");
-    kv_row(b, "shaft render target", ts ? ts : "n/a");
-    const char *gl = meta_str(tmeta, "godrays:gl_renderer");
-    kv_row(b, "GL renderer", gl ? gl : "n/a");
-    kv_num(b, "comparison (metrics) time", in->compare_seconds >= 0 ? in->compare_seconds : NAN, 1.0, "s");
-    gr_sb_puts(b, "</table>\n</div>\n</div>\n<p class=\"sub\">GPU times are GL_TIME_ELAPSED queries (n/a where the "
-                  "driver has no timer for a pass); on a machine without a GPU they measure Mesa's llvmpipe.</p>\n");
+    kv_num(b, "comparison (metrics) time, all techniques", in->compare_seconds >= 0 ? in->compare_seconds : NAN, 1.0, "s");
+    gr_sb_puts(b, "</table>\n");
 
     html_tuning_pages(b, c);
 
@@ -1045,12 +1284,15 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     gr_sb_puts(b, "<h2>Scene and settings</h2>\n");
     gr_sb_puts(b, "<h3>Ground-truth settings</h3>\n");
     html_settings_table(b, &gr_reference_param_table, &s->reference);
-    for (int i = 0; i < s->n_sections; i++) {
+    for (int k = 0; k < in->n_techniques; k++) {
+        const int i = gr_sections_find(in->techniques[k].name);
         const gr_param_table *tab = gr_sections_table(i);
-        gr_sb_puts(b, "<h3>Real-time technique <code>");
+        const void *set = gr_scene_section_const(s, i);
+        if (!tab || !set) continue;
+        gr_sb_puts(b, "<h3>Settings of <code>");
         gr_sb_html(b, tab->section);
         gr_sb_puts(b, "</code></h3>\n");
-        html_settings_table(b, tab, gr_scene_section_const(s, i));
+        html_settings_table(b, tab, set);
     }
     gr_sb_puts(b, "<details><summary>The scene, normalized (every default filled in)</summary>\n<pre>");
     char *sj = gr_scene_to_json(s);
@@ -1060,8 +1302,6 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     gr_sb_puts(b, "</pre></details>\n");
     gr_sb_puts(b, "<details><summary>Reference EXR metadata</summary>\n");
     html_meta_table(b, rm);
-    gr_sb_puts(b, "</details>\n<details><summary>Real-time EXR metadata</summary>\n");
-    html_meta_table(b, tmeta);
     gr_sb_puts(b, "</details>\n<p class=\"sub\">How to read this report: docs/report.md in the godrays sources.</p>\n"
                   "</body>\n</html>\n");
     return gr_sb_status(b, "index.html", err);
@@ -1069,15 +1309,51 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
 
 static gr_status check_input(const gr_report_input *in, gr_error *err)
 {
-    if (!in || !in->scene || !in->ref || !in->test || !in->metrics || !in->ref->pixels || !in->test->pixels)
-        return gr_fail(err, GR_E_INPUT, "report: missing scene, images or metrics");
-    if (in->ref->width != in->test->width || in->ref->height != in->test->height)
-        return gr_fail(err, GR_E_INPUT, "report: reference is %d x %d, test is %d x %d", in->ref->width,
-                       in->ref->height, in->test->width, in->test->height);
-    if (in->metrics->width != in->ref->width || in->metrics->height != in->ref->height)
-        return gr_fail(err, GR_E_INPUT, "report: the metrics are for %d x %d images, not %d x %d", in->metrics->width,
-                       in->metrics->height, in->ref->width, in->ref->height);
+    if (!in || !in->scene || !in->ref || !in->ref->pixels)
+        return gr_fail(err, GR_E_INPUT, "report: missing scene or reference image");
+    if (in->n_techniques < 1 || in->n_techniques > GR_REPORT_MAX_TECHNIQUES || !in->techniques)
+        return gr_fail(err, GR_E_INPUT, "report: %d techniques (1..%d)", in->n_techniques, GR_REPORT_MAX_TECHNIQUES);
+    for (int k = 0; k < in->n_techniques; k++) {
+        const gr_report_technique *t = &in->techniques[k];
+        if (!t->name || !t->name[0] || !t->test || !t->test->pixels || !t->metrics)
+            return gr_fail(err, GR_E_INPUT, "report: technique %d: missing name, image or metrics", k);
+        for (const char *p = t->name; *p; p++)
+            if (!((*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') || *p == '_'))
+                return gr_fail(err, GR_E_INPUT, "report: technique name '%s': only [a-z0-9_]", t->name);
+        if (strlen(t->name) > 40) return gr_fail(err, GR_E_INPUT, "report: technique name '%s': too long", t->name);
+        for (int j = 0; j < k; j++)
+            if (!strcmp(in->techniques[j].name, t->name))
+                return gr_fail(err, GR_E_INPUT, "report: technique '%s' given twice", t->name);
+        if (in->ref->width != t->test->width || in->ref->height != t->test->height)
+            return gr_fail(err, GR_E_INPUT, "report: reference is %d x %d, %s is %d x %d", in->ref->width,
+                           in->ref->height, t->name, t->test->width, t->test->height);
+        if (t->metrics->width != in->ref->width || t->metrics->height != in->ref->height)
+            return gr_fail(err, GR_E_INPUT, "report: the metrics of %s are for %d x %d images, not %d x %d", t->name,
+                           t->metrics->width, t->metrics->height, in->ref->width, in->ref->height);
+    }
     return GR_OK;
+}
+
+/* Stacks the rows of the contact sheet (same background as gr_report_contact_sheet). */
+static gr_image *stack_rows(gr_image *const *rows, int n)
+{
+    int W = 0, H = 0;
+    for (int i = 0; i < n; i++) {
+        if (rows[i]->width > W) W = rows[i]->width;
+        H += rows[i]->height;
+    }
+    gr_image *s = gr_image_create(W, H, 3, NULL);
+    if (!s) return NULL;
+    static const float bg[3] = {0.11f, 0.12f, 0.14f};
+    for (size_t i = 0; i < (size_t)W * (size_t)H; i++)
+        for (int c = 0; c < 3; c++) s->pixels[i * 3 + (size_t)c] = bg[c];
+    int y0 = 0;
+    for (int i = 0; i < n; i++) {
+        for (int y = 0; y < rows[i]->height; y++)
+            memcpy(gr_image_pixel(s, 0, y0 + y), gr_image_pixel(rows[i], 0, y), (size_t)rows[i]->width * 3 * sizeof(float));
+        y0 += rows[i]->height;
+    }
+    return s;
 }
 
 gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_result *res, gr_error *err)
@@ -1085,93 +1361,131 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
     const double t0 = now_s();
     gr_status st = check_input(in, err);
     if (st != GR_OK) return st;
-    ctx c;
-    memset(&c, 0, sizeof c);
-    c.dir = dir;
-    c.in = in;
-    const gr_metrics *m = in->metrics;
-    c.a = m->have_fit && m->fit_defined ? m->fit.scale : 1.0;
-    c.exposure = gr_report_exposure(in->ref, 1.0, 0.99, 0.8);
-    c.exposure_raw = gr_report_exposure(in->test, 1.0, 0.99, 0.8);
-    c.noise_y = ref_noise_rms_y(in->ref);
-    gr_image *sheet = NULL;
+    ctx *cp = calloc(1, sizeof *cp);
+    if (!cp) return gr_fail(err, GR_E_NOMEM, "report: out of memory");
+    ctx *c = cp;
+    c->dir = dir;
+    c->in = in;
+    const int nt = in->n_techniques;
+    double as[GR_REPORT_MAX_TECHNIQUES];
+    c->exposure = gr_report_exposure(in->ref, 1.0, 0.99, 0.8);
+    c->noise_y = ref_noise_rms_y(in->ref);
+    gr_report_rank(in->techniques, nt, c->order);
+    for (int k = 0; k < nt; k++) {
+        tctx *tc = &c->t[k];
+        tc->t = &in->techniques[k];
+        tech_stem(tc->t->name, tc->stem, sizeof tc->stem);
+        const gr_metrics *m = tc->t->metrics;
+        tc->a = as[k] = m->have_fit && m->fit_defined ? m->fit.scale : 1.0;
+        tc->exposure_raw = gr_report_exposure(tc->t->test, 1.0, 0.99, 0.8);
+        const double g = meta_num(tc->t->meta, "godrays:gpu_ms"), w = meta_num(tc->t->meta, "godrays:wall_ms");
+        tc->gpu_ms = g >= 0 ? g : NAN;
+        tc->wall_ms = w >= 0 ? w : NAN;
+    }
+    gr_image *sheet = NULL, *rows[GR_REPORT_MAX_TECHNIQUES] = {NULL};
     char *json = NULL;
     gr_strbuf html;
     gr_sb_init(&html);
-    char path[4200];
+    char path[4200], file[128];
 
     /* Everything that can fail for lack of memory or bad input is computed first. */
     if ((st = gr_report_make_dir(dir, err)) != GR_OK) goto done;
-    if ((st = gr_report_display(in->ref, c.exposure, &c.disp_ref, err)) != GR_OK) goto done;
-    if ((st = gr_report_display(in->test, c.exposure * c.a, &c.disp_fit, err)) != GR_OK) goto done;
-    if ((st = gr_report_display(in->test, c.exposure_raw, &c.disp_raw, err)) != GR_OK) goto done;
-    for (int k = 0; k < 2; k++) {
-        gr_diffmap_options dopt = {.kind = k ? GR_DIFFMAP_SIGNED : GR_DIFFMAP_ABS, .scale = c.a, .mask = NULL,
-                                   .stderr_bound = m->stderr_bound};
-        st = gr_diffmap_create(in->ref, in->test, &dopt, k ? &c.diff_signed : &c.diff_abs,
-                               k ? &c.info_signed : &c.info_abs, err);
-        if (st != GR_OK) goto done;
+    if ((st = gr_report_display(in->ref, c->exposure, &c->disp_ref, err)) != GR_OK) goto done;
+    for (int k = 0; k < nt; k++) {
+        tctx *tc = &c->t[k];
+        if ((st = gr_report_display(tc->t->test, c->exposure * tc->a, &tc->disp_fit, err)) != GR_OK) goto done;
+        if ((st = gr_report_display(tc->t->test, tc->exposure_raw, &tc->disp_raw, err)) != GR_OK) goto done;
+        for (int s = 0; s < 2; s++) {
+            gr_diffmap_options dopt = {.kind = s ? GR_DIFFMAP_SIGNED : GR_DIFFMAP_ABS, .scale = tc->a, .mask = NULL,
+                                       .stderr_bound = tc->t->metrics->stderr_bound};
+            st = gr_diffmap_create(in->ref, tc->t->test, &dopt, s ? &tc->diff_signed : &tc->diff_abs,
+                                   s ? &tc->info_signed : &tc->info_abs, err);
+            if (st != GR_OK) goto done;
+        }
     }
-    if (in->flip_map && (st = gr_flip_heatmap(in->flip_map, in->ref->width, in->ref->height, &c.flip_map, err)) != GR_OK)
-        goto done;
-    if ((st = compute_profiles(in, c.a, &c.pr, err)) != GR_OK) goto done;
-    c.have_profiles = 1;
-    summary_lines(&c);
+    if ((st = compute_profiles(in, as, &c->pr, err)) != GR_OK) goto done;
+    c->have_profiles = 1;
+    summary_lines(c);
 
     /* Files: images first, the pages that link them last. */
-    static const char *const names[6] = {"reference.png", "shafts.png", "shafts_raw.png", "diff_signed.png", "diff.png",
-                                         "flip.png"};
-    const gr_image *imgs[6] = {c.disp_ref, c.disp_fit, c.disp_raw, c.diff_signed, c.diff_abs, c.flip_map};
-    for (int i = 0; i < 6; i++) {
-        if (!imgs[i]) continue;
-        if ((st = join(path, sizeof path, dir, names[i], err)) != GR_OK) goto done;
-        if ((st = gr_oiio_write(path, imgs[i], err)) != GR_OK) goto done;
+    if ((st = join(path, sizeof path, dir, "reference.png", err)) != GR_OK) goto done;
+    if ((st = gr_oiio_write(path, c->disp_ref, err)) != GR_OK) goto done;
+    for (int k = 0; k < nt; k++) {
+        tctx *tc = &c->t[k];
+        static const char *const suffix[4] = {"", "_raw", "_diff_signed", "_diff"};
+        const gr_image *imgs[4] = {tc->disp_fit, tc->disp_raw, tc->diff_signed, tc->diff_abs};
+        for (int i = 0; i < 4; i++) {
+            snprintf(file, sizeof file, "%s%s.png", tc->stem, suffix[i]);
+            if ((st = join(path, sizeof path, dir, file, err)) != GR_OK) goto done;
+            if ((st = gr_oiio_write(path, imgs[i], err)) != GR_OK) goto done;
+        }
     }
-    {
-        char t0s[32];
-        char title[3][128];
+    /* summary.png: one row per technique in leaderboard order, the first with the global lines */
+    c->labelled = 1;
+    for (int r = 0; r < nt; r++) {
+        tctx *tc = &c->t[c->order[r]];
+        char t0s[32], title[3][128];
         snprintf(title[0], sizeof title[0], "ground truth (reference)");
-        snprintf(title[1], sizeof title[1], "real-time shafts x %s", fmt(c.a, t0s, sizeof t0s));
+        snprintf(title[1], sizeof title[1], "#%d %s x %s", r + 1, tc->t->name, fmt(tc->a, t0s, sizeof t0s));
         snprintf(title[2], sizeof title[2], "a Y(test) - Y(ref)  (blue: too dark)");
-        const gr_image *panels[3] = {c.disp_ref, c.disp_fit, c.diff_signed};
+        const gr_image *panels[3] = {c->disp_ref, tc->disp_fit, tc->diff_signed};
         const char *const titles[3] = {title[0], title[1], title[2]};
         const char *lines[5];
-        for (int i = 0; i < 5; i++) lines[i] = c.lines[i];
-        if ((st = gr_report_contact_sheet(panels, titles, lines, 5, 360, 800, &sheet, &c.labelled, err)) != GR_OK) goto done;
-        if ((st = join(path, sizeof path, dir, "summary.png", err)) != GR_OK) goto done;
-        if ((st = gr_oiio_write(path, sheet, err)) != GR_OK) goto done;
+        int nl = 0;
+        if (r == 0) {
+            lines[nl++] = c->lines[0];
+            lines[nl++] = c->lines[1];
+        }
+        for (int i = 0; i < 3; i++) lines[nl++] = tc->lines[i];
+        int lab = 0;
+        if ((st = gr_report_contact_sheet(panels, titles, lines, nl, 360, 800, &rows[r], &lab, err)) != GR_OK) goto done;
+        c->labelled = c->labelled && lab;
     }
+    sheet = stack_rows(rows, nt);
+    if (!sheet) {
+        st = gr_fail(err, GR_E_NOMEM, "report: out of memory for summary.png");
+        goto done;
+    }
+    if ((st = join(path, sizeof path, dir, "summary.png", err)) != GR_OK) goto done;
+    if ((st = gr_oiio_write(path, sheet, err)) != GR_OK) goto done;
     /* A chart PLplot could not draw is reported in the page, not fatal: the rest of the report
      * stands on its own. Running out of memory or disk is. */
-    st = draw_charts(dir, in, c.a, &c.pr, c.noise_y, &c.charts, c.chart_note, sizeof c.chart_note, err);
+    st = draw_charts(dir, in, as, &c->pr, c->noise_y, &c->charts, c->chart_note, sizeof c->chart_note, err);
     if (st == GR_E_RUNTIME) {
-        snprintf(c.chart_note, sizeof c.chart_note, "charts incomplete (%d drawn): %.400s", c.charts, err->msg);
+        snprintf(c->chart_note, sizeof c->chart_note, "charts incomplete (%d drawn): %.400s", c->charts, err->msg);
         st = GR_OK;
     }
     if (st != GR_OK) goto done;
-    if ((st = build_json(&c, &json, err)) != GR_OK) goto done;
+    if ((st = build_json(c, &json, err)) != GR_OK) goto done;
     if ((st = join(path, sizeof path, dir, "metrics.json", err)) != GR_OK) goto done;
     if ((st = write_text(path, json, err)) != GR_OK) goto done;
-    if ((st = build_html(&c, &html, err)) != GR_OK) goto done;
+    if ((st = build_html(c, &html, err)) != GR_OK) goto done;
     if ((st = join(path, sizeof path, dir, "index.html", err)) != GR_OK) goto done;
     if ((st = write_text(path, gr_sb_str(&html), err)) != GR_OK) goto done;
     if (res) {
-        res->exposure = c.exposure;
-        res->fit_scale = c.a;
-        res->charts = c.charts;
-        res->labelled = c.labelled;
+        res->exposure = c->exposure;
+        for (int k = 0; k < nt; k++) {
+            res->fit_scale[k] = c->t[k].a;
+            res->order[k] = c->order[k];
+        }
+        res->charts = c->charts;
+        res->labelled = c->labelled;
         res->seconds = now_s() - t0;
     }
 done:
     gr_sb_free(&html);
     cJSON_free(json);
     gr_image_destroy(sheet);
-    gr_image_destroy(c.disp_raw);
-    gr_image_destroy(c.disp_ref);
-    gr_image_destroy(c.disp_fit);
-    gr_image_destroy(c.diff_signed);
-    gr_image_destroy(c.diff_abs);
-    gr_image_destroy(c.flip_map);
-    free_profiles(&c.pr);
+    for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) gr_image_destroy(rows[k]);
+    gr_image_destroy(c->disp_ref);
+    for (int k = 0; k < nt; k++) {
+        tctx *tc = &c->t[k];
+        gr_image_destroy(tc->disp_fit);
+        gr_image_destroy(tc->disp_raw);
+        gr_image_destroy(tc->diff_signed);
+        gr_image_destroy(tc->diff_abs);
+    }
+    free_profiles(&c->pr);
+    free(cp);
     return st;
 }

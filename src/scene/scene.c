@@ -7,6 +7,7 @@
  * Every error carries the JSON path it concerns, so an error caused by a --set override
  * can be attributed to that override rather than to the file. */
 #include "scene/scene.h"
+#include "common/outfile.h"
 
 #include <cjson/cJSON.h>
 #include <errno.h>
@@ -291,6 +292,31 @@ static gr_status get_str(vctx *c, const cJSON *obj, const char *parent, const ch
     return GR_OK;
 }
 
+/* Names reach the terminal, JSON and HTML: control characters (C0, DEL, C1) and bytes that are
+ * not well-formed UTF-8 (RFC 3629: no overlongs, no surrogates, at most U+10FFFF) become '?'
+ * in place, so an escape sequence in a name cannot drive a terminal and every output stays
+ * valid UTF-8 for strict parsers. */
+static void sanitize_name(char *s)
+{
+    unsigned char *p = (unsigned char *)s;
+    while (*p) {
+        const unsigned c = p[0];
+        int n = c < 0x80 ? 1 : (c >= 0xc2 && c <= 0xdf) ? 2 : (c >= 0xe0 && c <= 0xef) ? 3 : (c >= 0xf0 && c <= 0xf4) ? 4 : 0;
+        unsigned cp = n == 1 ? c : n == 2 ? (c & 0x1f) : n == 3 ? (c & 0x0f) : (c & 0x07);
+        for (int k = 1; k < n; k++) {
+            if ((p[k] & 0xc0) != 0x80) { n = 0; break; }
+            cp = (cp << 6) | (p[k] & 0x3fu);
+        }
+        if (n == 3 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) n = 0;
+        if (n == 4 && (cp < 0x10000 || cp > 0x10ffff)) n = 0;
+        if (n == 0 || cp < 0x20 || cp == 0x7f || (cp >= 0x80 && cp <= 0x9f)) {
+            if (n == 0) n = 1;
+            for (int k = 0; k < n; k++) p[k] = '?';
+        }
+        p += n;
+    }
+}
+
 /* Range check with the same wording as the settings tables ("must be in (0, 180), got 190"). */
 static gr_status range(vctx *c, const char *path, double v, double lo, double hi, unsigned flags)
 {
@@ -518,6 +544,7 @@ static gr_status parse_occluders(vctx *c, const cJSON *v, gr_scene *s)
         if ((st = get_str(c, it, p, "name", o->name, sizeof o->name)) ||
             (st = get_vec3(c, it, p, "center_m", o->center_m)))
             return st;
+        sanitize_name(o->name);
     }
     s->n_occluders = n;
     return GR_OK;
@@ -582,6 +609,7 @@ static gr_status parse_scene(vctx *c, const cJSON *root, gr_scene *s)
     if (ver && (!cJSON_IsNumber(ver) || ver->valuedouble != 1.0))
         return vfail(c, "version", "unsupported scene format version, expected 1, got %s", got_text(ver, got, sizeof got));
     if ((st = get_str(c, root, "", "name", s->name, sizeof s->name))) return st;
+    sanitize_name(s->name);
     const cJSON *v;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "water")) && (st = parse_water(c, v, &s->water))) return st;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "sun")) && (st = parse_sun(c, v, &s->sun))) return st;
@@ -1260,6 +1288,23 @@ static gr_status parse_text(const char *json, const char *label, cJSON **out, gr
         near[k++] = *q;
     }
     near[k] = '\0';
+    /* cJSON stops at CJSON_NESTING_LIMIT open brackets: say so rather than "malformed" */
+    int depth = 0, in_str = 0;
+    for (const char *q = json; q < end && *q; q++) {
+        if (in_str) {
+            if (*q == '\\' && q[1]) q++;
+            else if (*q == '"') in_str = 0;
+        } else if (*q == '"') {
+            in_str = 1;
+        } else if (*q == '[' || *q == '{') {
+            depth++;
+        } else if (*q == ']' || *q == '}') {
+            depth--;
+        }
+    }
+    if (depth >= CJSON_NESTING_LIMIT)
+        return gr_fail(err, GR_E_INPUT, "%s:%d:%d: JSON nested deeper than %d levels", label, line, col,
+                       CJSON_NESTING_LIMIT);
     if (k == 0) return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON at end of input", label, line, col);
     return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON near '%s'", label, line, col, near);
 }
@@ -1352,6 +1397,8 @@ static gr_status load_file_impl(const char *path, const char *const *overrides, 
                                 gr_error *err)
 {
     if (!path) return gr_fail(err, GR_E_RUNTIME, "gr_scene_load_file: no path");
+    gr_status reg = gr_check_regular_input(path, err); /* a FIFO would block the open */
+    if (reg != GR_OK) return reg;
     FILE *f = fopen(path, "rb");
     if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, strerror(errno));
     size_t cap = 1 << 16, len = 0;

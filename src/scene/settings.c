@@ -24,7 +24,7 @@ static const gr_param reference_params[] = {
      .def = 256, .unit = "", .doc = "surface tessellation: cells along each axis of the lit patch"},
     {.name = "sun_samples", .type = GR_PT_INT, .offset = REF(sun_samples), .min = 1, .max = 4096,
      .def = 8, .unit = "", .doc = "passes per round: surface-grid offsets (and sun directions with sun_disc = sample)"},
-    {.name = "batches", .type = GR_PT_INT, .offset = REF(batches), .min = 1, .max = 1024, .def = 8,
+    {.name = "batches", .type = GR_PT_INT, .offset = REF(batches), .min = 2, .max = 1024, .def = 8,
      .unit = "", .doc = "independent batches for the standard-error estimate"},
     {.name = "seed", .type = GR_PT_U64, .offset = REF(seed), .min = 0, .max = 9007199254740991.0,
      .def = 1, .unit = "", .doc = "RNG seed: same seed, same bytes, any thread count"},

@@ -13,7 +13,7 @@ typedef struct gr_tune_cli {
     gr_tune_session_options so;   /* sets, n_sets, gl_platform, scene_path: the caller's */
     gr_tune_metric metric;
     double weights[GR_TM_COUNT];  /* --objective (metric GR_TM_WEIGHTED) */
-    int fit;                      /* -1: auto (on unless shafts.intensity is a parameter) */
+    int fit;                      /* -1: auto (on unless the gain_key setting is a parameter) */
     int normalize;                /* --normalize */
     int quiet;
     double fps;

@@ -1,4 +1,4 @@
-/* Shafts-vs-ground-truth error as a function of settings (objective.h). */
+/* A technique's error against the ground truth as a function of its settings (objective.h). */
 #include "tune/objective.h"
 
 #include <math.h>

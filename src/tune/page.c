@@ -33,7 +33,7 @@ void gr_tune_page_begin(gr_strbuf *b, const char *dir, const char *title_fmt, ..
     gr_sb_puts(b, "</h1>\n");
     if (parent_has(dir, "index.html") && parent_has(dir, "metrics.json"))
         gr_sb_puts(b, "<p>Part of the report of <code>godrays run</code>: <a href=\"../index.html\">../index.html</a> "
-                      "(ground truth against the shafts at the scene's settings).</p>\n");
+                      "(ground truth against every technique at the scene's settings).</p>\n");
 }
 
 void gr_tune_page_figure(gr_strbuf *b, const char *file, const char *caption)

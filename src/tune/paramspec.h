@@ -4,11 +4,10 @@
  * ranges and checks are the scene loader's. docs/tuning.md.
  *
  * Value of a parameter:
- *  - a number setting (double): the setting itself (shafts.K = 0.8);
- *  - an integer setting (shafts.N, shadow_map_size): the setting, sweep only, integer values;
- *  - an RGB setting (shafts.extinction, shafts.intensity): a SCALE on the scene's resolved
- *    value (extinction defaults to the medium's sigma_t, so shafts.extinction = 1 is the
- *    physical value and 0.5 halves all three channels).
+ *  - a number setting (double): the setting itself (NAME.K = 0.8);
+ *  - an integer setting: the setting, sweep only, integer values;
+ *  - an RGB setting: a SCALE on the scene's resolved value (an extinction that defaults to
+ *    the medium's sigma_t at 1 is the physical value, 0.5 halves all three channels).
  * Booleans and enums (caps, target_format) are not numeric: specs naming them are rejected. */
 #ifndef GR_TUNE_PARAMSPEC_H
 #define GR_TUNE_PARAMSPEC_H
@@ -27,7 +26,7 @@ typedef enum gr_tune_kind {
 } gr_tune_kind;
 
 typedef struct gr_tune_param {
-    char key[64];          /* "shafts.K" */
+    char key[64];          /* "NAME.KEY" */
     const gr_technique_class *cls; /* the technique NAME */
     const gr_param *p;     /* its descriptor in cls->params */
     gr_tune_kind kind;
@@ -40,20 +39,20 @@ typedef struct gr_tune_param {
  * bounds (gr_tune_param_default_bounds) and count is 0. */
 gr_status gr_tune_param_lookup(const char *flag, const char *key, gr_tune_param *out, gr_error *err);
 
-/* Parses a sweep axis "shafts.K=0.4:1.2:16" (lo:hi:count, inclusive). GR_E_USAGE, naming
+/* Parses a sweep axis "NAME.K=0.4:1.2:16" (lo:hi:count, inclusive). GR_E_USAGE, naming
  * flag and spec, for a missing '=', an unknown or non-numeric key, a non-numeric or
  * non-finite number, lo >= hi, count < 2 or > GR_TUNE_MAX_COUNT, non-integer ends or more
  * values than integers in the range for an integer setting, ends outside the setting's
  * valid range (scale < 0 for an RGB scale). */
 gr_status gr_tune_param_parse_sweep(const char *flag, const char *spec, gr_tune_param *out, gr_error *err);
 
-/* Parses a comma-separated list of keys "shafts.K,shafts.extinction" into at most max
+/* Parses a comma-separated list of keys "NAME.K,NAME.E" into at most max
  * params with default bounds. Integer settings are rejected (the optimizer is continuous:
  * sweep them instead), as are repeated keys and an empty list. */
 gr_status gr_tune_param_parse_list(const char *flag, const char *spec, gr_tune_param *out, int max, int *n,
                                    gr_error *err);
 
-/* Parses "shafts.K=0.2:2" and sets the bounds of the matching entry of params[0..n).
+/* Parses "NAME.K=0.2:2" and sets the bounds of the matching entry of params[0..n).
  * GR_E_USAGE if the key is not among them or the range is empty/invalid. */
 gr_status gr_tune_param_parse_bounds(const char *flag, const char *spec, gr_tune_param *params, int n,
                                      gr_error *err);

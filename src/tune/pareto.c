@@ -1,5 +1,6 @@
 /* Pareto fronts and the speed/error outputs (pareto.h). */
 #include "tune/pareto.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <math.h>
@@ -27,7 +28,12 @@ void gr_pareto_mark_fronts(gr_pareto_point *pts, int n)
     if (!c || !e || !f || !idx) {
         for (int i = 0; i < n; i++) pts[i].on_front = 0;
     } else {
-        for (int fam = 0; fam < 2; fam++) {
+        /* every family present (the ground truth = 0, technique k = 1 + k) */
+        int max_fam = -1;
+        for (int i = 0; i < n; i++)
+            if (pts[i].family > max_fam) max_fam = pts[i].family;
+        for (int i = 0; i < n; i++) pts[i].on_front = 0;
+        for (int fam = 0; fam <= max_fam; fam++) {
             int m = 0;
             for (int i = 0; i < n; i++)
                 if (pts[i].family == fam) {
@@ -47,24 +53,17 @@ void gr_pareto_mark_fronts(gr_pareto_point *pts, int n)
 
 gr_status gr_pareto_write_csv(const char *path, const gr_pareto_point *pts, int n, gr_error *err)
 {
-    char tmp[4200];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
+    gr_outfile of;
+    gr_status st = gr_outfile_open(&of, path, err);
+    if (st != GR_OK) return st;
+    FILE *f = of.f;
     fprintf(f, "family,label,settings,time_s,gpu_s,cost_s,error,on_front\n");
     for (int i = 0; i < n; i++)
         fprintf(f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g,%d\n",
                 pts[i].family_name[0] ? pts[i].family_name : pts[i].family == GR_PARETO_REFERENCE ? "reference" : "?",
                 pts[i].label, pts[i].settings, pts[i].time_s, pts[i].gpu_s, pts[i].cost_s, pts[i].error,
                 pts[i].on_front);
-    int bad = ferror(f);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    }
-    return GR_OK;
+    return gr_outfile_commit(&of, 0, err);
 }
 
 /* The points of one family as isolated markers (a NaN between points breaks the line, per

@@ -1,5 +1,6 @@
 /* Cases, ground truths and renderer shared by sweep and tune (session.h). */
 #include "tune/session.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <math.h>
@@ -80,18 +81,7 @@ void gr_tune_default_dir(const char *name, const char *sub, char *buf, size_t n)
 
 gr_status gr_tune_write_text(const char *path, const char *text, gr_error *err)
 {
-    char tmp[4300];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
-    int ok = fputs(text, f) >= 0;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok || rename(tmp, path) != 0) {
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    }
-    return GR_OK;
+    return gr_outfile_write(path, text, -1, err);
 }
 
 void gr_tune_session_close(gr_tune_session *s)

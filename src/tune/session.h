@@ -1,5 +1,5 @@
 /* What `godrays sweep` and `godrays tune` share: the scene, the cases (frames of the animated
- * waves x camera views), each case's ground truth (cached) and one shafts renderer; plus the
+ * waves x camera views), each case's ground truth (cached) and one technique instance; plus the
  * parsing of --frames, --times and --view. */
 #ifndef GR_TUNE_SESSION_H
 #define GR_TUNE_SESSION_H

@@ -1,5 +1,6 @@
-/* Grid sweeps of the shafts settings and their error surface (sweep.h). */
+/* Grid sweeps of a technique's settings and their error surface (sweep.h). */
 #include "tune/sweep.h"
+#include "common/outfile.h"
 
 #include <errno.h>
 #include <math.h>
@@ -84,34 +85,22 @@ gr_status gr_sweep_run(gr_tune_problem *p, gr_sweep_result *res, gr_sweep_progre
     return st;
 }
 
-/* fopen of path.tmp; the caller finishes with close_rename. */
-static FILE *open_tmp(const char *path, char *tmp, size_t n, gr_error *err)
+/* Atomic output (common/outfile); the caller finishes with close_rename. */
+static FILE *open_tmp(const char *path, gr_outfile *of, gr_error *err)
 {
-    if (snprintf(tmp, n, "%s.tmp", path) >= (int)n) {
-        gr_fail(err, GR_E_USAGE, "%s: path too long", path);
-        return NULL;
-    }
-    FILE *f = fopen(tmp, "w");
-    if (!f) gr_fail(err, GR_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
-    return f;
+    return gr_outfile_open(of, path, err) == GR_OK ? of->f : NULL;
 }
 
-static gr_status close_rename(FILE *f, const char *tmp, const char *path, gr_error *err)
+static gr_status close_rename(gr_outfile *of, gr_error *err)
 {
-    int bad = ferror(f);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        remove(tmp);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    }
-    return GR_OK;
+    return gr_outfile_commit(of, 0, err);
 }
 
 gr_status gr_sweep_write_csv(const char *path, const gr_tune_problem *p, const gr_sweep_result *res,
                              const char *const *case_labels, gr_error *err)
 {
-    char tmp[4200];
-    FILE *f = open_tmp(path, tmp, sizeof tmp, err);
+    gr_outfile of;
+    FILE *f = open_tmp(path, &of, err);
     if (!f) return err->status;
     fprintf(f, "%s", p->params[0].key);
     if (res->n_axes > 1) fprintf(f, ",%s", p->params[1].key);
@@ -131,7 +120,7 @@ gr_status gr_sweep_write_csv(const char *path, const gr_tune_problem *p, const g
             fputc('\n', f);
         }
     }
-    return close_rename(f, tmp, path, err);
+    return close_rename(&of, err);
 }
 
 /* ---- drawing ---------------------------------------------------------------------------- */

@@ -1,4 +1,4 @@
-/* `godrays sweep`: the error surface of the shafts over a grid of one or two settings, each
+/* `godrays sweep`: the error surface of a technique over a grid of one or two settings, each
  * grid point rendered once per case (frame, view) with one renderer and scored against that
  * case's ground truth; written as CSV, JSON and a plot (heat map with its minimum marked, or a
  * line chart for one axis). docs/tuning.md. */

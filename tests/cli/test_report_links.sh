@@ -40,8 +40,9 @@ words="$scene $small"
 case "$scene" in *[!A-Za-z0-9_./=:,+%@-]*) words="'$scene' $small" ;; esac
 for c in sweep tune pareto; do
     case $c in
-        sweep) extra=" --param shafts.K=0.2:2:16 --param shafts.extinction=0.1:4:16" ;;
-        tune) extra=" --params shafts.K,shafts.extinction" ;;
+        # the example: the first technique's first two number settings with a tuning box
+        sweep) extra=" --param shafts.K=0.2:2:16 --param shafts.shaft_length_m=5:100:16" ;;
+        tune) extra=" --params shafts.K,shafts.shaft_length_m" ;;
         pareto) extra="" ;;
     esac
     want="godrays $c $words$extra -o 'rep x/$c'"
@@ -77,7 +78,12 @@ for c in sweep tune; do
 done
 ck "second index still gives the pareto command" [ -n "$(command_in_page pareto)" ]
 grep -o 'href="[^"]*"' "$rep/index.html" | sed 's/^href="//; s/"$//' >hrefs.txt
-while read -r f; do ck "linked file $f exists" [ -s "$rep/$f" ]; done <hrefs.txt
+while read -r f; do
+    case $f in
+        '#'*) ck "anchor $f exists" grep -qF "id=\"${f#\#}\"" "$rep/index.html" ;; # the leaderboard's links
+        *) ck "linked file $f exists" [ -s "$rep/$f" ] ;;
+    esac
+done <hrefs.txt
 
 [ "$fail" -eq 0 ] && echo "all checks passed"
 exit $fail

@@ -33,8 +33,14 @@ ck "first run exits 0" [ "$rc" -eq 0 ]
 ck "first run renders the ground truth" grep -q "rendering the ground truth" err1.txt
 ck "summary table printed" grep -q "^  RMSE " out1.txt
 ck "summary names the report" grep -q "report: rep1/index.html" out1.txt
-for f in index.html summary.png metrics.json reference.png shafts.png shafts_raw.png diff.png diff_signed.png \
-         reference.exr shafts.exr radial_profile.png radial_profile_rgb.png error_vs_blur.png; do
+# one row per technique in the leaderboard: every built-in technique's files (`godrays techniques --json`)
+techs=$("$bin" techniques --json | python3 -c 'import json,sys; print(" ".join(t["name"] for t in json.load(sys.stdin)["techniques"]))')
+ck "techniques listed" [ -n "$techs" ]
+files="index.html summary.png metrics.json reference.png reference.exr radial_profile.png"
+for t in $techs; do
+    files="$files $t.png ${t}_raw.png ${t}_diff.png ${t}_diff_signed.png $t.exr ${t}_radial_profile_rgb.png ${t}_error_vs_blur.png"
+done
+for f in $files; do
     ck "rep1/$f written" [ -s "rep1/$f" ]
 done
 ck "no temporary files left" sh -c '! ls rep1 | grep -q tmp'
@@ -48,23 +54,31 @@ fi
 # 2. the run's metrics are compare's metrics on the EXRs it wrote (same stderr rule, same fit)
 "$bin" compare rep1/reference.exr rep1/shafts.exr --fit-scale --scene "$scene" --json >cmp.json 2>cmp.err
 ck "compare on the run's EXRs exits 0" [ $? -eq 0 ]
-block() { sed -n "/^\t\"$2\":/,/^\t}/p" "$1"; }
-block rep1/metrics.json metrics >run_metrics.txt
-block cmp.json metrics >cmp_metrics.txt
-block rep1/metrics.json fit >run_fit.txt
-block cmp.json fit >cmp_fit.txt
-ck "metrics block present" [ -s run_metrics.txt ]
-ck "raw metrics identical to godrays compare" cmp -s run_metrics.txt cmp_metrics.txt
-ck "fitted metrics identical to godrays compare" cmp -s run_fit.txt cmp_fit.txt
+# metrics.json: one entry per technique (schema 2, docs/report.md); the shafts' "compare" block
+# is what `godrays compare --json` writes
+same() { python3 - rep1/metrics.json cmp.json "$1" <<'PY'
+import json, sys
+run, cmp, key = json.load(open(sys.argv[1])), json.load(open(sys.argv[2])), sys.argv[3]
+t = [t for t in run["techniques"] if t["name"] == "shafts"][0]["compare"]
+sys.exit(0 if key in cmp and t.get(key) == cmp[key] else 1)
+PY
+}
+ck "raw metrics identical to godrays compare" same metrics
+ck "fitted metrics identical to godrays compare" same fitted
+ck "one metrics.json entry and one leaderboard row per technique" python3 -c '
+import json, sys
+d = json.load(open("rep1/metrics.json")); names = sys.argv[1].split()
+sys.exit(0 if sorted(t["name"] for t in d["techniques"]) == sorted(names) and sorted(d["leaderboard"]) == sorted(names) else 1)' "$techs"
+ck "index.html has the leaderboard" grep -q 'id="leaderboard"' rep1/index.html
 
 # 3. idiff on the RGB channels (idiff compares every channel: strip the stderr ones)
 if command -v idiff >/dev/null 2>&1 && command -v oiiotool >/dev/null 2>&1; then
-    if grep -q '"stderr_excluded_pixels":	0,' rep1/metrics.json; then
+    if grep -q '"stderr_excluded_pixels":	0,' cmp.json; then
         oiiotool rep1/reference.exr --ch R,G,B -o ref_rgb.exr
         idiff -a ref_rgb.exr rep1/shafts.exr >idiff.txt 2>&1
         cat idiff.txt
         # the RGB row of the raw metrics: first "rmse", "mae", "psnr_idiff_db" after "RGB"
-        val() { awk -v k="\"$1\":" '/^\t"metrics":/{m=1} m && /"RGB":/{r=1} m && r && $1==k {gsub(/,/,"",$2); print $2; exit}' rep1/metrics.json; }
+        val() { python3 -c 'import json,sys; d=json.load(open("rep1/metrics.json")); t=[t for t in d["techniques"] if t["name"]=="shafts"][0]; print(t["compare"]["metrics"]["channels"]["RGB"][sys.argv[1]])' "$1"; }
         rel() { awk -v a="$1" -v b="$2" 'BEGIN{d=a-b; if(d<0)d=-d; s=b<0?-b:b; exit !(d <= 2e-6*s + 1e-12)}'; }
         rms_ours=$(val rmse); mae_ours=$(val mae); psnr_ours=$(val psnr_idiff_db)
         rms_idiff=$(sed -n 's/^ *RMS error = \([0-9.eE+-]*\).*/\1/p' idiff.txt)

@@ -6,6 +6,7 @@
  *  - the preview's exposure (99th percentile of max(R, G, B) -> 0.8) and its sRGB encoding;
  *  - index.html: every <img> points at a file that exists, text is escaped, nothing external;
  *  - the contact sheet places each panel at its (integer-resized) size;
+ *  - two techniques: the leaderboard ranks the exact one (2 x the reference) first;
  *  - bad inputs are rejected. */
 #include <math.h>
 #include <stdio.h>
@@ -16,7 +17,6 @@
 #include <cjson/cJSON.h>
 
 #include "check.h"
-#include "compare/flip.h"
 #include "compare/metrics.h"
 #include "image/oiio.h"
 #include "report/plot.h"
@@ -182,59 +182,85 @@ int main(void)
     const double rmse_raw = sqrt(se_raw / nsc);
     CHECK(nsc == W * H - 16);
 
-    gr_metrics m;
+    /* a second technique: exactly twice the reference, so a = 1/2 and it leads the board */
+    gr_image *test2 = gr_image_create(W, H, 3, NULL);
+    for (int p = 0; p < W * H; p++)
+        for (int c = 0; c < 3; c++) test2->pixels[p * 3 + c] = 2.0f * ref->pixels[p * 6 + c];
+    gr_metrics m, m2;
     gr_metrics_options opt = {0};
     opt.fit_scale = 1;
     CHECK_OK(gr_metrics_compute(ref, test, &opt, &m, &err), err);
+    CHECK_OK(gr_metrics_compute(ref, test2, &opt, &m2, &err), err);
     gr_metadata rmeta, tmeta;
     gr_meta_init(&rmeta);
     gr_meta_init(&tmeta);
     gr_meta_set_double(&rmeta, "godrays:wall_s", 12.5);
     gr_meta_set_string(&rmeta, "godrays:note", "x < y & \"z\"");
-    gr_meta_set_int(&tmeta, "godrays:gpu_ns.shafts", 2000000);
-    gr_meta_set_int(&tmeta, "godrays:gpu_ns.shadow", -1);
+    gr_meta_set_string(&tmeta, "godrays:passes", "first main");
+    gr_meta_set_int(&tmeta, "godrays:gpu_ns.main", 2000000);
+    gr_meta_set_int(&tmeta, "godrays:gpu_ns.first", -1);
+    gr_meta_set_double(&tmeta, "godrays:gpu_ms", 2.0);
 
     const char *out = getenv("GODRAYS_TEST_OUT");
     char dir[1024], cmd[2200], path[1200];
     snprintf(dir, sizeof dir, "%s/report_write", out ? out : "/tmp");
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     CHECK(system(cmd) == 0);
-    /* the FLIP map and its statistics, as godrays run passes them */
-    float *flipmap = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
-    gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = a};
-    gr_flip_result fres;
-    CHECK_OK(gr_flip_compute(ref, test, &fo, flipmap, &fres, &err), err);
-    gr_report_input in = {.scene = scene, .ref = ref, .ref_meta = &rmeta, .test = test, .test_meta = &tmeta,
-                          .metrics = &m, .command_line = "godrays run <x>", .ref_seconds = 1.0,
-                          .shafts_seconds = 0.5, .compare_seconds = 0.1, .flip_map = flipmap, .flip = &fres};
+    gr_report_technique ts[2] = {
+        {.name = "wobble", .description = "test <one>", .test = test, .meta = &tmeta, .metrics = &m, .seconds = 0.5},
+        {.name = "exact", .test = test2, .metrics = &m2, .seconds = 0.25},
+    };
+    gr_report_input in = {.scene = scene, .ref = ref, .ref_meta = &rmeta, .n_techniques = 2, .techniques = ts,
+                          .command_line = "godrays run <x>", .ref_seconds = 1.0, .compare_seconds = 0.1};
     gr_report_result res;
     CHECK_OK(gr_report_write(dir, &in, &res, &err), err);
-    CHECK_NEAR(res.fit_scale, a, 1e-9 * a);
-    static const char *const files[] = {"index.html", "summary.png", "metrics.json", "reference.png", "shafts.png",
-                                        "shafts_raw.png", "diff.png", "diff_signed.png", "flip.png"};
+    CHECK_NEAR(res.fit_scale[0], a, 1e-9 * a);
+    CHECK_NEAR(res.fit_scale[1], 0.5, 1e-6);
+    CHECK(res.order[0] == 1 && res.order[1] == 0); /* exact first */
+    static const char *const files[] = {"index.html", "summary.png", "metrics.json", "reference.png", "wobble.png",
+                                        "wobble_raw.png", "wobble_diff.png", "wobble_diff_signed.png", "exact.png",
+                                        "exact_raw.png", "exact_diff.png", "exact_diff_signed.png"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) CHECK_MSG(exists(dir, files[i]), "%s missing", files[i]);
-    CHECK(res.charts == (gr_plot_available() ? 3 : 0));
+    CHECK(res.charts == (gr_plot_available() ? 5 : 0)); /* the shared profile + 2 per technique */
 
     /* metrics.json */
     snprintf(path, sizeof path, "%s/metrics.json", dir);
     char *text = slurp(path);
     cJSON *root = text ? cJSON_Parse(text) : NULL;
-    {
-        const cJSON *fj = cJSON_GetObjectItemCaseSensitive(root, "flip");
-        const cJSON *fm = cJSON_GetObjectItemCaseSensitive(fj, "mean");
-        CHECK(cJSON_IsNumber(fm) && fabs(fm->valuedouble - fres.mean) <= 1e-12);
-    }
     CHECK(root != NULL);
     if (root) {
-        cJSON *v = get(root, "previews.shafts_scale");
+        cJSON *tarr = cJSON_GetObjectItemCaseSensitive(root, "techniques");
+        CHECK(cJSON_IsArray(tarr) && cJSON_GetArraySize(tarr) == 2);
+        cJSON *t0 = cJSON_GetArrayItem(tarr, 0), *t1 = cJSON_GetArrayItem(tarr, 1);
+        cJSON *v = get(t0, "name");
+        CHECK(cJSON_IsString(v) && !strcmp(v->valuestring, "wobble"));
+        v = get(t0, "fit_scale");
         CHECK(cJSON_IsNumber(v) && fabs(v->valuedouble - a) <= 1e-9 * a);
-        v = get(root, "error_vs_blur.rmse_y_raw");
+        v = get(t0, "previews.scale");
+        CHECK(cJSON_IsNumber(v) && fabs(v->valuedouble - a) <= 1e-9 * a);
+        v = get(t0, "error_vs_blur.rmse_y_raw");
         CHECK(cJSON_IsArray(v) && cJSON_GetArraySize(v) == 4);
         if (cJSON_IsArray(v)) CHECK_REL(cJSON_GetArrayItem(v, 0)->valuedouble, rmse_raw, 1e-9);
+        v = get(t0, "errors_y.rmse");
+        CHECK(cJSON_IsNumber(v) && fabs(v->valuedouble - rmse_raw) <= 1e-9 * rmse_raw);
+        v = get(t0, "compare.stderr_excluded_pixels");
+        CHECK(cJSON_IsNumber(v) && v->valuedouble == 16);
+        v = get(t0, "gpu_ms");
+        CHECK(cJSON_IsNumber(v) && v->valuedouble == 2.0);
+        v = get(t0, "rank");
+        CHECK(cJSON_IsNumber(v) && v->valuedouble == 2);
+        v = get(t1, "rank");
+        CHECK(cJSON_IsNumber(v) && v->valuedouble == 1);
+        v = get(t1, "errors_y.rel_rmse_fit"); /* 2 r scaled by 1/2 is r: no error */
+        CHECK(cJSON_IsNumber(v) && fabs(v->valuedouble) <= 1e-6);
+        v = get(t1, "gpu_ms");
+        CHECK(cJSON_IsNull(v)); /* no metadata: unknown */
+        v = cJSON_GetObjectItemCaseSensitive(root, "leaderboard");
+        CHECK(cJSON_IsArray(v) && cJSON_GetArraySize(v) == 2 &&
+              !strcmp(cJSON_GetArrayItem(v, 0)->valuestring, "exact") &&
+              !strcmp(cJSON_GetArrayItem(v, 1)->valuestring, "wobble"));
         v = get(root, "reference.noise_rms_stderr_y");
         CHECK(cJSON_IsNumber(v) && fabs(v->valuedouble - noise) <= 1e-6 * noise);
-        v = get(root, "stderr_excluded_pixels");
-        CHECK(cJSON_IsNumber(v) && v->valuedouble == 16);
         v = get(root, "radial_profile.pixels");
         double total = 0;
         for (cJSON *e = v ? v->child : NULL; e; e = e->next) total += e->valuedouble;
@@ -248,7 +274,7 @@ int main(void)
         for (int p = 0; p < W * H; p++) mx[p] = ref->pixels[p * 6 + 2]; /* B is the largest here */
         qsort(mx, W * H, sizeof(float), cmp_f);
         const double e = 0.8 / mx[(int)((W * H - 1) * 0.99)];
-        v = get(root, "previews.exposure");
+        v = get(root, "reference.preview_exposure");
         CHECK(cJSON_IsNumber(v) && fabs(v->valuedouble - e) <= 1e-9 * e);
         /* reference.png holds sRGB(e * R) in 8 bits */
         gr_image *png = NULL;
@@ -285,20 +311,30 @@ int main(void)
             CHECK_MSG(exists(dir, name) && !strchr(name, '/'), "<img src=\"%s\"> is not a file in the folder", name);
             nimg++;
         }
-        CHECK_MSG(nimg == 6 + res.charts, "%d images in index.html", nimg); /* 6: with flip.png */
+        /* 2 thumbnails, 5 figures per technique (the reference beside each), the charts */
+        CHECK_MSG(nimg == 2 + 2 * 5 + res.charts, "%d images in index.html", nimg);
         CHECK(strstr(html, "16 pixels NOT SCORED") != NULL);
-        CHECK(strstr(html, "2 ms") != NULL); /* the shaft pass's GPU time from the metadata */
+        CHECK(strstr(html, "2 ms") != NULL); /* the main pass's GPU time from the metadata */
+        CHECK(strstr(html, "test &lt;one&gt;") != NULL);
+        const char *pe = strstr(html, "href=\"#t-exact\""), *pw = strstr(html, "href=\"#t-wobble\"");
+        CHECK(pe && pw && pe < pw); /* the leaderboard lists the better technique first */
     }
     free(html);
 
     /* bad inputs */
     gr_image *small = gr_image_create(W - 1, H, 3, NULL);
-    in.test = small;
+    ts[1].test = small;
     CHECK(gr_report_write(dir, &in, NULL, &err) == GR_E_INPUT);
-    in.test = test;
-    in.metrics = NULL;
+    ts[1].test = test2;
+    ts[0].metrics = NULL;
     CHECK(gr_report_write(dir, &in, NULL, &err) == GR_E_INPUT);
-    in.metrics = &m;
+    ts[0].metrics = &m;
+    ts[1].name = "wobble"; /* twice the same name */
+    CHECK(gr_report_write(dir, &in, NULL, &err) == GR_E_INPUT && strstr(err.msg, "twice"));
+    ts[1].name = "exact";
+    in.n_techniques = 0;
+    CHECK(gr_report_write(dir, &in, NULL, &err) == GR_E_INPUT);
+    in.n_techniques = 2;
     snprintf(path, sizeof path, "%s/index.html", dir);
     CHECK(gr_report_write(path, &in, NULL, &err) == GR_E_IO); /* a file where the folder should be */
     CHECK(strstr(err.msg, "index.html") != NULL);
@@ -306,7 +342,7 @@ int main(void)
     gr_image_destroy(small);
     gr_image_destroy(ref);
     gr_image_destroy(test);
-    free(flipmap);
+    gr_image_destroy(test2);
     gr_meta_free(&rmeta);
     gr_meta_free(&tmeta);
     free(scene);

@@ -50,5 +50,14 @@ int main(void)
     gr_pareto_mark_fronts(pts, 4);
     /* per family: the shafts are not dominated by the (slower, better) reference points */
     CHECK(pts[0].on_front == 1 && pts[1].on_front == 0 && pts[2].on_front == 1 && pts[3].on_front == 1);
+
+    /* a third family (a second technique): its own front, whatever the others' points */
+    gr_pareto_point q[6];
+    memcpy(q, pts, sizeof pts);
+    q[4] = (gr_pareto_point){.family = 2, .time_s = 0.05, .cost_s = 0.05, .error = 0.9}; /* dominated by family 1 */
+    q[5] = (gr_pareto_point){.family = 2, .time_s = 0.06, .cost_s = 0.06, .error = 0.95};
+    gr_pareto_mark_fronts(q, 6);
+    CHECK(q[2].on_front == 1 && q[3].on_front == 1);
+    CHECK(q[4].on_front == 1 && q[5].on_front == 0);
     CHECK_DONE();
 }

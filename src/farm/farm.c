@@ -1,0 +1,453 @@
+#include "farm/farm.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "report/cache.h"
+#include "tune/objective.h"
+#include "tune/session.h"
+
+static int exists(const char *p)
+{
+    struct stat sb;
+    return stat(p, &sb) == 0;
+}
+
+void gr_farm_part_path(const gr_farm_plan *plan, int c, int i, int j, char *buf, size_t n)
+{
+    snprintf(buf, n, "%s/parts/%s/tile-%d-of-%d.batches-%d-of-%d.part", plan->cache, plan->cases[c].key, i, plan->tiles, j,
+             plan->batch_parts);
+}
+
+/* What the cache holds for each case: the merged truth, its parts. */
+static void refresh(gr_farm_plan *plan)
+{
+    char p[8400];
+    for (int c = 0; c < plan->n_cases; c++) {
+        gr_farm_case *fc = &plan->cases[c];
+        gr_cache_path(plan->cache, fc->key, p, sizeof p, NULL);
+        fc->merged = exists(p);
+        fc->parts_done = 0;
+        for (int i = 0; i < plan->tiles; i++)
+            for (int j = 0; j < plan->batch_parts; j++) {
+                gr_farm_part_path(plan, c, i, j, p, sizeof p);
+                fc->parts_done += exists(p);
+            }
+    }
+}
+
+gr_status gr_farm_plan_cases(gr_farm_plan *plan, const gr_scene *scene, gr_error *err)
+{
+    double times[GR_FARM_MAX_CASES];
+    long frames[GR_FARM_MAX_CASES];
+    int nt = 0;
+    if (plan->frames[0]) {
+        gr_status st = gr_tune_parse_frames("--frames", plan->frames, plan->fps, times, GR_FARM_MAX_CASES, &nt, err);
+        if (st != GR_OK) return st;
+        long a = 0, b = 0, s = 1;
+        sscanf(plan->frames, "%ld:%ld:%ld", &a, &b, &s);
+        for (int k = 0; k < nt; k++) frames[k] = a + k * s;
+    }
+    int nv = 1 + plan->n_views, n = (nt ? nt : 1) * nv;
+    if (n > GR_FARM_MAX_CASES) return gr_fail(err, GR_E_USAGE, "--frames x --view: %d cases, at most %d", n, GR_FARM_MAX_CASES);
+    plan->cases = calloc((size_t)n, sizeof *plan->cases);
+    if (!plan->cases) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
+    plan->n_cases = n;
+    gr_scene *cs = malloc(sizeof *cs);
+    if (!cs) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
+    gr_status st = GR_OK;
+    for (int c = 0; c < n && st == GR_OK; c++) {
+        gr_farm_case *fc = &plan->cases[c];
+        int t = c / nv, v = c % nv;
+        fc->has_frame = nt > 0;
+        fc->frame = nt ? frames[t] : 0;
+        fc->view = v;
+        /* the case as tune makes it (water.time_s + frame / fps), so the keys are tune's */
+        fc->time_s = nt ? times[t] + scene->water.time_s : scene->water.time_s;
+        gr_tune_view view = {0.0, 0.0};
+        size_t l = 0;
+        fc->args[0] = '\0';
+        if (nt) l += (size_t)snprintf(fc->args + l, sizeof fc->args - l, "--frame %ld --fps %.17g", fc->frame, plan->fps);
+        if (v) {
+            st = gr_tune_parse_view("--view", plan->views[v - 1], &view, err);
+            if (st != GR_OK) break;
+            snprintf(fc->args + l, sizeof fc->args - l, "%s--view %s", l ? " " : "", plan->views[v - 1]);
+        }
+        st = gr_tune_make_case(scene, fc->time_s, v ? &view : NULL, cs, err);
+        if (st == GR_OK) st = gr_cache_key(cs, fc->key, err);
+    }
+    free(cs);
+    if (st == GR_OK) refresh(plan);
+    return st;
+}
+
+void gr_farm_plan_free(gr_farm_plan *plan)
+{
+    if (!plan) return;
+    free(plan->cases);
+    plan->cases = NULL;
+    plan->n_cases = 0;
+}
+
+void gr_farm_todo(const gr_farm_plan *plan, char *buf, size_t n)
+{
+    int per = plan->tiles * plan->batch_parts, total = plan->n_cases * per, start = -1;
+    size_t l = 0;
+    buf[0] = '\0';
+    char p[8400];
+    for (int t = 0; t <= total; t++) {
+        int todo = 0;
+        if (t < total) {
+            int c = t / per, r = t % per;
+            gr_farm_part_path(plan, c, r / plan->batch_parts, r % plan->batch_parts, p, sizeof p);
+            todo = !plan->cases[c].merged && !exists(p);
+        }
+        if (todo && start < 0) start = t;
+        if (!todo && start >= 0) {
+            if (l < n)
+                l += (size_t)snprintf(buf + l, n - l, "%s%d", l ? "," : "", start);
+            if (t - 1 > start && l < n) l += (size_t)snprintf(buf + l, n - l, "-%d", t - 1);
+            start = -1;
+        }
+    }
+}
+
+/* ---- writing ---- */
+
+/* s single-quoted for the shell */
+static void sq(FILE *f, const char *s)
+{
+    fputc('\'', f);
+    for (; *s; s++) {
+        if (*s == '\'') fputs("'\\''", f);
+        else fputc(*s, f);
+    }
+    fputc('\'', f);
+}
+
+typedef struct wfile { FILE *f; char path[8400], tmp[8500]; } wfile;
+
+static gr_status wopen(wfile *w, const gr_farm_plan *plan, const char *name, gr_error *err)
+{
+    snprintf(w->path, sizeof w->path, "%s/%s", plan->dir, name);
+    snprintf(w->tmp, sizeof w->tmp, "%s.tmp-%ld", w->path, (long)getpid());
+    w->f = fopen(w->tmp, "w");
+    if (!w->f) return gr_fail(err, GR_E_IO, "%s: cannot write: %s", w->path, strerror(errno));
+    return GR_OK;
+}
+
+static gr_status wclose(wfile *w, int exec, gr_error *err)
+{
+    int ok = !ferror(w->f);
+    ok = (fclose(w->f) == 0) && ok;
+    if (ok && exec) ok = chmod(w->tmp, 0755) == 0;
+    if (ok) ok = rename(w->tmp, w->path) == 0;
+    if (!ok) {
+        remove(w->tmp);
+        return gr_fail(err, GR_E_IO, "%s: write failed: %s", w->path, strerror(errno));
+    }
+    return GR_OK;
+}
+
+static void header(FILE *f, const gr_farm_plan *plan, const char *what)
+{
+    char date[64];
+    time_t now = time(NULL);
+    struct tm tm;
+    gmtime_r(&now, &tm);
+    strftime(date, sizeof date, "%Y-%m-%d %H:%M:%SZ", &tm);
+    fprintf(f, "#!/bin/bash\n# godrays farm: %s\n# Written by `%s` on %s (docs/farm.md).\n", what, plan->command, date);
+}
+
+static void sbatch_common(FILE *f, const gr_farm_plan *plan, const char *name, const char *log)
+{
+    fprintf(f, "#SBATCH --job-name=%s\n#SBATCH --output=%s/logs/%s.out\n#SBATCH --error=%s/logs/%s.err\n", name, plan->dir,
+            log, plan->dir, log);
+    if (plan->partition[0]) fprintf(f, "#SBATCH --partition=%s\n", plan->partition);
+    if (plan->time_limit[0]) fprintf(f, "#SBATCH --time=%s\n", plan->time_limit);
+}
+
+static void vars(FILE *f, const gr_farm_plan *plan)
+{
+    fputs("set -u\n# everything the job needs: the binary, the scene copy, the shared cache\nGODRAYS=", f);
+    sq(f, plan->binary);
+    fputs("\nFARM=", f);
+    sq(f, plan->dir);
+    fputs("\nSCENE=\"$FARM/scene.json\"\nexport GODRAYS_CACHE=", f);
+    sq(f, plan->cache);
+    fprintf(f, "\nTILES=%d\nBATCH_PARTS=%d\n", plan->tiles, plan->batch_parts);
+    fputs("# case C: its reference arguments and its ground truth's cache key\nCASE_ARGS=(", f);
+    for (int c = 0; c < plan->n_cases; c++) {
+        fputs(c ? "\n           " : "", f);
+        sq(f, plan->cases[c].args);
+    }
+    fputs(")\nCASE_KEYS=(", f);
+    for (int c = 0; c < plan->n_cases; c++) fprintf(f, "%s%s", c ? (c % 3 ? " " : "\n           ") : "", plan->cases[c].key);
+    fputs(")\n", f);
+}
+
+gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_error *err)
+{
+    char p[8400];
+    snprintf(p, sizeof p, "%s/logs", plan->dir);
+    if (mkdir(plan->dir, 0755) != 0 && errno != EEXIST)
+        return gr_fail(err, GR_E_IO, "%s: cannot create: %s", plan->dir, strerror(errno));
+    if (mkdir(p, 0755) != 0 && errno != EEXIST) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", p, strerror(errno));
+    wfile w;
+    gr_status st;
+    /* scene.json */
+    char *js = gr_scene_to_json(scene);
+    if (!js) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
+    st = wopen(&w, plan, "scene.json", err);
+    if (st == GR_OK) {
+        fputs(js, w.f);
+        fputc('\n', w.f);
+        st = wclose(&w, 0, err);
+    }
+    free(js);
+    if (st != GR_OK) return st;
+    int per = plan->tiles * plan->batch_parts;
+
+    /* parts.sh */
+    if ((st = wopen(&w, plan, "parts.sh", err)) != GR_OK) return st;
+    FILE *f = w.f;
+    header(f, plan, "the ground-truth parts, one per array task");
+    fprintf(f,
+            "# Task T renders case T / %d, tile (T %% %d) / %d, batch group T %% %d into\n"
+            "# $GODRAYS_CACHE/parts/KEY/ (skipped when that part or the case's merged truth is there).\n"
+            "# A failed attempt (killed, crashed) is retried up to RETRIES times; bad input (exit 2) is not.\n"
+            "# By hand: sbatch --array=0-%d parts.sh, or bash parts.sh T to run task T here.\n",
+            per, per, plan->batch_parts, plan->batch_parts, plan->n_cases * per - 1);
+    sbatch_common(f, plan, "godrays-parts", "part-%a");
+    if (plan->cpus > 0) fprintf(f, "#SBATCH --cpus-per-task=%d\n", plan->cpus);
+    fputs("#SBATCH --requeue\n", f);
+    vars(f, plan);
+    fprintf(f, "RETRIES=%d\n", plan->retries);
+    fputs("T=${1:-${SLURM_ARRAY_TASK_ID:?not an array task: give the task number as the argument}}\n"
+          "C=$((T / (TILES * BATCH_PARTS))); R=$((T % (TILES * BATCH_PARTS)))\n"
+          "I=$((R / BATCH_PARTS)); J=$((R % BATCH_PARTS)); KEY=${CASE_KEYS[$C]}\n"
+          "PART=\"$GODRAYS_CACHE/parts/$KEY/tile-$I-of-$TILES.batches-$J-of-$BATCH_PARTS.part\"\n"
+          "if [ -e \"$GODRAYS_CACHE/reference-$KEY.exr\" ] || [ -e \"$PART\" ]; then\n"
+          "  echo \"part $T: already in the cache\"; exit 0\n"
+          "fi\n"
+          "mkdir -p \"$GODRAYS_CACHE/parts/$KEY\"\n"
+          "attempt=1\n"
+          "while :; do\n"
+          "  echo \"part $T (case $C: ${CASE_ARGS[$C]}; tile $I/$TILES; batches $J/$BATCH_PARTS): attempt $attempt on $(hostname) at $(date -u +%FT%TZ)\"\n"
+          "  start=$(date +%s.%N)\n"
+          "  # shellcheck disable=SC2086 (the case's arguments are words)\n"
+          "  \"$GODRAYS\" reference \"$SCENE\" ${CASE_ARGS[$C]} --tile \"$I/$TILES\" --batch-part \"$J/$BATCH_PARTS\" \\\n"
+          "      --threads \"${SLURM_CPUS_PER_TASK:-0}\" --quiet -o \"$PART\" &\n"
+          "  pid=$!\n"
+          "  echo $pid > \"$FARM/logs/part-$T.pid\"\n"
+          "  wait $pid; rc=$?\n"
+          "  rm -f \"$FARM/logs/part-$T.pid\"\n"
+          "  if [ $rc -eq 0 ]; then\n"
+          "    echo \"part $T: done in $(awk \"BEGIN { print $(date +%s.%N) - $start }\") s\"; exit 0\n"
+          "  fi\n"
+          "  echo \"part $T: attempt $attempt failed (exit $rc)\" >&2\n"
+          "  if [ $rc -eq 2 ]; then echo \"part $T: FAILED (bad input, not retried)\" >&2; exit 2; fi\n"
+          "  if [ $attempt -ge $RETRIES ]; then echo \"part $T: FAILED after $attempt attempts\" >&2; exit 1; fi\n"
+          "  attempt=$((attempt + 1))\n"
+          "done\n",
+          f);
+    if ((st = wclose(&w, 1, err)) != GR_OK) return st;
+
+    /* merge.sh */
+    if ((st = wopen(&w, plan, "merge.sh", err)) != GR_OK) return st;
+    f = w.f;
+    header(f, plan, "merge each case's parts into the ground-truth cache");
+    fputs("# An array after the parts (whatever their outcome): task C merges case C (bash merge.sh:\n"
+          "# every case, here). A case whose truth is cached is skipped; a case with missing parts is\n"
+          "# reported with the tail of their logs (exit 1).\n",
+          f);
+    sbatch_common(f, plan, "godrays-merge", "merge-%a");
+    vars(f, plan);
+    fputs("mkdir -p \"$FARM/truth\"\n"
+          "fail=0\n"
+          "CASES=(\"${!CASE_KEYS[@]}\")\n"
+          "if [ -n \"${SLURM_ARRAY_TASK_ID:-}\" ]; then CASES=(\"$SLURM_ARRAY_TASK_ID\"); fi\n"
+          "for C in \"${CASES[@]}\"; do\n"
+          "  KEY=${CASE_KEYS[$C]}\n"
+          "  if [ -e \"$GODRAYS_CACHE/reference-$KEY.exr\" ]; then echo \"case $C: in the cache\"; continue; fi\n"
+          "  parts=(); missing=0\n"
+          "  for ((I = 0; I < TILES; I++)); do for ((J = 0; J < BATCH_PARTS; J++)); do\n"
+          "    P=\"$GODRAYS_CACHE/parts/$KEY/tile-$I-of-$TILES.batches-$J-of-$BATCH_PARTS.part\"\n"
+          "    T=$((C * TILES * BATCH_PARTS + I * BATCH_PARTS + J))\n"
+          "    if [ -e \"$P\" ]; then parts+=(\"$P\"); continue; fi\n"
+          "    missing=1\n"
+          "    echo \"case $C (${CASE_ARGS[$C]}): part $T missing (tile $I, batches $J); its log $FARM/logs/part-$T.err:\" >&2\n"
+          "    tail -n 5 \"$FARM/logs/part-$T.err\" 2>/dev/null | sed 's/^/    /' >&2\n"
+          "  done; done\n"
+          "  if [ $missing -ne 0 ]; then fail=1; continue; fi\n"
+          "  start=$(date +%s.%N)\n"
+          "  if \"$GODRAYS\" merge \"${parts[@]}\" --cache --no-preview -o \"$FARM/truth/case-$C.exr\"; then\n"
+          "    echo \"case $C: merged ${#parts[@]} parts in $(awk \"BEGIN { print $(date +%s.%N) - $start }\") s\"\n"
+          "  else fail=1; fi\n"
+          "done\n"
+          "exit $fail\n",
+          f);
+    if ((st = wclose(&w, 1, err)) != GR_OK) return st;
+
+    /* final.sh */
+    if ((st = wopen(&w, plan, "final.sh", err)) != GR_OK) return st;
+    f = w.f;
+    header(f, plan, "the final job on the merged ground truths (found in the cache)");
+    sbatch_common(f, plan, "godrays-final", "final");
+    if (plan->cpus > 0) fprintf(f, "#SBATCH --cpus-per-task=%d\n", plan->cpus);
+    fputs("set -u\nGODRAYS=", f);
+    sq(f, plan->binary);
+    fputs("\nFARM=", f);
+    sq(f, plan->dir);
+    fputs("\nSCENE=\"$FARM/scene.json\"\nexport GODRAYS_CACHE=", f);
+    sq(f, plan->cache);
+    fputc('\n', f);
+    if (!strcmp(plan->then, "tune")) {
+        fputs("\"$GODRAYS\" tune \"$SCENE\"", f);
+        if (plan->frames[0]) fprintf(f, " --frames %s --fps %.17g", plan->frames, plan->fps);
+        for (int v = 0; v < plan->n_views; v++) fprintf(f, " --view %s", plan->views[v]);
+        fprintf(f, " --quiet -o \"$FARM/tune\" %s\n", plan->then_args);
+    } else if (!strcmp(plan->then, "run")) {
+        fputs("# run takes the scene's own view; each frame's water time as tune computes it\nfail=0\n", f);
+        for (int c = 0; c < plan->n_cases; c++)
+            if (plan->cases[c].view == 0)
+                fprintf(f, "\"$GODRAYS\" run \"$SCENE\" --set water.time_s=%.17g --quiet -o \"$FARM/run/case-%d\" %s || fail=1\n",
+                        plan->cases[c].time_s, c, plan->then_args);
+        fputs("exit $fail\n", f);
+    } else {
+        fputs("echo \"nothing to do (farm --then none)\"\n", f);
+    }
+    if ((st = wclose(&w, 1, err)) != GR_OK) return st;
+
+    /* submit.sh */
+    char todo[8192];
+    gr_farm_todo(plan, todo, sizeof todo);
+    int unmerged = 0;
+    for (int c = 0; c < plan->n_cases; c++) unmerged += !plan->cases[c].merged;
+    if ((st = wopen(&w, plan, "submit.sh", err)) != GR_OK) return st;
+    f = w.f;
+    header(f, plan, "submit the parts, the merge and the final job");
+    fputs("# The array lists the parts not yet in the cache when this was written (a resubmission\n"
+          "# skips the rest; each task checks again when it starts). Job ids go to jobs.txt.\n"
+          "set -eu\nFARM=",
+          f);
+    sq(f, plan->dir);
+    fprintf(f, "\ncd \"$FARM\"\nARRAY=\"%s\"   # of 0-%d\n", todo, plan->n_cases * per - 1);
+    if (plan->max_parallel > 0) fprintf(f, "MAX_PARALLEL=\"%%%d\"   # at most this many tasks at once\n", plan->max_parallel);
+    else fputs("MAX_PARALLEL=\"\"   # \"%K\": at most K tasks at once (farm --max-parallel K)\n", f);
+    char mtodo[8192] = "";
+    for (int c = 0, start = -1; c <= plan->n_cases; c++) { /* the cases still to merge */
+        int todo_c = c < plan->n_cases && !plan->cases[c].merged;
+        size_t l = strlen(mtodo);
+        if (todo_c && start < 0) start = c;
+        if (!todo_c && start >= 0) {
+            if (c - 1 > start) snprintf(mtodo + l, sizeof mtodo - l, "%s%d-%d", l ? "," : "", start, c - 1);
+            else snprintf(mtodo + l, sizeof mtodo - l, "%s%d", l ? "," : "", start);
+            start = -1;
+        }
+    }
+    fprintf(f, "MERGE_ARRAY=\"%s\"   # cases whose truth is not in the cache yet (%d)\n", mtodo, unmerged);
+    fputs("P=\"\"; M=\"\"; F=\"\"\n"
+          "if [ -n \"$ARRAY\" ]; then P=$(sbatch --parsable --array=\"$ARRAY$MAX_PARALLEL\" parts.sh); P=${P%%;*}; fi\n"
+          "if [ -n \"$MERGE_ARRAY\" ]; then\n"
+          "  M=$(sbatch --parsable --array=\"$MERGE_ARRAY\" ${P:+--dependency=afterany:$P} merge.sh); M=${M%%;*}\n"
+          "fi\n",
+          f);
+    if (strcmp(plan->then, "none") != 0)
+        fputs("F=$(sbatch --parsable ${M:+--dependency=afterok:$M} final.sh); F=${F%%;*}\n", f);
+    fputs("printf 'parts %s\\nmerge %s\\nfinal %s\\n' \"${P:--}\" \"${M:--}\" \"${F:--}\" > jobs.txt\n"
+          "echo \"submitted: parts ${P:--} (tasks ${ARRAY:-none}), merge ${M:--}, final ${F:--}\"\n",
+          f);
+    if ((st = wclose(&w, 1, err)) != GR_OK) return st;
+
+    /* farm.json */
+    cJSON *j = cJSON_CreateObject();
+    if (!j) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
+    cJSON_AddStringToObject(j, "format", "godrays-farm-1");
+    cJSON_AddStringToObject(j, "command", plan->command);
+    cJSON_AddStringToObject(j, "binary", plan->binary);
+    cJSON_AddStringToObject(j, "cache", plan->cache);
+    cJSON_AddNumberToObject(j, "tiles", plan->tiles);
+    cJSON_AddNumberToObject(j, "batch_parts", plan->batch_parts);
+    cJSON_AddStringToObject(j, "then", plan->then);
+    cJSON *arr = cJSON_AddArrayToObject(j, "cases");
+    for (int c = 0; arr && c < plan->n_cases; c++) {
+        cJSON *o = cJSON_CreateObject();
+        if (!o) break;
+        cJSON_AddStringToObject(o, "args", plan->cases[c].args);
+        cJSON_AddStringToObject(o, "key", plan->cases[c].key);
+        cJSON_AddNumberToObject(o, "view", plan->cases[c].view);
+        cJSON_AddNumberToObject(o, "time_s", plan->cases[c].time_s);
+        cJSON_AddItemToArray(arr, o);
+    }
+    char *txt = cJSON_Print(j);
+    cJSON_Delete(j);
+    if (!txt) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
+    st = wopen(&w, plan, "farm.json", err);
+    if (st == GR_OK) {
+        fputs(txt, w.f);
+        fputc('\n', w.f);
+        st = wclose(&w, 0, err);
+    }
+    cJSON_free(txt);
+    return st;
+}
+
+gr_status gr_farm_load(const char *dir, gr_farm_plan *plan, gr_error *err)
+{
+    memset(plan, 0, sizeof *plan);
+    char p[8400];
+    snprintf(p, sizeof p, "%s/farm.json", dir);
+    FILE *f = fopen(p, "rb");
+    if (!f) return gr_fail(err, GR_E_INPUT, "%s: cannot open: %s (not a farm folder?)", p, strerror(errno));
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *buf = n > 0 ? malloc((size_t)n + 1) : NULL;
+    size_t got = buf ? fread(buf, 1, (size_t)n, f) : 0;
+    fclose(f);
+    if (!buf || got != (size_t)n) {
+        free(buf);
+        return gr_fail(err, GR_E_INPUT, "%s: cannot read", p);
+    }
+    buf[n] = '\0';
+    cJSON *j = cJSON_Parse(buf);
+    free(buf);
+    const cJSON *cases = j ? cJSON_GetObjectItemCaseSensitive(j, "cases") : NULL;
+    const cJSON *cache = j ? cJSON_GetObjectItemCaseSensitive(j, "cache") : NULL;
+    const cJSON *tiles = j ? cJSON_GetObjectItemCaseSensitive(j, "tiles") : NULL;
+    const cJSON *bp = j ? cJSON_GetObjectItemCaseSensitive(j, "batch_parts") : NULL;
+    if (!cJSON_IsArray(cases) || !cJSON_IsString(cache) || !cJSON_IsNumber(tiles) || !cJSON_IsNumber(bp) ||
+        tiles->valueint < 1 || bp->valueint < 1) {
+        cJSON_Delete(j);
+        return gr_fail(err, GR_E_INPUT, "%s: not a godrays farm plan (cases, cache, tiles, batch_parts)", p);
+    }
+    snprintf(plan->dir, sizeof plan->dir, "%s", dir);
+    snprintf(plan->cache, sizeof plan->cache, "%s", cache->valuestring);
+    plan->tiles = tiles->valueint;
+    plan->batch_parts = bp->valueint;
+    int nc = cJSON_GetArraySize(cases);
+    plan->cases = calloc(nc > 0 ? (size_t)nc : 1, sizeof *plan->cases);
+    if (!plan->cases) {
+        cJSON_Delete(j);
+        return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
+    }
+    const cJSON *o;
+    cJSON_ArrayForEach(o, cases)
+    {
+        const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, "args"), *k = cJSON_GetObjectItemCaseSensitive(o, "key");
+        gr_farm_case *fc = &plan->cases[plan->n_cases++];
+        snprintf(fc->args, sizeof fc->args, "%s", cJSON_IsString(a) ? a->valuestring : "");
+        snprintf(fc->key, sizeof fc->key, "%s", cJSON_IsString(k) ? k->valuestring : "");
+    }
+    cJSON_Delete(j);
+    refresh(plan);
+    return GR_OK;
+}

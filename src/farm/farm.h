@@ -1,0 +1,74 @@
+/* `godrays farm`: ground truths of a sequence of frames and views, split into parts
+ * (src/farm/parts.h) and run as a Slurm job array, merged into the ground-truth cache
+ * (src/report/cache.h) where run, sweep, tune and pareto find them. docs/farm.md.
+ *
+ * A farm folder holds everything the jobs need, readable and submittable by hand:
+ *   scene.json   the scene as normalized JSON (overrides applied): what every job renders
+ *   parts.sh     the array job: task T renders one part (case, tile, batch group) into
+ *                $GODRAYS_CACHE/parts/KEY/, skipping parts and cases already there, and
+ *                retrying a failed attempt (a killed process, a crash) up to `retries` times
+ *   merge.sh     after the array (whatever its outcome): merges every case's parts into the
+ *                cache, or names the missing parts with the tail of their logs (exit 1)
+ *   final.sh     after a successful merge: tune (or run) on the merged truths
+ *   submit.sh    the sbatch calls with their dependencies; writes jobs.txt
+ *   farm.json    the plan (cases, keys, tiles) for `godrays farm --status`
+ *   logs/        one log per task and job */
+#ifndef GR_FARM_FARM_H
+#define GR_FARM_FARM_H
+
+#include <stddef.h>
+#include "common/status.h"
+#include "scene/scene.h"
+
+#define GR_FARM_MAX_CASES 4096
+
+typedef struct gr_farm_case {
+    int has_frame;
+    long frame;
+    int view;               /* 0: the scene's own camera, k: extra view k - 1 */
+    double time_s;          /* water.time_s of the case */
+    char args[160];         /* reference arguments that select it ("--frame 10 --fps 30 --view 30,-10") */
+    char key[48];           /* its ground truth's cache key */
+    int merged;             /* its truth is in the cache already */
+    int parts_done;         /* parts already in the cache */
+} gr_farm_case;
+
+typedef struct gr_farm_plan {
+    char dir[4096];         /* farm folder (absolute) */
+    char binary[4096];      /* godrays binary the jobs run (absolute) */
+    char cache[4096];       /* shared cache folder (absolute): GODRAYS_CACHE in the jobs */
+    char partition[128];    /* "" = the site's default */
+    char time_limit[64];    /* sbatch --time ("" = the partition's) */
+    char frames[64];        /* --frames A:B:S as given ("" = the scene's time only) */
+    char views[8][64];      /* --view YAW,PITCH as given */
+    int n_views;
+    double fps;
+    int cpus;               /* --cpus-per-task (0 = not set) */
+    int tiles, batch_parts, retries, max_parallel;
+    char then[16];          /* "tune", "run" or "none" */
+    char then_args[1024];
+    char command[4096];     /* the farm command line, for the scripts' header */
+    int n_cases;
+    gr_farm_case *cases;    /* malloc'd */
+} gr_farm_plan;
+
+/* Fills plan->cases from the scene and plan's frames, fps and views: each case's key and
+ * what the cache already holds (merged truth, parts). GR_E_USAGE for bad --frames/--view. */
+gr_status gr_farm_plan_cases(gr_farm_plan *plan, const gr_scene *scene, gr_error *err);
+void gr_farm_plan_free(gr_farm_plan *plan); /* frees the cases; accepts NULL */
+
+/* Path of part (tile i, batch group j) of case c in the cache. */
+void gr_farm_part_path(const gr_farm_plan *plan, int c, int i, int j, char *buf, size_t n);
+
+/* Array indices of the parts still to render ("0-3,8,10-11"; "" if none) into buf. */
+void gr_farm_todo(const gr_farm_plan *plan, char *buf, size_t n);
+
+/* Writes the farm folder (scene.json, parts.sh, merge.sh, final.sh, submit.sh, farm.json,
+ * logs/). GR_E_IO naming the file. */
+gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_error *err);
+
+/* Reads farm.json of a farm folder back into plan (cases with keys and args; the cache
+ * states are refreshed). GR_E_INPUT naming the file. */
+gr_status gr_farm_load(const char *dir, gr_farm_plan *plan, gr_error *err);
+
+#endif

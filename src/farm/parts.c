@@ -1,0 +1,471 @@
+#include "farm/parts.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "report/cache.h"
+
+#define PART_MAGIC "GODRAYS-PART 1\n"
+
+void gr_part_rows(int i, int n, int h, int *row0, int *row1)
+{
+    *row0 = (int)((long long)i * h / n);
+    *row1 = (int)((long long)(i + 1) * h / n);
+}
+
+/* First probe row at or below image row `row` (probe rows are y stride + off), as the
+ * integrator's probe restricts itself to a part's rows. */
+static int probe_row(int row, int stride, int off, int h)
+{
+    int y = row <= off ? 0 : (row - off + stride - 1) / stride;
+    return y < h ? y : h;
+}
+
+/* ---- a growing byte buffer ---- */
+typedef struct buf { unsigned char *p; size_t n, cap; int bad; } buf;
+
+static void put(buf *b, const void *d, size_t n)
+{
+    if (b->bad) return;
+    if (b->n + n > b->cap) {
+        size_t c = b->cap ? b->cap : 1 << 16;
+        while (c < b->n + n) c *= 2;
+        unsigned char *q = realloc(b->p, c);
+        if (!q) { b->bad = 1; return; }
+        b->p = q;
+        b->cap = c;
+    }
+    memcpy(b->p + b->n, d, n);
+    b->n += n;
+}
+
+static int little_endian(void)
+{
+    const uint16_t one = 1;
+    return *(const unsigned char *)&one == 1;
+}
+
+gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_options *o, const gr_ref_result *res,
+                        const char *command, gr_error *err)
+{
+    const gr_ref_sums *s = res->sums;
+    if (!s) return gr_fail(err, GR_E_USAGE, "%s: the render kept no sums (gr_ref_options.keep_sums)", path);
+    if (!little_endian()) return gr_fail(err, GR_E_RUNTIME, "%s: part files are little-endian; this machine is not", path);
+    int W = s->W, B = s->B;
+    int row0 = o->row0, row1 = o->row1 ? o->row1 : s->H, b0 = o->batch0, b1 = o->batch1 ? o->batch1 : B;
+    buf pay = {0};
+    for (int y = row0; y < row1; y++)
+        for (int x = 0; x < W; x++) {
+            size_t p = (size_t)y * W + x;
+            put(&pay, s->sum + (p * B + b0) * 3, (size_t)(b1 - b0) * 3 * sizeof(double));
+        }
+    for (int y = row0; y < row1; y++)
+        for (int x = 0; x < W; x++) {
+            size_t p = (size_t)y * W + x;
+            put(&pay, s->count + p * B + b0, (size_t)(b1 - b0) * sizeof(uint32_t));
+        }
+    int py0 = 0, py1 = 0;
+    if (s->probe) {
+        py0 = probe_row(row0, s->probe_stride, s->probe_off, s->probe_h);
+        py1 = probe_row(row1, s->probe_stride, s->probe_off, s->probe_h);
+        for (int k = 0; k < s->probe_levels; k++) {
+            size_t a = (size_t)py0 * s->probe_w, e = (size_t)py1 * s->probe_w;
+            put(&pay, s->probe_sum[k] + a * 3, (e - a) * 3 * sizeof(double));
+            put(&pay, s->probe_count[k] + a, (e - a) * sizeof(uint32_t));
+        }
+    }
+    char key[GR_CACHE_KEY_LEN + 1];
+    gr_status st = pay.bad ? gr_fail(err, GR_E_NOMEM, "%s: out of memory", path) : gr_cache_key(scene, key, err);
+    char *scene_json = st == GR_OK ? gr_scene_to_json(scene) : NULL;
+    if (st == GR_OK && !scene_json) st = gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
+    cJSON *h = st == GR_OK ? cJSON_CreateObject() : NULL;
+    char *htxt = NULL;
+    if (h) {
+        char host[128] = "", date[64] = "", fnv[20];
+        gethostname(host, sizeof host - 1);
+        time_t now = time(NULL);
+        struct tm tm;
+        gmtime_r(&now, &tm);
+        strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &tm);
+        snprintf(fnv, sizeof fnv, "%016llx", gr_fnv1a64(GR_FNV_BASIS, pay.p, pay.n));
+        cJSON_AddStringToObject(h, "format", GR_PART_FORMAT);
+        cJSON_AddStringToObject(h, "cache_key", key);
+        cJSON_AddStringToObject(h, "scene_path", scene->source_path);
+        cJSON_AddStringToObject(h, "scene", scene_json);
+        cJSON_AddNumberToObject(h, "width", W);
+        cJSON_AddNumberToObject(h, "height", s->H);
+        cJSON_AddNumberToObject(h, "batches", B);
+        cJSON_AddNumberToObject(h, "row0", row0);
+        cJSON_AddNumberToObject(h, "row1", row1);
+        cJSON_AddNumberToObject(h, "batch0", b0);
+        cJSON_AddNumberToObject(h, "batch1", b1);
+        cJSON_AddNumberToObject(h, "passes", s->passes);
+        cJSON_AddNumberToObject(h, "probe", s->probe);
+        cJSON_AddNumberToObject(h, "probe_levels", s->probe_levels);
+        cJSON_AddNumberToObject(h, "probe_w", s->probe_w);
+        cJSON_AddNumberToObject(h, "probe_h", s->probe_h);
+        cJSON_AddNumberToObject(h, "probe_stride", s->probe_stride);
+        cJSON_AddNumberToObject(h, "probe_off", s->probe_off);
+        cJSON_AddNumberToObject(h, "probe_passes", s->probe_passes);
+        cJSON_AddNumberToObject(h, "probe_row0", py0);
+        cJSON_AddNumberToObject(h, "probe_row1", py1);
+        cJSON_AddNumberToObject(h, "probe_s", s->probe_s);
+        cJSON_AddNumberToObject(h, "beam_cell_m", s->beam_cell_m);
+        cJSON_AddNumberToObject(h, "beam_prims", (double)s->beam_prims);
+        cJSON_AddNumberToObject(h, "beam_build_s", s->beam_build_s);
+        cJSON_AddNumberToObject(h, "march_s", s->march_s);
+        cJSON_AddNumberToObject(h, "queries", (double)s->queries);
+        cJSON_AddNumberToObject(h, "shadows", (double)s->shadows);
+        cJSON_AddNumberToObject(h, "overflows", (double)s->overflows);
+        cJSON *pv = cJSON_AddObjectToObject(h, "provenance");
+        if (pv) {
+            cJSON_AddStringToObject(pv, "host", host);
+            cJSON_AddNumberToObject(pv, "pid", (double)getpid());
+            cJSON_AddStringToObject(pv, "date", date);
+            cJSON_AddNumberToObject(pv, "wall_s", res->wall_s);
+            const gr_meta_item *th = gr_meta_get(&res->meta, "godrays:threads");
+            cJSON_AddNumberToObject(pv, "threads", th ? th->num : scene->reference.threads);
+            cJSON_AddStringToObject(pv, "version", GR_VERSION);
+            cJSON_AddStringToObject(pv, "command", command ? command : "");
+        }
+        cJSON_AddNumberToObject(h, "payload_bytes", (double)pay.n);
+        cJSON_AddStringToObject(h, "payload_fnv1a64", fnv);
+        htxt = cJSON_PrintUnformatted(h);
+        cJSON_Delete(h);
+        if (!htxt) st = gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
+    } else if (st == GR_OK) {
+        st = gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
+    }
+    free(scene_json);
+    if (st == GR_OK) {
+        size_t tl = strlen(path) + 32;
+        char *tmp = malloc(tl);
+        FILE *f = NULL;
+        if (tmp) {
+            snprintf(tmp, tl, "%s.tmp-%ld", path, (long)getpid());
+            f = fopen(tmp, "wb");
+        }
+        if (!f) {
+            st = gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, tmp ? strerror(errno) : "out of memory");
+        } else {
+            int ok = fprintf(f, "%s%zu\n", PART_MAGIC, strlen(htxt)) > 0;
+            ok = ok && fwrite(htxt, 1, strlen(htxt), f) == strlen(htxt);
+            ok = ok && (pay.n == 0 || fwrite(pay.p, 1, pay.n, f) == pay.n);
+            ok = ok && fflush(f) == 0 && fsync(fileno(f)) == 0;
+            ok = (fclose(f) == 0) && ok;
+            if (!ok) st = gr_fail(err, GR_E_IO, "%s: write failed: %s", tmp, strerror(errno));
+            else if (rename(tmp, path) != 0) st = gr_fail(err, GR_E_IO, "%s: cannot rename into place: %s", path, strerror(errno));
+            if (st != GR_OK) remove(tmp);
+        }
+        free(tmp);
+    }
+    cJSON_free(htxt);
+    free(pay.p);
+    return st;
+}
+
+/* ---- reading ---- */
+
+typedef struct part {
+    const char *path;
+    cJSON *h;
+    unsigned char *data; /* the whole file */
+    const unsigned char *pay;
+    size_t pay_n;
+    int W, H, B, row0, row1, b0, b1, passes, probe, plevels, pw, ph, pstride, poff, ppasses, py0, py1;
+} part;
+
+static double num(const cJSON *h, const char *k, int *ok)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(h, k);
+    if (!cJSON_IsNumber(v)) { *ok = 0; return 0.0; }
+    return v->valuedouble;
+}
+
+static const char *str(const cJSON *h, const char *k)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(h, k);
+    return cJSON_IsString(v) ? v->valuestring : NULL;
+}
+
+static void part_free(part *p)
+{
+    cJSON_Delete(p->h);
+    free(p->data);
+    memset(p, 0, sizeof *p);
+}
+
+/* Reads and checks one part file (header fields, payload length and checksum). */
+static gr_status part_read(const char *path, part *p, gr_error *err)
+{
+    memset(p, 0, sizeof *p);
+    p->path = path;
+    FILE *f = fopen(path, "rb");
+    if (!f) return gr_fail(err, GR_E_INPUT, "%s: cannot open: %s", path, strerror(errno));
+    char line[64];
+    size_t hn = 0;
+    if (!fgets(line, sizeof line, f) || strcmp(line, PART_MAGIC) != 0) {
+        fclose(f);
+        return gr_fail(err, GR_E_INPUT, "%s: not a godrays part file (no \"GODRAYS-PART 1\" line)", path);
+    }
+    if (!fgets(line, sizeof line, f) || sscanf(line, "%zu", &hn) != 1 || hn == 0 || hn > ((size_t)1 << 30)) {
+        fclose(f);
+        return gr_fail(err, GR_E_INPUT, "%s: bad header length", path);
+    }
+    long start = ftell(f);
+    fseek(f, 0, SEEK_END);
+    long end = ftell(f);
+    fseek(f, start, SEEK_SET);
+    size_t total = end > start ? (size_t)(end - start) : 0;
+    if (total < hn) {
+        fclose(f);
+        return gr_fail(err, GR_E_INPUT, "%s: truncated header", path);
+    }
+    size_t want = total;
+    p->data = malloc(want + 1);
+    if (!p->data) {
+        fclose(f);
+        return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
+    }
+    size_t got = fread(p->data, 1, want, f);
+    fclose(f);
+    if (got != want) {
+        part_free(p);
+        return gr_fail(err, GR_E_INPUT, "%s: short read", path);
+    }
+    char save = (char)p->data[hn];
+    p->data[hn] = '\0';
+    p->h = cJSON_Parse((const char *)p->data);
+    p->data[hn] = (unsigned char)save;
+    if (!p->h) {
+        part_free(p);
+        return gr_fail(err, GR_E_INPUT, "%s: header is not JSON", path);
+    }
+    const char *fmt = str(p->h, "format");
+    if (!fmt || strcmp(fmt, GR_PART_FORMAT) != 0) {
+        part_free(p);
+        return gr_fail(err, GR_E_INPUT, "%s: format is not %s", path, GR_PART_FORMAT);
+    }
+    int ok = 1;
+    p->W = (int)num(p->h, "width", &ok);
+    p->H = (int)num(p->h, "height", &ok);
+    p->B = (int)num(p->h, "batches", &ok);
+    p->row0 = (int)num(p->h, "row0", &ok);
+    p->row1 = (int)num(p->h, "row1", &ok);
+    p->b0 = (int)num(p->h, "batch0", &ok);
+    p->b1 = (int)num(p->h, "batch1", &ok);
+    p->passes = (int)num(p->h, "passes", &ok);
+    p->probe = (int)num(p->h, "probe", &ok);
+    p->plevels = (int)num(p->h, "probe_levels", &ok);
+    p->pw = (int)num(p->h, "probe_w", &ok);
+    p->ph = (int)num(p->h, "probe_h", &ok);
+    p->pstride = (int)num(p->h, "probe_stride", &ok);
+    p->poff = (int)num(p->h, "probe_off", &ok);
+    p->ppasses = (int)num(p->h, "probe_passes", &ok);
+    p->py0 = (int)num(p->h, "probe_row0", &ok);
+    p->py1 = (int)num(p->h, "probe_row1", &ok);
+    double pn = num(p->h, "payload_bytes", &ok);
+    const char *fnv = str(p->h, "payload_fnv1a64");
+    if (!ok || !fnv || !str(p->h, "cache_key") || !str(p->h, "scene") || p->W < 1 || p->H < 1 || p->B < 2 ||
+        p->row0 < 0 || p->row1 > p->H || p->row0 >= p->row1 || p->b0 < 0 || p->b1 > p->B || p->b0 >= p->b1 ||
+        (p->probe && (p->plevels < 1 || p->plevels > GR_REF_PROBE_MAX_LEVELS || p->pw < 1 || p->ph < 1 || p->py0 < 0 ||
+                      p->py1 > p->ph || p->py0 > p->py1))) {
+        part_free(p);
+        return gr_fail(err, GR_E_INPUT, "%s: header fields missing or out of range", path);
+    }
+    size_t npix = (size_t)(p->row1 - p->row0) * p->W * (p->b1 - p->b0);
+    size_t expect = npix * (3 * sizeof(double) + sizeof(uint32_t));
+    if (p->probe) expect += (size_t)p->plevels * (size_t)(p->py1 - p->py0) * p->pw * (3 * sizeof(double) + sizeof(uint32_t));
+    if ((double)expect != pn || total - hn != expect) {
+        part_free(p);
+        return gr_fail(err, GR_E_INPUT, "%s: payload is %zu bytes, the header says %.0f (expected %zu): truncated or damaged",
+                       path, total - hn, pn, expect);
+    }
+    p->pay_n = expect;
+    p->pay = p->data + hn;
+    char h[20];
+    snprintf(h, sizeof h, "%016llx", gr_fnv1a64(GR_FNV_BASIS, p->pay, p->pay_n));
+    if (strcmp(h, fnv) != 0) {
+        part_free(p);
+        return gr_fail(err, GR_E_INPUT, "%s: payload checksum %s, the header says %s: damaged", path, h, fnv);
+    }
+    return GR_OK;
+}
+
+gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_ref_result *out, char *key,
+                         size_t key_n, gr_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (n < 1) return gr_fail(err, GR_E_USAGE, "merge: no parts given");
+    part *ps = calloc((size_t)n, sizeof *ps);
+    if (!ps) return gr_fail(err, GR_E_NOMEM, "merge: out of memory");
+    gr_status st = GR_OK;
+    int *owner = NULL;
+    gr_ref_sums *sums = NULL;
+    gr_ref_renderer *r = NULL;
+    for (int i = 0; i < n && st == GR_OK; i++) st = part_read(paths[i], &ps[i], err);
+    /* one scene, one set of settings, one image size (the cache key covers the scene's
+     * content and every reference setting but threads) */
+    const part *p0 = &ps[0];
+    for (int i = 1; i < n && st == GR_OK; i++) {
+        const part *p = &ps[i];
+        if (strcmp(str(p->h, "cache_key"), str(p0->h, "cache_key")) != 0)
+            st = gr_fail(err, GR_E_INPUT, "%s: another scene or settings than %s (cache key %s, not %s)", p->path,
+                         p0->path, str(p->h, "cache_key"), str(p0->h, "cache_key"));
+        else if (p->W != p0->W || p->H != p0->H || p->B != p0->B)
+            st = gr_fail(err, GR_E_INPUT, "%s: %dx%d with %d batches, %s is %dx%d with %d", p->path, p->W, p->H, p->B,
+                         p0->path, p0->W, p0->H, p0->B);
+    }
+    int W = p0->W, H = p0->H, B = p0->B;
+    /* coverage: every (row, batch) once */
+    if (st == GR_OK && !(owner = malloc((size_t)H * B * sizeof *owner))) st = gr_fail(err, GR_E_NOMEM, "merge: out of memory");
+    if (st == GR_OK) {
+        for (size_t k = 0; k < (size_t)H * B; k++) owner[k] = -1;
+        for (int i = 0; i < n && st == GR_OK; i++)
+            for (int y = ps[i].row0; y < ps[i].row1 && st == GR_OK; y++)
+                for (int b = ps[i].b0; b < ps[i].b1; b++) {
+                    int o = owner[(size_t)y * B + b];
+                    if (o >= 0) {
+                        st = gr_fail(err, GR_E_INPUT,
+                                     "%s: row %d, batch %d is also in %s (a duplicated or overlapping part)",
+                                     ps[i].path, y, b, ps[o].path);
+                        break;
+                    }
+                    owner[(size_t)y * B + b] = i;
+                }
+        for (int y = 0; y < H && st == GR_OK; y++)
+            for (int b = 0; b < B; b++)
+                if (owner[(size_t)y * B + b] < 0) {
+                    int y1 = y;
+                    while (y1 + 1 < H && owner[(size_t)(y1 + 1) * B + b] < 0) y1++;
+                    st = gr_fail(err, GR_E_INPUT, "merge: missing part: rows %d-%d of batch %d (of %dx%d, %d batches)", y,
+                                 y1, b, W, H, B);
+                    break;
+                }
+    }
+    /* the probe: the parts that hold batch 0 carry it, for their rows */
+    int probe = 0, pw = 0, ph = 0, plevels = 0;
+    for (int i = 0; i < n && st == GR_OK; i++)
+        if (ps[i].probe) {
+            if (!probe) {
+                probe = 1;
+                pw = ps[i].pw;
+                ph = ps[i].ph;
+                plevels = ps[i].plevels;
+            } else if (ps[i].pw != pw || ps[i].ph != ph || ps[i].plevels != plevels) {
+                st = gr_fail(err, GR_E_INPUT, "%s: probe grid %dx%d, other parts %dx%d", ps[i].path, ps[i].pw, ps[i].ph, pw, ph);
+            }
+        }
+    for (int i = 0; i < n && st == GR_OK && probe; i++)
+        if (ps[i].b0 == 0 && !ps[i].probe)
+            st = gr_fail(err, GR_E_INPUT, "%s: holds batch 0 but no surface-bias probe, other parts do", ps[i].path);
+    if (st == GR_OK && !(sums = gr_ref_sums_create(W, H, B, probe ? plevels : 0, probe ? pw : 0, probe ? ph : 0)))
+        st = gr_fail(err, GR_E_NOMEM, "merge: out of memory for %dx%d pixels x %d batches", W, H, B);
+    double wall = 0.0;
+    if (st == GR_OK) {
+        int ok = 1;
+        for (int i = 0; i < n; i++) {
+            const part *p = &ps[i];
+            const unsigned char *q = p->pay;
+            size_t nb = (size_t)(p->b1 - p->b0);
+            for (int y = p->row0; y < p->row1; y++)
+                for (int x = 0; x < W; x++) {
+                    size_t px = (size_t)y * W + x;
+                    memcpy(sums->sum + (px * B + p->b0) * 3, q, nb * 3 * sizeof(double));
+                    q += nb * 3 * sizeof(double);
+                }
+            for (int y = p->row0; y < p->row1; y++)
+                for (int x = 0; x < W; x++) {
+                    size_t px = (size_t)y * W + x;
+                    memcpy(sums->count + px * B + p->b0, q, nb * sizeof(uint32_t));
+                    q += nb * sizeof(uint32_t);
+                }
+            if (p->probe) {
+                size_t a = (size_t)p->py0 * pw, e = (size_t)p->py1 * pw;
+                for (int k = 0; k < p->plevels; k++) {
+                    memcpy(sums->probe_sum[k] + a * 3, q, (e - a) * 3 * sizeof(double));
+                    q += (e - a) * 3 * sizeof(double);
+                    memcpy(sums->probe_count[k] + a, q, (e - a) * sizeof(uint32_t));
+                    q += (e - a) * sizeof(uint32_t);
+                }
+                sums->probe = 1;
+                sums->probe_stride = p->pstride;
+                sums->probe_off = p->poff;
+                sums->probe_passes = p->ppasses;
+                sums->probe_s += num(p->h, "probe_s", &ok);
+            }
+            /* passes: every batch's passes, counted once per batch (tile 0 of each batch range) */
+            if (p->row0 == 0) sums->passes += p->passes;
+            if (p->b1 == B && p->row0 == 0) { /* the main passes' last beam set: the last batch's */
+                sums->beam_cell_m = num(p->h, "beam_cell_m", &ok);
+                sums->beam_prims = (long long)num(p->h, "beam_prims", &ok);
+            }
+            sums->beam_build_s += num(p->h, "beam_build_s", &ok);
+            sums->march_s += num(p->h, "march_s", &ok);
+            sums->queries += (long long)num(p->h, "queries", &ok);
+            sums->shadows += (long long)num(p->h, "shadows", &ok);
+            sums->overflows += (long long)num(p->h, "overflows", &ok);
+            const cJSON *pv = cJSON_GetObjectItemCaseSensitive(p->h, "provenance");
+            if (pv) wall += num(pv, "wall_s", &ok);
+        }
+        (void)ok;
+        /* the probe pixels: every probe row must have come with some part */
+        if (probe) {
+            for (int y = 0; y < ph && st == GR_OK; y++) {
+                int have = 0;
+                for (int i = 0; i < n && !have; i++) have = ps[i].probe && y >= ps[i].py0 && y < ps[i].py1;
+                if (!have) st = gr_fail(err, GR_E_INPUT, "merge: surface-bias probe row %d is in no part", y);
+            }
+        }
+    }
+    /* the scene, as the parts rendered it; its key must be theirs */
+    if (st == GR_OK) {
+        st = gr_scene_load_string(str(p0->h, "scene"), p0->path, NULL, 0, scene, err);
+        if (st == GR_OK) {
+            const char *sp = str(p0->h, "scene_path");
+            snprintf(scene->source_path, sizeof scene->source_path, "%s", sp ? sp : "");
+        }
+    }
+    char k[GR_CACHE_KEY_LEN + 1] = "";
+    if (st == GR_OK) st = gr_cache_key(scene, k, err);
+    if (st == GR_OK && strcmp(k, str(p0->h, "cache_key")) != 0)
+        st = gr_fail(err, GR_E_INPUT, "%s: its scene reloads with cache key %s, not %s (another godrays version?)", p0->path,
+                     k, str(p0->h, "cache_key"));
+    if (st == GR_OK) {
+        gr_ref_options o;
+        gr_ref_options_default(&o);
+        o.progress = 0;
+        st = gr_ref_create(scene, &o, &r, err);
+    }
+    if (st == GR_OK) st = gr_ref_assemble(r, sums, wall, out, err);
+    if (st == GR_OK) {
+        gr_meta_set_int(&out->meta, "godrays:merged_parts", n);
+        gr_meta_set_string(&out->meta, "godrays:wall_s_note", "wall_s: the parts' wall times added up");
+        for (int i = 0; i < n && st == GR_OK; i++) {
+            const cJSON *pv = cJSON_GetObjectItemCaseSensitive(ps[i].h, "provenance");
+            int ok = 1;
+            const char *host = pv ? str(pv, "host") : NULL, *date = pv ? str(pv, "date") : NULL;
+            char mk[48], line[1024];
+            snprintf(mk, sizeof mk, "godrays:part.%d", i);
+            snprintf(line, sizeof line, "%s: rows [%d, %d) batches [%d, %d) host %s pid %.0f date %s wall_s %.3f threads %.0f",
+                     ps[i].path, ps[i].row0, ps[i].row1, ps[i].b0, ps[i].b1, host ? host : "?",
+                     pv ? num(pv, "pid", &ok) : 0.0, date ? date : "?", pv ? num(pv, "wall_s", &ok) : 0.0,
+                     pv ? num(pv, "threads", &ok) : 0.0);
+            if (gr_meta_set_string(&out->meta, mk, line) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "merge: out of memory");
+        }
+        if (st != GR_OK) gr_ref_result_free(out);
+        else if (key) snprintf(key, key_n, "%s", k);
+    }
+    gr_ref_destroy(r);
+    gr_ref_sums_destroy(sums);
+    free(owner);
+    for (int i = 0; i < n; i++) part_free(&ps[i]);
+    free(ps);
+    return st;
+}

@@ -1,0 +1,852 @@
+/* Seed 004's radial blur and seed 003's localized variant (radial_blur.h;
+ * docs/radial-blur.md for the derivations and decisions). */
+#include "realtime/radial_blur.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/optics.h"
+#include "gl/gl.h"
+#include "realtime/frame.h"
+#include "realtime/scenegl.h"
+#include "realtime/shaders.h"
+
+#define MAX_WAVE_GROUPS 16 /* u_waves[80] in radial_blur_light.frag.glsl */
+#define MAX_LIGHTS 256
+
+/* Seed 004's listing defaults (GLSL version). */
+#define SEED_SAMPLES 100
+#define SEED_DECAY 0.96815
+#define SEED_EXPOSURE 0.2
+#define SEED_DENSITY 0.926
+#define SEED_WEIGHT 0.58767
+#define SEED_SAMPLE_SCALE 0.4
+
+/* ---- settings tables -------------------------------------------------------------------- */
+
+#define NONE 0u
+#define LO_X GR_PF_MIN_EXCL
+#define HI_X GR_PF_MAX_EXCL
+#define RB(field) offsetof(gr_radial_blur_settings, field)
+
+static const char *const format_names[] = {"rgba16f", "rgba8", NULL};
+
+#define COMMON_PARAMS                                                                                            \
+    {.name = "samples", .type = GR_PT_INT, .offset = RB(samples), .min = 1, .max = 1024, .def = SEED_SAMPLES,   \
+     .unit = "", .doc = "NUM_SAMPLES: taps marched toward the light (seed 004 / GPU Gems 3 ch. 13)"},            \
+    {.name = "decay", .type = GR_PT_DOUBLE, .offset = RB(decay), .min = 0, .max = 1, .flags = LO_X,            \
+     .def = SEED_DECAY, .unit = "", .doc = "per-tap decay: tap i weighs weight decay^(i-1)", .tune_lo = 0.85, .tune_hi = 0.999},                    \
+    {.name = "exposure", .type = GR_PT_DOUBLE, .offset = RB(exposure), .min = 0, .max = 1e6, .def = SEED_EXPOSURE, \
+     .unit = "", .doc = "final multiplier of the sum", .tune_lo = 0.02, .tune_hi = 2.0},                                                          \
+    {.name = "density", .type = GR_PT_DOUBLE, .offset = RB(density), .min = 0, .max = 2, .flags = LO_X,        \
+     .def = SEED_DENSITY, .unit = "", .doc = "fraction of the way to the light the N taps span", .tune_lo = 0.3, .tune_hi = 1.5},                \
+    {.name = "weight", .type = GR_PT_DOUBLE, .offset = RB(weight), .min = 0, .max = 1e6, .def = SEED_WEIGHT,    \
+     .unit = "", .doc = "weight of the marched taps (the centre tap has 1)", .tune_lo = 0.1, .tune_hi = 3.0},                                   \
+    {.name = "sample_scale", .type = GR_PT_DOUBLE, .offset = RB(sample_scale), .min = 0, .max = 1e6,           \
+     .def = SEED_SAMPLE_SCALE, .unit = "", .doc = "seed 004's '* 0.4' on every tap (GPU Gems 3 has 1)"},        \
+    {.name = "target_scale", .type = GR_PT_DOUBLE, .offset = RB(target_scale), .min = 0, .max = 1,             \
+     .flags = LO_X, .def = 0.5, .unit = "", .doc = "light pass target size / frame size, per axis", .tune_lo = 0.125, .tune_hi = 1.0},             \
+    {.name = "target_format", .type = GR_PT_ENUM, .offset = RB(target_format), .min = 0, .max = 1,             \
+     .def = GR_RB_RGBA16F, .enum_names = format_names, .unit = "",                                              \
+     .doc = "light pass storage (rgba8 bands; dither adds half-step noise before it)"},                         \
+    {.name = "light_radius_deg", .type = GR_PT_DOUBLE, .offset = RB(light_radius_deg), .min = 0, .max = 90,    \
+     .flags = LO_X, .def = 4.0, .unit = "deg",                                                                  \
+     .doc = "angular radius in air of the bright region around the sun (kernel (1-(a/a0)^2)^2)", .tune_lo = 0.5, .tune_hi = 20.0},               \
+    {.name = "threshold", .type = GR_PT_DOUBLE, .offset = RB(threshold), .min = 0, .max = 1, .flags = HI_X,    \
+     .def = 0, .unit = "", .doc = "subtracted from the light pass (1 = the flat-water peak)", .tune_lo = 0.0, .tune_hi = 0.5},                   \
+    {.name = "occluders", .type = GR_PT_BOOL, .offset = RB(occluders), .min = 0, .max = 1, .def = 1,           \
+     .unit = "", .doc = "draw occluders (and the seabed) black in the light pass"},                              \
+    {.name = "intensity", .type = GR_PT_RGB, .offset = RB(intensity), .min = 0, .max = 1e9, .def = 1,          \
+     .unit = "", .doc = "factor on the derived scale to the ground truth's units (1: exact at the sun, flat water)", \
+     .tune_lo = 0.05, .tune_hi = 20.0},                                                                           \
+    {.name = "dither", .type = GR_PT_BOOL, .offset = RB(dither), .min = 0, .max = 1, .def = 1, .unit = "",     \
+     .doc = "per-pixel jitter of the march start against banding (deterministic noise)"}
+
+static const gr_param blur_params[] = {
+    COMMON_PARAMS,
+    {.name = "fade_margin", .type = GR_PT_DOUBLE, .offset = RB(fade_margin), .min = 0, .max = 100, .def = 0.5,
+     .unit = "", .doc = "NDC beyond the screen edge over which the rays fade out (smoothstep)", .tune_lo = 0.1, .tune_hi = 3.0},
+};
+
+static const gr_param local_params[] = {
+    COMMON_PARAMS,
+    {.name = "lights", .type = GR_PT_INT, .offset = RB(lights), .min = 1, .max = MAX_LIGHTS, .def = 16, .unit = "",
+     .doc = "at most this many lights: the brightest cells of the light pass"},
+    {.name = "quad_size", .type = GR_PT_DOUBLE, .offset = RB(quad_size), .min = 0, .max = 4, .flags = LO_X,
+     .def = 0.3, .unit = "", .doc = "quad half-size as a fraction of the frame height", .tune_lo = 0.05, .tune_hi = 1.0},
+    {.name = "falloff", .type = GR_PT_DOUBLE, .offset = RB(falloff), .min = 0, .max = 16, .def = 2, .unit = "",
+     .doc = "(1 - r)^falloff to the quad's edge: 1 linear, 2 quadratic (seed 003)", .tune_lo = 0.5, .tune_hi = 4.0},
+    {.name = "cell_size", .type = GR_PT_DOUBLE, .offset = RB(cell_size), .min = 0, .max = 1, .flags = LO_X,
+     .def = 0.05, .unit = "", .doc = "light-selection cell side as a fraction of the frame height",
+     .tune_lo = 0.01, .tune_hi = 0.2},
+    {.name = "min_fraction", .type = GR_PT_DOUBLE, .offset = RB(min_fraction), .min = 0, .max = 1, .def = 0.02,
+     .unit = "", .doc = "cells dimmer than this fraction of the brightest one are no light"},
+    {.name = "normalize_overlap", .type = GR_PT_BOOL, .offset = RB(normalize_overlap), .min = 0, .max = 1,
+     .def = 1, .unit = "", .doc = "where quads overlap, divide by the summed falloff (if > 1)"},
+};
+#undef RB
+
+const gr_param_table gr_radial_blur_param_table = {"radial_blur", blur_params,
+                                                   sizeof blur_params / sizeof blur_params[0]};
+const gr_param_table gr_radial_blur_local_param_table = {"radial_blur_local", local_params,
+                                                         sizeof local_params / sizeof local_params[0]};
+
+/* ---- closed forms shared with the docs and tests ---------------------------------------- */
+
+double gr_radial_blur_gain(int samples, double decay, double weight)
+{
+    /* sum_{i=1..N} decay^(i-1) = (1 - decay^N) / (1 - decay) */
+    double geo = decay == 1.0 ? (double)samples : (1.0 - pow(decay, samples)) / (1.0 - decay);
+    return 1.0 + weight * geo;
+}
+
+double gr_radial_blur_fade(const double ndc[2], double clip_w, double margin)
+{
+    if (!(clip_w > 0)) return 0.0;
+    double e = fmax(fabs(ndc[0]), fabs(ndc[1]));
+    if (!(e > 1.0)) return 1.0;
+    if (!(margin > 0)) return 0.0;
+    double x = (e - 1.0) / margin;
+    if (x >= 1.0) return 0.0;
+    return 1.0 - x * x * (3.0 - 2.0 * x);
+}
+
+double gr_radial_blur_kernel_solid_angle(double a0)
+{
+    /* 2 pi int_0^a0 (1 - (a/a0)^2)^2 sin a da, Simpson with 512 intervals. */
+    const int n = 512;
+    double h = a0 / n, sum = 0.0;
+    for (int i = 0; i <= n; i++) {
+        double a = i * h, x = a / a0, k = (1.0 - x * x) * (1.0 - x * x) * sin(a);
+        sum += (i == 0 || i == n) ? k : (i % 2 ? 4.0 * k : 2.0 * k);
+    }
+    return 2.0 * GR_PI * sum * h / 3.0;
+}
+
+/* ---- class callbacks: check, resolve ------------------------------------------------------ */
+
+static gr_status rb_check(const gr_technique_class *cls, const void *settings, gr_error *err)
+{
+    const gr_radial_blur_settings *s = settings;
+    gr_status st = gr_param_validate(cls->params, settings, 1, err);
+    if (st != GR_OK) return st;
+    if (s->target_format != GR_RB_RGBA16F && s->target_format != GR_RB_RGBA8)
+        return gr_fail(err, GR_E_INPUT, "%s.target_format: invalid choice %d", cls->name, s->target_format);
+    return GR_OK;
+}
+
+/* Distance D from the eye to the flat surface along the refracted sun (m); <= 0 above it. */
+static double sun_path_m(const gr_scene *scene, const gr_frame *f)
+{
+    double depth = scene->water.rest_height_m - scene->camera.position_m[1];
+    return f->to_refr_sun[1] > 0 ? depth / f->to_refr_sun[1] : 0.0;
+}
+
+/* The scale k_c that puts the layer in the ground truth's units: looking straight at the
+ * refracted sun through flat water, with seed 004's defaults, the layer equals the single-
+ * scattering closed form sigma_s p_HG(0) T E D exp(-sigma_t D) (docs, "Units"):
+ * k_c = sigma_s,c p_HG(0; g) D Omega_eff / (n^2 0.2 0.4 G_seed). */
+static void units_scale(const gr_scene *scene, const gr_frame *f, double light_radius_deg, double k[3])
+{
+    double D = fmax(sun_path_m(scene, f), 0.0);
+    double omega = gr_radial_blur_kernel_solid_angle(light_radius_deg * GR_PI / 180.0);
+    double g_seed = gr_radial_blur_gain(SEED_SAMPLES, SEED_DECAY, SEED_WEIGHT);
+    double n = scene->medium.ior;
+    for (int c = 0; c < 3; c++)
+        k[c] = scene->medium.scattering[c] * gr_hg_phase(1.0, scene->medium.g) * D * omega /
+               (n * n * SEED_EXPOSURE * SEED_SAMPLE_SCALE * g_seed);
+}
+
+/* ---- state ------------------------------------------------------------------------------- */
+
+enum { PASS_DEPTH = 0, PASS_LIGHT = 1, PASS_BLUR = 2, PASS_RESOLVE = 3 };
+
+typedef struct rb_state {
+    gr_gl *gl;
+    int local;
+    char *shader_dir;
+    gr_scenegl *sg;
+    GLuint prog_light, prog_blur, prog_local, prog_resolve;
+    struct {
+        GLint inv_vp_rot, depth, wave_groups, waves, ior, to_sun, a0, extinction, t_flat, threshold, occluders,
+            eye_depth, dither8;
+    } ll;
+    struct {
+        GLint light, sun_uv, size, samples, density, decay, weight, scale, dither, falloff;
+    } lb, lq;
+    GLint loc_acc, loc_rscale, loc_normalize;
+    GLuint vao_empty, vao_quads, vbo_quads;
+    GLuint light_tex, light_fbo;
+    int light_w, light_h, light_fmt;
+    GLuint out_tex, out_fbo, acc_tex, acc_fbo; /* acc: radial_blur_local's quads, then resolved */
+    int out_w, out_h, acc_w, acc_h;
+    GLuint q_samples;
+    gr_gl_timer timer;
+    float *readback;
+    size_t readback_cap;
+    /* last render */
+    int rendered;
+    double sun_uv[2], fade;
+    int n_lights;
+    double light_uv[MAX_LIGHTS][2];
+} rb_state;
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static void get_blur_locs(GLuint p, GLint *light, GLint *sun_uv, GLint *size, GLint *samples, GLint *density,
+                          GLint *decay, GLint *weight, GLint *scale, GLint *dither, GLint *falloff)
+{
+    *light = glGetUniformLocation(p, "u_light");
+    *sun_uv = glGetUniformLocation(p, "u_sun_uv");
+    *size = glGetUniformLocation(p, "u_size");
+    *samples = glGetUniformLocation(p, "u_samples");
+    *density = glGetUniformLocation(p, "u_density");
+    *decay = glGetUniformLocation(p, "u_decay");
+    *weight = glGetUniformLocation(p, "u_weight");
+    *scale = glGetUniformLocation(p, "u_scale");
+    *dither = glGetUniformLocation(p, "u_dither");
+    *falloff = glGetUniformLocation(p, "u_falloff");
+}
+
+static void delete_tex_fbo(GLuint *tex, GLuint *fbo)
+{
+    if (*fbo) glDeleteFramebuffers(1, fbo);
+    if (*tex) glDeleteTextures(1, tex);
+    *fbo = *tex = 0;
+}
+
+static void rb_destroy(void *state)
+{
+    rb_state *r = state;
+    if (!r) return;
+    gr_scenegl_destroy(r->sg);
+    if (r->prog_light) glDeleteProgram(r->prog_light);
+    if (r->prog_blur) glDeleteProgram(r->prog_blur);
+    if (r->prog_local) glDeleteProgram(r->prog_local);
+    if (r->prog_resolve) glDeleteProgram(r->prog_resolve);
+    if (r->vao_empty) glDeleteVertexArrays(1, &r->vao_empty);
+    if (r->vao_quads) glDeleteVertexArrays(1, &r->vao_quads);
+    if (r->vbo_quads) glDeleteBuffers(1, &r->vbo_quads);
+    if (r->q_samples) glDeleteQueries(1, &r->q_samples);
+    if (r->timer.queries[0]) gr_gl_timer_free(&r->timer);
+    delete_tex_fbo(&r->light_tex, &r->light_fbo);
+    delete_tex_fbo(&r->out_tex, &r->out_fbo);
+    delete_tex_fbo(&r->acc_tex, &r->acc_fbo);
+    free(r->readback);
+    free(r->shader_dir);
+    free(r);
+}
+
+static gr_status rb_create(const gr_technique_class *cls, gr_gl *gl, const gr_technique_options *opts, void **state,
+                           gr_error *err)
+{
+    gr_status st;
+    const char *dir = opts ? opts->shader_dir : NULL;
+    *state = NULL;
+    if ((st = gr_shader_check_dir(dir, err)) != GR_OK) return st;
+    rb_state *r = calloc(1, sizeof *r);
+    if (!r) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", cls->name);
+    r->gl = gl;
+    r->local = !strcmp(cls->name, "radial_blur_local");
+    if (dir) {
+        size_t n = strlen(dir) + 1;
+        if (!(r->shader_dir = malloc(n))) {
+            free(r);
+            return gr_fail(err, GR_E_NOMEM, "%s: out of memory", cls->name);
+        }
+        memcpy(r->shader_dir, dir, n);
+    }
+    if ((st = gr_scenegl_create_dir(gl, dir, &r->sg, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program(dir, "radial_blur_screen.vert.glsl", "radial_blur_light.frag.glsl", NULL, 0,
+                                &r->prog_light, NULL, err)) != GR_OK)
+        goto fail;
+    if ((st = gr_shader_program(dir, "radial_blur_screen.vert.glsl", "radial_blur.frag.glsl", NULL, 0, &r->prog_blur,
+                                NULL, err)) != GR_OK)
+        goto fail;
+    if (r->local) {
+        if ((st = gr_shader_program(dir, "radial_blur_local.vert.glsl", "radial_blur_local.frag.glsl", NULL, 0,
+                                    &r->prog_local, NULL, err)) != GR_OK)
+            goto fail;
+        if ((st = gr_shader_program(dir, "radial_blur_screen.vert.glsl", "radial_blur_resolve.frag.glsl", NULL, 0,
+                                    &r->prog_resolve, NULL, err)) != GR_OK)
+            goto fail;
+        get_blur_locs(r->prog_local, &r->lq.light, &r->lq.sun_uv, &r->lq.size, &r->lq.samples, &r->lq.density,
+                      &r->lq.decay, &r->lq.weight, &r->lq.scale, &r->lq.dither, &r->lq.falloff);
+        r->loc_acc = glGetUniformLocation(r->prog_resolve, "u_acc");
+        r->loc_rscale = glGetUniformLocation(r->prog_resolve, "u_scale");
+        r->loc_normalize = glGetUniformLocation(r->prog_resolve, "u_normalize");
+    }
+    GLuint p = r->prog_light;
+    r->ll.inv_vp_rot = glGetUniformLocation(p, "u_inv_vp_rot");
+    r->ll.depth = glGetUniformLocation(p, "u_depth");
+    r->ll.wave_groups = glGetUniformLocation(p, "u_wave_groups");
+    r->ll.waves = glGetUniformLocation(p, "u_waves");
+    r->ll.ior = glGetUniformLocation(p, "u_ior");
+    r->ll.to_sun = glGetUniformLocation(p, "u_to_sun");
+    r->ll.a0 = glGetUniformLocation(p, "u_a0");
+    r->ll.extinction = glGetUniformLocation(p, "u_extinction");
+    r->ll.t_flat = glGetUniformLocation(p, "u_t_flat");
+    r->ll.threshold = glGetUniformLocation(p, "u_threshold");
+    r->ll.occluders = glGetUniformLocation(p, "u_occluders");
+    r->ll.eye_depth = glGetUniformLocation(p, "u_eye_depth");
+    r->ll.dither8 = glGetUniformLocation(p, "u_dither8");
+    get_blur_locs(r->prog_blur, &r->lb.light, &r->lb.sun_uv, &r->lb.size, &r->lb.samples, &r->lb.density,
+                  &r->lb.decay, &r->lb.weight, &r->lb.scale, &r->lb.dither, &r->lb.falloff);
+    glGenVertexArrays(1, &r->vao_empty);
+    glGenVertexArrays(1, &r->vao_quads);
+    glGenBuffers(1, &r->vbo_quads);
+    glBindVertexArray(r->vao_quads);
+    glBindBuffer(GL_ARRAY_BUFFER, r->vbo_quads);
+    GLsizei stride = (GLsizei)(6 * sizeof(float));
+    for (GLuint a = 0; a < 3; a++) {
+        glEnableVertexAttribArray(a);
+        glVertexAttribPointer(a, 2, GL_FLOAT, GL_FALSE, stride, (const void *)(a * 2 * sizeof(float)));
+    }
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glGenQueries(1, &r->q_samples);
+    gr_gl_timer_init(&r->timer);
+    if ((st = gr_gl_check("radial blur setup", err)) != GR_OK) goto fail;
+    *state = r;
+    return GR_OK;
+fail:
+    rb_destroy(r);
+    return st;
+}
+
+static gr_status make_color_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h, GLint filter, int border,
+                                   const char *what, gr_error *err)
+{
+    delete_tex_fbo(tex, fbo);
+    glGenTextures(1, tex);
+    glBindTexture(GL_TEXTURE_2D, *tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, ifmt, w, h);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    /* The light pass reads black outside the screen: taps that leave it add nothing (an
+     * edge clamp would smear the border texels into streaks). */
+    static const float black[4] = {0, 0, 0, 0};
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, border ? GL_CLAMP_TO_BORDER : GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, border ? GL_CLAMP_TO_BORDER : GL_CLAMP_TO_EDGE);
+    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, black);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
+    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (fs != GL_FRAMEBUFFER_COMPLETE)
+        return gr_fail(err, GR_E_GL, "%s (%dx%d): framebuffer incomplete (0x%04x)", what, w, h, (unsigned)fs);
+    return gr_gl_check(what, err);
+}
+
+static gr_status ensure_light(rb_state *r, int w, int h, int fmt, const char *name, gr_error *err)
+{
+    if (r->light_tex && r->light_w == w && r->light_h == h && r->light_fmt == fmt) return GR_OK;
+    char what[96];
+    snprintf(what, sizeof what, "%s.target_scale: light pass target", name);
+    r->light_w = 0;
+    gr_status st = make_color_target(&r->light_tex, &r->light_fbo,
+                                     fmt == GR_RB_RGBA8 ? GL_RGBA8 : fmt == GR_RB_RGBA16F ? GL_RGBA16F : GL_RGBA32F, w,
+                                     h, GL_LINEAR, 1, what, err);
+    if (st != GR_OK) return st;
+    r->light_w = w;
+    r->light_h = h;
+    r->light_fmt = fmt;
+    return GR_OK;
+}
+
+static gr_status ensure_out(rb_state *r, int w, int h, gr_error *err)
+{
+    if (r->out_tex && r->out_w == w && r->out_h == h) return GR_OK;
+    r->out_w = 0;
+    gr_status st = make_color_target(&r->out_tex, &r->out_fbo, GL_RGBA32F, w, h, GL_NEAREST, 0,
+                                     "camera.width/height: god-ray layer target", err);
+    if (st != GR_OK) return st;
+    r->out_w = w;
+    r->out_h = h;
+    return GR_OK;
+}
+
+static void set_blur_uniforms(GLuint prog, GLint light, GLint size, GLint samples, GLint density, GLint decay,
+                              GLint weight, GLint dither, const gr_radial_blur_settings *s, int w, int h)
+{
+    glUseProgram(prog);
+    glUniform1i(light, 0);
+    glUniform2f(size, (float)w, (float)h);
+    glUniform1i(samples, s->samples);
+    glUniform1f(density, (float)s->density);
+    glUniform1f(decay, (float)s->decay);
+    glUniform1f(weight, (float)s->weight);
+    glUniform1i(dither, s->dither);
+}
+
+/* Runs the full-screen blur from r->light_tex into r->out_fbo (w x h). */
+static void blur_pass(rb_state *r, const gr_radial_blur_settings *s, const double sun_uv[2], const double scale[3],
+                      int w, int h)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    glViewport(0, 0, w, h);
+    glDisable(GL_BLEND);
+    set_blur_uniforms(r->prog_blur, r->lb.light, r->lb.size, r->lb.samples, r->lb.density, r->lb.decay, r->lb.weight,
+                      r->lb.dither, s, w, h);
+    glUniform2f(r->lb.sun_uv, (float)sun_uv[0], (float)sun_uv[1]);
+    glUniform3f(r->lb.scale, (float)scale[0], (float)scale[1], (float)scale[2]);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r->light_tex);
+    glBindVertexArray(r->vao_empty);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+/* Reads r->out_fbo (w x h) into out's R, G, B (top row first). */
+static gr_status read_out(rb_state *r, int w, int h, gr_image *out, const char *what, gr_error *err)
+{
+    int ch[3] = {gr_image_channel(out, "R"), gr_image_channel(out, "G"), gr_image_channel(out, "B")};
+    size_t need = (size_t)w * (size_t)h * 4;
+    if (need > r->readback_cap) {
+        float *nb = realloc(r->readback, need * sizeof *nb);
+        if (!nb) return gr_fail(err, GR_E_NOMEM, "%s: out of memory for the readback", what);
+        r->readback = nb;
+        r->readback_cap = need;
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, r->readback);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    for (int y = 0; y < h; y++) {
+        const float *src = r->readback + (size_t)(h - 1 - y) * (size_t)w * 4;
+        for (int x = 0; x < w; x++) {
+            float *px = gr_image_pixel(out, x, y);
+            for (int c = 0; c < 3; c++) {
+                float v = src[(size_t)x * 4 + (size_t)c];
+                px[ch[c]] = isfinite(v) ? v : 0.0f; /* never NaN/Inf (counted as a failure below) */
+            }
+        }
+    }
+    return gr_gl_check(what, err);
+}
+
+/* ---- light selection (radial_blur_local) -------------------------------------------------- */
+
+typedef struct cell { double sum; int idx; } cell;
+
+static int cell_cmp(const void *a, const void *b)
+{
+    const cell *x = a, *y = b;
+    if (x->sum != y->sum) return x->sum < y->sum ? 1 : -1; /* brightest first */
+    return x->idx - y->idx;                                /* ties: deterministic */
+}
+
+/* The brightest cells of the light pass (luminance sums), each suppressing its 8 neighbours,
+ * at most s->lights, each placed at its cell's luminance-weighted centroid (docs, "Lights"). */
+static gr_status select_lights(rb_state *r, const gr_radial_blur_settings *s, gr_error *err)
+{
+    int w = r->light_w, h = r->light_h;
+    /* cells relative to the frame, so the lights (and their overlap) do not grow in number
+     * with the resolution */
+    int cp = (int)lround(s->cell_size * h);
+    if (cp < 1) cp = 1;
+    int cw = (w + cp - 1) / cp, chh = (h + cp - 1) / cp;
+    size_t need = (size_t)w * h * 4;
+    if (need > r->readback_cap) {
+        float *nb = realloc(r->readback, need * sizeof *nb);
+        if (!nb) return gr_fail(err, GR_E_NOMEM, "radial_blur_local: out of memory for the light readback");
+        r->readback = nb;
+        r->readback_cap = need;
+    }
+    cell *cells = malloc((size_t)cw * chh * sizeof *cells);
+    double *cx = calloc((size_t)cw * chh * 2, sizeof *cx);
+    unsigned char *taken = calloc((size_t)cw * chh, 1);
+    if (!cells || !cx || !taken) {
+        free(cells);
+        free(cx);
+        free(taken);
+        return gr_fail(err, GR_E_NOMEM, "radial_blur_local: out of memory for the light cells");
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, r->light_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, r->readback);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    for (int i = 0; i < cw * chh; i++) {
+        cells[i].sum = 0.0;
+        cells[i].idx = i;
+    }
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float *p = r->readback + ((size_t)y * w + x) * 4;
+            double lum = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+            if (!(lum > 0)) continue;
+            int c = (y / cp) * cw + x / cp;
+            cells[c].sum += lum;
+            cx[2 * c] += lum * (x + 0.5);
+            cx[2 * c + 1] += lum * (y + 0.5);
+        }
+    /* centroids before sorting (cx is indexed by cell) */
+    qsort(cells, (size_t)cw * chh, sizeof *cells, cell_cmp);
+    double top = cells[0].sum;
+    r->n_lights = 0;
+    for (int k = 0; k < cw * chh && r->n_lights < s->lights; k++) {
+        const cell *c = &cells[k];
+        if (!(c->sum > 0) || c->sum < s->min_fraction * top) break;
+        if (taken[c->idx]) continue;
+        int ix = c->idx % cw, iy = c->idx / cw;
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+                int x = ix + dx, y = iy + dy;
+                if (x >= 0 && x < cw && y >= 0 && y < chh) taken[y * cw + x] = 1;
+            }
+        r->light_uv[r->n_lights][0] = cx[2 * c->idx] / c->sum / w;
+        r->light_uv[r->n_lights][1] = cx[2 * c->idx + 1] / c->sum / h;
+        r->n_lights++;
+    }
+    free(cells);
+    free(cx);
+    free(taken);
+    return gr_gl_check("radial_blur_local: light selection", err);
+}
+
+/* ---- render ---------------------------------------------------------------------------------- */
+
+static gr_status rb_render(void *state, const gr_scene *scene, const void *settings, gr_image *out,
+                           gr_technique_stats *stats, gr_error *err)
+{
+    rb_state *r = state;
+    const gr_radial_blur_settings *s = settings;
+    const char *name = r->local ? "radial_blur_local" : "radial_blur";
+    double t0 = now_ms();
+    gr_status st;
+    gr_frame f;
+    gr_frame_init(scene, &f);
+    int W = f.width, H = f.height;
+    int ch[3] = {gr_image_channel(out, "R"), gr_image_channel(out, "G"), gr_image_channel(out, "B")};
+    if (out->width != W || out->height != H || ch[0] < 0 || ch[1] < 0 || ch[2] < 0)
+        return gr_fail(err, GR_E_INPUT, "%s: output image is %dx%d (needs %dx%d with R, G, B channels)", name,
+                       out->width, out->height, W, H);
+    double depth = scene->water.rest_height_m - f.eye[1];
+    if (!(depth > 0))
+        return gr_fail(err, GR_E_INPUT,
+                       "camera.position_m: y = %g is not below the water surface (y = %g); %s needs an underwater viewer",
+                       f.eye[1], scene->water.rest_height_m, name);
+    if (scene->water.n_waves > MAX_WAVE_GROUPS * 4)
+        return gr_fail(err, GR_E_INPUT, "water.waves: %d waves, %s takes at most %d", scene->water.n_waves, name,
+                       MAX_WAVE_GROUPS * 4);
+    int tw = (int)lround(W * s->target_scale), th = (int)lround(H * s->target_scale);
+    if (tw < 1) tw = 1;
+    if (th < 1) th = 1;
+    if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) return st;
+    if ((st = ensure_light(r, tw, th, s->target_format, name, err)) != GR_OK) return st;
+    if ((st = ensure_out(r, W, H, err)) != GR_OK) return st;
+    if (r->local && !(r->acc_tex && r->acc_w == W && r->acc_h == H)) {
+        r->acc_w = 0;
+        if ((st = make_color_target(&r->acc_tex, &r->acc_fbo, GL_RGBA32F, W, H, GL_NEAREST, 0,
+                                    "camera.width/height: radial_blur_local accumulator", err)) != GR_OK)
+            return st;
+        r->acc_w = W;
+        r->acc_h = H;
+    }
+
+    /* Waves in the seed's packing with wt folded to the eye (phase at eye-relative x0, z0). */
+    float waves[MAX_WAVE_GROUPS * 5 * 4];
+    memset(waves, 0, sizeof waves);
+    int groups = f.n_wave_groups;
+    for (int i = 0; i < scene->water.n_waves; i++) {
+        const gr_wave *wv = &scene->water.waves[i];
+        int g = i / 4, lane = i % 4;
+        double kx = wv->k * wv->dir[0], kz = wv->k * wv->dir[1];
+        double c = fmod(wv->omega_rad_s * f.time_s - wv->phase_rad - kx * f.eye[0] - kz * f.eye[2], 2.0 * GR_PI);
+        float *b = waves + (size_t)g * 20;
+        b[0 * 4 + lane] = f.waves_seed[g * 5 + 0][lane];
+        b[1 * 4 + lane] = f.waves_seed[g * 5 + 1][lane];
+        b[2 * 4 + lane] = f.waves_seed[g * 5 + 2][lane];
+        b[3 * 4 + lane] = f.waves_seed[g * 5 + 3][lane];
+        b[4 * 4 + lane] = (float)c;
+    }
+
+    double vp_rot[16], inv_rot[16];
+    float m[16];
+    gr_frame_view_proj_rot(&f, vp_rot);
+    if (gr_mat4_inverse(vp_rot, inv_rot) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection");
+
+    r->timer.used = 0;
+    r->timer.n = 0;
+    /* Pass 0: occluders' (and the seabed's) distance from the eye at the light target's size. */
+    unsigned depth_tex = 0;
+    gr_gl_timer_begin(&r->timer, PASS_DEPTH);
+    st = gr_scenegl_eye_depth(r->sg, scene, &f, tw, th, &depth_tex, err);
+    gr_gl_timer_end(&r->timer);
+    if (st != GR_OK) return st;
+
+    /* Pass 1: light pass into the reduced target. */
+    gr_gl_timer_begin(&r->timer, PASS_LIGHT);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->light_fbo);
+    glViewport(0, 0, tw, th);
+    glDisable(GL_BLEND);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_DITHER);
+    glUseProgram(r->prog_light);
+    gr_frame_matf(inv_rot, m);
+    glUniformMatrix4fv(r->ll.inv_vp_rot, 1, GL_FALSE, m);
+    glUniform1f(r->ll.depth, (float)depth);
+    glUniform1i(r->ll.wave_groups, groups);
+    glUniform4fv(r->ll.waves, MAX_WAVE_GROUPS * 5, waves);
+    glUniform1f(r->ll.ior, (float)f.ior);
+    glUniform3f(r->ll.to_sun, (float)f.to_sun[0], (float)f.to_sun[1], (float)f.to_sun[2]);
+    glUniform1f(r->ll.a0, (float)(s->light_radius_deg * GR_PI / 180.0));
+    glUniform3f(r->ll.extinction, (float)f.extinction[0], (float)f.extinction[1], (float)f.extinction[2]);
+    glUniform1f(r->ll.t_flat, (float)f.transmittance_flat);
+    glUniform1f(r->ll.threshold, (float)s->threshold);
+    glUniform1i(r->ll.occluders, s->occluders);
+    glUniform1i(r->ll.eye_depth, 1);
+    glUniform1i(r->ll.dither8, s->dither && s->target_format == GR_RB_RGBA8);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, depth_tex);
+    glActiveTexture(GL_TEXTURE0);
+    glBindVertexArray(r->vao_empty);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    gr_gl_timer_end(&r->timer);
+
+    /* Output scale: k * intensity * exposure * sample_scale * peak * fade, where peak = n^2 T_flat
+     * E / Omega_eff is the flat-water light-pass radiance at the sun (docs, "Units"). */
+    double omega = gr_radial_blur_kernel_solid_angle(s->light_radius_deg * GR_PI / 180.0);
+    double fade = r->local ? 1.0 : gr_radial_blur_fade(f.sun_ndc, f.sun_clip_w, s->fade_margin);
+    double scale[3], ku[3];
+    units_scale(scene, &f, s->light_radius_deg, ku);
+    for (int c = 0; c < 3; c++)
+        scale[c] = ku[c] * s->intensity[c] * s->exposure * s->sample_scale * f.ior * f.ior * f.transmittance_flat *
+                   f.sun_irradiance[c] / omega * fade;
+    r->sun_uv[0] = f.sun_uv[0];
+    r->sun_uv[1] = f.sun_uv[1];
+    r->fade = fade;
+
+    glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
+    if (!r->local) {
+        gr_gl_timer_begin(&r->timer, PASS_BLUR);
+        blur_pass(r, s, f.sun_uv, scale, W, H);
+        gr_gl_timer_end(&r->timer);
+    } else {
+        /* CPU light selection, then all quads in one draw into the float accumulator. */
+        if ((st = select_lights(r, s, err)) != GR_OK) {
+            glEndQuery(GL_SAMPLES_PASSED);
+            return st;
+        }
+        float *v = malloc((size_t)(r->n_lights > 0 ? r->n_lights : 1) * 6 * 6 * sizeof *v);
+        if (!v) {
+            glEndQuery(GL_SAMPLES_PASSED);
+            return gr_fail(err, GR_E_NOMEM, "radial_blur_local: out of memory for the quads");
+        }
+        static const float corners[6][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, -1}, {1, 1}, {-1, 1}};
+        float hx = (float)(s->quad_size * (double)H / (double)W), hy = (float)s->quad_size;
+        for (int l = 0; l < r->n_lights; l++)
+            for (int k = 0; k < 6; k++) {
+                float *p = v + ((size_t)l * 6 + (size_t)k) * 6;
+                p[0] = corners[k][0];
+                p[1] = corners[k][1];
+                p[2] = (float)r->light_uv[l][0];
+                p[3] = (float)r->light_uv[l][1];
+                p[4] = hx;
+                p[5] = hy;
+            }
+        glBindBuffer(GL_ARRAY_BUFFER, r->vbo_quads);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)((size_t)r->n_lights * 36 * sizeof *v), r->n_lights ? v : NULL,
+                     GL_STREAM_DRAW);
+        glBindBuffer(GL_ARRAY_BUFFER, 0);
+        free(v);
+        gr_gl_timer_begin(&r->timer, PASS_BLUR);
+        glBindFramebuffer(GL_FRAMEBUFFER, r->acc_fbo);
+        glViewport(0, 0, W, H);
+        glClearColor(0, 0, 0, 0);
+        glClear(GL_COLOR_BUFFER_BIT);
+        glEnable(GL_BLEND);
+        glBlendEquation(GL_FUNC_ADD);
+        glBlendFunc(GL_ONE, GL_ONE);
+        set_blur_uniforms(r->prog_local, r->lq.light, r->lq.size, r->lq.samples, r->lq.density, r->lq.decay,
+                          r->lq.weight, r->lq.dither, s, W, H);
+        glUniform1f(r->lq.falloff, (float)s->falloff);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, r->light_tex);
+        glBindVertexArray(r->vao_quads);
+        if (r->n_lights > 0) glDrawArrays(GL_TRIANGLES, 0, r->n_lights * 6);
+        glDisable(GL_BLEND);
+        gr_gl_timer_end(&r->timer);
+    }
+    glEndQuery(GL_SAMPLES_PASSED);
+    if (r->local) {
+        /* Resolve: accumulator -> god-ray layer (divide by the summed falloff, scale). */
+        gr_gl_timer_begin(&r->timer, PASS_RESOLVE);
+        glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+        glViewport(0, 0, W, H);
+        glUseProgram(r->prog_resolve);
+        glUniform1i(r->loc_acc, 0);
+        glUniform3f(r->loc_rscale, (float)scale[0], (float)scale[1], (float)scale[2]);
+        glUniform1i(r->loc_normalize, s->normalize_overlap);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, r->acc_tex);
+        glBindVertexArray(r->vao_empty);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        gr_gl_timer_end(&r->timer);
+    }
+    st = read_out(r, W, H, out, name, err);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (st != GR_OK) return st;
+    if (stats) {
+        static const char *const names[4] = {"eye_depth", "light", "blur", "resolve"};
+        memset(stats, 0, sizeof *stats);
+        double wall_ns = (now_ms() - t0) * 1e6;
+        stats->n_passes = r->local ? 4 : 3;
+        for (int p = 0; p < stats->n_passes; p++) {
+            snprintf(stats->pass_names[p], sizeof stats->pass_names[p], "%s",
+                     r->local && p == PASS_BLUR ? "quads" : names[p]);
+            long long ns = gr_gl_timer_ns(&r->timer, p);
+            /* a time longer than the whole call is a broken timer (llvmpipe's first query) */
+            stats->gpu_ns[p] = (ns >= 0 && (double)ns <= wall_ns) ? ns : -1;
+        }
+        GLuint64 n = 0;
+        glGetQueryObjectui64v(r->q_samples, GL_QUERY_RESULT, &n);
+        stats->fragments = (long long)n;
+        stats->wall_ms = now_ms() - t0;
+    }
+    r->rendered = 1;
+    return gr_image_check_finite(out, name, err);
+}
+
+/* ---- tests' entry points ------------------------------------------------------------------- */
+
+gr_status gr_radial_blur_blur_image(void *state, const gr_image *light, const double sun_uv[2],
+                                    const gr_radial_blur_settings *s, const double scale[3], gr_image *out,
+                                    gr_error *err)
+{
+    rb_state *r = state;
+    gr_status st;
+    if (light->nchannels < 3) return gr_fail(err, GR_E_INPUT, "injected light image: needs at least 3 channels");
+    if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) return st;
+    /* format 2 (internal): RGBA32F, so the injected values are exact */
+    if ((st = ensure_light(r, light->width, light->height, 2, "radial_blur", err)) != GR_OK) return st;
+    if ((st = ensure_out(r, out->width, out->height, err)) != GR_OK) return st;
+    float *px = malloc((size_t)light->width * light->height * 4 * sizeof *px);
+    if (!px) return gr_fail(err, GR_E_NOMEM, "injected light image: out of memory");
+    for (int y = 0; y < light->height; y++)
+        for (int x = 0; x < light->width; x++) {
+            const float *src = light->pixels + ((size_t)y * light->width + x) * (size_t)light->nchannels;
+            float *d = px + ((size_t)(light->height - 1 - y) * light->width + x) * 4;
+            for (int c = 0; c < 3; c++) d[c] = src[c];
+            d[3] = 1.0f;
+        }
+    glBindTexture(GL_TEXTURE_2D, r->light_tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, light->width, light->height, GL_RGBA, GL_FLOAT, px);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    free(px);
+    blur_pass(r, s, sun_uv, scale, out->width, out->height);
+    st = read_out(r, out->width, out->height, out, "radial_blur (injected light)", err);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    return st;
+}
+
+int gr_radial_blur_local_lights(void *state, double (*uv)[2], int max)
+{
+    rb_state *r = state;
+    int n = r->n_lights < max ? r->n_lights : max;
+    for (int i = 0; i < n; i++) {
+        uv[i][0] = r->light_uv[i][0];
+        uv[i][1] = r->light_uv[i][1];
+    }
+    return r->n_lights;
+}
+
+/* The light pass of the last render (RGBA float, top row first, as stored: the normalized
+ * light pass s of docs/radial-blur.md). */
+static gr_status rb_read_target(void *state, gr_image **out, gr_error *err)
+{
+    rb_state *r = state;
+    *out = NULL;
+    if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "radial blur: no render yet, no light pass to read");
+    gr_status st = gr_gl_make_current(r->gl, err);
+    if (st != GR_OK) return st;
+    int w = r->light_w, h = r->light_h;
+    gr_image *img = gr_image_create(w, h, 4, NULL);
+    float *tmp = malloc((size_t)w * h * 4 * sizeof *tmp);
+    if (!img || !tmp) {
+        gr_image_destroy(img);
+        free(tmp);
+        return gr_fail(err, GR_E_NOMEM, "radial blur: out of memory for the light pass readback");
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, r->light_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, tmp);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    size_t row = (size_t)w * 4;
+    for (int y = 0; y < h; y++) memcpy(img->pixels + (size_t)y * row, tmp + (size_t)(h - 1 - y) * row, row * sizeof *tmp);
+    free(tmp);
+    if ((st = gr_gl_check("radial blur light pass readback", err)) != GR_OK) {
+        gr_image_destroy(img);
+        return st;
+    }
+    *out = img;
+    return GR_OK;
+}
+
+/* ---- metadata ----------------------------------------------------------------------------- */
+
+static gr_status rb_metadata(void *state, const gr_scene *scene, const void *settings, const gr_technique_stats *stats,
+                             gr_metadata *meta, gr_error *err)
+{
+    rb_state *r = state;
+    (void)scene;
+    (void)settings;
+    (void)stats;
+    char val[128];
+    gr_status st;
+    snprintf(val, sizeof val, "%.9g %.9g", r->sun_uv[0], r->sun_uv[1]);
+    if ((st = gr_meta_set_string(meta, "godrays:radial_blur_sun_uv", val)) != GR_OK) goto fail;
+    if ((st = gr_meta_set_double(meta, "godrays:radial_blur_fade", r->fade)) != GR_OK) goto fail;
+    snprintf(val, sizeof val, "%dx%d", r->light_w, r->light_h);
+    if ((st = gr_meta_set_string(meta, "godrays:radial_blur_target_size", val)) != GR_OK) goto fail;
+    if (r->local && (st = gr_meta_set_int(meta, "godrays:radial_blur_lights", r->n_lights)) != GR_OK) goto fail;
+    return GR_OK;
+fail:
+    return gr_fail(err, st, "radial blur metadata: cannot add an entry (%s)", gr_status_name(st));
+}
+
+const gr_technique_class gr_radial_blur_class = {
+    .name = "radial_blur",
+    .description = "seeds 004/GPU Gems 3 ch. 13: radial blur of the refracted sun seen through the surface",
+    .params = &gr_radial_blur_param_table,
+    .settings_size = sizeof(gr_radial_blur_settings),
+    .origin = "built-in",
+    .gain_key = "intensity",
+    .check = rb_check,
+    .create = rb_create,
+    .destroy = rb_destroy,
+    .render = rb_render,
+    .metadata = rb_metadata,
+    .read_target = rb_read_target,
+};
+
+const gr_technique_class gr_radial_blur_local_class = {
+    .name = "radial_blur_local",
+    .description = "seed 003: localized radial blur, one quad per bright surface patch, one draw",
+    .params = &gr_radial_blur_local_param_table,
+    .settings_size = sizeof(gr_radial_blur_settings),
+    .origin = "built-in",
+    .gain_key = "intensity",
+    .check = rb_check,
+    .create = rb_create,
+    .destroy = rb_destroy,
+    .render = rb_render,
+    .metadata = rb_metadata,
+    .read_target = rb_read_target,
+};
