@@ -38,7 +38,7 @@ techs=$("$bin" techniques --json | python3 -c 'import json,sys; print(" ".join(t
 ck "techniques listed" [ -n "$techs" ]
 files="index.html summary.png metrics.json reference.png reference.exr radial_profile.png"
 for t in $techs; do
-    files="$files $t.png ${t}_raw.png ${t}_diff.png ${t}_diff_signed.png $t.exr ${t}_radial_profile_rgb.png ${t}_error_vs_blur.png"
+    files="$files $t.png ${t}_raw.png ${t}_diff.png ${t}_diff_signed.png ${t}_flip.png $t.exr ${t}_radial_profile_rgb.png ${t}_error_vs_blur.png"
 done
 for f in $files; do
     ck "rep1/$f written" [ -s "rep1/$f" ]
