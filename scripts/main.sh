@@ -11,7 +11,7 @@ JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j "$JOBS"
 
-# ---- the main job: ground truth (cached after the first run) + real-time shafts + report ----
+# ---- the main job: ground truth (cached after the first run) + every real-time technique + leaderboard report ----
 build/godrays run "$SCENE"
 
 build/godrays info

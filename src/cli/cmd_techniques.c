@@ -111,6 +111,17 @@ static int print_json(void)
         cJSON_AddStringToObject(t, "origin", c->origin ? c->origin : "built-in");
         if (c->gain_key) cJSON_AddStringToObject(t, "gain_key", c->gain_key);
         else cJSON_AddNullToObject(t, "gain_key");
+        cJSON *ld = cJSON_AddArrayToObject(t, "ladder"); /* pareto's speed/quality levels */
+        for (int k = 0; ld && k < c->n_ladder; k++) {
+            cJSON *lv = cJSON_CreateObject();
+            if (!lv || !cJSON_AddItemToArray(ld, lv)) {
+                cJSON_Delete(lv);
+                ok = 0;
+                break;
+            }
+            cJSON_AddStringToObject(lv, "settings", c->ladder[k].settings ? c->ladder[k].settings : "");
+            cJSON_AddBoolToObject(lv, "quick", c->ladder[k].quick != 0);
+        }
         cJSON *ps = cJSON_AddArrayToObject(t, "settings");
         for (size_t k = 0; ps && k < c->params->count; k++) {
             cJSON *po = param_json(&c->params->params[k]);

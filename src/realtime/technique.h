@@ -102,9 +102,11 @@ struct gr_technique_class {
 
 /* ---- registry --------------------------------------------------------------------------- */
 
-/* The techniques known to this process: the built-in ones (registered on first use) and the
- * user techniques added with gr_technique_add_dir. Also makes their sections known to the
- * scene loader, so load scenes AFTER adding user techniques. */
+/* The techniques known to this process: the built-in ones (registered on first use of any
+ * function below) and the user techniques added with gr_technique_add_dir. Also makes their
+ * sections known to the scene loader (src/scene/sections.h), so load scenes AFTER the first
+ * registry call (e.g. gr_technique_count()) and after adding user techniques: a scene loaded
+ * before knows none of their sections. */
 int gr_technique_count(void);
 const gr_technique_class *gr_technique_at(int i);
 const gr_technique_class *gr_technique_find(const char *name); /* NULL if unknown */

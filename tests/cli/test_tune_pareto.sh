@@ -1,8 +1,10 @@
 #!/bin/sh
 # `godrays pareto --quick` on a small scene: exit 0, pareto.csv with the documented columns and
-# one row per point (2 ground-truth levels + 2 N x 2 target scales x 2 formats = 10), times and
-# errors positive and finite, each family with at least one point on its front, and the lowest
-# time and the lowest error of each family on its front (a property of any Pareto front).
+# one row per point (2 ground-truth levels + for each technique of `godrays techniques --json`
+# the quick levels of its ladder, or one point at the scene's settings without a ladder; for
+# the shafts 2 N x 2 target scales x 2 formats = 8), times and errors positive and finite,
+# each family with at least one point on its front, and the lowest time and the lowest error
+# of each family on its front (a property of any Pareto front).
 # The folder's parent holds the files of a `godrays run` report (index.html, metrics.json;
 # stand-ins here), so the page links back to it (cli.report_links checks the rest).
 bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
@@ -24,12 +26,18 @@ if [ $rc -ne 0 ]; then echo "FAIL: pareto exit $rc"; exit 1; fi
 cat "$dir/out"
 [ -s "$dir/p/pareto.png" ] && [ -s "$dir/p/index.html" ] || { echo "FAIL: no pareto.png or index.html"; exit 1; }
 grep -qF '<a href="../index.html">' "$dir/p/index.html" || { echo "FAIL: pareto page does not link ../index.html"; exit 1; }
-python3 - "$dir/p/pareto.csv" <<'PY'
-import csv, math, sys
+"$bin" techniques --json >"$dir/techniques.json" || { echo "FAIL: godrays techniques --json"; exit 1; }
+python3 - "$dir/p/pareto.csv" "$dir/techniques.json" <<'PY'
+import csv, json, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
+techs = json.load(open(sys.argv[2]))["techniques"]
 assert list(rows[0].keys()) == ["family", "label", "settings", "time_s", "gpu_s", "cost_s", "error", "on_front"], rows[0].keys()
-assert len(rows) == 10, len(rows)
-for fam, n in (("reference", 2), ("shafts", 8)):
+want = [("reference", 2)]
+for t in techs:
+    want.append((t["name"], sum(1 for l in t["ladder"] if l["quick"]) if t["ladder"] else 1))
+assert dict(want).get("shafts", 8) == 8, want
+assert len(rows) == sum(n for _, n in want), (len(rows), want)
+for fam, n in want:
     pts = [r for r in rows if r["family"] == fam]
     assert len(pts) == n, (fam, len(pts))
     for r in pts:
