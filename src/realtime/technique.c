@@ -12,12 +12,14 @@
 #include "realtime/shafts.h"
 #include "realtime/radial_blur.h"
 #include "realtime/slicing.h"
+#include "realtime/froxel.h"
 
 static const gr_technique_class *const builtins[] = {
     &gr_shafts_class,
     &gr_radial_blur_class,
     &gr_radial_blur_local_class,
     &gr_slicing_class,
+    &gr_froxel_class,
 };
 
 /* ---- registry ------------------------------------------------------------------------- */

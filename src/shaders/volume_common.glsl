@@ -58,11 +58,13 @@ float vol_hg(float cos_t, float g)
 
 // In-scattered radiance per metre at p toward the eye (view direction w, away from the eye):
 // sigma_s p(T . -w) E_sun C(p) / mu_t exp(-sigma_t depth / mu_t) V(p); 0 above the surface.
-vec3 vol_inscatter(vec3 p, vec3 w)
+// Without the phase (constant along a view ray for the one directional light):
+vec3 vol_inscatter_nophase(vec3 p)
 {
     float depth = u_rest - p.y;
     if (depth <= 0.0) return vec3(0.0);
     float mu = -u_refr.y;
     float e = vol_caustic(p, depth) / mu;
-    return u_sigma_s * vol_hg(dot(u_refr, -w), u_g) * u_esun * e * exp(-u_sigma_t * (depth / mu)) * vol_shadow(p);
+    return u_sigma_s * u_esun * e * exp(-u_sigma_t * (depth / mu)) * vol_shadow(p);
 }
+vec3 vol_inscatter(vec3 p, vec3 w) { return vol_inscatter_nophase(p) * vol_hg(dot(u_refr, -w), u_g); }
