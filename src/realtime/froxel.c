@@ -35,9 +35,9 @@ static const gr_param params[] = {
      .doc = "sample each froxel at a deterministic noise depth instead of its middle"},
     {.name = "phase_per_pixel", .type = GR_PT_BOOL, .offset = SL(phase_per_pixel), .min = 0, .max = 1, .def = 0,
      .unit = "", .doc = "apply the HG phase per pixel (one directional light: constant along a ray) instead of per froxel"},
-    {.name = "texture_size", .type = GR_PT_INT, .offset = SL(texture_size), .min = 8, .max = 4096, .def = 256,
+    {.name = "texture_size", .type = GR_PT_INT, .offset = SL(texture_size), .min = 8, .max = 4096, .def = 512,
      .unit = "texels", .doc = "caustic texture side (rendered at twice this, 2x2 box filtered)"},
-    {.name = "grid", .type = GR_PT_INT, .offset = SL(grid), .min = 2, .max = 2048, .def = 128, .unit = "cells",
+    {.name = "grid", .type = GR_PT_INT, .offset = SL(grid), .min = 2, .max = 2048, .def = 256, .unit = "cells",
      .doc = "water grid cells per patch side (beam-traced triangles: 2 grid^2 per depth)"},
     {.name = "patch_m", .type = GR_PT_DOUBLE, .offset = SL(patch_m), .min = 0, .max = 1e4, .flags = LO_X, .def = 24,
      .unit = "m", .doc = "caustic patch side: the texture repeats with this period"},
@@ -68,7 +68,7 @@ static const gr_technique_level ladder[] = {
     {"grid_x=40,grid_y=23,grid_z=16,texture_size=128,grid=64,caustic_depths=4", 1},
     {"grid_x=80,grid_y=45,grid_z=32,texture_size=128,grid=96,caustic_depths=6", 0},
     {"grid_x=160", 1},
-    {"grid_x=320,grid_y=180,grid_z=128,texture_size=512,grid=256,caustic_depths=12", 0},
+    {"grid_x=320,grid_y=180,grid_z=128,texture_size=1024,grid=512,caustic_depths=16", 0},
 };
 
 typedef struct fx_state {

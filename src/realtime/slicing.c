@@ -26,9 +26,9 @@ static const gr_param params[] = {
      .def = GR_VOL_EXPONENTIAL, .enum_names = dist_names, .unit = "", .doc = "spacing of the planes in view depth"},
     {.name = "near_m", .type = GR_PT_DOUBLE, .offset = SL(near_m), .min = 0, .max = 1e4, .flags = LO_X, .def = 0.5,
      .unit = "m", .doc = "exponential spacing: the first plane's view depth", .tune_lo = 0.05, .tune_hi = 4.0},
-    {.name = "texture_size", .type = GR_PT_INT, .offset = SL(texture_size), .min = 8, .max = 4096, .def = 256,
+    {.name = "texture_size", .type = GR_PT_INT, .offset = SL(texture_size), .min = 8, .max = 4096, .def = 512,
      .unit = "texels", .doc = "caustic texture side (rendered at twice this, 2x2 box filtered)"},
-    {.name = "grid", .type = GR_PT_INT, .offset = SL(grid), .min = 2, .max = 2048, .def = 128, .unit = "cells",
+    {.name = "grid", .type = GR_PT_INT, .offset = SL(grid), .min = 2, .max = 2048, .def = 256, .unit = "cells",
      .doc = "water grid cells per patch side (beam-traced triangles: 2 grid^2 per depth)"},
     {.name = "patch_m", .type = GR_PT_DOUBLE, .offset = SL(patch_m), .min = 0, .max = 1e4, .flags = LO_X, .def = 24,
      .unit = "m", .doc = "caustic patch side: the texture repeats with this period"},
@@ -59,7 +59,7 @@ static const gr_technique_level ladder[] = {
     {"slices=8,texture_size=128,grid=64,caustic_depths=4", 1},
     {"slices=16,texture_size=128,grid=96,caustic_depths=6", 0},
     {"slices=32", 1},
-    {"slices=64,texture_size=512,grid=256,caustic_depths=12", 0},
+    {"slices=64,texture_size=1024,grid=512,caustic_depths=16", 0},
 };
 
 typedef struct sl_state {
