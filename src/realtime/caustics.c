@@ -34,9 +34,9 @@ gr_status gr_vol_program(const char *dir, const gr_vol_stage *stages, int n, uns
     GLuint prog = glCreateProgram();
     if (!prog) return gr_fail(err, GR_E_GL, "%s: glCreateProgram failed", stages[0].files[0]);
     for (int s = 0; s < n && s < 6; s++) {
-        char *src[3] = {NULL, NULL, NULL};
+        char *src[4] = {NULL, NULL, NULL, NULL};
         int k = 0;
-        for (; k < 3 && stages[s].files[k]; k++)
+        for (; k < 4 && stages[s].files[k]; k++)
             if ((st = gr_shader_source(dir, stages[s].files[k], &src[k], NULL, err)) != GR_OK) break;
         if (st == GR_OK) {
             sh[s] = glCreateShader(stages[s].type);
@@ -53,7 +53,7 @@ gr_status gr_vol_program(const char *dir, const gr_vol_stage *stages, int n, uns
                 glAttachShader(prog, sh[s]);
             }
         }
-        for (int j = 0; j < 3; j++) free(src[j]);
+        for (int j = 0; j < 4; j++) free(src[j]);
         if (st != GR_OK) break;
     }
     if (st == GR_OK) {
@@ -90,9 +90,9 @@ gr_status gr_caustics_create(const char *shader_dir, gr_caustics **out, gr_error
     *out = NULL;
     gr_caustics *c = calloc(1, sizeof *c);
     if (!c) return gr_fail(err, GR_E_NOMEM, "caustics: out of memory");
-    const gr_vol_stage st3[3] = {{GL_VERTEX_SHADER, {"caustics.vert.glsl", NULL, NULL}},
-                                 {GL_GEOMETRY_SHADER, {"caustics.geom.glsl", NULL, NULL}},
-                                 {GL_FRAGMENT_SHADER, {"caustics.frag.glsl", NULL, NULL}}};
+    const gr_vol_stage st3[3] = {{GL_VERTEX_SHADER, {"caustics.vert.glsl", NULL, NULL, NULL}},
+                                 {GL_GEOMETRY_SHADER, {"caustics.geom.glsl", NULL, NULL, NULL}},
+                                 {GL_FRAGMENT_SHADER, {"caustics.frag.glsl", NULL, NULL, NULL}}};
     gr_status st = gr_vol_program(shader_dir, st3, 3, &c->prog, err);
     if (st != GR_OK) {
         free(c);
@@ -145,10 +145,14 @@ gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_fram
         if (c->tex) glDeleteTextures(1, &c->tex);
         glGenTextures(1, &c->tex);
         glBindTexture(GL_TEXTURE_2D_ARRAY, c->tex);
-        glTexStorage3D(GL_TEXTURE_2D_ARRAY, 2, GL_R32F, S2, S2, p->n_depths);
+        /* the whole mip chain: level 1 is the 2x2 supersampled texture, the coarser ones
+         * filter distant lookups (fragment shaders; compute shaders read level 1) */
+        int levels = 1;
+        while ((S2 >> levels) >= 1) levels++;
+        glTexStorage3D(GL_TEXTURE_2D_ARRAY, levels, GL_R32F, S2, S2, p->n_depths);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_REPEAT);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_REPEAT);
-        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
         glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
         c->tex_size = p->size;
@@ -259,6 +263,8 @@ void gr_vol_locations(unsigned p, gr_vol_locs *l)
     l->sigma_s = glGetUniformLocation(p, "u_sigma_s");
     l->g = glGetUniformLocation(p, "u_g");
     l->esun = glGetUniformLocation(p, "u_esun");
+    l->texel = glGetUniformLocation(p, "u_texel");
+    l->sun_rw = glGetUniformLocation(p, "u_sun_rw");
 }
 
 void gr_vol_set(const gr_vol_locs *l, const gr_vol_inputs *in)
@@ -288,6 +294,9 @@ void gr_vol_set(const gr_vol_locs *l, const gr_vol_inputs *in)
     glUniform1f(l->g, (float)in->g);
     glUniform3f(l->esun, (float)(f->sun_irradiance[0] * in->gain[0]), (float)(f->sun_irradiance[1] * in->gain[1]),
                 (float)(f->sun_irradiance[2] * in->gain[2]));
+    glUniform1f(l->texel, (float)(in->cp->patch_m / in->cp->size));
+    /* the disc seen from below: Snell's law shrinks its angular radius to asin(sin(r) / n) */
+    glUniform1f(l->sun_rw, in->sun_disc ? (float)asin(sin(f->sun_angular_radius_rad) / f->ior) : 0.0f);
     glActiveTexture(GL_TEXTURE2);
     glBindTexture(GL_TEXTURE_2D_ARRAY, gr_caustics_texture(in->caustics));
     glActiveTexture(GL_TEXTURE3);

@@ -55,7 +55,7 @@ void gr_caustics_depths(int n, double first_m, double last_m, double *out);
 /* ---- shared program builder ---- */
 typedef struct gr_vol_stage {
     unsigned type;           /* GL_VERTEX_SHADER, GL_GEOMETRY_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER */
-    const char *files[3];    /* concatenated in order (the first starts with #version); NULL-ended */
+    const char *files[4];    /* concatenated in order (the first starts with #version); NULL-ended */
 } gr_vol_stage;
 gr_status gr_vol_program(const char *dir, const gr_vol_stage *stages, int n, unsigned *program, gr_error *err);
 
@@ -63,7 +63,7 @@ gr_status gr_vol_program(const char *dir, const gr_vol_stage *stages, int n, uns
 /* ---- what the volume techniques share (volume_common.glsl's uniforms) ---- */
 typedef struct gr_vol_locs {
     int caustics, n_depths, cdepth, corigin, patch, refr, rest, shadow, light_vp, use_shadow, sigma_t, sigma_s, g,
-        esun;
+        esun, texel, sun_rw;
 } gr_vol_locs;
 typedef struct gr_vol_inputs {
     const gr_frame *f;
@@ -72,6 +72,7 @@ typedef struct gr_vol_inputs {
     unsigned shadow_tex;          /* 0: no shadow map */
     double light_vp[16];          /* world -> shadow clip */
     double sigma_t[3], sigma_s[3], g, gain[3];
+    int sun_disc;                 /* 1: blur the caustics by the sun's disc (mip level per plane) */
 } gr_vol_inputs;
 void gr_vol_locations(unsigned program, gr_vol_locs *l);
 /* Sets the uniforms of the current program and binds the caustic stack to unit 2 and the

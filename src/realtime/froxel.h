@@ -21,6 +21,7 @@ typedef struct gr_froxel_settings {
     double caustic_first_m, caustic_last_m;
     double extinction[3];
     double g;
+    int sun_disc;           /* blur the caustic planes by the sun's disc */
     double intensity[3];
     int shadow_map_size;
     double shadow_extent_m;

@@ -44,6 +44,8 @@ static const gr_param params[] = {
     {.name = "g", .type = GR_PT_DOUBLE, .offset = SL(g), .min = -1, .max = 1, .flags = LO_X | GR_PF_MAX_EXCL | FROM,
      .def = NAN, .unit = "", .scene_source = "medium.g", .doc = "HG asymmetry; default: the medium's",
      .tune_lo = 0.5, .tune_hi = 0.98},
+    {.name = "sun_disc", .type = GR_PT_BOOL, .offset = SL(sun_disc), .min = 0, .max = 1, .def = 1, .unit = "",
+     .doc = "blur each caustic plane by the sun's disc (the mip level of its blur diameter)"},
     {.name = "intensity", .type = GR_PT_RGB, .offset = SL(intensity), .min = 0, .max = 1e9, .def = 1, .unit = "",
      .doc = "gain on the physical radiance (1: no fit)", .tune_lo = 0.2, .tune_hi = 5.0},
     {.name = "shadow_map_size", .type = GR_PT_INT, .offset = SL(shadow_map_size), .min = 16, .max = 8192, .def = 1024,
@@ -106,8 +108,8 @@ static gr_status sl_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     if ((st = gr_scenegl_create_dir(gl, dir, &r->sg, err)) != GR_OK) goto fail;
     if ((st = gr_caustics_create(dir, &r->caus, err)) != GR_OK) goto fail;
     const gr_vol_stage stages[2] = {
-        {GL_VERTEX_SHADER, {"volume_screen.vert.glsl", NULL, NULL}},
-        {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_common.glsl", "slicing.frag.glsl"}}};
+        {GL_VERTEX_SHADER, {"volume_screen.vert.glsl", NULL, NULL, NULL}},
+        {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "slicing.frag.glsl"}}};
     if ((st = gr_vol_program(dir, stages, 2, &r->prog, err)) != GR_OK) goto fail;
     gr_vol_locations(r->prog, &r->vl);
     r->l_inv = glGetUniformLocation(r->prog, "u_inv_vp_rot");
@@ -223,6 +225,7 @@ static gr_status sl_render(void *state, const gr_scene *scene, const void *setti
         in.gain[c] = s->intensity[c];
     }
     in.g = s->g;
+    in.sun_disc = s->sun_disc;
 
     double tmax = gr_vol_t_max(scene);
     double far = gr_vol_far_depth(scene, &f, tmax);

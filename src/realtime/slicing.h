@@ -21,6 +21,7 @@ typedef struct gr_slicing_settings {
     double caustic_first_m, caustic_last_m; /* stack depths, geometric between these */
     double extinction[3];   /* sigma_t on both paths; default: the medium's */
     double g;               /* HG asymmetry; default: the medium's */
+    int sun_disc;           /* blur the caustic planes by the sun's disc */
     double intensity[3];    /* gain on the physical result (1) */
     int shadow_map_size;
     double shadow_extent_m; /* half side of the shadow map's square around the eye */

@@ -17,13 +17,22 @@ uniform vec3 u_sigma_t;         // extinction (1/m), both paths
 uniform vec3 u_sigma_s;         // scattering (1/m)
 uniform float u_g;              // HG asymmetry
 uniform vec3 u_esun;            // E_sun x gain (W/m^2 per channel)
+uniform float u_texel;          // texel side of the sampled (base) level (m)
+uniform float u_sun_rw;         // the sun's angular radius in water (rad): 0 = a point sun
 
 const float PI = 3.14159265358979;
 
 float vol_caustic_layer(vec3 p, float depth, int j)
 {
     vec3 q = p + u_refr * ((u_cdepth[j] - depth) / -u_refr.y);
-    return texture(u_caustics, vec3((q.xz - u_corigin) / u_patch, float(j))).r;
+    vec3 uv = vec3((q.xz - u_corigin) / u_patch, float(j));
+    // The sun's disc blurs the pattern over a diameter 2 d r_w at depth d: the mip level whose
+    // texel matches it (a box for the disc; docs, "Sun disc"), or the footprint's if coarser.
+    float lod = log2(max(2.0 * u_cdepth[j] * u_sun_rw / u_texel, 1e-6));
+#ifdef VOL_FRAGMENT
+    lod = max(lod, textureQueryLod(u_caustics, uv.xy).y);
+#endif
+    return textureLod(u_caustics, uv, max(lod, 0.0)).r;
 }
 
 // Horizontal irradiance per unit E_sun at p (eye-relative), depth = u_rest - p.y.
