@@ -645,6 +645,10 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     }
     size_t lit = 0;
     for (size_t t = 0; t < ntri; t++) {
+        if ((t & 65535) == 0 && p->interrupt && *p->interrupt) { /* Ctrl-C, every 65536 triangles */
+            free(pos); free(drift); free(jv); gr_beams_destroy(b);
+            return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
+        }
         beam_tri *bt = &b->tri[t];
         memset(bt, 0, sizeof *bt);
         uint32_t cell = (uint32_t)(t >> 1), idx[3];

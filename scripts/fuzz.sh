@@ -28,7 +28,7 @@ run_one() {
   local work=build-fuzz/corpus-${1#fuzz_}
   mkdir -p "$work"
   # -rss_limit_mb: the readers' size caps keep every input far below it
-  build-fuzz/"$t" -max_total_time="$secs" -rss_limit_mb=2048 -timeout=10 -max_len=65536 -print_final_stats=1 \
+  build-fuzz/"$t" -max_total_time="$secs" -rss_limit_mb=2048 -timeout=30 -max_len=65536 -print_final_stats=1 \
     -artifact_prefix=build-fuzz/findings/"$t"- "$work" "$c" >build-fuzz/"$t".log 2>&1
   local rc=$?
   local n

@@ -28,6 +28,8 @@ GODRAYS_PACKAGES=(
   blender python3-numpy
   # a single-node Slurm cluster for the farm test (tests/farm/test_slurm.sh, docs/farm.md)
   slurm-wlm munge
+  # libFuzzer targets (tests/fuzz, scripts/fuzz.sh): clang and its fuzzer runtime
+  clang libclang-rt-14-dev
 )
 
 installed() {

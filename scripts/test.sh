@@ -77,6 +77,13 @@ fi
 (cd build && ctest --output-on-failure -j "$JOBS") || { status=1; echo "test.sh: FAILED: tests in build/" >&2; }
 phase "ctest build/ (all)"
 
+# A short fuzz run of each libFuzzer target where clang is present (docs/reliability.md):
+# 60 s each, two at a time.
+if command -v clang >/dev/null 2>&1; then
+  FUZZ_JOBS=2 ./scripts/fuzz.sh 60 || { status=1; echo "test.sh: FAILED: fuzzing (build-fuzz/findings/)" >&2; }
+  phase "fuzz (3 targets x 60 s)"
+fi
+
 summary
 [ "$status" -eq 0 ] && echo "test.sh: all passed" || echo "test.sh: FAILED" >&2
 exit "$status"

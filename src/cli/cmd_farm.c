@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "farm/farm.h"
+#include "report/cache.h"
 #include "realtime/technique.h"
 
 static void usage(FILE *f)
@@ -31,8 +32,8 @@ static void usage(FILE *f)
             "\n"
             "options:\n"
             "  -o, --output DIR     farm folder: scripts, scene copy, logs (default farm-SCENENAME)\n"
-            "  --cache DIR          shared ground-truth cache (default $GODRAYS_CACHE; one of them\n"
-            "                       is needed, on a file system every node sees)\n"
+            "  --cache DIR          shared ground-truth cache (default $GODRAYS_CACHE, else the\n"
+            "                       user cache that run uses); every node must see it\n"
             "  --frames A:B:S       frames A, A+S, ..., B at water.time_s + frame/fps (as tune)\n"
             "  --fps F              frames per second (default 30)\n"
             "  --view YAW,PITCH     an extra camera view (repeatable, at most 8; as tune)\n"
@@ -207,8 +208,14 @@ static int farm_with(gr_args *args)
         if (nex > 1) snprintf(plan.then_args + tl, sizeof plan.then_args - tl, "%s", ex[1]->name);
     }
     if (!cache) cache = getenv("GODRAYS_CACHE");
-    if (!cache || !cache[0])
-        return gr_cli_usage_error(cmd, "no shared cache folder: set GODRAYS_CACHE or give --cache DIR");
+    char user_cache[4096];
+    if (!cache || !cache[0]) { /* the cache run and tune use here; the nodes must see it too */
+        gr_error cerr = {GR_OK, ""};
+        if (gr_cache_dir(user_cache, sizeof user_cache, &cerr) != GR_OK) return gr_cli_report(cmd, &cerr);
+        cache = user_cache;
+        fprintf(stderr, "godrays farm: note: GODRAYS_CACHE is not set: the jobs use %s, which every node must see at "
+                        "that path (docs/farm.md)\n", cache);
+    }
     gr_scene *scene = NULL;
     if ((rc = gr_args_load_scene(args, &scene)) != 0) return rc;
     gr_error err = {GR_OK, ""};

@@ -61,6 +61,10 @@ gr_status gr_outfile_begin(gr_outfile *o, const char *path, gr_error *err)
     char *target = final_target(path);
     if (!target) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
     struct stat sb;
+    if (stat(target, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        free(target);
+        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(EISDIR));
+    }
     if (stat(target, &sb) == 0 && !S_ISREG(sb.st_mode)) {
         gr_status st = gr_fail(err, GR_E_INPUT, "%s: exists and is %s, not a regular file: refusing to replace it",
                                path, kind_name(sb.st_mode));

@@ -1,7 +1,8 @@
 /* Output files written atomically, the one way every writer in godrays replaces a file
  * (docs/reliability.md):
- *  - an existing output that is not a regular file (a device node, a FIFO, a socket, a
- *    folder) is refused with GR_E_INPUT (exit 2): nothing is created, the node stays;
+ *  - an existing output that is not a regular file (a device node, a FIFO, a socket) is
+ *    refused with GR_E_INPUT (exit 2): nothing is created, the node stays (a folder:
+ *    GR_E_IO "Is a directory", as the rename would fail);
  *  - a symbolic link is followed: its final target is the file replaced, the link stays;
  *  - the data goes to TARGET.tmp-PID-N (N counts this process's outputs, so concurrent
  *    processes and threads never share a temporary name) in the target's folder;

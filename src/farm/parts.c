@@ -292,8 +292,9 @@ static gr_status part_read(const char *path, part *p, gr_error *err)
     char h[20];
     snprintf(h, sizeof h, "%016llx", gr_fnv1a64(GR_FNV_BASIS, p->pay, p->pay_n));
     if (strcmp(h, fnv) != 0) {
-        part_free(p);
-        return gr_fail(err, GR_E_INPUT, "%s: payload checksum %s, the header says %s: damaged", path, h, fnv);
+        gr_fail(err, GR_E_INPUT, "%s: payload checksum %s, the header says %s: damaged", path, h, fnv);
+        part_free(p); /* fnv lives in the header */
+        return GR_E_INPUT;
     }
     return GR_OK;
 }

@@ -250,38 +250,77 @@ static int channel_before(const char *a, const char *b)
     return strcmp(a, b) < 0;
 }
 
-/* Points every decoder channel at its place in img for the chunk whose top-left pixel is
- * (x0, y0) relative to the data window. */
-static gr_status aim_decoder(exr_decode_pipeline_t *dec, gr_image *img, int x0, int y0,
+/* Decoding goes through a planar scratch buffer (one plane per channel), copied into img by
+ * name afterwards: OpenEXRCore 3.1's interleaved fast paths (e.g. four HALF channels decoded
+ * to interleaved FLOAT) write the channels in the file's (alphabetical: A, B, G, R) order from
+ * the first channel's pointer, which put A into R and ran past the pixel. */
+typedef struct exr_scratch {
+    float *buf;
+    size_t cap; /* floats */
+} exr_scratch;
+
+/* Points every decoder channel at its plane of the scratch buffer for the chunk whose
+ * top-left pixel is (x0, y0) relative to the data window. */
+static gr_status aim_decoder(exr_decode_pipeline_t *dec, gr_image *img, int x0, int y0, exr_scratch *sc,
                              const char *path, gr_error *err)
 {
-    const size_t nc = (size_t)img->nchannels, w = (size_t)img->width;
+    size_t total = 0;
     for (int i = 0; i < dec->channel_count; i++) {
         exr_coding_channel_info_t *ch = &dec->channels[i];
-        int c = gr_image_channel(img, ch->channel_name);
-        if (c < 0)
+        if (gr_image_channel(img, ch->channel_name) < 0)
             return gr_fail(err, GR_E_INPUT, "%s: chunk channel '%s' is not in the channel list", path, ch->channel_name);
-        if (ch->height == 0 || ch->width == 0) { ch->decode_to_ptr = NULL; continue; }
+        if (ch->height == 0 || ch->width == 0) continue;
         if (x0 < 0 || y0 < 0 || x0 + ch->width > img->width || y0 + ch->height > img->height)
             return gr_fail(err, GR_E_INPUT, "%s: chunk at (%d, %d) of %d x %d pixels does not fit the %d x %d data window",
                            path, x0, y0, ch->width, ch->height, img->width, img->height);
+        total += (size_t)ch->width * (size_t)ch->height;
+    }
+    if (total > sc->cap) {
+        float *b = realloc(sc->buf, total * sizeof *b);
+        if (!b) return gr_fail(err, GR_E_NOMEM, "%s: out of memory for a chunk of %zu samples", path, total);
+        sc->buf = b;
+        sc->cap = total;
+    }
+    size_t off = 0;
+    for (int i = 0; i < dec->channel_count; i++) {
+        exr_coding_channel_info_t *ch = &dec->channels[i];
+        if (ch->height == 0 || ch->width == 0) { ch->decode_to_ptr = NULL; continue; }
         ch->user_bytes_per_element = (int16_t)sizeof(float);
         ch->user_data_type = EXR_PIXEL_FLOAT; /* HALF and UINT are converted by the decoder */
-        ch->user_pixel_stride = (int32_t)(nc * sizeof(float));
-        ch->user_line_stride = (int32_t)(w * nc * sizeof(float));
-        ch->decode_to_ptr = (uint8_t *)(img->pixels + ((size_t)y0 * w + (size_t)x0) * nc + (size_t)c);
+        ch->user_pixel_stride = (int32_t)sizeof(float);
+        ch->user_line_stride = (int32_t)((size_t)ch->width * sizeof(float));
+        ch->decode_to_ptr = (uint8_t *)(sc->buf + off);
+        off += (size_t)ch->width * (size_t)ch->height;
     }
     return GR_OK;
 }
 
+/* Copies the decoded planes into img, each channel to its place by name. */
+static void scatter_planes(const exr_decode_pipeline_t *dec, gr_image *img, int x0, int y0, const exr_scratch *sc)
+{
+    const size_t nc = (size_t)img->nchannels, w = (size_t)img->width;
+    size_t off = 0;
+    for (int i = 0; i < dec->channel_count; i++) {
+        const exr_coding_channel_info_t *ch = &dec->channels[i];
+        if (ch->height == 0 || ch->width == 0) continue;
+        const size_t c = (size_t)gr_image_channel(img, ch->channel_name);
+        for (int y = 0; y < ch->height; y++) {
+            const float *src = sc->buf + off + (size_t)y * (size_t)ch->width;
+            float *dst = img->pixels + ((size_t)(y0 + y) * w + (size_t)x0) * nc + c;
+            for (int x = 0; x < ch->width; x++) dst[(size_t)x * nc] = src[x];
+        }
+        off += (size_t)ch->width * (size_t)ch->height;
+    }
+}
+
 static gr_status decode_chunk(exr_const_context_t ctx, const exr_chunk_info_t *cinfo,
                               exr_decode_pipeline_t *dec, int *first, gr_image *img, int x0, int y0,
-                              const char *path, gr_error *err)
+                              exr_scratch *sc, const char *path, gr_error *err)
 {
     exr_result_t rv = *first ? exr_decoding_initialize(ctx, 0, cinfo, dec)
                              : exr_decoding_update(ctx, 0, cinfo, dec);
     if (rv != EXR_ERR_SUCCESS) return exr_fail(err, path, rv, GR_E_INPUT, "decoder setup");
-    gr_status st = aim_decoder(dec, img, x0, y0, path, err);
+    gr_status st = aim_decoder(dec, img, x0, y0, sc, path, err);
     if (st != GR_OK) return st;
     if (*first) {
         rv = exr_decoding_choose_default_routines(ctx, 0, dec);
@@ -294,6 +333,7 @@ static gr_status decode_chunk(exr_const_context_t ctx, const exr_chunk_info_t *c
         snprintf(what, sizeof what, "decoding the chunk at (%d, %d)", x0, y0);
         return exr_fail(err, path, rv, GR_E_INPUT, what);
     }
+    scatter_planes(dec, img, x0, y0, sc);
     return GR_OK;
 }
 
@@ -306,6 +346,7 @@ static gr_status read_pixels(exr_const_context_t ctx, exr_storage_t storage, gr_
     if (rv != EXR_ERR_SUCCESS) return exr_fail(err, path, rv, GR_E_INPUT, "data window");
     gr_status st = GR_OK;
     int first = 1;
+    exr_scratch sc = {NULL, 0};
     if (storage == EXR_STORAGE_SCANLINE) {
         int32_t lines = 0;
         rv = exr_get_scanlines_per_chunk(ctx, 0, &lines);
@@ -314,7 +355,7 @@ static gr_status read_pixels(exr_const_context_t ctx, exr_storage_t storage, gr_
             exr_chunk_info_t cinfo;
             rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &cinfo);
             if (rv != EXR_ERR_SUCCESS) { st = exr_fail(err, path, rv, GR_E_INPUT, "chunk table"); break; }
-            st = decode_chunk(ctx, &cinfo, &dec, &first, img, 0, cinfo.start_y - dw.min.y, path, err);
+            st = decode_chunk(ctx, &cinfo, &dec, &first, img, 0, cinfo.start_y - dw.min.y, &sc, path, err);
         }
     } else {
         /* Tiled: level 0 (the full-resolution image) of any level mode. */
@@ -329,11 +370,12 @@ static gr_status read_pixels(exr_const_context_t ctx, exr_storage_t storage, gr_
                 exr_chunk_info_t cinfo;
                 rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &cinfo);
                 if (rv != EXR_ERR_SUCCESS) { st = exr_fail(err, path, rv, GR_E_INPUT, "tile table"); break; }
-                st = decode_chunk(ctx, &cinfo, &dec, &first, img, (int)((uint32_t)tx * tw), (int)((uint32_t)ty * th), path, err);
+                st = decode_chunk(ctx, &cinfo, &dec, &first, img, (int)((uint32_t)tx * tw), (int)((uint32_t)ty * th), &sc, path, err);
             }
         }
     }
     if (!first || dec.channels) exr_decoding_destroy(ctx, &dec);
+    free(sc.buf);
     return st;
 }
 

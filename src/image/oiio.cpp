@@ -98,6 +98,13 @@ class StderrCapture {
     int saved_ = -1;
 };
 
+// Appends libpng's captured text to an OpenImageIO message unless it already says it.
+void add_lib_text(std::string &why, const std::string &lib)
+{
+    const std::string core = lib.compare(0, 8, "libpng: ") == 0 ? lib.substr(8) : lib;
+    if (!core.empty() && why.find(core) == std::string::npos) why += " (" + lib + ")";
+}
+
 // Writes w x h x nc pixels of type `type` to a temporary file (common/outfile) in the format
 // that `path`'s extension names, reads it back (OpenImageIO's PNG writer does not report a
 // failed write: a full disk left a 0-byte or truncated file), then renames it over `path`.
@@ -226,13 +233,13 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
             if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
             std::fclose(f);
             const std::string lib = cap.take();
-            if (!lib.empty()) why += " (" + lib + ")";
+            add_lib_text(why, lib);
             return fail(err, GR_E_INPUT, path, "cannot read as an image", why);
         }
         if (!in) {
             std::string why = OIIO::geterror();
             const std::string lib = cap.take();
-            if (!lib.empty()) why += " (" + lib + ")";
+            add_lib_text(why, lib);
             // A missing or unreadable file is an I/O error; anything else is bad input.
             FILE *f = std::fopen(path, "rb");
             if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
@@ -272,7 +279,7 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         if (!read_ok) {
             std::string why = in->geterror();
             const std::string lib = cap.take();
-            if (!lib.empty()) why += " (" + lib + ")";
+            add_lib_text(why, lib);
             gr_status st = fail(err, GR_E_INPUT, path, "reading pixels", why);
             gr_image_destroy(img);
             return st;

@@ -426,10 +426,7 @@ static gr_status read_out(rb_state *r, int w, int h, gr_image *out, const char *
         const float *src = r->readback + (size_t)(h - 1 - y) * (size_t)w * 4;
         for (int x = 0; x < w; x++) {
             float *px = gr_image_pixel(out, x, y);
-            for (int c = 0; c < 3; c++) {
-                float v = src[(size_t)x * 4 + (size_t)c];
-                px[ch[c]] = isfinite(v) ? v : 0.0f; /* never NaN/Inf (counted as a failure below) */
-            }
+            for (int c = 0; c < 3; c++) px[ch[c]] = src[(size_t)x * 4 + (size_t)c]; /* NaN/Inf: checked by the caller */
         }
     }
     return gr_gl_check(what, err);
@@ -821,6 +818,15 @@ fail:
     return gr_fail(err, st, "radial blur metadata: cannot add an entry (%s)", gr_status_name(st));
 }
 
+static void rb_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)
+{
+    rb_state *r = state;
+    (void)stats;
+    int k = snprintf(buf, n, "light target %dx%d, refracted sun at uv (%.3f, %.3f), fade %.3g", r->light_w,
+                     r->light_h, r->sun_uv[0], r->sun_uv[1], r->fade);
+    if (r->local && k > 0 && (size_t)k < n) snprintf(buf + k, n - (size_t)k, ", %d light(s)", r->n_lights);
+}
+
 const gr_technique_class gr_radial_blur_class = {
     .name = "radial_blur",
     .description = "seeds 004/GPU Gems 3 ch. 13: radial blur of the refracted sun seen through the surface",
@@ -834,6 +840,7 @@ const gr_technique_class gr_radial_blur_class = {
     .render = rb_render,
     .metadata = rb_metadata,
     .read_target = rb_read_target,
+    .summary = rb_summary,
 };
 
 const gr_technique_class gr_radial_blur_local_class = {
@@ -849,4 +856,5 @@ const gr_technique_class gr_radial_blur_local_class = {
     .render = rb_render,
     .metadata = rb_metadata,
     .read_target = rb_read_target,
+    .summary = rb_summary,
 };

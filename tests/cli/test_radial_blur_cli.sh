@@ -1,7 +1,8 @@
 #!/bin/sh
 # The radial blurs through the CLI: `godrays techniques` lists both; `godrays render` writes a
 # finite EXR for each; bad settings (scene section or --set) exit 2 with one stderr line naming
-# the setting, through the scene loader; nothing is written then.
+# the setting, through the scene loader; a shader that fails to compile exits 1 with its GLSL
+# log; nothing is written then.
 bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
@@ -44,6 +45,11 @@ expect 2 "radial_blur_local.falloff" validate "$dir/s.json" --set radial_blur_lo
 sed 's/"samples": 40, "decay": 0.95/"samples": 40, "decay": 2/' "$dir/s.json" >"$dir/section.json"
 expect 2 "section.json: radial_blur.decay" render radial_blur "$dir/section.json" -o "$o"
 expect 2 "camera.position_m" render radial_blur "$dir/s.json" -o "$o" --set "camera.position_m=[0, 2, 0]"
+# A blur shader that does not compile (--shader-dir): exit 1, the file and the GLSL log on one line.
+mkdir "$dir/shaders"
+printf '#version 330 core\nout vec4 o;\nvoid main() { o = vec4(undeclared_thing, 1.0); }\n' >"$dir/shaders/radial_blur.frag.glsl"
+expect 1 "radial_blur.frag.glsl: GLSL compile failed" render radial_blur "$dir/s.json" -o "$o" --shader-dir "$dir/shaders"
+grep -q "undeclared_thing" "$dir/err" || { echo "FAIL: the GLSL log does not name the bad identifier"; fail=1; }
 if ls "$dir"/bad* >/dev/null 2>&1; then echo "FAIL: a failed run left output files"; fail=1; fi
 [ "$fail" -eq 0 ] && echo "all checks passed"
 exit $fail

@@ -85,7 +85,7 @@ PartitionName=test Nodes=$H Default=YES MaxTime=INFINITE State=UP
 EOF
 export SLURM_CONF=$T/slurm.conf
 slurmctld -f "$SLURM_CONF" || { echo "FAIL: slurmctld did not start"; fail=1; exit 1; }
-slurmd -f "$SLURM_CONF" || { echo "FAIL: slurmd did not start"; fail=1; exit 1; }
+slurmd -f "$SLURM_CONF" -N "$H" || { echo "FAIL: slurmd did not start"; fail=1; exit 1; }
 for _ in $(seq 60); do
   [ "$(sinfo -h -o %t 2>/dev/null)" = "idle" ] && break
   sleep 0.5

@@ -253,6 +253,35 @@ int main(void)
         CHECK(nl == 1 && fabs(uv[0][0] - 0.5) < cell_u && fabs(uv[0][1] - 0.5) < cell_v);
         gr_image_destroy(a);
         free(fl);
+
+        /* steep waves (data/scenes/hard/waves_near_loop.json): the sun seen through them breaks
+         * into separate glints; each light sits on a bright texel of the light pass */
+        snprintf(path, sizeof path, "%s/data/scenes/hard/waves_near_loop.json", src ? src : ".");
+        gr_scene *wl = malloc(sizeof *wl);
+        if (gr_scene_load_file(path, NULL, 0, wl, &err) != GR_OK) {
+            fprintf(stderr, "%s\n", err.msg);
+            return 1;
+        }
+        rb_test_settings(lc, wl, &s);
+        a = rb_test_render(lc, ls, wl, &s, NULL);
+        nl = gr_radial_blur_local_lights(ls, uv, 256);
+        gr_image *lt = NULL;
+        CHECK_OK(lc->read_target(ls, &lt, &err), err);
+        if (lt) {
+            double lmax = 0;
+            for (int i = 0; i < lt->width * lt->height; i++) lmax = fmax(lmax, lt->pixels[i * 4 + 2]);
+            for (int i = 0; i < nl; i++) {
+                int tx = (int)(uv[i][0] * lt->width), ty = (int)((1.0 - uv[i][1]) * lt->height);
+                float v = gr_image_pixel(lt, tx, ty)[2];
+                printf("glint light %d at (%.3f, %.3f): light pass %.3g of max %.3g\n", i, uv[i][0], uv[i][1], v, lmax);
+                CHECK(v > 0.05 * lmax);
+            }
+            gr_image_destroy(lt);
+        }
+        CHECK(nl >= 2);
+        preview(a, "radial_blur_local_waves", 1.0);
+        gr_image_destroy(a);
+        free(wl);
         lc->destroy(ls);
         gr_gl_destroy(gl2);
         free(sc);
