@@ -196,8 +196,8 @@ static void beam_bounds(const struct RTCBoundsFunctionArguments *args)
 
 typedef struct lookup_state {
     float u, y, w;           /* the point, sheared */
-    gr_beam_hit *hits;
-    int n, max, overflow;
+    gr_beam_hits *out;       /* grows as needed */
+    int oom;
 } lookup_state;
 
 /* The exact test of one primitive: is the point in the slab's height interval and in the
@@ -301,8 +301,17 @@ static void beam_test(const gr_beams *b, uint32_t prim, lookup_state *s)
     float path = l0 * d0 * v0->ity + l1 * d1 * v1->ity + l2 * d2 * v2->ity;
     if (path < 0.0f) return;
     if (!(e_h > 0.0f)) return;
-    if (s->n >= s->max) { s->overflow = 1; return; }
-    gr_beam_hit *h = &s->hits[s->n++];
+    gr_beam_hits *o = s->out;
+    if (o->n >= o->cap) {
+        /* the list grows: a point near a strong focus under fine cells lies in thousands of
+         * blurred footprints, and every one of them carries light */
+        int cap = o->cap ? 2 * o->cap : 64;
+        gr_beam_hit *nh = realloc(o->h, (size_t)cap * sizeof *nh);
+        if (!nh) { s->oom = 1; return; }
+        o->h = nh;
+        o->cap = cap;
+    }
+    gr_beam_hit *h = &o->h[o->n++];
     h->prim = prim;
     h->e_h = e_h;
     h->path_m = path;
@@ -390,8 +399,20 @@ static void beam_occluded(const struct RTCOccludedFunctionNArguments *args)
 }
 
 /* sort by primitive id: the sum over beams then has one order whatever the BVH */
+static int cmp_hit(const void *a, const void *b)
+{
+    unsigned x = ((const gr_beam_hit *)a)->prim, y = ((const gr_beam_hit *)b)->prim;
+    return (x > y) - (x < y);
+}
+
 static void sort_hits(gr_beam_hit *hits, int n)
 {
+    /* primitive ids are unique: any sort gives the same order; long lists (near a focus)
+     * must not cost n^2 */
+    if (n > 32) {
+        qsort(hits, (size_t)n, sizeof *hits, cmp_hit);
+        return;
+    }
     for (int i = 1; i < n; i++) {
         gr_beam_hit h = hits[i];
         int j = i - 1;
@@ -400,27 +421,33 @@ static void sort_hits(gr_beam_hit *hits, int n)
     }
 }
 
-int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hit *hits, int max_hits, int *overflow)
+void gr_beam_hits_free(gr_beam_hits *h)
 {
-    if (overflow) *overflow = 0;
+    if (!h) return;
+    free(h->h);
+    h->h = NULL;
+    h->n = h->cap = 0;
+}
+
+int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
+{
+    out->n = 0;
     if (!b || !b->bvh) return 0;
     lookup_state s;
     s.y = p.y;
     s.u = p.x - b->sx * p.y;
     s.w = p.z - b->sz * p.y;
-    s.hits = hits;
-    s.n = 0;
-    s.max = max_hits;
-    s.overflow = 0;
+    s.out = out;
+    s.oom = 0;
     struct RTCPointQuery q;
     q.x = s.u; q.y = s.y; q.z = s.w; q.time = 0.0f; q.radius = 0.0f;
     struct RTCPointQueryContext ctx;
     rtcInitPointQueryContext(&ctx);
     query_state qs = {b, &s};
     rtcPointQuery(b->bvh, &q, &ctx, beam_query, &qs);
-    sort_hits(hits, s.n);
-    if (overflow) *overflow = s.overflow;
-    return s.n;
+    if (s.oom) return -1;
+    sort_hits(out->h, out->n);
+    return out->n;
 }
 
 gr_beam_ray *gr_beam_ray_create(void) { return calloc(1, sizeof(gr_beam_ray)); }
@@ -515,23 +542,20 @@ int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, co
     return 0;
 }
 
-int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 p, gr_beam_hit *hits, int max_hits,
-                        int *overflow)
+int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 p, gr_beam_hits *out)
 {
-    if (overflow) *overflow = 0;
+    out->n = 0;
     if (!b || !b->bvh) return 0;
     lookup_state s;
     s.y = p.y;
     s.u = p.x - b->sx * p.y;
     s.w = p.z - b->sz * p.y;
-    s.hits = hits;
-    s.n = 0;
-    s.max = max_hits;
-    s.overflow = 0;
+    s.out = out;
+    s.oom = 0;
     for (int i = r->first[k]; i < r->first[k + 1]; i++) beam_test(b, r->bin[i], &s);
-    sort_hits(hits, s.n);
-    if (overflow) *overflow = s.overflow;
-    return s.n;
+    if (s.oom) return -1;
+    sort_hits(out->h, out->n);
+    return out->n;
 }
 
 static gr_status build_surface_mesh(gr_rtc *rtc, gr_beams *b, const gr_dvec3 *pos, gr_error *err)

@@ -79,10 +79,18 @@ typedef struct gr_beam_hit {
     gr_vec3 T;               /* unit refracted direction at the point (interpolated) */
 } gr_beam_hit;
 
+/* A growable list of hits (caller-owned, reused between lookups; zero-initialize it, free
+ * it with gr_beam_hits_free). It grows as needed: no lookup ever drops a beam. */
+typedef struct gr_beam_hits {
+    gr_beam_hit *h;
+    int n, cap;
+} gr_beam_hits;
+void gr_beam_hits_free(gr_beam_hits *h); /* accepts NULL */
+
 /* Finds every beam containing the local point p (with the disc convolution: every beam
- * whose disc-blurred footprint reaches p, e_h being the disc average); returns how many
- * (at most max_hits, *overflow set to 1 if more were found), sorted by primitive id. */
-int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hit *hits, int max_hits, int *overflow);
+ * whose disc-blurred footprint reaches p, e_h being the disc average) into out->h[0..n-1],
+ * sorted by primitive id; returns n, or -1 when out of memory. */
+int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out);
 
 /* The beams along one camera ray, for a march: one BVH traversal per ray instead of one
  * point query per march point, with the same hits as gr_beams_lookup at each point (the
@@ -97,8 +105,7 @@ void gr_beam_ray_destroy(gr_beam_ray *r);   /* accepts NULL */
 int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, const float *t, int npts,
                          gr_beam_ray *r);
 /* Every beam through march point k, p = o + t[k] d, like gr_beams_lookup. */
-int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 p, gr_beam_hit *hits, int max_hits,
-                        int *overflow);
+int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 p, gr_beam_hits *out);
 
 /* The kernel's geometry in its own units (the disc of directions = the unit disc), exposed
  * for tests: the fraction of the unit disc on the side c . n >= -s of a line at signed

@@ -17,12 +17,12 @@
 #include "core/gerstner.h"
 #include "core/optics.h"
 #include "core/rng.h"
+#include "core/student.h"
 #include "reference/beams.h"
 #include "reference/embree_scene.h"
 #include "reference/progress.h"
 #include "scene/settings.h"
 
-#define REF_MAX_HITS 256
 #define REF_DEFAULT_MAX_PRIMS ((size_t)16 * 1024 * 1024)
 #define REF_EXP_LIMIT 700.0 /* exp(-700) ~ 1e-304: below any image value, above denormals */
 
@@ -71,10 +71,18 @@ struct gr_ref_renderer {
     double beam_build_s;
     /* surface-bias probe: mean |bias| / mean (-1 = not estimated), its cost and size */
     double bias_rel, bias_probe_s;
+    double bias_ratio, bias_order; /* the probe's |L_4h - L_2h| / |L_2h - L_h| and the order p used */
+    double bias_rel_cons;     /* the same with the measured order (conservative) */
     gr_beam_stats main_beams; /* the main passes' last beam set (the probe builds others) */
     int have_main_beams;
     long long bias_probe_pixels;
     int bias_probe_passes;
+    /* per probe pixel (pw x ph, stride PROBE_STRIDE, offset poff), RGB: the signed Richardson
+     * estimate of the surface bias (bias.R/G/B channels; NULL when not estimated) */
+    float *bias_px;
+    int bias_pw, bias_ph, bias_poff;
+    double bias_block_p95;    /* 95th percentile of |block bias| / max(block mean, image mean) */
+    int bias_blocks;
 };
 
 void gr_ref_options_default(gr_ref_options *o)
@@ -287,6 +295,7 @@ void gr_ref_destroy(gr_ref_renderer *r)
 {
     if (!r) return;
     gr_beams_destroy(r->beams);
+    free(r->bias_px);
     gr_ref_geometry_destroy(r->geom);
     gr_rtc_destroy(r->rtc);
     free(r);
@@ -365,22 +374,38 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
 
 /* Sunlight arriving at the local point x: every beam through it under waves, the closed
  * form on flat water (and outside the lit region, where the waves' mean is used). With
- * `ray` (the beams collected along a camera ray), x must be the ray's march point k. */
-static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray, int k, ref_light *out,
-                    gr_beam_hit *hits, int *overflow)
+ * `ray` (the beams collected along a camera ray), x must be the ray's march point k. The
+ * lists grow as needed (no beam is ever dropped); returns the number of lights in
+ * *lights, or -1 when out of memory. */
+static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray, int k, ref_light **lights,
+                    int *lcap, gr_beam_hits *hits)
 {
+    if (*lcap < 1) {
+        ref_light *nl = realloc(*lights, 64 * sizeof *nl);
+        if (!nl) return -1;
+        *lights = nl;
+        *lcap = 64;
+    }
     if (!r->flat) {
         double u = x.x - r->sx * x.y, w = x.z - r->sz * x.y;
         const gr_beam_region *g = &r->region;
         if (x.y >= g->y_min && u >= g->u0 && u <= g->u1 && w >= g->w0 && w <= g->w1) {
-            int n = ray ? gr_beams_ray_lookup(r->beams, ray, k, x, hits, REF_MAX_HITS, overflow)
-                        : gr_beams_lookup(r->beams, x, hits, REF_MAX_HITS, overflow);
+            int n = ray ? gr_beams_ray_lookup(r->beams, ray, k, x, hits) : gr_beams_lookup(r->beams, x, hits);
+            if (n < 0) return -1;
+            if (n > *lcap) {
+                ref_light *nl = realloc(*lights, (size_t)n * sizeof *nl);
+                if (!nl) return -1;
+                *lights = nl;
+                *lcap = n;
+            }
+            ref_light *out = *lights;
             int m = 0;
             for (int i = 0; i < n; i++) {
-                if (!(hits[i].T.y < 0.0f)) continue;
-                out[m].T = hits[i].T;
-                out[m].eperp = hits[i].e_h / -hits[i].T.y; /* horizontal -> perpendicular to T */
-                out[m].path = hits[i].path_m;
+                const gr_beam_hit *h = &hits->h[i];
+                if (!(h->T.y < 0.0f)) continue;
+                out[m].T = h->T;
+                out[m].eperp = h->e_h / -h->T.y; /* horizontal -> perpendicular to T */
+                out[m].path = h->path_m;
                 m++;
             }
             return m;
@@ -388,6 +413,7 @@ static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray,
     }
     float depth = -x.y;
     if (!(depth > 0.0f)) return 0;
+    ref_light *out = *lights;
     out[0].T = r->Tp;
     out[0].eperp = r->flat_eperp;
     out[0].path = depth / r->mu_t;
@@ -396,22 +422,25 @@ static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray,
 
 double gr_ref_irradiance_h(const gr_ref_renderer *r, gr_dvec3 world)
 {
-    gr_beam_hit hits[REF_MAX_HITS];
-    ref_light l[REF_MAX_HITS];
-    int of = 0;
+    gr_beam_hits hits = {NULL, 0, 0};
+    ref_light *l = NULL;
+    int lcap = 0;
     gr_vec3 x = gr_d3_to_f(gr_d3_sub(world, r->origin));
-    int n = light_at(r, x, NULL, 0, l, hits, &of);
-    double e = 0.0;
+    int n = light_at(r, x, NULL, 0, &l, &lcap, &hits);
+    double e = n < 0 ? NAN : 0.0; /* out of memory: NaN, never a silently smaller value */
     for (int i = 0; i < n; i++) e += (double)l[i].eperp * -(double)l[i].T.y;
+    free(l);
+    gr_beam_hits_free(&hits);
     return e;
 }
 
 int gr_ref_beam_count(const gr_ref_renderer *r, gr_dvec3 world)
 {
     if (r->flat || !r->beams) return 0;
-    gr_beam_hit hits[REF_MAX_HITS];
-    int of = 0;
-    return gr_beams_lookup(r->beams, gr_d3_to_f(gr_d3_sub(world, r->origin)), hits, REF_MAX_HITS, &of);
+    gr_beam_hits hits = {NULL, 0, 0};
+    int n = gr_beams_lookup(r->beams, gr_d3_to_f(gr_d3_sub(world, r->origin)), &hits);
+    gr_beam_hits_free(&hits);
+    return n;
 }
 
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
@@ -451,10 +480,10 @@ typedef struct ref_job {
     atomic_int rows_done;
     atomic_int stop;
     /* per-thread counters, summed after the pass */
-    atomic_llong queries, shadow_rays, overflows;
+    atomic_llong queries, shadow_rays, max_hits; /* max_hits: the most beams at one point */
 } ref_job;
 
-typedef struct ref_counters { long long queries, shadow_rays, overflows; } ref_counters;
+typedef struct ref_counters { long long queries, shadow_rays, max_hits; } ref_counters;
 
 /* Stratum j of n over the pixel: an nx x ny grid of cells (nx the largest divisor of n not
  * above sqrt(n)); the sample is jittered within its cell. */
@@ -472,8 +501,9 @@ static void pixel_stratum(int j, int n, ref_rng *g, double *jx, double *jy)
  * sample is stratum j of the n camera samples its batch takes in this round. */
 /* Per-thread scratch memory of the march. */
 typedef struct ref_scratch {
-    gr_beam_hit *hits;
+    gr_beam_hits hits;   /* grow as needed */
     ref_light *lights;
+    int lcap;
     gr_beam_ray *ray;
     double *t;     /* march points along the ray (m) */
     float *tf;     /* the same in float, as the points are placed */
@@ -481,7 +511,7 @@ typedef struct ref_scratch {
 
 static void scratch_free(ref_scratch *sc)
 {
-    free(sc->hits);
+    gr_beam_hits_free(&sc->hits);
     free(sc->lights);
     gr_beam_ray_destroy(sc->ray);
     free(sc->t);
@@ -490,22 +520,22 @@ static void scratch_free(ref_scratch *sc)
 
 static int scratch_alloc(ref_scratch *sc, int steps)
 {
-    sc->hits = malloc(REF_MAX_HITS * sizeof *sc->hits);
-    sc->lights = malloc(REF_MAX_HITS * sizeof *sc->lights);
+    memset(sc, 0, sizeof *sc);
+    sc->lights = malloc(64 * sizeof *sc->lights);
+    sc->lcap = 64;
     sc->ray = gr_beam_ray_create();
     sc->t = malloc((size_t)steps * sizeof *sc->t);
     sc->tf = malloc((size_t)steps * sizeof *sc->tf);
-    if (sc->hits && sc->lights && sc->ray && sc->t && sc->tf) return 0;
+    if (sc->lights && sc->ray && sc->t && sc->tf) return 0;
     scratch_free(sc);
     memset(sc, 0, sizeof *sc);
     return -1;
 }
 
-static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, ref_rng *g, double L[3],
-                          double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
+/* Returns 0, or -1 when out of memory (a growing hit list). */
+static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, ref_rng *g, double L[3],
+                         double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
 {
-    gr_beam_hit *hits = sc->hits;
-    ref_light *lights = sc->lights;
     const gr_camera *c = &r->scene.camera;
     double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), aspect = (double)c->width / (double)c->height;
     double jx, jy;
@@ -525,7 +555,7 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n
     if (!(D > 0.0f)) D = 0.0f;
     *len = D;
     *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
-    if (D == 0.0f) return;
+    if (D == 0.0f) return 0;
     int n = r->set.steps;
     /* March density ~ exp(-lam t) on [0, D], lam = sig_ref (1 - w_y / mu_t0): the camera
      * ray's extinction times the sunlight's extinction down to the point on flat water, so
@@ -552,12 +582,12 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n
     for (int k = 0; k < n; k++) {
         double t = sc->t[k];
         gr_vec3 x = gr_v3_madd(o, d, sc->tf[k]);
-        int of = 0;
-        int m = light_at(r, x, ray, k, lights, hits, &of);
+        int m = light_at(r, x, ray, k, &sc->lights, &sc->lcap, &sc->hits);
+        if (m < 0) return -1;
         cnt->queries++;
-        cnt->overflows += of;
+        if (m > cnt->max_hits) cnt->max_hits = m;
         for (int i = 0; i < m; i++) {
-            const ref_light *l = &lights[i];
+            const ref_light *l = &sc->lights[i];
             if (r->geom->shadow) {
                 cnt->shadow_rays++;
                 if (gr_ref_shadowed(r->geom, x, gr_v3_scale(l->T, -1.0f), l->path)) continue;
@@ -573,6 +603,7 @@ static void render_sample(const gr_ref_renderer *r, int px, int py, int j, int n
             }
         }
     }
+    return 0;
 }
 
 static void *worker(void *arg)
@@ -587,6 +618,7 @@ static void *worker(void *arg)
     ref_accum *acc = job->acc;
     ref_scratch sc;
     ref_counters cnt = {0, 0, 0};
+    int oom = 0;
     /* camera samples are stratified over the pixel within a batch (like the passes' strata):
      * this pass is the k-th of its batch in the round */
     int per_batch = r->passes_per_round / r->batches, k_in_batch = (job->pass % r->passes_per_round) / r->batches;
@@ -610,8 +642,11 @@ static void *worker(void *arg)
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
-                render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, &g, L, &tr, &len, &cnt,
-                              &sc);
+                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, &g, L, &tr, &len,
+                                  &cnt, &sc) != 0) {
+                    oom = 1;
+                    break;
+                }
                 sum[0] += L[0];
                 sum[1] += L[1];
                 sum[2] += L[2];
@@ -621,13 +656,19 @@ static void *worker(void *arg)
                     acc->aov[ai * 2 + 1] += len;
                 }
             }
+            if (oom) break;
+        }
+        if (oom) {
+            atomic_store(&job->stop, 2); /* out of memory: the pass fails, nothing is dropped */
+            break;
         }
         if (r->opt.interrupt && *r->opt.interrupt) break; /* the row may be unfinished: not counted */
         atomic_fetch_add(&job->rows_done, 1);
     }
     atomic_fetch_add(&job->queries, cnt.queries);
     atomic_fetch_add(&job->shadow_rays, cnt.shadow_rays);
-    atomic_fetch_add(&job->overflows, cnt.overflows);
+    long long mh = atomic_load(&job->max_hits);
+    while (cnt.max_hits > mh && !atomic_compare_exchange_weak(&job->max_hits, &mh, cnt.max_hits)) {}
     scratch_free(&sc);
     return NULL;
 }
@@ -657,6 +698,15 @@ static int cmp_by_value(const void *a, const void *b)
 }
 
 typedef struct ref_errors { double rel_mean, rel_p95, frac_1pct, mean, p95; } ref_errors;
+
+/* --target-error E: the relative standard errors come from B batch means, B - 1 degrees of
+ * freedom; the target is met when their Student-t 95 % half-widths are within those a
+ * known standard error E would give, t_{0.975, B-1} se <= 1.96 E (docs/reference.md). */
+static int target_met(const ref_errors *e, int batches, double target)
+{
+    double k = gr_student_t975(batches - 1) / GR_NORMAL_Q975;
+    return k * e->rel_mean < target && k * e->rel_p95 < target;
+}
 
 /* Image-level error estimates from the batch images (docs/reference.md, "Error bars"). */
 static gr_status image_errors(const ref_accum *acc, ref_errors *e)
@@ -744,11 +794,18 @@ static gr_status image_errors(const ref_accum *acc, ref_errors *e)
     return GR_OK;
 }
 
+static float bias_at(const gr_ref_renderer *r, int x, int y, int c);
+
 static gr_status build_image(const gr_ref_renderer *r, const ref_accum *acc, gr_ref_result *out, gr_error *err)
 {
     static const char *const names[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "transmittance", "ray_length"};
-    int nch = acc->aov ? 8 : 6, B = acc->B;
-    gr_image *img = gr_image_create(acc->W, acc->H, nch, names);
+    static const char *const names_b[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "bias.R", "bias.G", "bias.B"};
+    static const char *const names_ab[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "transmittance", "ray_length",
+                                           "bias.R", "bias.G", "bias.B"};
+    /* bias.R/G/B (the surface-bias probe's signed estimate of the pixel's 5 x 5 block) come last */
+    int bias = r->bias_px != NULL && r->bias_pw > 0 && r->bias_ph > 0;
+    int nch = (acc->aov ? 8 : 6) + (bias ? 3 : 0), B = acc->B;
+    gr_image *img = gr_image_create(acc->W, acc->H, nch, bias ? (acc->aov ? names_ab : names_b) : names);
     if (!img) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for a %dx%d image", acc->W, acc->H);
     uint32_t min_n = UINT32_MAX;
     for (int y = 0; y < acc->H; y++)
@@ -780,10 +837,11 @@ static gr_status build_image(const gr_ref_renderer *r, const ref_accum *acc, gr_
                 px[6] = n ? (float)(acc->aov[p * 2] / n) : 0.0f;
                 px[7] = n ? (float)(acc->aov[p * 2 + 1] / n) : 0.0f;
             }
+            if (bias)
+                for (int c = 0; c < 3; c++) px[nch - 3 + c] = bias_at(r, x, y, c);
         }
     out->image = img;
     out->spp = min_n == UINT32_MAX ? 0 : (int)min_n;
-    (void)r;
     return GR_OK;
 }
 
@@ -836,32 +894,48 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     /* bias next to the noise (docs/reference.md section 4): the surface tessellation is the
      * only discretization bias; measured on this scene by the probe (surface_bias_probe) */
     SET(gr_meta_set_double(m, "godrays:bias_surface_rel_est", finite_or(r->bias_rel, -1.0)));
-    /* the bound: twice the estimate; unit.ref_convergence checks that the probe lies within a
-     * factor 2 of the bias measured against a 2x finer tessellation */
-    SET(gr_meta_set_double(m, "godrays:bias_surface_rel_bound", r->bias_rel >= 0.0 ? finite_or(2.0 * r->bias_rel, -1.0) : -1.0));
+    if (r->bias_rel >= 0.0 && !r->flat) SET(gr_meta_set_double(m, "godrays:bias_surface_order", finite_or(r->bias_order, -1.0)));
+    /* the bound: twice the estimate (unit.ref_convergence checks that the estimate is at least
+     * half the bias measured against a 2x finer tessellation), or the figure with the measured
+     * order where that is larger (cells that do not resolve the waves yet: docs/reference.md) */
+    SET(gr_meta_set_double(m, "godrays:bias_surface_rel_bound",
+                           r->bias_rel >= 0.0 ? finite_or(r->flat ? 0.0 : fmax(2.0 * r->bias_rel, r->bias_rel_cons), -1.0) : -1.0));
+    if (r->bias_rel >= 0.0 && !r->flat)
+        SET(gr_meta_set_double(m, "godrays:bias_surface_rel_measured_order", finite_or(r->bias_rel_cons, -1.0)));
     if (r->flat)
         snprintf(buf, sizeof buf, "none: flat water takes the closed form (no tessellation)");
     else if (r->bias_rel >= 0.0)
         snprintf(buf, sizeof buf,
-                 "Richardson (O(h^2)) from %lld pixels (every %dth) x %d passes at surface_res %d and %d, %.2f s",
+                 "Richardson from %lld pixels (every %dth) x %d passes at surface_res %d, %d and %d: difference ratio "
+                 "%.2f, measured order %.2f (clamped to [1, 2]), %.2f s",
                  r->bias_probe_pixels, PROBE_STRIDE, r->bias_probe_passes, r->set.surface_res,
-                 r->set.surface_res / 2 > 2 ? r->set.surface_res / 2 : 2, r->bias_probe_s);
+                 r->set.surface_res / 2 > 2 ? r->set.surface_res / 2 : 2, r->set.surface_res / 4 > 2 ? r->set.surface_res / 4 : 2,
+                 r->bias_ratio, r->bias_order, r->bias_probe_s);
     else
         snprintf(buf, sizeof buf, "not estimated (reference.bias_probe = false or interrupted); -1");
     SET(gr_meta_set_string(m, "godrays:bias_surface_probe", buf));
+    /* per-block bias next to the mean's (bias.R/G/B channels; 10 x 10 pixel blocks) */
+    SET(gr_meta_set_double(m, "godrays:bias_block_p95_rel", r->bias_px ? finite_or(r->bias_block_p95, -1.0) : (r->flat ? 0.0 : -1.0)));
+    SET(gr_meta_set_int(m, "godrays:stderr_dof", r->batches - 1));
     SET(gr_meta_set_string(m, "godrays:bias_note",
                            "bias_surface_rel_est = mean |pixel bias| / image mean from the surface tessellation "
-                           "(measured here, see bias_surface_probe; bound = 2x the estimate); march steps: "
+                           "(measured here with order 2, see bias_surface_probe; bound = max(2x the estimate, the figure with "
+                           "the measured order, bias_surface_rel_measured_order); bias.* channels and bias_block_p95_rel "
+                           "use the measured order; march steps: "
                            "unbiased (jittered strata), noise only; sun disc: convolved to first order, error "
                            "below 0.3 % L1 (sun_disc = sample: unbiased); cutoff tail <= transmittance_cutoff * "
                            "S_max / sigma_t (docs/reference.md)"));
     SET(gr_meta_set_string(m, "godrays:error_bars",
-                           "stderr.* channels: batch-mean spread (noise only); discretization bias: docs/reference.md"));
+                           r->bias_px ? "stderr.* channels: batch-mean spread (noise only; Student t with stderr_dof "
+                                        "degrees of freedom); bias.* channels: the surface bias of the pixel's 5x5 block "
+                                        "(signed Richardson estimate from the probe; |bias| + t stderr bounds the error)"
+                                      : "stderr.* channels: batch-mean spread (noise only; Student t with stderr_dof "
+                                        "degrees of freedom); discretization bias: docs/reference.md"));
 #undef SET
     return st;
 }
 
-typedef struct ref_march_totals { double march_s; long long queries, shadows, overflows; } ref_march_totals;
+typedef struct ref_march_totals { double march_s; long long queries, shadows, max_hits; } ref_march_totals;
 
 /* Marches one pass over the rows [y0, y1) of acc with r->threads workers (thread handles in th),
  * the progress bar going from frac0 to frac0 + span. *complete = 0 when interrupted. */
@@ -883,7 +957,7 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
     atomic_init(&job.stop, 0);
     atomic_init(&job.queries, 0);
     atomic_init(&job.shadow_rays, 0);
-    atomic_init(&job.overflows, 0);
+    atomic_init(&job.max_hits, 0);
     *complete = 0;
     double tm = mono_s();
     int started = 0;
@@ -906,33 +980,66 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
     tot->march_s += mono_s() - tm;
     tot->queries += atomic_load(&job.queries);
     tot->shadows += atomic_load(&job.shadow_rays);
-    tot->overflows += atomic_load(&job.overflows);
+    if (atomic_load(&job.max_hits) > tot->max_hits) tot->max_hits = atomic_load(&job.max_hits);
     if (atomic_load(&job.stop) == 2) return gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
     *complete = atomic_load(&job.rows_done) >= y1 - y0;
     return GR_OK;
 }
 
 /* Surface-bias probe (docs/reference.md, section 4). Every PROBE_STRIDE-th pixel in x and y
- * is rendered again for the first PROBE_PASSES passes, once with the beam sets of surface_res
- * (cell h) and once with those of surface_res / 2 (2h), from the same random numbers (camera
- * samples, march steps, sun directions, grid offsets in cells). The tessellation's error is
- * O(h^2) (section 2.2), so Richardson's extrapolation gives the bias at h per pixel as
- * (L_2h - L_h) / 3; r->bias_rel = the mean of its absolute value over the probe pixels
- * divided by their mean value: the same figure as the convergence study's table. What noise
- * the common random numbers leave in the difference makes it an overestimate. */
-/* The probe's estimate from its two accumulators of np pixels (sums at h and at 2h). */
-static double probe_bias(const double *sum_h, const uint32_t *cnt_h, const double *sum_2h, const uint32_t *cnt_2h,
-                         size_t np)
+ * is rendered again for the first PROBE_PASSES passes with the beam sets of surface_res
+ * (cell h), surface_res / 2 (2h) and surface_res / 4 (4h), from the same random numbers
+ * (camera samples, march steps, grid offsets in cells). The tessellation's error is O(h^p),
+ * p = 2 once the cells resolve the waves (section 2.2), less before: the order is measured
+ * from the three levels, r = mean |L_4h - L_2h| / mean |L_2h - L_h|, p = log2 r clamped to
+ * [1, 2] (clamping p at 2 when r > 4 overestimates; noise in the differences flattens r and
+ * also overestimates). Richardson then gives the bias at h per pixel as
+ * (L_2h - L_h) / (2^p - 1); r->bias_rel = the mean of its absolute value over the probe
+ * pixels divided by their mean value: the same figure as the convergence study's table. */
+/* The probe's figures from its per-level sums (np probe pixels, [pixel * 3 + c]; level k has
+ * cells 2^k h): the estimate (order 2), the figure with the measured order, the order, and
+ * the per-pixel signed estimates (bias channels). Shared by gr_ref_render and
+ * gr_ref_assemble, so that merged parts give the same bytes. */
+static int probe_stats(gr_ref_renderer *r, double *const sum[3], uint32_t *const cnt[3], size_t np, int pw, int ph,
+                       int off)
 {
-    double d = 0.0, v = 0.0;
+    enum { NL = 3 };
+    float *bpx = malloc(np * 3 * sizeof *bpx + 1);
+    if (!bpx) return -1;
+    double d1 = 0.0, d2 = 0.0, v = 0.0;
     for (size_t i = 0; i < np; i++) {
-        if (!cnt_h[i] || !cnt_2h[i]) continue;
-        double lh = (sum_h[3 * i] + sum_h[3 * i + 1] + sum_h[3 * i + 2]) / (3.0 * cnt_h[i]);
-        double l2h = (sum_2h[3 * i] + sum_2h[3 * i + 1] + sum_2h[3 * i + 2]) / (3.0 * cnt_2h[i]);
-        d += fabs(l2h - lh) / 3.0; /* Richardson, p = 2: e_h = (L_2h - L_h) / (2^2 - 1) */
-        v += lh;
+        double l[NL] = {0.0, 0.0, 0.0};
+        for (int k = 0; k < NL; k++)
+            for (int c = 0; c < 3; c++) l[k] += cnt[k][i] ? sum[k][i * 3 + c] / (3.0 * cnt[k][i]) : 0.0;
+        d1 += fabs(l[1] - l[0]);
+        d2 += fabs(l[2] - l[1]);
+        v += l[0];
     }
-    return v > 0.0 && isfinite(d) ? d / v : (d > 0.0 ? -1.0 : 0.0);
+    /* the measured order of convergence, clamped to [1, 2] */
+    double ratio = d1 > 0.0 ? d2 / d1 : 4.0, order = ratio > 0.0 ? log2(ratio) : 2.0;
+    if (!(order <= 2.0)) order = 2.0;
+    if (!(order >= 1.0)) order = 1.0;
+    double div = pow(2.0, order) - 1.0; /* Richardson: e_h = (L_2h - L_h) / (2^p - 1) */
+    for (size_t i = 0; i < np; i++)
+        for (int c = 0; c < 3; c++) {
+            double lh = cnt[0][i] ? sum[0][i * 3 + c] / cnt[0][i] : 0.0, l2h = cnt[1][i] ? sum[1][i * 3 + c] / cnt[1][i] : 0.0;
+            double e = (l2h - lh) / div; /* signed, per channel */
+            bpx[i * 3 + c] = isfinite(e) ? (float)e : 0.0f;
+        }
+    /* the estimate: the asymptotic order 2 (divide by 3); the conservative figure: the
+     * measured order (convergence accelerates as h shrinks, so the order measured on the
+     * coarser pair is a lower bound of the order at h and the figure an upper one) */
+    r->bias_rel = v > 0.0 && isfinite(d1) ? d1 / 3.0 / v : (d1 > 0.0 ? -1.0 : 0.0);
+    r->bias_rel_cons = v > 0.0 && isfinite(d1) ? d1 / div / v : (d1 > 0.0 ? -1.0 : 0.0);
+    r->bias_ratio = ratio;
+    r->bias_order = order;
+    r->bias_probe_pixels = (long long)np;
+    free(r->bias_px);
+    r->bias_px = bpx;
+    r->bias_pw = pw;
+    r->bias_ph = ph;
+    r->bias_poff = off;
+    return 0;
 }
 
 /* First probe row at or below image row `row` (rows py = y stride + off). */
@@ -945,20 +1052,22 @@ static int probe_row(int row, int stride, int off, int h)
 static gr_status surface_bias_probe(gr_ref_renderer *r, gr_ref_sums *keep, pthread_t *th, gr_progress *prog, double frac0, double span,
                                     ref_march_totals *tot, gr_error *err)
 {
+    enum { NL = 3 }; /* levels h, 2h, 4h */
     int W = r->scene.camera.width, H = r->scene.camera.height;
     int off = W > PROBE_STRIDE / 2 && H > PROBE_STRIDE / 2 ? PROBE_STRIDE / 2 : 0;
-    ref_accum a[2];
+    int res = r->set.surface_res, lres[NL];
+    for (int k = 0; k < NL; k++) lres[k] = (res >> k) > 2 ? res >> k : 2;
+    int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
+    ref_accum a[NL];
     memset(a, 0, sizeof a);
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < NL; k++) {
         a[k].W = (W - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
         a[k].H = (H - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
-        a[k].B = 1;
+        a[k].B = 1; /* the passes summed: the sums a part file carries (src/farm/parts.h) */
     }
     size_t np = (size_t)a[0].W * a[0].H;
-    int res = r->set.surface_res, res2 = res / 2 > 2 ? res / 2 : 2;
-    int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
     gr_status st = GR_OK;
-    for (int k = 0; k < 2 && st == GR_OK; k++) {
+    for (int k = 0; k < NL && st == GR_OK; k++) {
         a[k].sum = calloc(np * 3, sizeof *a[k].sum);
         a[k].count = calloc(np, sizeof *a[k].count);
         if (!a[k].sum || !a[k].count) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
@@ -967,26 +1076,29 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, gr_ref_sums *keep, pthre
     /* a part probes its own rows' probe pixels */
     int y0 = probe_row(r->opt.row0, PROBE_STRIDE, off, a[0].H), y1 = probe_row(r->opt.row1, PROBE_STRIDE, off, a[0].H);
     for (int p = 0; p < passes && st == GR_OK && complete; p++)
-        for (int k = 0; k < 2 && st == GR_OK && complete; k++) {
-            r->set.surface_res = k ? res2 : res;
+        for (int k = 0; k < NL && st == GR_OK && complete; k++) {
+            r->set.surface_res = lres[k];
             r->beams_pass = -1; /* another resolution: rebuild */
             st = gr_ref_prepare_pass(r, p, err);
             if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; break; }
             if (st == GR_OK)
-                st = march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, y0, y1, th, prog, frac0 + span * (2 * p + k) / (2.0 * passes),
-                                span / (2.0 * passes), "surface-bias probe", tot, &complete, err);
+                st = march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, y0, y1, th, prog,
+                                frac0 + span * (NL * p + k) / (NL * (double)passes), span / (NL * (double)passes),
+                                "surface-bias probe", tot, &complete, err);
         }
     r->set.surface_res = res;
     r->beams_pass = -1;
     if (st == GR_OK && complete) {
-        r->bias_rel = probe_bias(a[0].sum, a[0].count, a[1].sum, a[1].count, np);
-        r->bias_probe_pixels = (long long)np;
+        double *sums[NL] = {a[0].sum, a[1].sum, a[2].sum};
+        uint32_t *cnts[NL] = {a[0].count, a[1].count, a[2].count};
+        if (probe_stats(r, sums, cnts, np, a[0].W, a[0].H, off) != 0)
+            st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
         r->bias_probe_passes = passes;
-        if (keep) { /* hand the sums over */
+        if (st == GR_OK && keep) { /* hand the sums over */
             keep->probe_w = a[0].W;
             keep->probe_h = a[0].H;
-            keep->probe_levels = 2;
-            for (int k = 0; k < 2; k++) {
+            keep->probe_levels = NL;
+            for (int k = 0; k < NL; k++) {
                 free(keep->probe_sum[k]);
                 free(keep->probe_count[k]);
                 keep->probe_sum[k] = a[k].sum;
@@ -1000,11 +1112,57 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, gr_ref_sums *keep, pthre
             keep->probe_passes = passes;
         }
     }
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < NL; k++) {
         free(a[k].sum);
         free(a[k].count);
     }
     return st;
+}
+
+/* The surface-bias estimate of image pixel (x, y), channel c: that of its probe pixel (the
+ * PROBE_STRIDE x PROBE_STRIDE block it lies in). */
+static float bias_at(const gr_ref_renderer *r, int x, int y, int c)
+{
+    int i = x / PROBE_STRIDE, j = y / PROBE_STRIDE;
+    if (i >= r->bias_pw) i = r->bias_pw - 1;
+    if (j >= r->bias_ph) j = r->bias_ph - 1;
+    return r->bias_px[((size_t)j * r->bias_pw + (size_t)i) * 3 + c];
+}
+
+/* Block bias: over blocks of 2 x 2 probe pixels (10 x 10 image pixels), the mean of the probe
+ * pixels' signed estimates (RGB mean) relative to max(block mean, image mean) (the same
+ * normalization as the 1 % standard-error figure); the 95th percentile of its magnitude. The
+ * probe's residual noise enters the magnitude: an overestimate, not an underestimate. */
+static void block_bias(gr_ref_renderer *r, const gr_image *img, double image_mean)
+{
+    r->bias_block_p95 = -1.0;
+    r->bias_blocks = 0;
+    if (!r->bias_px || !img) return;
+    int bw = (r->bias_pw + 1) / 2, bh = (r->bias_ph + 1) / 2, bs = 2 * PROBE_STRIDE;
+    double *v = malloc((size_t)bw * bh * sizeof *v);
+    if (!v) return;
+    size_t n = 0;
+    for (int J = 0; J < bh; J++)
+        for (int I = 0; I < bw; I++) {
+            double b = 0.0, m = 0.0;
+            int nb = 0, nm = 0;
+            for (int j = 2 * J; j < 2 * J + 2 && j < r->bias_ph; j++)
+                for (int i = 2 * I; i < 2 * I + 2 && i < r->bias_pw; i++, nb++)
+                    for (int c = 0; c < 3; c++) b += r->bias_px[((size_t)j * r->bias_pw + (size_t)i) * 3 + c] / 3.0;
+            for (int y = J * bs; y < (J + 1) * bs && y < img->height; y++)
+                for (int x = I * bs; x < (I + 1) * bs && x < img->width; x++, nm++) {
+                    const float *px = gr_image_pixel((gr_image *)img, x, y);
+                    m += (px[0] + px[1] + px[2]) / 3.0;
+                }
+            if (!nb || !nm) continue;
+            double den = fmax(m / nm, image_mean);
+            if (den > 0.0) v[n++] = fabs(b / nb) / den;
+        }
+    if (n) {
+        r->bias_block_p95 = percentile(v, n, 0.95);
+        r->bias_blocks = (int)n;
+    }
+    free(v);
 }
 
 /* The end of a render from its sums: image, error bars, statistics, metadata (shared by
@@ -1020,6 +1178,9 @@ static gr_status finish_result(gr_ref_renderer *r, const ref_accum *acc, const r
     if (image_errors(acc, &e) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
     if (st == GR_OK) st = build_image(r, acc, out, err);
     if (st != GR_OK) return st;
+    block_bias(r, out->image, e.mean);
+    out->bias_block_p95 = r->bias_block_p95;
+    out->target_met = r->set.target_error > 0.0 ? target_met(&e, acc->B, r->set.target_error) : 1;
     out->wall_s = wall_s;
     out->rel_se_mean = e.rel_mean;
     out->rel_se_p95 = e.rel_p95;
@@ -1045,7 +1206,8 @@ static gr_status finish_result(gr_ref_renderer *r, const ref_accum *acc, const r
     if (fill_metadata(r, out, &e, out->queries_per_s) != GR_OK)
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for metadata");
     gr_meta_set_double(&out->meta, "godrays:shadow_rays_per_s", out->shadow_rays_per_s);
-    gr_meta_set_int(&out->meta, "godrays:beam_overflows", tot->overflows);
+    /* the most beams at one march point (the list grows; -1: not carried through parts) */
+    gr_meta_set_int(&out->meta, "godrays:beam_max_hits", tot->max_hits);
     return GR_OK;
 }
 
@@ -1139,7 +1301,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         if (st != GR_OK || out->partial) break;
         if (rounds > 1) {
             if (image_errors(&acc, &e) != GR_OK) { st = gr_fail(err, GR_E_NOMEM, "reference: out of memory"); break; }
-            if (e.rel_mean < r->set.target_error && e.rel_p95 < r->set.target_error) break;
+            if (target_met(&e, acc.B, r->set.target_error)) break;
         }
     }
     /* the tessellation's bias, measured on this scene (flat water has none: closed form) */
@@ -1156,6 +1318,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     gr_progress_finish(prog);
     gr_progress_destroy(prog);
     free(th);
+    if (st == GR_OK && (r->flat || out->partial || !probe)) { free(r->bias_px); r->bias_px = NULL; }
     if (st == GR_OK) st = finish_result(r, &acc, &tot, mono_s() - t0, out, err);
     if (st == GR_OK && keep) { /* the raw sums for a part file (src/farm/parts.h) */
         keep->W = acc.W;
@@ -1173,7 +1336,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         keep->march_s = tot.march_s;
         keep->queries = tot.queries;
         keep->shadows = tot.shadows;
-        keep->overflows = tot.overflows;
+        keep->overflows = 0; /* nothing overflows: the hit list grows */
         out->sums = keep;
         keep = NULL;
     }
@@ -1194,13 +1357,16 @@ gr_status gr_ref_assemble(gr_ref_renderer *r, const gr_ref_sums *sums, double wa
                        sums->W, sums->H, sums->B, r->scene.camera.width, r->scene.camera.height, r->batches);
     ref_accum acc = {sums->W, sums->H, sums->B, sums->sum, sums->count, NULL};
     r->bias_rel = r->flat ? 0.0 : -1.0;
-    if (sums->probe && sums->probe_levels != 2)
-        return gr_fail(err, GR_E_INPUT, "reference: sums with %d probe levels; this integrator's probe has 2",
+    free(r->bias_px);
+    r->bias_px = NULL;
+    if (sums->probe && sums->probe_levels != 3)
+        return gr_fail(err, GR_E_INPUT, "reference: sums with %d probe levels; this integrator's probe has 3",
                        sums->probe_levels);
     if (sums->probe && !r->flat) {
-        r->bias_rel = probe_bias(sums->probe_sum[0], sums->probe_count[0], sums->probe_sum[1], sums->probe_count[1],
-                                 (size_t)sums->probe_w * sums->probe_h);
-        r->bias_probe_pixels = (long long)sums->probe_w * sums->probe_h;
+        int off = r->scene.camera.width > PROBE_STRIDE / 2 && r->scene.camera.height > PROBE_STRIDE / 2 ? PROBE_STRIDE / 2 : 0;
+        if (probe_stats(r, sums->probe_sum, sums->probe_count, (size_t)sums->probe_w * sums->probe_h, sums->probe_w,
+                        sums->probe_h, off) != 0)
+            return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
         r->bias_probe_passes = sums->probe_passes;
         r->bias_probe_s = sums->probe_s;
     }
@@ -1210,7 +1376,7 @@ gr_status gr_ref_assemble(gr_ref_renderer *r, const gr_ref_sums *sums, double wa
     r->main_beams.prims = (size_t)sums->beam_prims;
     r->beam_build_s = sums->beam_build_s;
     out->passes = sums->passes;
-    ref_march_totals tot = {sums->march_s, sums->queries, sums->shadows, sums->overflows};
+    ref_march_totals tot = {sums->march_s, sums->queries, sums->shadows, -1};
     gr_status st = finish_result(r, &acc, &tot, wall_s, out, err);
     if (st != GR_OK) gr_ref_result_free(out);
     return st;
@@ -1236,8 +1402,7 @@ long long gr_ref_surface_triangles(const gr_ref_renderer *r)
 double gr_ref_lookup_rate(const gr_ref_renderer *r, const double box[6], int n)
 {
     if (r->flat || !r->beams || n < 1) return 0.0;
-    gr_beam_hit *hits = malloc(REF_MAX_HITS * sizeof *hits);
-    if (!hits) return 0.0;
+    gr_beam_hits hits = {NULL, 0, 0};
     gr_rng g = gr_rng_make(42, 2, 0);
     long long found = 0;
     double t0 = mono_s();
@@ -1245,11 +1410,10 @@ double gr_ref_lookup_rate(const gr_ref_renderer *r, const double box[6], int n)
         double y = box[4] + (box[5] - box[4]) * gr_rng_double(&g);
         double u = box[0] + (box[1] - box[0]) * gr_rng_double(&g), w = box[2] + (box[3] - box[2]) * gr_rng_double(&g);
         gr_vec3 p = gr_v3((float)(u + r->sx * y), (float)y, (float)(w + r->sz * y));
-        int of = 0;
-        found += gr_beams_lookup(r->beams, p, hits, REF_MAX_HITS, &of);
+        found += gr_beams_lookup(r->beams, p, &hits);
     }
     double dt = mono_s() - t0;
-    free(hits);
+    gr_beam_hits_free(&hits);
     (void)found;
     return dt > 0.0 ? n / dt : 0.0;
 }

@@ -78,7 +78,8 @@ gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_levels, int probe
 void gr_ref_sums_destroy(gr_ref_sums *s); /* accepts NULL */
 
 typedef struct gr_ref_result {
-    gr_image *image;        /* R, G, B, stderr.R, stderr.G, stderr.B [, transmittance, ray_length] */
+    gr_image *image;        /* R, G, B, stderr.R, stderr.G, stderr.B [, transmittance, ray_length]
+                               [, bias.R, bias.G, bias.B] (with the surface-bias probe) */
     gr_metadata meta;       /* "godrays:*" keys: settings, samples, errors, timings */
     int partial;            /* 1 if interrupted: fewer samples than asked */
     int spp;                /* camera samples per pixel actually taken (pixels done last) */
@@ -94,6 +95,9 @@ typedef struct gr_ref_result {
     int rounds, max_rounds; /* rounds of passes done; the cap that --target-error refines up to */
     double bias_surface_rel;/* surface-tessellation bias: mean |pixel bias| / image mean,
                                measured by the probe (0 on flat water, -1 if not estimated) */
+    double bias_block_p95;  /* 95th percentile over 10x10-pixel blocks of |block bias| / max(block
+                               mean, image mean) (-1 if not estimated) */
+    int target_met;         /* --target-error: 1 when met (Student t, batches - 1 dof); 1 if off */
     gr_ref_sums *sums;      /* with gr_ref_options.keep_sums: the raw sums (freed with the result) */
 } gr_ref_result;
 

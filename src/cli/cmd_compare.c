@@ -22,6 +22,7 @@
 #include "report/profile.h"
 #include "scene/scene.h"
 #include "compare/metrics.h"
+#include "image/exr.h"
 #include "compare/metrics_io.h"
 #include "image/oiio.h"
 #include "report/report.h"
@@ -117,14 +118,16 @@ static cJSON *image_json(const char *path, const gr_image *img, const int rgb[3]
     return o;
 }
 
-/* Every compared sample of img is 0: a "perfect" fit (a = 0, RMSE 0, PSNR inf, SSIM 1) that
- * means nothing. */
-static int all_zero(const gr_image *img, const int rgb[3])
+/* Every sample of img's channels other than stderr.* is 0: the metrics would give a "perfect"
+ * fit (a = 0, RMSE 0, PSNR inf, SSIM 1) that means nothing. */
+static int all_zero(const gr_image *img)
 {
     const size_t n = (size_t)img->width * (size_t)img->height, nc = (size_t)img->nchannels;
-    for (size_t p = 0; p < n; p++)
-        for (int k = 0; k < 3; k++)
-            if (img->pixels[p * nc + (size_t)rgb[k]] != 0.0f) return 0;
+    for (size_t c = 0; c < nc; c++) {
+        if (!strncmp(img->names[c], "stderr.", 7)) continue;
+        for (size_t p = 0; p < n; p++)
+            if (img->pixels[p * nc + c] != 0.0f) return 0;
+    }
     return 1;
 }
 
@@ -146,6 +149,7 @@ int cmd_compare(int argc, char **argv)
     const char *scene_path = NULL, *sets[32];
     int n_sets = 0;
     int flip_mode = -1; /* -1: from REF's file extension */
+    char flip_skipped[GR_ERROR_MSG_MAX] = "";
     gr_metrics_options opt = {0};
     gr_flip_options fopt = {0};
     gr_args args; /* no overrides: nothing to free */
@@ -230,6 +234,8 @@ int cmd_compare(int argc, char **argv)
                 fopt.exposures_given = 1, fopt.start_exposure = e0, fopt.stop_exposure = e1, fopt.n_exposures = k;
             }
         } else if (!strcmp(a, "--max-memory")) {
+            const int vrc = gr_args_value(&args, &v);
+            if (vrc) return vrc;
             gr_error merr;
             double bytes;
             if (gr_memlimit_parse("--max-memory", v, &bytes, &merr) != GR_OK) return gr_cli_usage_error(cmd, "%s", merr.msg);
@@ -285,15 +291,64 @@ int cmd_compare(int argc, char **argv)
     }
     if (st == GR_OK) {
         /* the metrics, blurs and difference images: about 170 bytes per pixel, measured
-         * (2.8 GB for 4096 x 4096; docs/reliability.md) */
+         * (2.8 GB for 4096 x 4096; docs/reliability.md); FLIP's working set on top, counted
+         * from its buffers (an upper bound: they are allocated after the metrics' are freed):
+         * 22 double planes, 2 x 3 double colours, 2 float maps, 1 double for the quantiles */
+        const double per_px = 170.0 + (do_flip ? 22.0 * 8 + 6.0 * 8 + 2.0 * 4 + 8.0 : 0.0);
         char detail[96];
-        snprintf(detail, sizeof detail, "%d x %d pixels at about 170 bytes each", ref->width, ref->height);
-        st = gr_memlimit_check("the comparison", 170.0 * ref->width * (double)ref->height, detail, &err);
+        snprintf(detail, sizeof detail, "%d x %d pixels at about %.0f bytes each", ref->width, ref->height, per_px);
+        st = gr_memlimit_check("the comparison", per_px * ref->width * (double)ref->height, detail, &err);
     }
+    if (st == GR_OK && all_zero(ref))
+        st = gr_fail(&err, GR_E_INPUT, "reference %s is zero everywhere: no metric can say anything about the test "
+                     "image (camera inside an occluder, a medium without scattering, no light reaching the view?)",
+                     paths[0]);
     if (st != GR_OK) goto fail;
 
+    /* The structure metrics' geometry first: the metric sets carry their summary (as in
+     * `godrays run`), the "structure" object the details. */
+    gr_structure_options so = {0};
+    if (do_struct) {
+        if (scene_path) {
+            gr_scene sc;
+            st = gr_scene_load_file(scene_path, sets, n_sets, &sc, &err);
+            if (st == GR_OK) st = gr_structure_scene_vp(&sc, ref->width, ref->height, &vp[0], &vp[1], &err);
+            if (st != GR_OK) {
+                if (st != GR_E_NOMEM) err.status = GR_E_INPUT;
+                gr_error_prefix(&err, "--scene %s", scene_path);
+                goto fail;
+            }
+            /* de-glow by the angle to the refracted sun, rings one pixel wide */
+            sc.camera.width = ref->width, sc.camera.height = ref->height;
+            angles = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
+            if (!angles) {
+                st = gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
+                goto fail;
+            }
+            double dir[3];
+            gr_profile_sun_view_dir(&sc, dir);
+            gr_profile_angles(&sc.camera, dir, angles);
+            so.radial = angles, so.radial_bin = sc.camera.fov_deg / ref->height;
+        }
+        so.vp_x = vp[0], so.vp_y = vp[1];
+        opt.structure = &so;
+    }
     opt.mask = mask;
     if (!do_basic) opt.skip_ssim = opt.skip_blur = 1;
+    /* a ground truth's stderr comes from a few batches: its degrees of freedom, for Student's t */
+    {
+        gr_metadata meta;
+        gr_meta_init(&meta);
+        gr_image *tmp = NULL;
+        gr_error e2 = {0};
+        size_t n = strlen(paths[0]);
+        if (n > 4 && !strcmp(paths[0] + n - 4, ".exr") && gr_exr_read(paths[0], &tmp, &meta, &e2) == GR_OK) {
+            const gr_meta_item *it = gr_meta_get(&meta, "godrays:stderr_dof");
+            if (it && it->type != GR_META_STRING && it->num >= 1.0) opt.stderr_dof = (int)it->num;
+        }
+        gr_image_destroy(tmp);
+        gr_meta_free(&meta);
+    }
     gr_metrics m;
     const double t0 = now_s();
     st = gr_metrics_compute(ref, test, &opt, &m, &err);
@@ -334,7 +389,18 @@ int cmd_compare(int argc, char **argv)
             ft = scaled;
         }
         const double t1 = now_s();
-        st = gr_flip_compute(ref, ft, &fopt, flipmap, &fres, &err);
+        gr_error ferr = {GR_OK, ""};
+        double e0, e1;
+        int ne;
+        if (fopt.mode == GR_FLIP_HDR && !fopt.exposures_given &&
+            gr_flip_exposures(ref, fopt.tonemapper, &e0, &e1, &ne, &ferr) != GR_OK) {
+            /* a black reference (all-zero, or a zero median) gives HDR-FLIP no exposure range:
+             * FLIP is left out, said so, instead of failing the whole comparison */
+            snprintf(flip_skipped, sizeof flip_skipped, "%s", ferr.msg);
+            do_flip = 0;
+        } else {
+            st = gr_flip_compute(ref, ft, &fopt, flipmap, &fres, &err);
+        }
         t_flip = now_s() - t1;
         if (st != GR_OK) goto fail;
     }
@@ -342,28 +408,6 @@ int cmd_compare(int argc, char **argv)
     gr_structure_compare sres;
     double t_struct = 0.0;
     if (do_struct) {
-        gr_structure_options so = {0};
-        if (scene_path) {
-            gr_scene sc;
-            st = gr_scene_load_file(scene_path, sets, n_sets, &sc, &err);
-            if (st == GR_OK) st = gr_structure_scene_vp(&sc, ref->width, ref->height, &vp[0], &vp[1], &err);
-            if (st != GR_OK) {
-                if (st != GR_E_NOMEM) err.status = GR_E_INPUT;
-                gr_error_prefix(&err, "--scene %s", scene_path);
-                goto fail;
-            }
-            /* de-glow by the angle to the refracted sun, rings one pixel wide */
-            sc.camera.width = ref->width, sc.camera.height = ref->height;
-            angles = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
-            if (!angles) {
-                st = gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
-                goto fail;
-            }
-            double dir[3];
-            gr_profile_sun_view_dir(&sc, dir);
-            gr_profile_angles(&sc.camera, dir, angles);
-            so.radial = angles, so.radial_bin = sc.camera.fov_deg / ref->height;
-        }
         if (!scored) {
             scored = malloc((size_t)ref->width * (size_t)ref->height);
             if (!scored) {
@@ -373,7 +417,7 @@ int cmd_compare(int argc, char **argv)
             st = gr_metrics_scored_pixels(ref, mask, opt.stderr_bound, scored, NULL, NULL, &err);
             if (st != GR_OK) goto fail;
         }
-        so.vp_x = vp[0], so.vp_y = vp[1], so.scored = scored;
+        so.scored = scored;
         const double t2 = now_s();
         st = gr_structure_compare_images(ref, test, &so, &sres, &err);
         t_struct = now_s() - t2;
@@ -394,6 +438,10 @@ int cmd_compare(int argc, char **argv)
     if (do_struct && (!sj || !cJSON_AddNumberToObject(sj, "time_s", t_struct) ||
                       !cJSON_AddItemToObject(root, "structure", sj))) {
         cJSON_Delete(sj);
+        st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
+        goto fail;
+    }
+    if (flip_skipped[0] && !cJSON_AddStringToObject(root, "flip_skipped", flip_skipped)) {
         st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
         goto fail;
     }
@@ -467,16 +515,13 @@ int cmd_compare(int argc, char **argv)
         }
     }
 
-    if (all_zero(ref, m.ref_rgb))
-        fprintf(stderr, "godrays compare: warning: the reference %s is zero everywhere scored: RMSE, PSNR, SSIM and the "
-                "scale fit say nothing about the test image (is the camera inside an occluder, or the medium "
-                "without scattering?)\n", paths[0]);
     if (json) {
         printf("%s\n", text);
     } else {
         printf("reference %s, test %s\n", paths[0], paths[1]);
         if (do_basic) gr_metrics_print_table(stdout, &m);
         if (do_flip) gr_flip_print(stdout, "FLIP", &fres, scale);
+        if (flip_skipped[0]) printf("  FLIP not computed: %s\n", flip_skipped);
         if (do_struct) gr_structure_print(stdout, &sres, vp[0], vp[1]);
         if (outdir)
             printf("wrote %s/metrics.json, %s/diff.png, %s/diff_signed.png%s%s%s\n", outdir, outdir, outdir,

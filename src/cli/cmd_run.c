@@ -14,10 +14,12 @@
 #include <time.h>
 
 #include "compare/metrics.h"
+#include "compare/structure.h"
 #include "image/exr.h"
 #include "realtime/technique.h"
 #include "reference/integrator.h"
 #include "report/cache.h"
+#include "report/profile.h"
 #include "report/report.h"
 #include "report/sequence.h"
 #include "scene/scene.h"
@@ -287,6 +289,7 @@ static int run_with(gr_args *args)
     const int nf = n_times > 0 ? n_times : 1;
 
     gr_scene *scene = NULL, *cases = NULL;
+    float *angles = NULL;
     gr_image **seq_test = NULL; /* seq_test[k * nf + i], i >= 1 (frame 0: test[k]) */
     ref_out *seq_ref = NULL;    /* frames >= 1 (frame 0: ro) */
     char *seq_json = NULL;
@@ -385,9 +388,32 @@ static int run_with(gr_args *args)
 
     if (!quiet) fprintf(stderr, "godrays run: comparing...\n");
     t = now_s();
+    const gr_meta_item *dof = gr_meta_get(&ro.meta, "godrays:stderr_dof"); /* Student t for significance */
+    /* beam structure around the refracted sun's vanishing point, de-glowed by the angle to
+     * the sun (docs/metrics.md), in every technique's metric sets; skipped when the beams have
+     * no finite vanishing point (parallel to the image plane) */
+    gr_structure_options so = {.radial_bin = scene->camera.fov_deg / scene->camera.height};
+    int with_structure = 0;
+    {
+        gr_error e2 = {GR_OK, ""};
+        angles = malloc((size_t)scene->camera.width * (size_t)scene->camera.height * sizeof(float));
+        if (!angles) {
+            gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
+            goto fail;
+        }
+        if (gr_structure_scene_vp(scene, scene->camera.width, scene->camera.height, &so.vp_x, &so.vp_y, &e2) == GR_OK) {
+            double dir[3];
+            gr_profile_sun_view_dir(scene, dir);
+            gr_profile_angles(&scene->camera, dir, angles);
+            so.radial = angles;
+            with_structure = 1;
+        }
+    }
     for (int k = 0; k < nt; k++) {
         gr_metrics_options mopt = {0};
         mopt.fit_scale = 1; /* a technique's intensity is an arbitrary factor (seed 000) */
+        if (with_structure) mopt.structure = &so;
+        if (dof && dof->type != GR_META_STRING && dof->num >= 1.0) mopt.stderr_dof = (int)dof->num;
         if (gr_metrics_compute(ro.img, test[k], &mopt, &mets[k], &err) != GR_OK) goto fail;
         ts[k].metrics = &mets[k];
     }
@@ -452,6 +478,7 @@ static int run_with(gr_args *args)
 fail:
     rc = gr_cli_report(cmd, &err);
 done:
+    free(angles);
     gr_gl_destroy(gl);
     gr_image_destroy(ro.img);
     gr_meta_free(&ro.meta);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "compare/blur.h"
+#include "core/student.h"
 
 const double gr_metrics_blur_sigmas[GR_METRICS_NSCALES] = {1.0, 4.0, 16.0};
 
@@ -44,6 +45,9 @@ typedef struct ctx {
     long long n_scored;
     int have_stderr;
     int serr[3];                  /* stderr channel indices in ref */
+    int have_bias;                /* ref carries bias.R/G/B (a bias estimate per pixel) */
+    int sbias[3];
+    double z;                     /* significance quantile: Student t (stderr_dof) or GR_METRICS_STDERR_Z */
     double eps[GR_MCH_COUNT];     /* rel MSE epsilons (independent of the test scale) */
     double peak_ref[GR_MCH_COUNT];
     double ssim_c1, ssim_c2;
@@ -63,6 +67,7 @@ typedef struct acc {
     double m_ref, m_test;
 } acc;
 
+/* s: the difference that noise and bias together explain (z stderr + |bias|) */
 static void acc_add(acc *a, double r, double t, double s, int have_s, double eps, int x, int y, int c)
 {
     const double d = t - r, f = fabs(d);
@@ -79,7 +84,7 @@ static void acc_add(acc *a, double r, double t, double s, int have_s, double eps
         a->max_f = f, a->mx = x, a->my = y, a->mc = c;
         a->m_ref = r, a->m_test = t;
     }
-    if (have_s && f <= GR_METRICS_STDERR_Z * s) a->nsig++;
+    if (have_s && f <= s) a->nsig++;
     a->n++;
 }
 
@@ -250,14 +255,20 @@ static gr_status compute_set(const ctx *cx, const int rr[3], const int tr[3], do
         double yr = 0.0, yt = 0.0;
         for (int c = 0; c < 3; c++) {
             const double r = (double)rp[rr[c]], t = scale * (double)tp[tr[c]];
-            const double s = cx->have_stderr ? fabs((double)rp[cx->serr[c]]) : 0.0;
+            const double s = cx->have_stderr ? cx->z * fabs((double)rp[cx->serr[c]]) +
+                                                   (cx->have_bias ? fabs((double)rp[cx->sbias[c]]) : 0.0)
+                                             : 0.0;
             acc_add(&a[c], r, t, s, cx->have_stderr, cx->eps[c], x, y, -1);
             acc_add(&a[GR_MCH_RGB], r, t, s, cx->have_stderr, cx->eps[GR_MCH_RGB], x, y, c);
             yr += lum_w[c] * r;
             yt += lum_w[c] * t;
         }
-        acc_add(&a[GR_MCH_Y], yr, yt, cx->have_stderr ? stderr_y(cx, p) : 0.0, cx->have_stderr, cx->eps[GR_MCH_Y],
-                x, y, -1);
+        double sy = 0.0;
+        if (cx->have_stderr) {
+            sy = cx->z * stderr_y(cx, p);
+            for (int c = 0; cx->have_bias && c < 3; c++) sy += lum_w[c] * fabs((double)rp[cx->sbias[c]]);
+        }
+        acc_add(&a[GR_MCH_Y], yr, yt, sy, cx->have_stderr, cx->eps[GR_MCH_Y], x, y, -1);
     }
     for (int c = 0; c < GR_MCH_COUNT; c++) acc_finish(&a[c], cx->eps[c], cx->peak_ref[c], &set->ch[c]);
     set->ssim_y = 1.0;
@@ -401,6 +412,12 @@ gr_status gr_metrics_compute(const gr_image *ref, const gr_image *test, const gr
     gr_metrics_pick_rgb(ref, rr);
     gr_metrics_pick_rgb(test, tr);
     cx.have_stderr = find_stderr(ref, cx.serr);
+    cx.sbias[0] = gr_image_channel(ref, "bias.R");
+    cx.sbias[1] = gr_image_channel(ref, "bias.G");
+    cx.sbias[2] = gr_image_channel(ref, "bias.B");
+    cx.have_bias = cx.sbias[0] >= 0 && cx.sbias[1] >= 0 && cx.sbias[2] >= 0;
+    /* a standard error from B batches has B - 1 degrees of freedom: Student's t */
+    cx.z = opt->stderr_dof > 0 ? gr_student_t975(opt->stderr_dof) : GR_METRICS_STDERR_Z;
 
     unsigned char *scored = malloc(cx.n);
     if (!scored) return gr_fail(err, GR_E_NOMEM, "metrics: cannot allocate %zu pixels", cx.n);
@@ -412,7 +429,9 @@ gr_status gr_metrics_compute(const gr_image *ref, const gr_image *test, const gr
     out->n_pixels = (long long)cx.n;
     out->have_stderr = cx.have_stderr;
     out->stderr_bound = bound;
-    out->stderr_z = GR_METRICS_STDERR_Z;
+    out->stderr_z = cx.z;
+    out->stderr_dof = opt->stderr_dof;
+    out->have_bias = cx.have_bias;
 
     /* Which pixels are scored, and the scale-independent statistics of the reference. */
     double sabs[GR_MCH_COUNT] = {0}, pk[GR_MCH_COUNT];

@@ -53,7 +53,8 @@ typedef struct gr_channel_metrics {
     int max_c;                    /* the channel (0 R, 1 G, 2 B) for GR_MCH_RGB, else -1 */
     double max_ref, max_test;     /* the two values there */
     double rmse_blur[GR_METRICS_NSCALES]; /* RMSE after blurring at gr_metrics_blur_sigmas[] */
-    long long n_not_significant;  /* with stderr: samples with |t - r| <= z stderr (z above) */
+    long long n_not_significant;  /* with stderr: samples with |t - r| <= z stderr (+ |bias| when REF
+                                     has bias channels): what noise and bias together explain */
     long long n_samples;          /* scored samples of this row (3 n_scored for GR_MCH_RGB) */
 } gr_channel_metrics;
 
@@ -82,7 +83,9 @@ typedef struct gr_metrics {
     long long n_stderr_excluded;  /* in the mask, but reference luminance rel. stderr > bound */
     int have_stderr;              /* REF carried stderr.R/G/B */
     double stderr_bound;          /* the bound used (INFINITY: none) */
-    double stderr_z;              /* GR_METRICS_STDERR_Z */
+    double stderr_z;              /* Student t975(stderr_dof), or GR_METRICS_STDERR_Z when unknown */
+    int stderr_dof;               /* degrees of freedom of the stderr (0: unknown, normal) */
+    int have_bias;                /* REF carried bias.R/G/B: not significant = |d| <= z stderr + |bias| */
     double ssim_L;                /* SSIM dynamic range: peak_ref of luminance */
     double ssim_c1, ssim_c2;      /* (K1 L)^2, (K2 L)^2 */
     gr_metrics_set raw;           /* TEST as given */
@@ -98,6 +101,8 @@ typedef struct gr_metrics_options {
     int fit_scale;                /* also compute the best scale fit and the metrics after it */
     int skip_ssim;                /* leave SSIM out (cheap sweeps) */
     int skip_blur;                /* leave the multi-scale RMSE out */
+    int stderr_dof;               /* degrees of freedom of REF's stderr (batches - 1; the reference
+                                     writes godrays:stderr_dof): z = Student t975; 0: z = 2 */
     const gr_flip_options *flip;  /* also FLIP with these options (scored and test_scale are
                                      set here); NULL: no FLIP */
     const gr_structure_options *structure; /* also the structure comparison (scored is set

@@ -98,8 +98,11 @@ static cJSON *conventions_json(const gr_metrics *m)
                                             "scored pixels (edges, mask)") &&
          cJSON_AddStringToObject(o, "ssim", "Wang et al. 2004 on luminance, 11x11 Gaussian window sigma 1.5 "
                                             "renormalized at edges, K1 0.01, K2 0.03, L = peak_ref of Y") &&
-         cJSON_AddStringToObject(o, "significance", "|d| <= z * stderr(ref) is not significant; "
+         cJSON_AddStringToObject(o, "significance", "|d| <= z * stderr(ref) + |bias(ref)| is not significant "
+                                                    "(bias when REF has bias.* channels); z = Student t975 with "
+                                                    "significance_dof degrees of freedom (2 when 0 = unknown); "
                                                     "stderr(Y) = sum of w_c stderr_c (any correlation)") &&
+         add_num(o, "significance_dof", m->stderr_dof) && cJSON_AddBoolToObject(o, "reference_bias_channels", m->have_bias) &&
          cJSON_AddStringToObject(o, "stderr_exclusion", "pixels with stderr(Y) / |Y ref| > bound are not scored") &&
          add_num(o, "significance_z", m->stderr_z) && add_num(o, "ssim_K1", GR_SSIM_K1) &&
          add_num(o, "ssim_K2", GR_SSIM_K2) && add_num(o, "ssim_L", m->ssim_L) && add_num(o, "ssim_C1", m->ssim_c1) &&
@@ -191,7 +194,7 @@ static void print_set(FILE *f, const gr_metrics *m, const gr_metrics_set *s)
     }
     if (m->have_stderr) {
         char label[48];
-        snprintf(label, sizeof label, "not signif. (<=%gse) %%", m->stderr_z);
+        snprintf(label, sizeof label, "not signif. (<=%.4gse%s) %%", m->stderr_z, m->have_bias ? "+|b|" : "");
         ROW(label, ch->n_samples > 0 ? 100.0 * (double)ch->n_not_significant / (double)ch->n_samples : 0.0, 2, 1);
     }
 #undef ROW

@@ -145,7 +145,7 @@ static void arc_profile(const double *s, const unsigned char *scored, int w, int
 }
 
 /* Angular spectrum of one annulus of the smoothed de-glowed field s. Returns the arc analysed
- * in degrees (0: unusable) and fills P[0..m_max]. buf: 2 n_theta doubles. */
+ * in degrees (0: unusable) and fills P[0..m_max]. buf: 4 n_theta doubles. */
 static double annulus_spectrum(const double *s, const unsigned char *scored, int w, int h,
                                const gr_structure_options *o, double r0, double r1, double *P, double *buf,
                                unsigned char *valid)
@@ -177,13 +177,16 @@ static double annulus_spectrum(const double *s, const unsigned char *scored, int
         wt[l] = len == nt ? 1.0 : pow(sin(PI * (l + 0.5) / len), 2.0);
         sw += wt[l], swf += wt[l] * f[(start + l) % nt];
     }
+    /* e^{-i m theta_j} = e^{-i 2 pi ((m j) mod N) / N}: one table of N cosines and sines */
+    double *ct = buf + 2 * (size_t)nt, *st = buf + 3 * (size_t)nt;
+    for (int j = 0; j < nt; j++) ct[j] = cos(2.0 * PI * j / nt), st[j] = sin(2.0 * PI * j / nt);
+    for (int l = 0; l < len; l++) wt[l] *= f[(start + l) % nt] - swf / sw; /* wt now holds w (f - mean) */
     for (int m = 1; m <= o->m_max; m++) {
         double re = 0.0, im = 0.0;
         for (int l = 0; l < len; l++) {
-            const int j = (start + l) % nt;
-            const double th = 2.0 * PI * j / nt, v = wt[l] * (f[j] - swf / sw);
-            re += v * cos(m * th);
-            im -= v * sin(m * th);
+            const int k = (int)(((long long)m * ((start + l) % nt)) % nt);
+            re += wt[l] * ct[k];
+            im -= wt[l] * st[k];
         }
         P[m] = 2.0 * (re * re + im * im) / (sw * sw);
     }
@@ -285,7 +288,7 @@ static gr_status one_image(const gr_image *img, const gr_structure_options *o, g
     const size_t n = (size_t)w * (size_t)h;
     memset(out, 0, sizeof *out);
     double *y = malloc(n * sizeof(double)), *gf = malloc(n * sizeof(double)), *gc = malloc(n * sizeof(double));
-    double *buf = malloc(2 * (size_t)o->n_theta * sizeof(double));
+    double *buf = malloc(4 * (size_t)o->n_theta * sizeof(double));
     unsigned char *valid = malloc((size_t)o->n_theta);
     gr_status st = GR_OK;
     if (!y || !gf || !gc || !buf || !valid) {

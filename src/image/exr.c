@@ -485,6 +485,36 @@ static gr_status probe_file(const char *path, gr_error *err)
     return GR_OK;
 }
 
+gr_status gr_exr_check(const char *path, gr_error *err)
+{
+    if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "EXR check: no input path");
+    gr_status st = gr_check_regular_input(path, err);
+    if (st == GR_OK) st = probe_file(path, err);
+    if (st != GR_OK) return st;
+    struct stat fsb;
+    const long long file_size = stat(path, &fsb) == 0 ? (long long)fsb.st_size : -1;
+    g_exr_msg[0] = '\0';
+    exr_context_initializer_t init = exr_init_for(1);
+    exr_context_t ctx = NULL;
+    exr_result_t rv = exr_start_read(&ctx, path, &init);
+    exr_storage_t storage;
+    exr_attr_box2i_t dw;
+    if (rv != EXR_ERR_SUCCESS) {
+        st = exr_fail(err, path, rv, GR_E_INPUT, "bad header");
+    } else if ((rv = exr_get_storage(ctx, 0, &storage)) != EXR_ERR_SUCCESS) {
+        st = exr_fail(err, path, rv, GR_E_INPUT, "storage type");
+    } else if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
+        st = gr_fail(err, GR_E_INPUT, "%s: deep or unknown EXR storage (%d) is not supported", path, (int)storage);
+    } else if ((rv = exr_get_data_window(ctx, 0, &dw)) != EXR_ERR_SUCCESS) {
+        st = exr_fail(err, path, rv, GR_E_INPUT, "data window");
+    } else {
+        st = gr_image_check_size(path, (int64_t)dw.max.x - dw.min.x + 1, (int64_t)dw.max.y - dw.min.y + 1, 1, err);
+        if (st == GR_OK) st = check_chunks(ctx, storage, &dw, file_size, path, err);
+    }
+    if (ctx) exr_finish(&ctx);
+    return st;
+}
+
 gr_status gr_exr_read(const char *path, gr_image **out, gr_metadata *meta, gr_error *err)
 {
     if (out) *out = NULL;

@@ -98,6 +98,47 @@ class StderrCapture {
     int saved_ = -1;
 };
 
+// The chunk list of a PNG file against its size, before libpng sees it: libpng allocates what a
+// chunk's length field claims (a 2 KB file whose tEXt chunk claimed 2 GB took 2 GB of memory,
+// found by fuzzing), so a chunk that does not fit the file is refused first. A file that is not
+// a PNG at all is left to the reader's own message.
+gr_status check_png_chunks(const char *path, gr_error *err, bool *complete = nullptr)
+{
+    if (complete) *complete = false;
+    FILE *f = std::fopen(path, "rb");
+    if (!f) return GR_OK; // the reader reports it
+    unsigned char b[8];
+    gr_status st = GR_OK;
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (std::fseek(f, 0, SEEK_END) == 0) {
+        const long long size = std::ftell(f);
+        std::rewind(f);
+        if (size > 0 && std::fread(b, 1, 8, f) == 8 && !std::memcmp(b, sig, 8)) {
+            long long pos = 8;
+            while (pos + 8 <= size && std::fread(b, 1, 8, f) == 8) {
+                const unsigned long long len = (unsigned long long)b[0] << 24 | (unsigned long long)b[1] << 16 |
+                                               (unsigned long long)b[2] << 8 | b[3];
+                char type[5] = {(char)b[4], (char)b[5], (char)b[6], (char)b[7], 0};
+                for (char &c : type)
+                    if (c && (c < 'A' || (c > 'Z' && c < 'a') || c > 'z')) c = '?';
+                if ((long long)len > size - pos - 12) {
+                    st = gr_fail(err, GR_E_INPUT, "%s: PNG chunk '%s' at byte %lld claims %llu bytes, past the end of the "
+                                 "%lld-byte file", path, type, pos, len, size);
+                    break;
+                }
+                if (!std::memcmp(type, "IEND", 4)) {
+                    if (complete) *complete = true;
+                    break;
+                }
+                pos += 12 + (long long)len;
+                if (std::fseek(f, (long)(len + 4), SEEK_CUR) != 0) break;
+            }
+        }
+    }
+    std::fclose(f);
+    return st;
+}
+
 // Appends libpng's captured text to an OpenImageIO message unless it already says it.
 void add_lib_text(std::string &why, const std::string &lib)
 {
@@ -127,8 +168,17 @@ gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::Ty
             st = fail(err, GR_E_IO, path, "closing file", out->geterror());
     }
     out.reset();
-    if (st == GR_OK) {
-        StderrCapture quiet; // libpng's own line about the truncated file: the message says it
+    bool png_done = false;
+    if (st == GR_OK && format == "png") {
+        // PNG: the chunk list must end with IEND inside the file (read back through libpng, a
+        // truncated file longjmps out of OpenImageIO's reader and leaks)
+        gr_error perr;
+        if (check_png_chunks(tmp.c_str(), &perr, &png_done) != GR_OK || !png_done)
+            st = gr_fail(err, GR_E_IO, "%s: cannot write: the file written is incomplete (is the disk full?)", path);
+        png_done = true;
+    }
+    if (st == GR_OK && !png_done) {
+        StderrCapture quiet; // a reader's own line about the truncated file: the message says it
         auto in = OIIO::ImageInput::create(format);
         std::vector<unsigned char> back(spec.image_bytes());
         OIIO::ImageSpec got;
@@ -212,12 +262,19 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         std::fclose(f);
         return gr_fail(err, GR_E_INPUT, "%s: not a supported image file name (the reader takes %s)", path, READ_EXTS);
     }
-    // EXR files go through the project's own reader (image/exr.c): it checks the data window
-    // and the chunk table against the file before allocating, where OpenEXR's C++ reader
-    // behind OpenImageIO rebuilt a huge offset table for seconds from a 2.5 KB file.
-    if (!std::strcmp(format, "openexr")) return gr_exr_read(path, out, nullptr, err);
+    // EXR files pass the project's checks first (image/exr.c: data window and chunk table
+    // against the file, before anything is allocated): OpenEXR's C++ reader behind
+    // OpenImageIO rebuilt a huge offset table for seconds from a 2.5 KB file.
+    if (!std::strcmp(format, "openexr")) {
+        gr_status est = gr_exr_check(path, err);
+        if (est != GR_OK) return est;
+    }
     // libpng prints its own line ("IHDR: CRC error"): kept for the message (PNG only, so
     // that anything else a reader prints, a sanitizer's report included, stays visible)
+    if (!std::strcmp(format, "png")) {
+        gr_status pst = check_png_chunks(path, err);
+        if (pst != GR_OK) return pst;
+    }
     StderrCapture cap(!std::strcmp(format, "png"));
     try {
         // The reader of the extension's format only: OpenImageIO's fallback would try every

@@ -11,9 +11,13 @@
 #include "core/optics.h"
 #include "core/shaftgeom.h"
 #include "gl/gl.h"
+#include "realtime/frame.h"
+#include "realtime/scenegl.h"
 #include "realtime/shaders.h"
 
 #define MAX_WAVE_GROUPS 16 /* must match shafts.vert.glsl */
+#define GRID_FLOATS 6
+#define TARGET_RGBA32F 2 /* path and flux: signed sums need a float target */
 #define SPHERE_STACKS 24
 #define SPHERE_SLICES 48
 /* Projection planes of the camera; with the shafts' forced clip z (seed VS) only w matters
@@ -30,20 +34,21 @@ const char *const gr_shafts_pass_names[GR_SHAFTS_NPASS] = {"shadow", "shafts", "
 #define HI_X GR_PF_MAX_EXCL
 #define FROM GR_PF_FROM_SCENE
 static const char *const target_format_names[] = {"rgba8", "rgba16f", NULL};
+static const char *const variant_names[] = {"seed", "path", "flux", NULL};
 
 #define SH(field) offsetof(gr_shafts_settings, field)
 static const gr_param shafts_params[] = {
     {.name = "N", .type = GR_PT_INT, .offset = SH(N), .min = 2, .max = 1024, .def = 11, .unit = "",
      .doc = "grid vertices along each side of the shaft grid (seed eq. 5.5.6); (N-1)^2 shafts"},
     {.name = "K", .type = GR_PT_DOUBLE, .offset = SH(K), .min = 0, .max = 10, .flags = LO_X,
-     .def = 0.8, .unit = "", .doc = "spacing adjustment factor K of seed eq. 5.5.6",
+     .def = 1.2, .unit = "", .doc = "spacing adjustment factor K of seed eq. 5.5.6",
      .tune_lo = 0.2, .tune_hi = 2.0},
     {.name = "shaft_length_m", .type = GR_PT_DOUBLE, .offset = SH(shaft_length_m), .min = 0,
      .max = 10000, .flags = LO_X, .def = 30, .unit = "m",
      .doc = "extrusion length of the bottom vertices along the refracted sun ray",
      .tune_lo = 5.0, .tune_hi = 100.0},
     {.name = "shaft_width", .type = GR_PT_DOUBLE, .offset = SH(shaft_width), .min = 0, .max = 1,
-     .flags = LO_X, .def = 1.0, .unit = "", .doc = "shaft width as a fraction of the grid cell",
+     .flags = LO_X, .def = 0.7, .unit = "", .doc = "shaft width as a fraction of the grid cell",
      .tune_lo = 0.1, .tune_hi = 1.0},
     {.name = "caps", .type = GR_PT_BOOL, .offset = SH(caps), .min = 0, .max = 1, .def = 1, .unit = "",
      .doc = "draw the top and bottom faces of each parallelepiped"},
@@ -59,8 +64,8 @@ static const gr_param shafts_params[] = {
      .doc = "extinction c of seed eq. 5.5.3; default: the medium's sigma_t",
      .tune_lo = 0.1, .tune_hi = 4.0},
     {.name = "g", .type = GR_PT_DOUBLE, .offset = SH(g), .min = -1, .max = 1,
-     .flags = LO_X | HI_X | FROM, .def = NAN, .unit = "", .scene_source = "medium.g",
-     .doc = "HG eccentricity of the final pass (seed eq. 5.5.4); default: the medium's g",
+     .flags = LO_X | HI_X, .def = 0.5, .unit = "",
+     .doc = "HG eccentricity of the seed variant's final pass (seed eq. 5.5.4: \"use g equal to 0.5\")",
      .tune_lo = 0.0, .tune_hi = 0.99},
     {.name = "bias", .type = GR_PT_DOUBLE, .offset = SH(bias), .min = 0, .max = 10, .def = 0.15,
      .unit = "", .doc = "constant added to the shaft intensity before the phase (seed, second pass)",
@@ -73,6 +78,18 @@ static const gr_param shafts_params[] = {
     {.name = "shadow_bias", .type = GR_PT_DOUBLE, .offset = SH(shadow_bias), .min = 0, .max = 100,
      .def = 0.05, .unit = "m", .doc = "depth bias of the shadow comparison",
      .tune_lo = 0.0, .tune_hi = 1.0},
+    {.name = "variant", .type = GR_PT_ENUM, .offset = SH(variant), .min = 0, .max = 2, .def = GR_SHAFTS_SEED,
+     .enum_names = variant_names, .unit = "",
+     .doc = "seed (the listings), path (length of shaft traversed), flux (area-ratio slabs, focusing)"},
+    {.name = "target_prescale", .type = GR_PT_DOUBLE, .offset = SH(target_prescale), .min = 0, .max = 1e6,
+     .flags = LO_X, .def = 0.125, .unit = "",
+     .doc = "seed variant: factor on each shaft fragment before blending, divided out in the final pass"},
+    {.name = "stable_grid", .type = GR_PT_BOOL, .offset = SH(stable_grid), .min = 0, .max = 1, .def = 0, .unit = "",
+     .doc = "snap P to the grid spacing and quantize S (cross-fade between levels): shafts stay put"},
+    {.name = "depth_test", .type = GR_PT_BOOL, .offset = SH(depth_test), .min = 0, .max = 1, .def = 0, .unit = "",
+     .doc = "hide shaft surfaces behind the occluders and the seabed as seen from the eye"},
+    {.name = "slabs", .type = GR_PT_INT, .offset = SH(slabs), .min = 1, .max = 256, .def = 16, .unit = "",
+     .doc = "flux variant: depth slabs per shaft (each with its own cross-section area)"},
 };
 #undef SH
 
@@ -91,6 +108,8 @@ const gr_shafts_settings *gr_shafts_scene_settings(const gr_scene *scene)
 typedef struct shaft_locs {
     GLint origin, spacing, width, length, extinction, sun_dir, eta, r0;
     GLint view_proj, shadow_matrix, wave_groups, waves, shadow_map, shadow_bias;
+    GLint variant, ratio, refr_flat, sun_radius_w, prescale, depth_test, eye_depth, target_size;
+    GLint half, corner_pos, corner_refr;
 } shaft_locs;
 
 struct gr_shafts {
@@ -104,8 +123,14 @@ struct gr_shafts {
     GLint loc_inv_vp, loc_texel, loc_shafts, loc_hgg, loc_refr_sun, loc_intensity, loc_bias;
 
     GLuint vao_grid, vbo_grid, ibo_grid;
-    int grid_N, grid_nshafts;
-    float *grid_cpu; /* 5 floats per vertex: cell.xy, corner.xy, bottom */
+    int grid_N, grid_slabs, grid_nshafts;
+    float *grid_cpu; /* GRID_FLOATS floats per vertex: cell.xy, corner.xy, bottom, mid */
+    gr_scenegl *scenegl; /* eye depth for depth_test */
+    /* flux pre-pass: one texel per shaft corner (2 (N-1) per side), position + transmittance
+     * and refracted direction (shafts_corner.frag.glsl) */
+    GLuint prog_corner, corner_tex[2], corner_fbo;
+    int corner_size;
+    shaft_locs lk;
 
     GLuint vao_occ, vbo_occ;
     float *occ_cpu;
@@ -136,6 +161,16 @@ typedef struct frame_setup {
     float origin_rel[3];
     int groups;
     float waves[MAX_WAVE_GROUPS * 5 * 4];
+    /* stable_grid: two grid levels (spacing, snapped P, wave constants) and their weights */
+    int n_levels;
+    double lvl_S[2], lvl_weight[2];
+    float lvl_origin[2][3];
+    float lvl_waves[2][MAX_WAVE_GROUPS * 5 * 4];
+    int fmt;          /* target format actually used (TARGET_RGBA32F for path, flux) */
+    int caps, slabs;  /* caps drawn; slabs per shaft */
+    float ratio;      /* path: cos(theta_i) / cos(theta_t) / width^2 */
+    float sun_radius_w;
+    float final_intensity[3], final_hgg[3], final_bias;
     float view_proj[16], inv_view_proj[16], shadow_matrix[16], light_vp[16];
     float shadow_bias_depth;
     float hgg[3];
@@ -242,6 +277,17 @@ static void get_shaft_locs(GLuint prog, shaft_locs *l)
     l->waves = glGetUniformLocation(prog, "u_waves");
     l->shadow_map = glGetUniformLocation(prog, "u_shadow_map");
     l->shadow_bias = glGetUniformLocation(prog, "u_shadow_bias");
+    l->variant = glGetUniformLocation(prog, "u_variant");
+    l->ratio = glGetUniformLocation(prog, "u_ratio");
+    l->refr_flat = glGetUniformLocation(prog, "u_refr_flat");
+    l->sun_radius_w = glGetUniformLocation(prog, "u_sun_radius_w");
+    l->prescale = glGetUniformLocation(prog, "u_prescale");
+    l->depth_test = glGetUniformLocation(prog, "u_depth_test");
+    l->eye_depth = glGetUniformLocation(prog, "u_eye_depth");
+    l->target_size = glGetUniformLocation(prog, "u_target_size");
+    l->half = glGetUniformLocation(prog, "u_half");
+    l->corner_pos = glGetUniformLocation(prog, "u_corner_pos");
+    l->corner_refr = glGetUniformLocation(prog, "u_corner_refr");
 }
 
 static int has_extension(const char *name)
@@ -320,6 +366,11 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
         return st;
     r->from_dir += nd;
 
+    if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_corner.frag.glsl", NULL, 0,
+                                &r->prog_corner, &nd, err)) != GR_OK)
+        return st;
+    r->from_dir += nd;
+    get_shaft_locs(r->prog_corner, &r->lk);
     r->loc_light_vp = glGetUniformLocation(r->prog_shadow, "u_light_view_proj");
     get_shaft_locs(r->prog_shafts, &r->ls);
     r->loc_inv_vp = glGetUniformLocation(r->prog_final, "u_inv_view_proj");
@@ -367,6 +418,9 @@ void gr_shafts_destroy(gr_shafts *r)
         if (r->prog_shafts) glDeleteProgram(r->prog_shafts);
         if (r->prog_final) glDeleteProgram(r->prog_final);
         if (r->prog_capture) glDeleteProgram(r->prog_capture);
+        if (r->prog_corner) glDeleteProgram(r->prog_corner);
+        if (r->corner_fbo) glDeleteFramebuffers(1, &r->corner_fbo);
+        if (r->corner_tex[0]) glDeleteTextures(2, r->corner_tex);
         if (r->vao_grid) glDeleteVertexArrays(1, &r->vao_grid);
         if (r->vbo_grid) glDeleteBuffers(1, &r->vbo_grid);
         if (r->ibo_grid) glDeleteBuffers(1, &r->ibo_grid);
@@ -380,6 +434,7 @@ void gr_shafts_destroy(gr_shafts *r)
         delete_tex_fbo(&r->shadow_tex, &r->shadow_fbo);
         delete_tex_fbo(&r->target_tex, &r->target_fbo);
         delete_tex_fbo(&r->frame_tex, &r->frame_fbo);
+        gr_scenegl_destroy(r->scenegl);
         if (r->owns_gl) gr_gl_destroy(r->gl);
     }
     free(r->grid_cpu);
@@ -393,15 +448,18 @@ const gr_gl *gr_shafts_gl(const gr_shafts *r) { return r ? r->gl : NULL; }
 int gr_shafts_shaders_from_dir(const gr_shafts *r) { return r ? r->from_dir : 0; }
 
 /* Static shaft geometry for N grid vertices per side: (N-1)^2 separate parallelepipeds,
- * one per grid cell, 8 vertices each; indices: all lateral faces first, then all caps, so
- * one draw call covers "caps off" (24 per shaft) or "caps on" (36 per shaft). */
-static gr_status ensure_grid(gr_shafts *r, int N, gr_error *err)
+ * one per grid cell, each cut into `slabs` closed slabs along its length (1 but for the flux
+ * variant), 8 vertices per slab; indices: all lateral faces first, then all caps, so one draw
+ * call covers "caps off" (24 per slab) or "caps on" (36 per slab). Every face is wound
+ * counter-clockwise seen from outside the slab (outward normals), which the path and flux
+ * variants need to tell entry faces (front-facing) from exit faces. */
+static gr_status ensure_grid(gr_shafts *r, int N, int slabs, gr_error *err)
 {
-    if (r->grid_N == N) return GR_OK;
+    if (r->grid_N == N && r->grid_slabs == slabs) return GR_OK;
     int cells = N - 1;
-    int ns = cells * cells;
+    int ns = cells * cells * slabs;
     size_t nv = (size_t)ns * 8;
-    float *v = malloc(nv * 5 * sizeof *v);
+    float *v = malloc(nv * GRID_FLOATS * sizeof *v);
     GLuint *idx = malloc((size_t)ns * 36 * sizeof *idx);
     if (!v || !idx) {
         free(v);
@@ -409,53 +467,60 @@ static gr_status ensure_grid(gr_shafts *r, int N, gr_error *err)
         return gr_fail(err, GR_E_NOMEM, "shafts.N = %d: out of memory for the shaft grid", N);
     }
     static const float corners[4][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {0.5f, 0.5f}, {-0.5f, 0.5f}};
+    /* x right, z forward, y up: face 0-1-5-4 (z = -0.5 side) has normal (1,0,0) x (1,-1,0) =
+     * (0,0,-1), outward; the top cap 0-3-2-1 faces +y, the bottom cap 4-5-6-7 faces -y. */
     static const int lateral[4][4] = {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
-    static const int cap[2][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}};
+    static const int cap[2][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}};
     double half = 0.5 * (double)(N - 1);
     GLuint *lat = idx, *caps = idx + (size_t)ns * 24;
     for (int j = 0; j < cells; j++)
-        for (int i = 0; i < cells; i++) {
-            int sh = j * cells + i;
-            float cx = (float)((double)i + 0.5 - half), cz = (float)((double)j + 0.5 - half);
-            for (int k = 0; k < 8; k++) {
-                float *p = v + ((size_t)sh * 8 + (size_t)k) * 5;
-                p[0] = cx;
-                p[1] = cz;
-                p[2] = corners[k & 3][0];
-                p[3] = corners[k & 3][1];
-                p[4] = k >= 4 ? 1.0f : 0.0f;
+        for (int i = 0; i < cells; i++)
+            for (int b = 0; b < slabs; b++) {
+                int sh = (j * cells + i) * slabs + b;
+                float cx = (float)((double)i + 0.5 - half), cz = (float)((double)j + 0.5 - half);
+                for (int k = 0; k < 8; k++) {
+                    float *p = v + ((size_t)sh * 8 + (size_t)k) * GRID_FLOATS;
+                    p[0] = cx;
+                    p[1] = cz;
+                    p[2] = corners[k & 3][0];
+                    p[3] = corners[k & 3][1];
+                    p[4] = (float)((double)(b + (k >= 4 ? 1 : 0)) / (double)slabs);
+                    p[5] = (float)(((double)b + 0.5) / (double)slabs);
+                }
+                GLuint base = (GLuint)sh * 8u;
+                for (int f = 0; f < 4; f++) {
+                    const int *q = lateral[f];
+                    GLuint *o = lat + (size_t)sh * 24 + (size_t)f * 6;
+                    o[0] = base + (GLuint)q[0]; o[1] = base + (GLuint)q[1]; o[2] = base + (GLuint)q[2];
+                    o[3] = base + (GLuint)q[0]; o[4] = base + (GLuint)q[2]; o[5] = base + (GLuint)q[3];
+                }
+                for (int f = 0; f < 2; f++) {
+                    const int *q = cap[f];
+                    GLuint *o = caps + (size_t)sh * 12 + (size_t)f * 6;
+                    o[0] = base + (GLuint)q[0]; o[1] = base + (GLuint)q[1]; o[2] = base + (GLuint)q[2];
+                    o[3] = base + (GLuint)q[0]; o[4] = base + (GLuint)q[2]; o[5] = base + (GLuint)q[3];
+                }
             }
-            GLuint base = (GLuint)sh * 8u;
-            for (int f = 0; f < 4; f++) {
-                const int *q = lateral[f];
-                GLuint *o = lat + (size_t)sh * 24 + (size_t)f * 6;
-                o[0] = base + (GLuint)q[0]; o[1] = base + (GLuint)q[1]; o[2] = base + (GLuint)q[2];
-                o[3] = base + (GLuint)q[0]; o[4] = base + (GLuint)q[2]; o[5] = base + (GLuint)q[3];
-            }
-            for (int f = 0; f < 2; f++) {
-                const int *q = cap[f];
-                GLuint *o = caps + (size_t)sh * 12 + (size_t)f * 6;
-                o[0] = base + (GLuint)q[0]; o[1] = base + (GLuint)q[1]; o[2] = base + (GLuint)q[2];
-                o[3] = base + (GLuint)q[0]; o[4] = base + (GLuint)q[2]; o[5] = base + (GLuint)q[3];
-            }
-        }
     glBindVertexArray(r->vao_grid);
     glBindBuffer(GL_ARRAY_BUFFER, r->vbo_grid);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 5 * sizeof *v), v, GL_STATIC_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * GRID_FLOATS * sizeof *v), v, GL_STATIC_DRAW);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->ibo_grid);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)ns * 36 * sizeof *idx), idx, GL_STATIC_DRAW);
-    GLsizei stride = (GLsizei)(5 * sizeof(float));
+    GLsizei stride = (GLsizei)(GRID_FLOATS * sizeof(float));
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, stride, (const void *)0);
     glEnableVertexAttribArray(1);
     glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, stride, (const void *)(2 * sizeof(float)));
     glEnableVertexAttribArray(2);
     glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, stride, (const void *)(4 * sizeof(float)));
+    glEnableVertexAttribArray(3);
+    glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, stride, (const void *)(5 * sizeof(float)));
     glBindVertexArray(0);
     free(idx);
     free(r->grid_cpu);
     r->grid_cpu = v;
     r->grid_N = N;
+    r->grid_slabs = slabs;
     r->grid_nshafts = ns;
     return gr_gl_check("shafts.N: uploading the shaft grid", err);
 }
@@ -497,6 +562,35 @@ static gr_status make_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h
     return gr_gl_check(what, err);
 }
 
+/* The flux pre-pass's two RGBA32F corner textures, 2 (N-1) texels per side. */
+static gr_status ensure_corners(gr_shafts *r, int N, gr_error *err)
+{
+    int n = 2 * (N - 1);
+    if (r->corner_size == n && r->corner_fbo) return GR_OK;
+    if (r->corner_fbo) glDeleteFramebuffers(1, &r->corner_fbo);
+    if (r->corner_tex[0]) glDeleteTextures(2, r->corner_tex);
+    r->corner_size = 0;
+    glGenTextures(2, r->corner_tex);
+    glGenFramebuffers(1, &r->corner_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->corner_fbo);
+    for (int i = 0; i < 2; i++) {
+        glBindTexture(GL_TEXTURE_2D, r->corner_tex[i]);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, n, n);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, r->corner_tex[i], 0);
+    }
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, bufs);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (fs != GL_FRAMEBUFFER_COMPLETE)
+        return gr_fail(err, GR_E_GL, "shafts.N = %d: flux corner target %dx%d incomplete (0x%04x)", N, n, n, (unsigned)fs);
+    r->corner_size = n;
+    return gr_gl_check("shafts.N: flux corner target", err);
+}
+
 static gr_status ensure_targets(gr_shafts *r, const frame_setup *f, gr_error *err)
 {
     gr_status st;
@@ -507,15 +601,15 @@ static gr_status ensure_targets(gr_shafts *r, const frame_setup *f, gr_error *er
         if (st != GR_OK) return st;
         r->shadow_size = f->s.shadow_map_size;
     }
-    if (r->target_w != f->tw || r->target_h != f->th || r->target_fmt != f->s.target_format || !r->target_tex) {
+    if (r->target_w != f->tw || r->target_h != f->th || r->target_fmt != f->fmt || !r->target_tex) {
         r->target_w = 0;
-        GLenum ifmt = f->s.target_format == GR_TARGET_RGBA16F ? GL_RGBA16F : GL_RGBA8;
+        GLenum ifmt = f->fmt == TARGET_RGBA32F ? GL_RGBA32F : f->fmt == GR_TARGET_RGBA16F ? GL_RGBA16F : GL_RGBA8;
         st = make_target(&r->target_tex, &r->target_fbo, ifmt, f->tw, f->th, 0, GL_LINEAR,
                          "shafts.target_scale: shaft render target", err);
         if (st != GR_OK) return st;
         r->target_w = f->tw;
         r->target_h = f->th;
-        r->target_fmt = f->s.target_format;
+        r->target_fmt = f->fmt;
     }
     if (r->frame_w != f->W || r->frame_h != f->H || !r->frame_tex) {
         r->frame_w = 0;
@@ -573,33 +667,77 @@ static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in
     if (!(isfinite(f->P.x) && isfinite(f->P.z) && f->S > 0 && isfinite(f->S)))
         return gr_fail(err, GR_E_INPUT, "sun.elevation_deg: no finite recentering point P for this sun and camera");
     gr_dvec3 orel = gr_d3_sub(f->P, f->eye);
-    f->origin_rel[0] = (float)orel.x;
-    f->origin_rel[1] = (float)orel.y;
-    f->origin_rel[2] = (float)orel.z;
-
-    /* Wave constants, packed by groups of 4 like the seed: kx, kz, A/|k|, A, c, with
-     * c = w t - phi0 - k.P folded mod 2 pi in double (eq. 5.5.7: phase = k.X0 - w t + phi0). */
     if (w->n_waves > MAX_WAVE_GROUPS * 4)
         return gr_fail(err, GR_E_INPUT, "water.waves: %d waves, the shafts renderer takes at most %d",
                        w->n_waves, MAX_WAVE_GROUPS * 4);
     f->groups = (w->n_waves + 3) / 4;
-    double t = w->time_s;
     double amp_sum = 0.0, steep = 0.0;
     for (int i = 0; i < w->n_waves; i++) {
-        const gr_wave *wv = &w->waves[i];
-        int g = i / 4, lane = i % 4;
-        double kx = wv->k * wv->dir[0], kz = wv->k * wv->dir[1];
-        double c = wv->omega_rad_s * t - wv->phase_rad - (kx * f->P.x + kz * f->P.z);
-        c = fmod(c, 2.0 * GR_PI);
-        float *base = f->waves + (size_t)g * 20;
-        base[0 * 4 + lane] = (float)kx;
-        base[1 * 4 + lane] = (float)kz;
-        base[2 * 4 + lane] = wv->k > 0 ? (float)(wv->amplitude_m / wv->k) : 0.0f;
-        base[3 * 4 + lane] = (float)wv->amplitude_m;
-        base[4 * 4 + lane] = (float)c;
-        amp_sum += fabs(wv->amplitude_m);
-        steep += fabs(wv->amplitude_m) * wv->k;
+        amp_sum += fabs(w->waves[i].amplitude_m);
+        steep += fabs(w->waves[i].amplitude_m) * w->waves[i].k;
     }
+    /* Grid levels: one at (P, S); with stable_grid, S quantized to powers of two 2^l <= S <
+     * 2^(l+1), cross-faded by the fraction of log2 S, and P snapped to each level's spacing
+     * (docs/realtime-shafts.md "stable_grid"). */
+    f->n_levels = 1;
+    f->lvl_S[0] = f->S;
+    f->lvl_weight[0] = 1.0;
+    gr_dvec3 lvl_P[2] = {f->P, f->P};
+    if (s->stable_grid) {
+        double L = log2(f->S), l = floor(L), a = L - l;
+        f->lvl_S[0] = exp2(l);
+        f->lvl_S[1] = exp2(l + 1.0);
+        f->lvl_weight[0] = 1.0 - a;
+        f->lvl_weight[1] = a;
+        f->n_levels = 2;
+        for (int k = 0; k < 2; k++) {
+            double Sk = f->lvl_S[k];
+            lvl_P[k] = gr_d3(Sk * floor(f->P.x / Sk + 0.5), f->P.y, Sk * floor(f->P.z / Sk + 0.5));
+        }
+    }
+    /* Wave constants, packed by groups of 4 like the seed: kx, kz, A/|k|, A, c, with
+     * c = w t - phi0 - k.P folded mod 2 pi in double (eq. 5.5.7: phase = k.X0 - w t + phi0). */
+    double t = w->time_s;
+    for (int k = 0; k < f->n_levels; k++) {
+        gr_dvec3 rel = gr_d3_sub(lvl_P[k], f->eye);
+        f->lvl_origin[k][0] = (float)rel.x;
+        f->lvl_origin[k][1] = (float)rel.y;
+        f->lvl_origin[k][2] = (float)rel.z;
+        for (int i = 0; i < w->n_waves; i++) {
+            const gr_wave *wv = &w->waves[i];
+            int g = i / 4, lane = i % 4;
+            double kx = wv->k * wv->dir[0], kz = wv->k * wv->dir[1];
+            double c = wv->omega_rad_s * t - wv->phase_rad - (kx * lvl_P[k].x + kz * lvl_P[k].z);
+            c = fmod(c, 2.0 * GR_PI);
+            float *base = f->lvl_waves[k] + (size_t)g * 20;
+            base[0 * 4 + lane] = (float)kx;
+            base[1 * 4 + lane] = (float)kz;
+            base[2 * 4 + lane] = wv->k > 0 ? (float)(wv->amplitude_m / wv->k) : 0.0f;
+            base[3 * 4 + lane] = (float)wv->amplitude_m;
+            base[4 * 4 + lane] = (float)c;
+        }
+    }
+    memcpy(f->origin_rel, f->lvl_origin[0], sizeof f->origin_rel);
+    memcpy(f->waves, f->lvl_waves[0], sizeof f->waves);
+
+    /* Variant: target format, caps, slabs, physical factors (docs "Variants"). */
+    double cos_i = fabs(I.y), cos_t = fabs(f->T.y);
+    f->fmt = s->variant == GR_SHAFTS_SEED ? s->target_format : TARGET_RGBA32F;
+    f->caps = s->variant == GR_SHAFTS_SEED ? s->caps : 1; /* signed sums need closed shafts */
+    f->slabs = s->variant == GR_SHAFTS_FLUX ? s->slabs : 1;
+    f->ratio = (float)(cos_i / fmax(cos_t, 1e-9) / (s->shaft_width * s->shaft_width));
+    double alpha = 0.5 * scene->sun.angular_diameter_deg * GR_PI / 180.0;
+    f->sun_radius_w = (float)(alpha * cos_i / (ior * fmax(cos_t, 1e-9)));
+    double gv = s->variant == GR_SHAFTS_SEED ? s->g : scene->medium.g;
+    f->final_hgg[0] = (float)(1.0 - gv * gv);
+    f->final_hgg[1] = (float)(1.0 + gv * gv);
+    f->final_hgg[2] = (float)(2.0 * gv);
+    for (int c = 0; c < 3; c++) {
+        double phys = s->variant == GR_SHAFTS_SEED ? 1.0
+                                                   : scene->medium.scattering[c] * scene->sun.irradiance[c] / (4.0 * GR_PI);
+        f->final_intensity[c] = (float)(s->intensity[c] * phys / s->target_prescale);
+    }
+    f->final_bias = s->variant == GR_SHAFTS_SEED ? (float)s->bias : 0.0f;
 
     /* Camera: view matrix without translation (positions are viewer-relative). */
     double aspect = (double)f->W / (double)f->H;
@@ -624,7 +762,8 @@ static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in
     gr_dvec3 a = fabs(e3.x) < 0.9 ? gr_d3(1, 0, 0) : gr_d3(0, 0, 1);
     gr_dvec3 e1 = gr_d3_norm(gr_d3_cross(e3, a));
     gr_dvec3 e2 = gr_d3_cross(e3, e1);
-    double half_grid = 0.5 * (double)s->N * f->S * fmax(1.0, s->shaft_width);
+    double half_grid = 0.5 * (double)s->N * f->lvl_S[f->n_levels - 1] * fmax(1.0, s->shaft_width)
+                       + (s->stable_grid ? f->lvl_S[f->n_levels - 1] : 0.0);
     double radius = sqrt(2.0) * half_grid + amp_sum + s->shaft_length_m * fmin(1.0, steep + 0.05);
     double znear = -(radius + amp_sum + 1.0);
     double zfar = s->shaft_length_m + radius + amp_sum + 1.0;
@@ -723,7 +862,7 @@ static void set_shaft_uniforms(GLuint prog, const shaft_locs *l, const frame_set
     const gr_shafts_settings *s = &f->s;
     glUseProgram(prog);
     glUniform3fv(l->origin, 1, f->origin_rel);
-    glUniform1f(l->spacing, (float)f->S);
+    glUniform1f(l->spacing, (float)f->lvl_S[0]);
     glUniform1f(l->width, (float)s->shaft_width);
     glUniform1f(l->length, (float)s->shaft_length_m);
     glUniform3f(l->extinction, (float)s->extinction[0], (float)s->extinction[1], (float)s->extinction[2]);
@@ -736,6 +875,17 @@ static void set_shaft_uniforms(GLuint prog, const shaft_locs *l, const frame_set
     if (f->groups > 0) glUniform4fv(l->waves, f->groups * 5, f->waves);
     glUniform1i(l->shadow_map, 0);
     glUniform1f(l->shadow_bias, f->shadow_bias_depth);
+    glUniform1i(l->variant, s->variant);
+    glUniform1f(l->ratio, f->ratio);
+    glUniform3f(l->refr_flat, (float)f->T.x, (float)f->T.y, (float)f->T.z);
+    glUniform1f(l->sun_radius_w, f->sun_radius_w);
+    glUniform1f(l->prescale, (float)s->target_prescale);
+    glUniform1i(l->depth_test, s->depth_test);
+    glUniform1i(l->eye_depth, 1);
+    glUniform2f(l->target_size, (float)f->tw, (float)f->th);
+    glUniform1f(l->half, (float)(0.5 * (double)(f->N - 1)));
+    glUniform1i(l->corner_pos, 2);
+    glUniform1i(l->corner_refr, 3);
 }
 
 static long long query_result(GLuint q)
@@ -760,8 +910,19 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
         goto done;
     }
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
-    if ((st = ensure_grid(r, f->N, err)) != GR_OK) goto done;
+    if ((st = ensure_grid(r, f->N, f->slabs, err)) != GR_OK) goto done;
     if ((st = ensure_targets(r, f, err)) != GR_OK) goto done;
+    if (f->s.variant == GR_SHAFTS_FLUX && (st = ensure_corners(r, f->N, err)) != GR_OK) goto done;
+    GLuint eye_depth_tex = 0;
+    if (f->s.depth_test) {
+        /* scenegl's eye depth of the occluders and seabed at the target's resolution */
+        if (!r->scenegl && (st = gr_scenegl_create_dir(r->gl, r->shader_dir, &r->scenegl, err)) != GR_OK) goto done;
+        gr_frame fr;
+        gr_frame_init(scene, &fr);
+        unsigned tex = 0;
+        if ((st = gr_scenegl_eye_depth(r->scenegl, scene, &fr, f->tw, f->th, &tex, err)) != GR_OK) goto done;
+        eye_depth_tex = tex;
+    }
     size_t n_occ = 0;
     if ((st = build_occluders(r, scene, f->P, &n_occ, err)) != GR_OK) goto done;
 
@@ -789,7 +950,7 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glEndQuery(GL_TIME_ELAPSED);
 
     /* Pass 2: shafts, additive, no depth test, no culling, into the reduced target. */
-    GLsizei n_idx = (GLsizei)(f->nshafts * (f->s.caps ? 36 : 24));
+    GLsizei n_idx = (GLsizei)(f->nshafts * f->slabs * (f->caps ? 36 : 24));
     glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_SHAFTS]);
     glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
     if (r->have_pipeline_stats) {
@@ -805,10 +966,47 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
     set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, eye_depth_tex);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, r->shadow_tex);
     glBindVertexArray(r->vao_grid);
-    glDrawElements(GL_TRIANGLES, n_idx, GL_UNSIGNED_INT, (const void *)0);
+    for (int k = 0; k < f->n_levels; k++) {
+        if (f->lvl_weight[k] <= 0.0) continue;
+        if (f->s.variant == GR_SHAFTS_FLUX) {
+            /* pre-pass: the level's corners, then back to the shaft pass's state */
+            glDisable(GL_BLEND);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->corner_fbo);
+            glViewport(0, 0, r->corner_size, r->corner_size);
+            set_shaft_uniforms(r->prog_corner, &r->lk, f, scene);
+            glUniform3fv(r->lk.origin, 1, f->lvl_origin[k]);
+            glUniform1f(r->lk.spacing, (float)f->lvl_S[k]);
+            if (f->groups > 0) glUniform4fv(r->lk.waves, f->groups * 5, f->lvl_waves[k]);
+            glBindVertexArray(r->vao_empty);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+            glViewport(0, 0, f->tw, f->th);
+            glEnable(GL_BLEND);
+            set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
+            glActiveTexture(GL_TEXTURE2);
+            glBindTexture(GL_TEXTURE_2D, r->corner_tex[0]);
+            glActiveTexture(GL_TEXTURE3);
+            glBindTexture(GL_TEXTURE_2D, r->corner_tex[1]);
+            glActiveTexture(GL_TEXTURE0);
+            glBindVertexArray(r->vao_grid);
+        }
+        /* stable_grid: each level drawn with its weight folded into the prescale */
+        glUniform3fv(r->ls.origin, 1, f->lvl_origin[k]);
+        glUniform1f(r->ls.spacing, (float)f->lvl_S[k]);
+        if (f->groups > 0) glUniform4fv(r->ls.waves, f->groups * 5, f->lvl_waves[k]);
+        glUniform1f(r->ls.prescale, (float)(f->s.target_prescale * f->lvl_weight[k]));
+        glDrawElements(GL_TRIANGLES, n_idx, GL_UNSIGNED_INT, (const void *)0);
+    }
+    for (GLenum u = GL_TEXTURE1; u <= GL_TEXTURE3; u++) {
+        glActiveTexture(u);
+        glBindTexture(GL_TEXTURE_2D, 0);
+    }
+    glActiveTexture(GL_TEXTURE0);
     glDisable(GL_BLEND);
     if (r->have_pipeline_stats) {
         glEndQuery(GL_FRAGMENT_SHADER_INVOCATIONS);
@@ -826,10 +1024,10 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glUniformMatrix4fv(r->loc_inv_vp, 1, GL_TRUE, f->inv_view_proj);
     glUniform2f(r->loc_texel, 1.0f / (float)f->tw, 1.0f / (float)f->th);
     glUniform1i(r->loc_shafts, 0);
-    glUniform3fv(r->loc_hgg, 1, f->hgg);
+    glUniform3fv(r->loc_hgg, 1, f->final_hgg);
     glUniform3f(r->loc_refr_sun, (float)f->T.x, (float)f->T.y, (float)f->T.z);
-    glUniform3f(r->loc_intensity, (float)f->s.intensity[0], (float)f->s.intensity[1], (float)f->s.intensity[2]);
-    glUniform1f(r->loc_bias, (float)f->s.bias);
+    glUniform3fv(r->loc_intensity, 1, f->final_intensity);
+    glUniform1f(r->loc_bias, f->final_bias);
     glBindTexture(GL_TEXTURE_2D, r->target_tex);
     glBindVertexArray(r->vao_empty);
     glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
@@ -940,7 +1138,7 @@ gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts
             goto done;
         get_shaft_locs(r->prog_capture, &r->lc);
     }
-    if ((st = ensure_grid(r, f->N, err)) != GR_OK) goto done;
+    if ((st = ensure_grid(r, f->N, 1, err)) != GR_OK) goto done;
     if ((st = ensure_targets(r, f, err)) != GR_OK) goto done;
     /* A surfaceless context has no default framebuffer: draw calls need a complete FBO
      * bound even with rasterizer discard on. */
@@ -969,7 +1167,7 @@ gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts
     glGetBufferSubData(GL_TRANSFORM_FEEDBACK_BUFFER, 0, (GLsizeiptr)bytes, data);
     for (int i = 0; i < nv; i++) {
         gr_shafts_vertex *v = &(*out)[i];
-        const float *g = r->grid_cpu + (size_t)i * 5;
+        const float *g = r->grid_cpu + (size_t)i * GRID_FLOATS;
         const float *d = data + (size_t)i * 6;
         v->cell[0] = g[0];
         v->cell[1] = g[1];
@@ -1161,7 +1359,7 @@ static void tech_summary(void *state, const gr_technique_stats *stats, char *buf
     double tpx = (double)s.target_width * (double)s.target_height;
     snprintf(buf, n, "%d shafts, target %dx%d (%s), fragments blended %lld (overdraw %.2f), vertices %lld "
              "(VS invocations %lld)", s.n_shafts, s.target_width, s.target_height,
-             t->r->target_fmt == GR_TARGET_RGBA16F ? "rgba16f" : "rgba8", s.fragments,
+             t->r->target_fmt == TARGET_RGBA32F ? "rgba32f" : t->r->target_fmt == GR_TARGET_RGBA16F ? "rgba16f" : "rgba8", s.fragments,
              tpx > 0 ? (double)s.fragments / tpx : 0.0, s.vertices_submitted, s.vs_invocations);
 }
 

@@ -22,6 +22,10 @@ extern const gr_technique_class gr_shafts_class;
 
 /* The scene section "shafts": settings and their descriptor table (shafts.c). */
 typedef enum gr_target_format { GR_TARGET_RGBA8 = 0, GR_TARGET_RGBA16F = 1 } gr_target_format;
+/* What a shaft fragment adds (docs/realtime-shafts.md "Variants"): the seed's per-vertex
+ * intensity per surface crossed; the length of shaft traversed (signed faces); the same with
+ * each depth slab's irradiance from the area ratio of its cross-section (focusing). */
+typedef enum gr_shafts_variant { GR_SHAFTS_SEED = 0, GR_SHAFTS_PATH = 1, GR_SHAFTS_FLUX = 2 } gr_shafts_variant;
 
 /* Real-time shafts (seed 000), every undocumented choice exposed. */
 typedef struct gr_shafts_settings {
@@ -38,6 +42,11 @@ typedef struct gr_shafts_settings {
     double intensity[3];          /* user factor in the second pass */
     int shadow_map_size;          /* shadow map resolution (texels per side) */
     double shadow_bias;           /* depth bias of the shadow comparison (m) */
+    int variant;                  /* gr_shafts_variant */
+    double target_prescale;       /* factor on each fragment before blending, divided out after */
+    int stable_grid;              /* P snapped to the grid, S quantized with a cross-fade */
+    int depth_test;               /* shafts hidden behind occluders / seabed seen from the eye */
+    int slabs;                    /* flux: depth slabs per shaft */
 } gr_shafts_settings;
 
 extern const gr_param_table gr_shafts_param_table;

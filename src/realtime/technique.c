@@ -11,11 +11,15 @@
 /* ---- the built-in techniques: ONE LINE EACH (their header declares the class) -------- */
 #include "realtime/shafts.h"
 #include "realtime/radial_blur.h"
+#include "realtime/slicing.h"
+#include "realtime/froxel.h"
 
 static const gr_technique_class *const builtins[] = {
     &gr_shafts_class,
     &gr_radial_blur_class,
     &gr_radial_blur_local_class,
+    &gr_slicing_class,
+    &gr_froxel_class,
 };
 
 /* ---- registry ------------------------------------------------------------------------- */

@@ -14,6 +14,7 @@
 #include <cjson/cJSON.h>
 
 #include "compare/diffmap.h"
+#include "compare/flip.h"
 #include "compare/metrics_io.h"
 #include "image/oiio.h"
 #include "report/html.h"
@@ -580,9 +581,12 @@ static void html_metrics_table(gr_strbuf *b, const gr_metrics *m, const gr_metri
         snprintf(label, sizeof label, "RMSE after blur, sigma %g px", gr_metrics_blur_sigmas[k]);
         ROW(label, cm->rmse_blur[k]);
     }
-    if (m->have_stderr)
-        ROW("not significant (|d| <= 2 stderr), %",
-            cm->n_samples > 0 ? 100.0 * (double)cm->n_not_significant / (double)cm->n_samples : NAN);
+    if (m->have_stderr) {
+        char sl[96]; /* z: Student t with the reference's batches - 1 degrees of freedom, or 2 */
+        snprintf(sl, sizeof sl, "not significant (|d| <= %.3g stderr%s), %%", m->stderr_z,
+                 m->have_bias ? " + |bias|" : "");
+        ROW(sl, cm->n_samples > 0 ? 100.0 * (double)cm->n_not_significant / (double)cm->n_samples : NAN);
+    }
 #undef ROW
     gr_sb_puts(b, "<tr><td class=\"l\">max error at (x, y)</td>");
     for (int c = 0; c < GR_MCH_COUNT; c++) {
@@ -697,6 +701,8 @@ typedef struct tctx {
     double gpu_ms, wall_ms;        /* from its metadata (NaN: unknown) */
     gr_image *disp_fit, *disp_raw, *diff_signed, *diff_abs;
     gr_diffmap_info info_signed, info_abs;
+    gr_image *flip_map;            /* per-pixel HDR-FLIP of a * test, magma (docs/metrics.md) */
+    gr_flip_result flip;
     char lines[3][512];            /* its summary lines */
 } tctx;
 
@@ -810,6 +816,12 @@ static cJSON *technique_json(const ctx *c, int k, int rank)
     jstr(pv, "raw", file, &ok);
     jnum(pv, "scale", tc->a, &ok);
     jnum(pv, "raw_exposure", tc->exposure_raw, &ok);
+    {
+        cJSON *fj = gr_flip_to_json(&tc->flip, tc->a);
+        snprintf(file, sizeof file, "%s_flip.png", tc->stem);
+        jstr(fj, "map", file, &ok);
+        jadd(o, "flip", fj, &ok);
+    }
     cJSON *dj = cJSON_CreateObject();
     jadd(o, "difference_images", dj, &ok);
     for (int s = 0; ok && s < 2; s++) {
@@ -1090,7 +1102,7 @@ static void html_technique(ctx *c, gr_strbuf *b, int k)
     const gr_report_technique *t = tc->t;
     const gr_metrics *m = t->metrics;
     const gr_metadata *tmeta = t->meta;
-    char cap[1024], f[4][96], tt[4][64];
+    char cap[1024], f[5][96], tt[4][64];
     gr_sb_puts(b, "<h2 id=\"t-");
     gr_sb_html(b, t->name);
     gr_sb_puts(b, "\">Technique <code>");
@@ -1111,6 +1123,7 @@ static void html_technique(ctx *c, gr_strbuf *b, int k)
     snprintf(f[1], sizeof f[1], "%s_diff_signed.png", tc->stem);
     snprintf(f[2], sizeof f[2], "%s_diff.png", tc->stem);
     snprintf(f[3], sizeof f[3], "%s_raw.png", tc->stem);
+    snprintf(f[4], sizeof f[4], "%s_flip.png", tc->stem);
     gr_sb_puts(b, "<div class=\"grid\">\n");
     snprintf(cap, sizeof cap, "Ground truth, exposure %s (its 99th percentile -> 0.8), sRGB.%s",
              fmt(c->exposure, tt[0], sizeof tt[0]), in->ref_cached ? " Read from the cache." : "");
@@ -1132,6 +1145,11 @@ static void html_technique(ctx *c, gr_strbuf *b, int k)
     snprintf(cap, sizeof cap, "%s as rendered (a = 1), own exposure %s.", t->name,
              fmt(tc->exposure_raw, tt[0], sizeof tt[0]));
     html_figure(b, f[3], tc->disp_raw, "technique as rendered", cap);
+    snprintf(cap, sizeof cap,
+             "HDR-FLIP per pixel of a x %s against the ground truth (Andersson et al. 2020, 2021; docs/metrics.md): "
+             "magma from 0 (black, no visible difference) to 1 (pale yellow); mean %.4f, median %.4f.",
+             t->name, tc->flip.mean, tc->flip.median);
+    html_figure(b, f[4], tc->flip_map, "FLIP map", cap);
     gr_sb_puts(b, "</div>\n");
     if (t->exr && in->ref_exr) {
         gr_sb_puts(b, "<p class=\"sub\">The linear images: <a href=\"");
@@ -1428,6 +1446,16 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
                                    s ? &tc->info_signed : &tc->info_abs, err);
             if (st != GR_OK) goto done;
         }
+        {
+            /* HDR-FLIP of a * test over every pixel, and its magma picture */
+            float *fm = malloc((size_t)in->ref->width * (size_t)in->ref->height * sizeof(float));
+            gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = tc->a};
+            st = fm ? gr_flip_compute(in->ref, tc->t->test, &fo, fm, &tc->flip, err)
+                    : gr_fail(err, GR_E_NOMEM, "report: out of memory for the FLIP map");
+            if (st == GR_OK) st = gr_flip_heatmap(fm, in->ref->width, in->ref->height, &tc->flip_map, err);
+            free(fm);
+            if (st != GR_OK) goto done;
+        }
     }
     if ((st = compute_profiles(in, as, &c->pr, err)) != GR_OK) goto done;
     c->have_profiles = 1;
@@ -1438,9 +1466,9 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
     if ((st = gr_oiio_write(path, c->disp_ref, err)) != GR_OK) goto done;
     for (int k = 0; k < nt; k++) {
         tctx *tc = &c->t[k];
-        static const char *const suffix[4] = {"", "_raw", "_diff_signed", "_diff"};
-        const gr_image *imgs[4] = {tc->disp_fit, tc->disp_raw, tc->diff_signed, tc->diff_abs};
-        for (int i = 0; i < 4; i++) {
+        static const char *const suffix[5] = {"", "_raw", "_diff_signed", "_diff", "_flip"};
+        const gr_image *imgs[5] = {tc->disp_fit, tc->disp_raw, tc->diff_signed, tc->diff_abs, tc->flip_map};
+        for (int i = 0; i < 5; i++) {
             snprintf(file, sizeof file, "%s%s.png", tc->stem, suffix[i]);
             if ((st = join(path, sizeof path, dir, file, err)) != GR_OK) goto done;
             if ((st = gr_oiio_write(path, imgs[i], err)) != GR_OK) goto done;
@@ -1510,6 +1538,7 @@ done:
         gr_image_destroy(tc->disp_raw);
         gr_image_destroy(tc->diff_signed);
         gr_image_destroy(tc->diff_abs);
+        gr_image_destroy(tc->flip_map);
     }
     free_profiles(&c->pr);
     free(cp);

@@ -1,22 +1,66 @@
 #version 330 core
-// Seed 000 shaft pixel shader: interpolated intensity times an unfiltered shadow test.
+// Seed 000 shaft pixel shader: interpolated intensity times an unfiltered shadow test
+// (variant seed); the signed length integral of the path and flux variants
+// (docs/realtime-shafts.md "Variants").
 
 in vec3 v_intensity;
 in vec4 v_shadow_pos;
 in vec3 v_world;
+in float v_len;
+in float v_tr;
+in float v_ratio;
 
 uniform sampler2D u_shadow_map; // depth along the refracted sun, [0,1] over [near, far]
 uniform float u_shadow_bias;    // depth bias in the same [0,1] units
+uniform int u_variant;          // 0 seed, 1 path, 2 flux
+uniform float u_prescale;       // factor before blending (divided out in the final pass)
+uniform vec3 u_extinction;      // c (1/m)
+uniform vec3 u_refr_flat;       // T of the flat surface
+uniform int u_depth_test;       // 1: eye depth of occluders / seabed in u_eye_depth
+uniform sampler2D u_eye_depth;  // distance (m) from the eye to the first occluder or the seabed
+uniform vec2 u_target_size;     // shaft target size (texels)
 
 layout(location = 0) out vec4 o_color;
 
+// (1 - e^-x) / x, stable near 0
+vec3 expint1(vec3 x)
+{
+    vec3 big = (1.0 - exp(-x)) / x;
+    vec3 small = 1.0 - x * (0.5 - x * (1.0 / 6.0 - x / 24.0));
+    return mix(big, small, lessThan(abs(x), vec3(1e-2)));
+}
+
 void main()
 {
-    // Distance to the light source (normalized depth along the refracted sun).
-    float z = v_shadow_pos.z / v_shadow_pos.w;
-    // Fetch shadowmap (point sampled, as the seed's sampler state).
-    float sz = textureProj(u_shadow_map, v_shadow_pos).x;
-    float lit = (z - u_shadow_bias < sz) ? 1.0 : 0.0;
-    // Alpha 1 per fragment: in a float target it counts the shafts' surfaces crossed.
-    o_color = vec4(v_intensity * lit, 1.0);
+    float t = length(v_world);
+    float t_max = 1e30;
+    if (u_depth_test != 0) t_max = texture(u_eye_depth, gl_FragCoord.xy / u_target_size).x;
+    if (u_variant == 0) {
+        if (t > t_max) discard;
+        // Distance to the light source (normalized depth along the refracted sun).
+        float z = v_shadow_pos.z / v_shadow_pos.w;
+        // Fetch shadowmap (point sampled, as the seed's sampler state).
+        float sz = textureProj(u_shadow_map, v_shadow_pos).x;
+        float lit = (z - u_shadow_bias < sz) ? 1.0 : 0.0;
+        // Alpha 1 per fragment: in a float target it counts the shafts' surfaces crossed.
+        o_color = vec4(v_intensity * lit * u_prescale, 1.0);
+        return;
+    }
+    // Path / flux: along the view ray w, the light path under water is s(t) = s0 + t w.T_y
+    // ... s grows by w.y / T.y per metre, so exp(-c (s + t)) = exp(-c s0) exp(-c k t) with
+    // k = 1 + w.y / T.y, whose integral from the eye to t is exp(-c s0) t (1 - e^{-c k t}) / (c k t).
+    // Entry faces subtract it, exit faces add it; their sum is the integral over the length
+    // of shaft traversed (for c = 0: exit t minus entry t).
+    vec3 w = v_world / max(t, 1e-6);
+    float dsdt = w.y / u_refr_flat.y;
+    float len = v_len;
+    if (t > t_max) {            // the ray stops at the occluder / seabed: crossing moved there
+        len += (t_max - t) * dsdt;
+        t = t_max;
+    }
+    float k = 1.0 + dsdt;
+    vec3 e0 = exp(-u_extinction * (len - dsdt * t)); // exp(-c s0): s0 = light path at t = 0
+    vec3 v = e0 * t * expint1(u_extinction * k * t) * (v_tr * v_ratio);
+    float sgn = gl_FrontFacing ? -1.0 : 1.0; // outward winding: front = entry
+    o_color = vec4(sgn * v * u_prescale, sgn);
 }

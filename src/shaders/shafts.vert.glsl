@@ -8,7 +8,9 @@
 
 layout(location = 0) in vec2 a_cell;    // cell centre, in grid cells, relative to P
 layout(location = 1) in vec2 a_corner;  // corner of the shaft's cross-section, +-0.5 cell
-layout(location = 2) in float a_bottom; // 0: top vertex, 1: bottom vertex (seed: input.length > 0)
+layout(location = 2) in float a_bottom; // fraction of the extrusion length: 0 top (seed: input.length = 0),
+                                        // 1 bottom; k / slabs for the flux variant's slab boundaries
+layout(location = 3) in float a_mid;    // flux: fraction of the length at the slab's middle
 
 uniform vec3 u_origin;        // P - viewer (m): seed `origin`, eq. 5.5.5a
 uniform float u_spacing;      // S (m): seed `spacing`, eq. 5.5.6
@@ -25,10 +27,20 @@ uniform int u_wave_groups;    // number of groups of 4 waves
 // z component of the wave vector and the constant is c = w t - phi0 - k.P (mod 2 pi, in
 // double on the CPU), so phase = k.(X0 - P) - c = k.X0 - w t + phi0, eq. 5.5.7.
 uniform vec4 u_waves[MAX_WAVE_GROUPS * 5];
+uniform int u_variant;        // 0 seed, 1 path, 2 flux (docs/realtime-shafts.md "Variants")
+uniform float u_ratio;        // path: irradiance factor cos(theta_i) / cos(theta_t) / width^2 (flat water)
+uniform vec3 u_refr_flat;     // flux: T of the flat surface (cross-sections are taken across it)
+uniform float u_sun_radius_w; // flux: the sun's angular radius under water (rad), the regularizer
+uniform float u_half;         // flux: (N - 1) / 2
+uniform sampler2D u_corner_pos;  // flux: corner positions (viewer-relative) and transmittance
+uniform sampler2D u_corner_refr; // flux: corner refracted directions (shafts_corner.frag.glsl)
 
 out vec3 v_intensity;   // seed: output.intensity (read as input.outScattering by its PS)
 out vec4 v_shadow_pos;  // seed: output.shadowmapPos
 out vec3 v_world;       // viewer-relative world position (transform-feedback capture only)
+out float v_len;        // path, flux: distance travelled under water along the refracted ray (m)
+out float v_tr;         // path, flux: Fresnel transmittance at the shaft's top
+out float v_ratio;      // path, flux: irradiance across the beam / (E_sun), constant per slab
 
 // Seed eq. 5.5.2a with the incidence cosine as argument (the listing declares 3 parameters
 // and calls it with 2); clamped so that pow never sees a negative base.
@@ -39,15 +51,13 @@ float fast_fresnel(float cos_i, float r0)
     return r0 + (1.0 - r0) * (m2 * m2 * m);
 }
 
-void main()
+// Seed CalculateWaterNormal (eq. 5.5.8), plus the displacement of eq. 5.5.7, at a rest
+// position relative to P.
+void surface(vec2 rest, out vec3 disp, out vec3 normal)
 {
-    // Scale and translate the vertex on the water surface (rest position, relative to P).
-    vec2 rest = (a_cell + a_corner * u_width) * u_spacing;
-
-    // Seed CalculateWaterNormal (eq. 5.5.8), plus the displacement of eq. 5.5.7.
     vec3 t1 = vec3(1.0, 0.0, 0.0);
     vec3 t2 = vec3(0.0, 0.0, 1.0);
-    vec3 disp = vec3(0.0);
+    disp = vec3(0.0);
     for (int i = 0, j = 0; i < u_wave_groups; i++, j += 5) {
         vec4 kx = u_waves[j];
         vec4 ky = u_waves[j + 1];
@@ -73,14 +83,61 @@ void main()
         t2.z -= dot(Ainvk, ky * cosp * ky);
         t2.y += dot(A, (-sinp) * ky);
     }
-    vec3 normal = normalize(cross(t2, t1));
+    normal = normalize(cross(t2, t1));
+}
+
+void main()
+{
+    if (u_variant == 2) {
+        // Flux (docs: "flux"): the slab's irradiance across the beam is the flux through the
+        // shaft's top face, E_sun |A_top . I| T, over its cross-section across T at the slab's
+        // middle, regularized by the sun disc's blur area pi r^2, r = alpha_w s, as a smooth
+        // maximum sqrt(A^2 + (pi r^2)^2): the section where it is wide, the blur disc at a focus.
+        // The 4 corners come from the pre-pass; every vertex of a slab computes the same value.
+        ivec2 cell = ivec2(floor(a_cell + u_half));
+        vec3 q[4];
+        vec3 rd[4];
+        float trs = 0.0;
+        int own = 0;
+        for (int k = 0; k < 4; k++) {
+            ivec2 c = ivec2((k == 1 || k == 2) ? 1 : 0, (k >= 2) ? 1 : 0);
+            vec4 pt = texelFetch(u_corner_pos, 2 * cell + c, 0);
+            q[k] = pt.xyz;
+            trs += 0.25 * pt.w;
+            rd[k] = texelFetch(u_corner_refr, 2 * cell + c, 0).xyz;
+            if ((a_corner.x > 0.0) == (c.x == 1) && (a_corner.y > 0.0) == (c.y == 1)) own = k;
+        }
+        float smid = a_mid * u_length;
+        vec3 m0 = q[0] + rd[0] * smid, m1 = q[1] + rd[1] * smid, m2 = q[2] + rd[2] * smid, m3 = q[3] + rd[3] * smid;
+        float a_top = 0.5 * abs(dot(cross(q[2] - q[0], q[3] - q[1]), u_sun_dir));
+        float a_sec = 0.5 * abs(dot(cross(m2 - m0, m3 - m1), u_refr_flat));
+        float r = u_sun_radius_w * smid;
+        float a_disc = 3.14159265 * r * r;
+        float a_eff = sqrt(a_sec * a_sec + a_disc * a_disc);
+        // each shaft carries its whole cell's flux (width^2 of the cell is drawn)
+        v_ratio = a_top * trs / max(a_eff, 1e-12) / (u_width * u_width);
+        v_tr = 1.0;
+        float lenf = a_bottom * u_length;
+        vec3 posf = q[own] + rd[own] * lenf;
+        v_len = lenf;
+        v_intensity = vec3(0.0);
+        v_shadow_pos = u_shadow_matrix * vec4(posf, 1.0);
+        v_world = posf;
+        gl_Position = u_view_proj * vec4(posf, 1.0);
+        gl_Position.z = 0.01;
+        return;
+    }
+    // Scale and translate the vertex on the water surface (rest position, relative to P).
+    vec2 rest = (a_cell + a_corner * u_width) * u_spacing;
+    vec3 disp, normal;
+    surface(rest, disp, normal);
 
     // Top vertices on the Gerstner surface (eq. 5.5.7; the seed's listing leaves them flat).
     vec3 pos = u_origin + vec3(rest.x, 0.0, rest.y) + disp;
 
     // Extrude bottom vertices along the refracted sunlight (eq. 5.5.1, GLSL refract).
     float len = a_bottom * u_length;
-    if (a_bottom > 0.5) {
+    if (a_bottom > 0.0) {
         vec3 refr = refract(u_sun_dir, normal, u_eta);
         pos += refr * len;
     }
@@ -89,6 +146,9 @@ void main()
     float tr = 1.0 - fast_fresnel(dot(-u_sun_dir, normal), u_r0);
     float total_dist = len + length(pos);
     v_intensity = exp(-total_dist * u_extinction) * tr;
+    v_len = len;
+    v_tr = tr;
+    v_ratio = u_ratio;
 
     v_shadow_pos = u_shadow_matrix * vec4(pos, 1.0);
     v_world = pos;

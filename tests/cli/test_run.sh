@@ -38,7 +38,7 @@ techs=$("$bin" techniques --json | python3 -c 'import json,sys; print(" ".join(t
 ck "techniques listed" [ -n "$techs" ]
 files="index.html summary.png metrics.json reference.png reference.exr radial_profile.png"
 for t in $techs; do
-    files="$files $t.png ${t}_raw.png ${t}_diff.png ${t}_diff_signed.png $t.exr ${t}_radial_profile_rgb.png ${t}_error_vs_blur.png"
+    files="$files $t.png ${t}_raw.png ${t}_diff.png ${t}_diff_signed.png ${t}_flip.png $t.exr ${t}_radial_profile_rgb.png ${t}_error_vs_blur.png"
 done
 for f in $files; do
     ck "rep1/$f written" [ -s "rep1/$f" ]
@@ -52,7 +52,7 @@ if command -v iinfo >/dev/null 2>&1 && [ -n "$entry" ]; then
 fi
 
 # 2. the run's metrics are compare's metrics on the EXRs it wrote (same stderr rule, same fit)
-"$bin" compare rep1/reference.exr rep1/shafts.exr --fit-scale --json >cmp.json 2>cmp.err
+"$bin" compare rep1/reference.exr rep1/shafts.exr --fit-scale --scene "$scene" --json >cmp.json 2>cmp.err
 ck "compare on the run's EXRs exits 0" [ $? -eq 0 ]
 # metrics.json: one entry per technique (schema 2, docs/report.md); the shafts' "compare" block
 # is what `godrays compare --json` writes

@@ -5,6 +5,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
 
+#include <math.h>
+
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -77,10 +79,17 @@ int main(void)
             CHECK(meta_num(&m, "godrays:wall_s") > 0);
             CHECK(meta_num(&m, "godrays:rel_stderr_mean") > 0);
             CHECK(meta_num(&m, "godrays:spp") >= 8);
-            /* the wavy scene's surface bias is measured (probe on by default), the bound twice it */
+            /* the wavy scene's surface bias is measured (probe on by default); the bound is the
+             * larger of twice the estimate and the figure with the measured order */
             double be = meta_num(&m, "godrays:bias_surface_rel_est"), bb = meta_num(&m, "godrays:bias_surface_rel_bound");
+            double bo = meta_num(&m, "godrays:bias_surface_rel_measured_order");
             CHECK_MSG(be > 0.0 && be < 1.0, "bias estimate %g", be);
-            CHECK_NEAR(bb, 2.0 * be, 1e-12 * bb);
+            CHECK_NEAR(bb, fmax(2.0 * be, bo), 1e-12 * bb);
+            CHECK(bo >= be); /* the measured order is at most 2 */
+            CHECK(meta_num(&m, "godrays:stderr_dof") == 7);
+            CHECK(meta_num(&m, "godrays:bias_block_p95_rel") >= 0.0);
+            const char *bc[] = {"bias.R", "bias.G", "bias.B"};
+            for (int i = 0; i < 3; i++) CHECK_MSG(gr_image_channel(img, bc[i]) >= 0, "channel %s missing", bc[i]);
             CHECK(gr_meta_get(&m, "godrays:bias_surface_probe") != NULL);
         }
         gr_image_destroy(img);

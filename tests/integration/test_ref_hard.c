@@ -7,7 +7,7 @@
  *  sigma_tiny    the clear-water limit: the layer is linear in the coefficients (x2 -> x2)
  *  sigma_huge    no denormal slowdown: render time within 2.5x of sigma_t = 0.2 /m, and the
  *                flat-water closed form at the centre pixel (Oracle 1)
- *  waves_near_loop  no beam overflow; flux still conserved over a large area
+ *  waves_near_loop  beams found (the hit list grows, no cap); flux still conserved over a large area
  *  camera_1mm    rays end after ~mm: every pixel below sigma_s p_max E_w D_max
  *  far_offset    the default scene moved by 1e5 m (wave phases shifted to match): same image */
 #include "check.h"
@@ -24,7 +24,7 @@ static const char *scene_path(const char *name)
     return path_buf;
 }
 
-typedef struct stats { double mean, maxv; int argx, argy, w, h; double secs; long long overflows; gr_ref_result res; } stats;
+typedef struct stats { double mean, maxv; int argx, argy, w, h; double secs; long long max_hits; gr_ref_result res; } stats;
 
 static double now_s(void)
 {
@@ -59,14 +59,16 @@ static stats render(const char *name, const char *extra1, const char *extra2)
     for (int y = 0; y < img->height; y++)
         for (int x = 0; x < img->width; x++) {
             float *p = gr_image_pixel(img, x, y);
-            for (int c = 0; c < img->nchannels; c++) bad += !(isfinite(p[c]) && p[c] >= 0.0f);
+            /* every channel finite; all but the signed bias estimates (bias.*) non-negative */
+            for (int c = 0; c < img->nchannels; c++)
+                bad += !(isfinite(p[c]) && (p[c] >= 0.0f || !strncmp(img->names[c], "bias.", 5)));
             double v = (p[0] + p[1] + p[2]) / 3.0;
             st.mean += v;
             if (v > st.maxv) { st.maxv = v; st.argx = x; st.argy = y; }
         }
     st.mean /= (double)img->width * img->height;
-    const gr_meta_item *of = gr_meta_get(&st.res.meta, "godrays:beam_overflows");
-    st.overflows = of ? (long long)of->num : 0;
+    const gr_meta_item *of = gr_meta_get(&st.res.meta, "godrays:beam_max_hits");
+    st.max_hits = of ? (long long)of->num : 0;
     CHECK_MSG(bad == 0, "%s: %d values not finite or negative", name, bad);
     CHECK_MSG(st.mean > 0.0, "%s: black image", name);
     printf("%-22s %-32s mean %.4g max %.4g at (%d, %d) in %.2f s\n", name, extra1 ? extra1 : "", st.mean, st.maxv,
@@ -150,7 +152,9 @@ int main(void)
     CHECK_MSG(huge.secs < 2.5 * mild.secs + 0.05, "denormal slowdown? %g s vs %g s", huge.secs, mild.secs);
 
     stats loop = render("hard/waves_near_loop", NULL, NULL);
-    CHECK_MSG(loop.overflows == 0, "beam list overflowed %lld times", loop.overflows);
+    /* the hit list grows (no cap, unit.ref_nocap): only the most beams at a point is reported */
+    printf("waves near loop: up to %lld beams at a march point\n", loop.max_hits);
+    CHECK_MSG(loop.max_hits >= 1, "the loop scene must have beams (godrays:beam_max_hits %lld)", loop.max_hits);
     CHECK_MSG(loop_flux_ok(), "waves near the loop limit: flux must still be conserved");
 
     stats mm = render("hard/camera_1mm", NULL, NULL);

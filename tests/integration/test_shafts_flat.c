@@ -24,7 +24,7 @@ static const char *scene_json =
     "\"camera\": {\"position_m\": [0, -20, 0], \"yaw_deg\": 0, \"pitch_deg\": 90, \"fov_deg\": 60,"
     "\"width\": 161, \"height\": 91},"
     "\"shafts\": {\"N\": 2, \"K\": 0.8, \"shaft_length_m\": 10, \"shaft_width\": 1, \"bias\": 0.15,"
-    "\"intensity\": [1, 2, 3], \"target_format\": \"rgba16f\"}}";
+    "\"intensity\": [1, 2, 3], \"target_format\": \"rgba16f\", \"target_prescale\": 1}}";
 
 static double hg_seed(double cos_t, double g)
 {

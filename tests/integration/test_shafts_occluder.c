@@ -19,7 +19,8 @@
     "\"medium\": {\"absorption_per_m\": [0.04, 0.07, 0.11], \"scattering_per_m\": 0.01, \"g\": 0.5},"           \
     "\"camera\": {\"position_m\": [0, -20, 0], \"yaw_deg\": 0, \"pitch_deg\": 90, \"fov_deg\": 60,"             \
     "\"width\": 161, \"height\": 91},"                                                                          \
-    "\"shafts\": {\"N\": 2, \"K\": 0.8, \"shaft_length_m\": 10, \"target_format\": \"rgba16f\"},"
+    "\"shafts\": {\"N\": 2, \"K\": 0.8, \"shaft_length_m\": 10, \"target_format\": \"rgba16f\","    \
+    "\"shaft_width\": 1, \"target_prescale\": 1},"
 
 static const char *json_none = SCENE_HEAD "\"occluders\": []}";
 static const char *json_between =

@@ -15,7 +15,7 @@ static const char *scene_json =
     "\"medium\": {\"absorption_per_m\": 0.005, \"scattering_per_m\": 0.005, \"g\": 0.5},"
     "\"camera\": {\"position_m\": [0, -6, 0], \"yaw_deg\": 0, \"pitch_deg\": 0, \"fov_deg\": 60,"
     "\"width\": 160, \"height\": 90},"
-    "\"shafts\": {\"N\": 33, \"K\": 2.0, \"shaft_length_m\": 30, \"shaft_width\": 0.5}}";
+    "\"shafts\": {\"N\": 33, \"K\": 2.0, \"shaft_length_m\": 30, \"shaft_width\": 0.5, \"target_prescale\": 1}}";
 
 int main(void)
 {

@@ -41,6 +41,7 @@ static gr_scene *load(int w, int h, int side, int beams)
     if (beams) sets[n++] = "shafts.shaft_width=0.4", sets[n++] = "shafts.target_format=rgba16f", sets[n++] = "shafts.g=0.5";
     gr_scene *s = malloc(sizeof *s);
     gr_error err;
+    gr_technique_count(); /* the built-in techniques' sections ("shafts") */
     if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
         fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
         exit(1);

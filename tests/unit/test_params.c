@@ -58,7 +58,8 @@ static void test_defaults(void)
     /* values from the project brief that are not tuning knobs */
     CHECK(r.seed == 1ull && r.threads == 0 && r.target_error == 0.0 && r.transmittance_cutoff == 1e-3);
     CHECK(s.caps == 1 && s.target_format == GR_TARGET_RGBA8);
-    CHECK(isnan(s.extinction[0]) && isnan(s.extinction[1]) && isnan(s.extinction[2]) && isnan(s.g));
+    CHECK(isnan(s.extinction[0]) && isnan(s.extinction[1]) && isnan(s.extinction[2]));
+    CHECK(s.g == 0.5); /* the seed's g (issue 12), no longer the medium's */
     /* every field equals its descriptor's default, read back through the typed struct */
     CHECK(r.spp == (int)gr_param_find(&gr_reference_param_table, "spp")->def);
     CHECK(s.N == (int)gr_param_find(&gr_shafts_param_table, "N")->def);

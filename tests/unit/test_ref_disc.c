@@ -88,16 +88,17 @@ static void field(setup *u, gr_dvec3 I, double radius, double *E)
     u->bp.disc_e2 = u->e2;
     CHECK_OK(gr_beams_build(u->rtc, &u->bp, &b, &err), err);
     if (!b) exit(1);
-    static gr_beam_hit hits[256];
+    gr_beam_hits hits = {NULL, 0, 0};
     for (int i = 0; i < NP; i++) {
         double e = 0.0;
         for (int x = 0; x < NX; x++) {
-            int of = 0, n = gr_beams_lookup(b, gr_d3_to_f(probe(i, x)), hits, 256, &of);
-            CHECK(!of);
-            for (int k = 0; k < n; k++) e += hits[k].e_h;
+            int n = gr_beams_lookup(b, gr_d3_to_f(probe(i, x)), &hits);
+            CHECK(n >= 0);
+            for (int k = 0; k < n; k++) e += hits.h[k].e_h;
         }
         E[i] = e / NX;
     }
+    gr_beam_hits_free(&hits);
     gr_beams_destroy(b);
 }
 

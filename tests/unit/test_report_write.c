@@ -219,7 +219,8 @@ int main(void)
     CHECK(res.order[0] == 1 && res.order[1] == 0); /* exact first */
     static const char *const files[] = {"index.html", "summary.png", "metrics.json", "reference.png", "wobble.png",
                                         "wobble_raw.png", "wobble_diff.png", "wobble_diff_signed.png", "exact.png",
-                                        "exact_raw.png", "exact_diff.png", "exact_diff_signed.png"};
+                                        "exact_raw.png", "exact_diff.png", "exact_diff_signed.png", "wobble_flip.png",
+                                        "exact_flip.png"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) CHECK_MSG(exists(dir, files[i]), "%s missing", files[i]);
     CHECK(res.charts == (gr_plot_available() ? 5 : 0)); /* the shared profile + 2 per technique */
 
@@ -253,6 +254,12 @@ int main(void)
         CHECK(cJSON_IsNumber(v) && v->valuedouble == 1);
         v = get(t1, "errors_y.rel_rmse_fit"); /* 2 r scaled by 1/2 is r: no error */
         CHECK(cJSON_IsNumber(v) && fabs(v->valuedouble) <= 1e-6);
+        v = get(t1, "flip.mean"); /* the same image after the fit: FLIP 0 (within float rounding of a) */
+        CHECK(cJSON_IsNumber(v) && fabs(v->valuedouble) <= 1e-3);
+        v = get(t0, "flip.mean");
+        CHECK(cJSON_IsNumber(v) && v->valuedouble > 0.0);
+        v = get(t0, "flip.map");
+        CHECK(cJSON_IsString(v) && !strcmp(v->valuestring, "wobble_flip.png"));
         v = get(t1, "gpu_ms");
         CHECK(cJSON_IsNull(v)); /* no metadata: unknown */
         v = cJSON_GetObjectItemCaseSensitive(root, "leaderboard");
@@ -314,8 +321,8 @@ int main(void)
             CHECK_MSG(exists(dir, name) && !strchr(name, '/'), "<img src=\"%s\"> is not a file in the folder", name);
             nimg++;
         }
-        /* 2 thumbnails, 5 figures per technique (the reference beside each), the charts */
-        CHECK_MSG(nimg == 2 + 2 * 5 + res.charts, "%d images in index.html", nimg);
+        /* 2 thumbnails, 6 figures per technique (the reference beside each), the charts */
+        CHECK_MSG(nimg == 2 + 2 * 6 + res.charts, "%d images in index.html", nimg); /* 6 with the FLIP map */
         CHECK(strstr(html, "16 pixels NOT SCORED") != NULL);
         CHECK(strstr(html, "2 ms") != NULL); /* the main pass's GPU time from the metadata */
         CHECK(strstr(html, "test &lt;one&gt;") != NULL);

@@ -54,7 +54,7 @@ static void test_defaults(void)
         CHECK(SHAFTS(s)->extinction[k] == s->medium.absorption[k] + s->medium.scattering[k]);
         CHECK(s->medium.extinction[k] == s->medium.absorption[k] + s->medium.scattering[k]);
     }
-    CHECK(SHAFTS(s)->g == s->medium.g);
+    CHECK(SHAFTS(s)->g == 0.5); /* the seed's g (issue 12), not derived from the medium */
     CHECK(strlen(s->hash) == 16);
     CHECK(s->source_path[0] == '\0');
     free(s);
@@ -203,7 +203,7 @@ static void test_medium(void)
     /* Pope & Fry 1997 absorption and Morel 1974 scattering at 650/550/450 nm, g = 0 */
     CHECK(s->medium.absorption[0] == 0.340 && s->medium.absorption[1] == 0.0565 && s->medium.absorption[2] == 0.00922);
     CHECK(s->medium.scattering[0] == 0.0009 && s->medium.scattering[1] == 0.0019 && s->medium.scattering[2] == 0.0045);
-    CHECK(s->medium.g == 0.0 && SHAFTS(s)->g == 0.0);
+    CHECK(s->medium.g == 0.0 && SHAFTS(s)->g == 0.5);
     CHECK(!strcmp(s->medium.preset, "pure_seawater"));
     free(s);
     /* explicit keys override the preset per key */
@@ -233,11 +233,8 @@ static void test_refresh(void)
     /* NaN asks for re-derivation from the medium */
     s->medium.scattering[0] = 0.5;
     SHAFTS(s)->extinction[0] = NAN;
-    SHAFTS(s)->g = NAN;
-    s->medium.g = 0.7;
     CHECK(gr_scene_refresh(s, &err) == GR_OK);
     CHECK(SHAFTS(s)->extinction[0] == s->medium.absorption[0] + 0.5);
-    CHECK(SHAFTS(s)->g == 0.7);
     /* refresh re-validates */
     s->camera.fov_deg = 200.0;
     CHECK(gr_scene_refresh(s, &err) == GR_E_INPUT);

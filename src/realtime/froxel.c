@@ -1,0 +1,399 @@
+/* Froxel fog lit through the caustic texture (froxel.h; docs/volume-techniques.md). */
+#include "realtime/froxel.h"
+#include "realtime/slicing.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "gl/gl.h"
+#include "realtime/caustics.h"
+#include "realtime/frame.h"
+#include "realtime/scenegl.h"
+
+#define MAX_SLICES 256
+
+#define LO_X GR_PF_MIN_EXCL
+#define FROM GR_PF_FROM_SCENE
+#define SL(f) offsetof(gr_froxel_settings, f)
+static const char *const dist_names[] = {"linear", "exponential", NULL};
+
+static const gr_param params[] = {
+    {.name = "grid_x", .type = GR_PT_INT, .offset = SL(grid_x), .min = 1, .max = 1024, .def = 160, .unit = "",
+     .doc = "froxels across the view"},
+    {.name = "grid_y", .type = GR_PT_INT, .offset = SL(grid_y), .min = 1, .max = 1024, .def = 90, .unit = "",
+     .doc = "froxels up the view"},
+    {.name = "grid_z", .type = GR_PT_INT, .offset = SL(grid_z), .min = 1, .max = MAX_SLICES, .def = 64, .unit = "",
+     .doc = "depth slices"},
+    {.name = "distribution", .type = GR_PT_ENUM, .offset = SL(distribution), .min = 0, .max = 1,
+     .def = GR_VOL_EXPONENTIAL, .enum_names = dist_names, .unit = "", .doc = "spacing of the depth slices"},
+    {.name = "near_m", .type = GR_PT_DOUBLE, .offset = SL(near_m), .min = 0, .max = 1e4, .flags = LO_X, .def = 0.5,
+     .unit = "m", .doc = "exponential spacing: the first slice's far face (view depth)", .tune_lo = 0.05, .tune_hi = 4.0},
+    {.name = "jitter", .type = GR_PT_BOOL, .offset = SL(jitter), .min = 0, .max = 1, .def = 0, .unit = "",
+     .doc = "sample each froxel at a deterministic noise depth instead of its middle"},
+    {.name = "phase_per_pixel", .type = GR_PT_BOOL, .offset = SL(phase_per_pixel), .min = 0, .max = 1, .def = 0,
+     .unit = "", .doc = "apply the HG phase per pixel (one directional light: constant along a ray) instead of per froxel"},
+    {.name = "texture_size", .type = GR_PT_INT, .offset = SL(texture_size), .min = 8, .max = 4096, .def = 512,
+     .unit = "texels", .doc = "caustic texture side (rendered at twice this, 2x2 box filtered)"},
+    {.name = "grid", .type = GR_PT_INT, .offset = SL(grid), .min = 2, .max = 2048, .def = 256, .unit = "cells",
+     .doc = "water grid cells per patch side (beam-traced triangles: 2 grid^2 per depth)"},
+    {.name = "patch_m", .type = GR_PT_DOUBLE, .offset = SL(patch_m), .min = 0, .max = 1e4, .flags = LO_X, .def = 24,
+     .unit = "m", .doc = "caustic patch side: the texture repeats with this period"},
+    {.name = "caustic_depths", .type = GR_PT_INT, .offset = SL(caustic_depths), .min = 1, .max = GR_CAUSTICS_MAX_DEPTHS,
+     .def = 8, .unit = "", .doc = "planes of the caustic stack"},
+    {.name = "caustic_first_m", .type = GR_PT_DOUBLE, .offset = SL(caustic_first_m), .min = 0, .max = 1e4,
+     .flags = LO_X, .def = 1, .unit = "m", .doc = "shallowest caustic plane below the rest height"},
+    {.name = "caustic_last_m", .type = GR_PT_DOUBLE, .offset = SL(caustic_last_m), .min = 0, .max = 1e4,
+     .flags = LO_X, .def = 25, .unit = "m", .doc = "deepest caustic plane (geometric spacing between)"},
+    {.name = "extinction", .type = GR_PT_RGB, .offset = SL(extinction), .min = 0, .max = 1e4, .flags = FROM,
+     .def = NAN, .unit = "1/m", .scene_source = "medium.extinction",
+     .doc = "sigma_t along the sun's and the view path; default: the medium's", .tune_lo = 0.5, .tune_hi = 2.0},
+    {.name = "g", .type = GR_PT_DOUBLE, .offset = SL(g), .min = -1, .max = 1, .flags = LO_X | GR_PF_MAX_EXCL | FROM,
+     .def = NAN, .unit = "", .scene_source = "medium.g", .doc = "HG asymmetry; default: the medium's",
+     .tune_lo = 0.5, .tune_hi = 0.98},
+    {.name = "sun_disc", .type = GR_PT_BOOL, .offset = SL(sun_disc), .min = 0, .max = 1, .def = 1, .unit = "",
+     .doc = "blur each caustic plane by the sun's disc (the mip level of its blur diameter)"},
+    {.name = "intensity", .type = GR_PT_RGB, .offset = SL(intensity), .min = 0, .max = 1e9, .def = 1, .unit = "",
+     .doc = "gain on the physical radiance (1: no fit)", .tune_lo = 0.2, .tune_hi = 5.0},
+    {.name = "shadow_map_size", .type = GR_PT_INT, .offset = SL(shadow_map_size), .min = 16, .max = 8192, .def = 1024,
+     .unit = "texels", .doc = "occluders' shadow map side"},
+    {.name = "shadow_extent_m", .type = GR_PT_DOUBLE, .offset = SL(shadow_extent_m), .min = 0, .max = 1e5,
+     .flags = LO_X, .def = 40, .unit = "m", .doc = "half side of the shadow map's square around the eye"},
+};
+#undef SL
+
+static const gr_param_table table = {"froxel", params, sizeof params / sizeof params[0]};
+
+static const gr_technique_level ladder[] = {
+    {"grid_x=40,grid_y=23,grid_z=16,texture_size=128,grid=64,caustic_depths=4", 1},
+    {"grid_x=80,grid_y=45,grid_z=32,texture_size=128,grid=96,caustic_depths=6", 0},
+    {"grid_x=160", 1},
+    {"grid_x=320,grid_y=180,grid_z=128,texture_size=1024,grid=512,caustic_depths=16", 0},
+};
+
+typedef struct fx_state {
+    gr_gl *gl;
+    gr_scenegl *sg;
+    gr_caustics *caus;
+    GLuint prog, prog_scatter, prog_integrate, vao, out_tex, out_fbo, vol_tex[2];
+    int out_w, out_h, vol_dims[3];
+    gr_vol_locs vl, vl_s;
+    GLint l_inv, l_fwd, l_bounds, l_eye_depth, l_size, l_tmax, l_nz, l_integrated;
+    GLint s_grid, s_bounds, s_inv, s_fwd, s_jitter, s_phase, l_phase;
+    GLint i_grid, i_bounds, i_inv, i_fwd, i_sigma;
+    gr_gl_timer timer;
+    GLuint q_samples;
+    long long triangles;
+    int n_slices;
+} fx_state;
+
+static void fx_destroy(void *state)
+{
+    fx_state *r = state;
+    if (!r) return;
+    if (r->gl && gr_gl_make_current(r->gl, NULL) == GR_OK) {
+        if (r->prog) glDeleteProgram(r->prog);
+        if (r->prog_scatter) glDeleteProgram(r->prog_scatter);
+        if (r->prog_integrate) glDeleteProgram(r->prog_integrate);
+        if (r->vao) glDeleteVertexArrays(1, &r->vao);
+        if (r->out_fbo) glDeleteFramebuffers(1, &r->out_fbo);
+        if (r->out_tex) glDeleteTextures(1, &r->out_tex);
+        if (r->vol_tex[0]) glDeleteTextures(2, r->vol_tex);
+        if (r->q_samples) glDeleteQueries(1, &r->q_samples);
+        gr_gl_timer_free(&r->timer);
+    }
+    gr_caustics_destroy(r->caus);
+    gr_scenegl_destroy(r->sg);
+    free(r);
+}
+
+static gr_status fx_create(const gr_technique_class *cls, gr_gl *gl, const gr_technique_options *opts, void **state,
+                           gr_error *err)
+{
+    (void)cls;
+    *state = NULL;
+    const char *dir = opts ? opts->shader_dir : NULL;
+    fx_state *r = calloc(1, sizeof *r);
+    if (!r) return gr_fail(err, GR_E_NOMEM, "froxel: out of memory");
+    r->gl = gl;
+    gr_status st;
+    if ((st = gr_scenegl_create_dir(gl, dir, &r->sg, err)) != GR_OK) goto fail;
+    if ((st = gr_caustics_create(dir, &r->caus, err)) != GR_OK) goto fail;
+    const gr_vol_stage apply[2] = {
+        {GL_VERTEX_SHADER, {"volume_screen.vert.glsl", NULL, NULL, NULL}},
+        {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "froxel_apply.frag.glsl"}}};
+    const gr_vol_stage scatter[1] = {
+        {GL_COMPUTE_SHADER, {"volume_version.glsl", "volume_common.glsl", "froxel_scatter.comp.glsl", NULL}}};
+    const gr_vol_stage integrate[1] = {{GL_COMPUTE_SHADER, {"froxel_integrate.comp.glsl", NULL, NULL, NULL}}};
+    if ((st = gr_vol_program(dir, apply, 2, &r->prog, err)) != GR_OK) goto fail;
+    if ((st = gr_vol_program(dir, scatter, 1, &r->prog_scatter, err)) != GR_OK) goto fail;
+    if ((st = gr_vol_program(dir, integrate, 1, &r->prog_integrate, err)) != GR_OK) goto fail;
+    gr_vol_locations(r->prog, &r->vl);
+    gr_vol_locations(r->prog_scatter, &r->vl_s);
+    r->l_inv = glGetUniformLocation(r->prog, "u_inv_vp_rot");
+    r->l_fwd = glGetUniformLocation(r->prog, "u_forward");
+    r->l_bounds = glGetUniformLocation(r->prog, "u_bounds");
+    r->l_eye_depth = glGetUniformLocation(r->prog, "u_eye_depth");
+    r->l_size = glGetUniformLocation(r->prog, "u_size");
+    r->l_tmax = glGetUniformLocation(r->prog, "u_tmax");
+    r->l_nz = glGetUniformLocation(r->prog, "u_nz");
+    r->l_integrated = glGetUniformLocation(r->prog, "u_integrated");
+    r->s_grid = glGetUniformLocation(r->prog_scatter, "u_grid");
+    r->s_bounds = glGetUniformLocation(r->prog_scatter, "u_bounds");
+    r->s_inv = glGetUniformLocation(r->prog_scatter, "u_inv_vp_rot");
+    r->s_fwd = glGetUniformLocation(r->prog_scatter, "u_forward");
+    r->s_jitter = glGetUniformLocation(r->prog_scatter, "u_jitter");
+    r->s_phase = glGetUniformLocation(r->prog_scatter, "u_phase_pixel");
+    r->l_phase = glGetUniformLocation(r->prog, "u_phase_pixel");
+    r->i_grid = glGetUniformLocation(r->prog_integrate, "u_grid");
+    r->i_bounds = glGetUniformLocation(r->prog_integrate, "u_bounds");
+    r->i_inv = glGetUniformLocation(r->prog_integrate, "u_inv_vp_rot");
+    r->i_fwd = glGetUniformLocation(r->prog_integrate, "u_forward");
+    r->i_sigma = glGetUniformLocation(r->prog_integrate, "u_sigma_t");
+    glGenVertexArrays(1, &r->vao);
+    glGenQueries(1, &r->q_samples);
+    gr_gl_timer_init(&r->timer);
+    if ((st = gr_gl_check("froxel setup", err)) != GR_OK) goto fail;
+    *state = r;
+    return GR_OK;
+fail:
+    fx_destroy(r);
+    return st;
+}
+
+static gr_status ensure_volume(fx_state *r, int x, int y, int z, gr_error *err)
+{
+    if (r->vol_tex[0] && r->vol_dims[0] == x && r->vol_dims[1] == y && r->vol_dims[2] == z) return GR_OK;
+    if (r->vol_tex[0]) glDeleteTextures(2, r->vol_tex);
+    glGenTextures(2, r->vol_tex);
+    for (int i = 0; i < 2; i++) {
+        glBindTexture(GL_TEXTURE_3D, r->vol_tex[i]);
+        glTexStorage3D(GL_TEXTURE_3D, 1, GL_RGBA32F, x, y, z);
+        glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    }
+    glBindTexture(GL_TEXTURE_3D, 0);
+    r->vol_dims[0] = x;
+    r->vol_dims[1] = y;
+    r->vol_dims[2] = z;
+    return gr_gl_check("froxel.grid_x/grid_y/grid_z: froxel volume", err);
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+static gr_status fx_check(const gr_technique_class *cls, const void *settings, gr_error *err)
+{
+    const gr_froxel_settings *s = settings;
+    gr_status st = gr_param_validate(cls->params, settings, 1, err);
+    if (st != GR_OK) return st;
+    if (!(s->caustic_last_m >= s->caustic_first_m))
+        return gr_fail(err, GR_E_INPUT, "froxel.caustic_last_m = %g: must be >= froxel.caustic_first_m (%g)",
+                       s->caustic_last_m, s->caustic_first_m);
+    return GR_OK;
+}
+
+static gr_status ensure_out(fx_state *r, int w, int h, gr_error *err)
+{
+    if (r->out_tex && r->out_w == w && r->out_h == h) return GR_OK;
+    if (r->out_fbo) glDeleteFramebuffers(1, &r->out_fbo);
+    if (r->out_tex) glDeleteTextures(1, &r->out_tex);
+    glGenTextures(1, &r->out_tex);
+    glBindTexture(GL_TEXTURE_2D, r->out_tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &r->out_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, r->out_tex, 0);
+    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (fs != GL_FRAMEBUFFER_COMPLETE)
+        return gr_fail(err, GR_E_GL, "camera.width/height: froxel target %dx%d incomplete", w, h);
+    r->out_w = w;
+    r->out_h = h;
+    return gr_gl_check("froxel target", err);
+}
+
+enum { P_SHADOW, P_DEPTH, P_CAUSTICS, P_SCATTER, P_INTEGRATE, P_APPLY };
+
+static gr_status fx_render(void *state, const gr_scene *scene, const void *settings, gr_image *out,
+                           gr_technique_stats *stats, gr_error *err)
+{
+    fx_state *r = state;
+    const gr_froxel_settings *s = settings;
+    double t0 = now_ms();
+    gr_frame f;
+    gr_frame_init(scene, &f);
+    int W = f.width, H = f.height;
+    gr_status st;
+    if (out->width != W || out->height != H || gr_image_channel(out, "R") < 0 || gr_image_channel(out, "G") < 0 ||
+        gr_image_channel(out, "B") < 0)
+        return gr_fail(err, GR_E_INPUT, "froxel: output image is %dx%d (needs %dx%d with R, G, B)", out->width,
+                       out->height, W, H);
+    if (!(f.rest_height_m - f.eye[1] > 0))
+        return gr_fail(err, GR_E_INPUT, "camera.position_m: y = %g is not below the water surface; froxel needs an underwater viewer",
+                       f.eye[1]);
+    if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) return st;
+    if ((st = ensure_out(r, W, H, err)) != GR_OK) return st;
+    r->timer.used = 0;
+    r->timer.n = 0;
+
+    gr_vol_inputs in;
+    memset(&in, 0, sizeof in);
+    gr_caustics_params cp = {.size = s->texture_size, .grid = s->grid, .patch_m = s->patch_m,
+                             .n_depths = s->caustic_depths, .fresnel = 1};
+    gr_caustics_depths(cp.n_depths, s->caustic_first_m, s->caustic_last_m, cp.depths_m);
+    in.f = &f;
+    in.caustics = r->caus;
+    in.cp = &cp;
+    if (scene->n_occluders > 0) {
+        gr_gl_timer_begin(&r->timer, P_SHADOW);
+        st = gr_scenegl_shadow_map(r->sg, scene, &f, s->shadow_map_size, f.eye, s->shadow_extent_m, &in.shadow_tex,
+                                   in.light_vp, err);
+        gr_gl_timer_end(&r->timer);
+        if (st != GR_OK) return st;
+    } else {
+        for (int i = 0; i < 16; i++) in.light_vp[i] = i % 5 == 0;
+    }
+    unsigned depth_tex = 0;
+    gr_gl_timer_begin(&r->timer, P_DEPTH);
+    st = gr_scenegl_eye_depth(r->sg, scene, &f, W, H, &depth_tex, err);
+    gr_gl_timer_end(&r->timer);
+    if (st != GR_OK) return st;
+    gr_gl_timer_begin(&r->timer, P_CAUSTICS);
+    st = gr_caustics_build(r->caus, scene, &f, &cp, err);
+    gr_gl_timer_end(&r->timer);
+    if (st != GR_OK) return st;
+    r->triangles = gr_caustics_triangles(r->caus);
+    for (int c = 0; c < 3; c++) {
+        in.sigma_t[c] = s->extinction[c];
+        in.sigma_s[c] = scene->medium.scattering[c];
+        in.gain[c] = s->intensity[c];
+    }
+    in.g = s->g;
+    in.sun_disc = s->sun_disc;
+
+    double tmax = gr_vol_t_max(scene);
+    double far = gr_vol_far_depth(scene, &f, tmax);
+    double b[MAX_SLICES + 1];
+    int nz = s->grid_z;
+    gr_vol_bounds(nz, s->distribution == GR_VOL_EXPONENTIAL, s->near_m, far, b);
+    float bf[MAX_SLICES + 1];
+    for (int i = 0; i <= nz; i++) bf[i] = (float)b[i];
+    double rot[16], inv[16];
+    gr_frame_view_proj_rot(&f, rot);
+    if (gr_mat4_inverse(rot, inv) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection");
+    float m[16];
+    gr_frame_matf(inv, m);
+    if ((st = ensure_volume(r, s->grid_x, s->grid_y, nz, err)) != GR_OK) return st;
+
+    /* pass: in-scattering per froxel */
+    gr_gl_timer_begin(&r->timer, P_SCATTER);
+    glUseProgram(r->prog_scatter);
+    gr_vol_set(&r->vl_s, &in);
+    glUniform3i(r->s_grid, s->grid_x, s->grid_y, nz);
+    glUniform1fv(r->s_bounds, nz + 1, bf);
+    glUniformMatrix4fv(r->s_inv, 1, GL_FALSE, m);
+    glUniform3f(r->s_fwd, (float)f.forward[0], (float)f.forward[1], (float)f.forward[2]);
+    glUniform1i(r->s_jitter, s->jitter);
+    glUniform1i(r->s_phase, s->phase_per_pixel);
+    glBindImageTexture(0, r->vol_tex[0], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute((GLuint)((s->grid_x + 7) / 8), (GLuint)((s->grid_y + 7) / 8), (GLuint)nz);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    gr_gl_timer_end(&r->timer);
+
+    /* pass: Hillaire's front-to-back integration */
+    gr_gl_timer_begin(&r->timer, P_INTEGRATE);
+    glUseProgram(r->prog_integrate);
+    glUniform3i(r->i_grid, s->grid_x, s->grid_y, nz);
+    glUniform1fv(r->i_bounds, nz + 1, bf);
+    glUniformMatrix4fv(r->i_inv, 1, GL_FALSE, m);
+    glUniform3f(r->i_fwd, (float)f.forward[0], (float)f.forward[1], (float)f.forward[2]);
+    glUniform3f(r->i_sigma, (float)in.sigma_t[0], (float)in.sigma_t[1], (float)in.sigma_t[2]);
+    glBindImageTexture(0, r->vol_tex[0], 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, r->vol_tex[1], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute((GLuint)((s->grid_x + 7) / 8), (GLuint)((s->grid_y + 7) / 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    gr_gl_timer_end(&r->timer);
+
+    /* pass: per pixel, the integrated volume at the ray's end */
+    gr_gl_timer_begin(&r->timer, P_APPLY);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    glViewport(0, 0, W, H);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(r->prog);
+    gr_vol_set(&r->vl, &in);
+    glUniformMatrix4fv(r->l_inv, 1, GL_FALSE, m);
+    glUniform3f(r->l_fwd, (float)f.forward[0], (float)f.forward[1], (float)f.forward[2]);
+    glUniform1fv(r->l_bounds, nz + 1, bf);
+    glUniform1i(r->l_nz, nz);
+    glUniform1i(r->l_phase, s->phase_per_pixel);
+    glUniform1i(r->l_eye_depth, 1);
+    glUniform1i(r->l_integrated, 4);
+    glUniform2f(r->l_size, (float)W, (float)H);
+    glUniform1f(r->l_tmax, (float)tmax);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, depth_tex);
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_3D, r->vol_tex[1]);
+    glActiveTexture(GL_TEXTURE0);
+    glBindVertexArray(r->vao);
+    glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glEndQuery(GL_SAMPLES_PASSED);
+    gr_gl_timer_end(&r->timer);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    r->n_slices = nz;
+    st = gr_vol_readback(r->out_fbo, W, H, out, "froxel readback", err);
+    if (st != GR_OK) return st;
+    if (stats) {
+        static const char *const names[6] = {"shadow", "eye_depth", "caustics", "scatter", "integrate", "apply"};
+        memset(stats, 0, sizeof *stats);
+        double wall_ns = (now_ms() - t0) * 1e6;
+        stats->n_passes = 6;
+        for (int p = 0; p < 6; p++) {
+            snprintf(stats->pass_names[p], sizeof stats->pass_names[p], "%s", names[p]);
+            long long ns = gr_gl_timer_ns(&r->timer, p);
+            stats->gpu_ns[p] = (ns >= 0 && (double)ns <= wall_ns) ? ns : -1;
+        }
+        GLuint64 n = 0;
+        glGetQueryObjectui64v(r->q_samples, GL_QUERY_RESULT, &n);
+        stats->fragments = (long long)n;
+        stats->wall_ms = now_ms() - t0;
+    }
+    return gr_image_check_finite(out, "froxel", err);
+}
+
+static void fx_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)
+{
+    const fx_state *r = state;
+    (void)stats;
+    snprintf(buf, n, "%dx%dx%d froxels, %lld caustic triangles", r->vol_dims[0], r->vol_dims[1], r->n_slices, r->triangles);
+}
+
+const gr_technique_class gr_froxel_class = {
+    .name = "froxel",
+    .description = "froxel fog (Wronski 2014, Hillaire 2015) lit through seed 002's caustic texture as a cookie",
+    .params = &table,
+    .settings_size = sizeof(gr_froxel_settings),
+    .origin = "built-in",
+    .gain_key = "intensity",
+    .ladder = ladder,
+    .n_ladder = sizeof ladder / sizeof ladder[0],
+    .check = fx_check,
+    .create = fx_create,
+    .destroy = fx_destroy,
+    .render = fx_render,
+    .summary = fx_summary,
+};

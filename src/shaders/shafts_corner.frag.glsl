@@ -1,0 +1,56 @@
+#version 330 core
+// Flux variant pre-pass (docs/realtime-shafts.md "flux"): one texel per shaft corner, texel
+// (2 i + cx, 2 j + cz) for cell (i, j) and corner (cx, cz) in {0, 1}^2: the corner on the
+// Gerstner surface (eq. 5.5.7, viewer-relative), its Fresnel transmittance (eq. 5.5.2b) and
+// its refracted sun direction (eq. 5.5.1), evaluated once instead of in every slab vertex.
+
+#define MAX_WAVE_GROUPS 16
+
+uniform vec3 u_origin;        // P - viewer (m)
+uniform float u_spacing;      // S (m)
+uniform float u_width;        // shaft width as a fraction of the cell
+uniform float u_half;         // (N - 1) / 2
+uniform vec3 u_sun_dir;       // I
+uniform float u_eta;          // 1 / ior
+uniform float u_r0;           // Schlick R0
+uniform int u_wave_groups;
+uniform vec4 u_waves[MAX_WAVE_GROUPS * 5]; // as shafts.vert.glsl
+
+layout(location = 0) out vec4 o_pos_tr; // corner position (viewer-relative), transmittance
+layout(location = 1) out vec4 o_refr;   // refracted direction
+
+void main()
+{
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec2 cell = vec2(p / 2) + 0.5 - u_half;
+    vec2 corner = vec2((p.x & 1) != 0 ? 0.5 : -0.5, (p.y & 1) != 0 ? 0.5 : -0.5);
+    vec2 rest = (cell + corner * u_width) * u_spacing;
+    vec3 t1 = vec3(1.0, 0.0, 0.0);
+    vec3 t2 = vec3(0.0, 0.0, 1.0);
+    vec3 disp = vec3(0.0);
+    for (int i = 0, j = 0; i < u_wave_groups; i++, j += 5) {
+        vec4 kx = u_waves[j];
+        vec4 ky = u_waves[j + 1];
+        vec4 Ainvk = u_waves[j + 2];
+        vec4 A = u_waves[j + 3];
+        vec4 wt = u_waves[j + 4];
+        vec4 phase = kx * rest.x + ky * rest.y - wt;
+        vec4 sinp = sin(phase);
+        vec4 cosp = cos(phase);
+        disp.x -= dot(Ainvk, kx * sinp);
+        disp.z -= dot(Ainvk, ky * sinp);
+        disp.y += dot(A, cosp);
+        t1.x -= dot(Ainvk, kx * cosp * kx);
+        t1.z -= dot(Ainvk, ky * cosp * kx);
+        t1.y += dot(A, (-sinp) * kx);
+        t2.x -= dot(Ainvk, kx * cosp * ky);
+        t2.z -= dot(Ainvk, ky * cosp * ky);
+        t2.y += dot(A, (-sinp) * ky);
+    }
+    vec3 n = normalize(cross(t2, t1));
+    float m = 1.0 - clamp(dot(-u_sun_dir, n), 0.0, 1.0);
+    float m2 = m * m;
+    float tr = 1.0 - (u_r0 + (1.0 - u_r0) * (m2 * m2 * m));
+    o_pos_tr = vec4(u_origin + vec3(rest.x, 0.0, rest.y) + disp, tr);
+    o_refr = vec4(refract(u_sun_dir, n, u_eta), 0.0);
+}

@@ -1,0 +1,1 @@
+#define VOL_FRAGMENT 1
