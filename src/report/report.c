@@ -1281,7 +1281,8 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
         gr_viewer_item vi[GR_REPORT_MAX_TECHNIQUES];
         for (int r = 0; r < in->n_techniques; r++) { /* leaderboard order: 1 = the best */
             const tctx *tc = &c->t[c->order[r]];
-            vi[r] = (gr_viewer_item){.name = tc->t->name, .stem = tc->stem, .test = tc->t->test, .scale = tc->a};
+            vi[r] = (gr_viewer_item){.name = tc->t->name, .test = tc->t->test, .scale = tc->a,
+                                     .flip_map = tc->flip_map, .flip_mean = tc->flip.mean};
         }
         gr_status vst = gr_viewer_write(c->dir, in->ref, vi, in->n_techniques, c->exposure, b, err);
         if (vst != GR_OK) return vst;

@@ -7,7 +7,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "compare/flip.h"
 #include "compare/metrics.h"
 #include "image/oiio.h"
 
@@ -26,7 +25,8 @@ static const char *const JS[] = {
     "off.width = W; off.height = H;\n",
     "var ox = off.getContext('2d'), buf = ox.createImageData(W, H);\n",
     "var S = {tech: 0, mode: 'flip', showTest: false, zoom: 1, px: 0, py: 0, fit: cv.width / W};\n",
-    "var truth = null, tests = [], flips = [], pending = 1 + 2 * D.tech.length;\n",
+    "var truth = null, tests = [], flips = [], pending = 1 + D.tech.length;\n",
+    "D.tech.forEach(function (t) { if (t.flip) pending++; });\n",
     "var lut = new Uint8ClampedArray(4097);\n",
     "for (var i = 0; i <= 4096; i++) {\n",
     "  var x = i / 4096;\n",
@@ -66,7 +66,7 @@ static const char *const JS[] = {
     "decode(D.truth, function (f) { truth = f; loaded(); });\n",
     "D.tech.forEach(function (t, k) {\n",
     "  decode(t.img, function (f) { tests[k] = f; loaded(); });\n",
-    "  image(t.flip, function (im) { flips[k] = im; loaded(); });\n",
+    "  if (t.flip) image(t.flip, function (im) { flips[k] = im; loaded(); });\n",
     "});\n",
     "function tone(f, gain, x0, x1) {\n",
     "  var o = buf.data;\n",
@@ -87,8 +87,14 @@ static const char *const JS[] = {
     "  var t = D.tech[S.tech], g = D.exposure * Math.pow(2, ev.value / 10);\n",
     "  var text;\n",
     "  if (S.mode === 'flipmap') {\n",
-    "    ox.drawImage(flips[S.tech], 0, 0);\n",
-    "    text = 'FLIP map of ' + t.name + ' (mean ' + t.flipMean.toPrecision(3) + ', at 0 EV; magma: black 0, yellow 1)';\n",
+    "    if (flips[S.tech]) {\n",
+    "      ox.drawImage(flips[S.tech], 0, 0);\n",
+    "      text = 'HDR-FLIP map of ' + t.name + ' x a (mean ' + t.flipMean.toPrecision(3) + '; magma: black 0, yellow 1)';\n",
+    "    } else {\n",
+    "      ox.fillStyle = '#000';\n",
+    "      ox.fillRect(0, 0, W, H);\n",
+    "      text = 'no FLIP map for ' + t.name;\n",
+    "    }\n",
     "  } else {\n",
     "    if (S.mode === 'wipe') {\n",
     "      var xw = wipeX();\n",
@@ -396,8 +402,7 @@ gr_status gr_viewer_write(const char *dir, const gr_image *ref, const gr_viewer_
     const int step = (ref->width + GR_VIEWER_MAX_WIDTH - 1) / GR_VIEWER_MAX_WIDTH;
     gr_strbuf data;
     gr_sb_init(&data);
-    gr_image *r = shrink(ref, step, 1.0), *t = NULL, *re = NULL, *te = NULL, *heat = NULL;
-    float *map = NULL;
+    gr_image *r = shrink(ref, step, 1.0), *t = NULL, *hs = NULL;
     gr_status st = GR_OK;
     if (!r) {
         st = gr_fail(err, GR_E_NOMEM, "report: out of memory for the comparison");
@@ -407,46 +412,31 @@ gr_status gr_viewer_write(const char *dir, const gr_image *ref, const gr_viewer_
     gr_sb_printf(&data, "window.GRV_DATA = {w: %d, h: %d, step: %d, exposure: %.9g, truth: ", w, h, step, exposure);
     if ((st = rgbe_url(dir, r, &data, err)) != GR_OK) goto done;
     gr_sb_puts(&data, ",\ntech: [");
-    /* FLIP of what the page shows at 0 EV: both images times the report's exposure (the
-     * technique also times its a), LDR-FLIP (display range [0, 1]), full resolution. */
-    re = shrink(ref, 1, exposure);
-    map = malloc((size_t)ref->width * (size_t)ref->height * sizeof *map);
-    if (!re || !map) {
-        st = gr_fail(err, GR_E_NOMEM, "report: out of memory for the FLIP maps");
-        goto done;
-    }
     for (int k = 0; k < n; k++) {
         const gr_viewer_item *it = &items[k];
         gr_image_destroy(t);
-        gr_image_destroy(te);
-        gr_image_destroy(heat);
-        heat = NULL;
+        gr_image_destroy(hs);
+        hs = NULL;
         t = shrink(it->test, step, 1.0);
-        te = shrink(it->test, 1, exposure * it->scale);
-        if (!t || !te) {
+        if (!t) {
             st = gr_fail(err, GR_E_NOMEM, "report: out of memory for the comparison");
             goto done;
         }
-        gr_flip_options fo = {0};
-        gr_flip_result fr;
-        if ((st = gr_flip_compute(re, te, &fo, map, &fr, err)) != GR_OK) goto done;
-        if ((st = gr_flip_heatmap(map, ref->width, ref->height, &heat, err)) != GR_OK) goto done;
-        char path[4300];
-        snprintf(path, sizeof path, "%s/%s_flip.png", dir, it->stem);
-        if ((st = gr_oiio_write(path, heat, err)) != GR_OK) goto done;
-        /* the page's copy at the page's size */
-        gr_image *hs = step > 1 ? shrink(heat, step, 1.0) : NULL;
         gr_sb_puts(&data, k ? ",\n{name: " : "\n{name: ");
         js_string(&data, it->name);
-        gr_sb_printf(&data, ", scale: %.9g, flipMean: %.6g, img: ", it->scale, fr.mean);
-        if ((st = rgbe_url(dir, t, &data, err)) != GR_OK) {
-            gr_image_destroy(hs);
-            goto done;
-        }
+        gr_sb_printf(&data, ", scale: %.9g, flipMean: %.6g, img: ", it->scale, it->flip_map ? it->flip_mean : 0.0);
+        if ((st = rgbe_url(dir, t, &data, err)) != GR_OK) goto done;
         gr_sb_puts(&data, ", flip: ");
-        st = png_url(dir, hs ? hs : heat, &data, err);
-        gr_image_destroy(hs);
-        if (st != GR_OK) goto done;
+        if (it->flip_map) { /* the page's copy at the page's size */
+            hs = step > 1 ? shrink(it->flip_map, step, 1.0) : NULL;
+            if (step > 1 && !hs) {
+                st = gr_fail(err, GR_E_NOMEM, "report: out of memory for the comparison");
+                goto done;
+            }
+            if ((st = png_url(dir, hs ? hs : it->flip_map, &data, err)) != GR_OK) goto done;
+        } else {
+            gr_sb_puts(&data, "null");
+        }
         gr_sb_puts(&data, "}");
     }
     gr_sb_puts(&data, "]};\n");
@@ -478,7 +468,8 @@ gr_status gr_viewer_write(const char *dir, const gr_image *ref, const gr_viewer_
                      "ground truth and the technique (times its fitted a); w: wipe (the slider, or click where "
                      "the line goes); m: the FLIP map; wheel or +/-: zoom, drag: pan, 0: reset; [ and ]: "
                      "exposure -/+ 0.5 EV; 1-9: technique. The images are the linear renders, tone mapped here "
-                     "(exposure, sRGB); the FLIP map is LDR-FLIP of the two images as shown at 0 EV.");
+                     "(exposure, sRGB); the FLIP map is HDR-FLIP of the technique x a against the truth (magma: "
+                     "black 0, yellow 1; it does not change with the exposure).");
     if (step > 1) gr_sb_printf(html, " Shown at 1/%d of the render's size (box filter).", step);
     gr_sb_puts(html, "</p>\n</div>\n<script>\n");
     gr_sb_puts(html, gr_sb_str(&data));
@@ -488,9 +479,6 @@ done:
     gr_sb_free(&data);
     gr_image_destroy(r);
     gr_image_destroy(t);
-    gr_image_destroy(re);
-    gr_image_destroy(te);
-    gr_image_destroy(heat);
-    free(map);
+    gr_image_destroy(hs);
     return st;
 }

@@ -2,7 +2,7 @@
  * between the ground truth and a technique (a click on the image, or the space bar: FLIP's own
  * premise, alternate the images), wipes between them (a slider), zooms (wheel, +/-) and pans
  * (drag), changes the exposure (a slider, in stops around the report's exposure) and shows the
- * FLIP map (LDR-FLIP of what the page shows at its default exposure, magma colour map,
+ * FLIP map the report computed (HDR-FLIP of a T against the truth, magma colour map,
  * compare/flip.h). Vanilla JavaScript inside the page, no external resource, works from file://.
  *
  * The images stay linear: each is embedded as a data: URL of an 8-bit RGB PNG twice as tall as
@@ -20,17 +20,20 @@
 
 typedef struct gr_viewer_item {
     const char *name;          /* the technique's name (shown, HTML-escaped) */
-    const char *stem;          /* file stem: STEM_flip.png is written into the folder */
     const gr_image *test;      /* R, G, B (linear) */
     double scale;              /* the fitted a applied to the test */
+    const gr_image *flip_map;  /* its FLIP heat map (display-encoded RGB, the image's size;
+                                  gr_flip_heatmap), NULL: none */
+    double flip_mean;          /* its mean FLIP (shown with the map) */
 } gr_viewer_item;
 
 /* Images wider than this are shrunk by an integer box factor in the page. */
 #define GR_VIEWER_MAX_WIDTH 1280
 
-/* Writes DIR/STEM_flip.png for each item and appends the comparison block (a <section> with
- * its canvas, controls and <script>) to html. exposure: the report's preview exposure (the
- * slider's 0 EV). GR_E_INPUT for sizes that differ from ref's; GR_E_IO; GR_E_NOMEM. */
+/* Appends the comparison block (its canvas, controls and <script>) to html; dir is the
+ * report's folder (for temporary files only: nothing stays there). exposure: the report's
+ * preview exposure (the slider's 0 EV). GR_E_INPUT for sizes that differ from ref's; GR_E_IO;
+ * GR_E_NOMEM. */
 gr_status gr_viewer_write(const char *dir, const gr_image *ref, const gr_viewer_item *items, int n, double exposure,
                           gr_strbuf *html, gr_error *err);
 
