@@ -99,21 +99,16 @@ void gr_scenegl_destroy(gr_scenegl *s)
 
 /* ---- occluder mesh (world, double) ------------------------------------------------------ */
 
-static gr_status build_mesh(gr_scenegl *s, const gr_scene *scene, gr_error *err)
+size_t gr_occluder_mesh_count(const gr_scene *scene)
 {
     size_t need = 0;
     for (int i = 0; i < scene->n_occluders; i++)
         need += scene->occluders[i].type == GR_OCC_BOX ? 36 : (size_t)SPHERE_STACKS * SPHERE_SLICES * 6;
-    if (need > s->mesh_cap) {
-        double *nb = realloc(s->mesh, need * 3 * sizeof *nb);
-        float *nu = realloc(s->upload, need * 3 * sizeof *nu);
-        if (nb) s->mesh = nb;
-        if (nu) s->upload = nu;
-        if (!nb || !nu) return gr_fail(err, GR_E_NOMEM, "occluders: out of memory for %zu vertices", need);
-        s->mesh_cap = need;
-        s->upload_cap = need;
-    }
-    double *o = s->mesh;
+    return need;
+}
+
+void gr_occluder_mesh(const gr_scene *scene, double *o)
+{
     size_t n = 0;
 #define PUT(v) do { o[n * 3] = (v).x; o[n * 3 + 1] = (v).y; o[n * 3 + 2] = (v).z; n++; } while (0)
     for (int i = 0; i < scene->n_occluders; i++) {
@@ -156,7 +151,22 @@ static gr_status build_mesh(gr_scenegl *s, const gr_scene *scene, gr_error *err)
         }
     }
 #undef PUT
-    s->mesh_n = n;
+}
+
+static gr_status build_mesh(gr_scenegl *s, const gr_scene *scene, gr_error *err)
+{
+    size_t need = gr_occluder_mesh_count(scene);
+    if (need > s->mesh_cap) {
+        double *nb = realloc(s->mesh, need * 3 * sizeof *nb);
+        float *nu = realloc(s->upload, need * 3 * sizeof *nu);
+        if (nb) s->mesh = nb;
+        if (nu) s->upload = nu;
+        if (!nb || !nu) return gr_fail(err, GR_E_NOMEM, "occluders: out of memory for %zu vertices", need);
+        s->mesh_cap = need;
+        s->upload_cap = need;
+    }
+    gr_occluder_mesh(scene, s->mesh);
+    s->mesh_n = need;
     return GR_OK;
 }
 

@@ -5,12 +5,20 @@
 #ifndef GR_SCENEGL_H
 #define GR_SCENEGL_H
 
+#include <stddef.h>
+
 #include "common/status.h"
 #include "gl/glctx.h"
 #include "realtime/frame.h"
 #include "scene/scene.h"
 
 typedef struct gr_scenegl gr_scenegl; /* opaque; current context only */
+
+/* The occluders as world-space triangles (no GL): boxes as 12 triangles, spheres as a
+ * 24 x 48 stack/slice tessellation. gr_occluder_mesh writes gr_occluder_mesh_count(scene)
+ * vertices, 3 doubles each, into xyz. Every technique draws the same occluders. */
+size_t gr_occluder_mesh_count(const gr_scene *scene);
+void gr_occluder_mesh(const gr_scene *scene, double *xyz);
 
 /* Compiles the shared programs in the current context gl (embedded shaders; shader_dir, may
  * be NULL, overrides them file by file as for the shafts). Textures returned below belong to

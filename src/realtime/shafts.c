@@ -18,8 +18,6 @@
 #define MAX_WAVE_GROUPS 16 /* must match shafts.vert.glsl */
 #define GRID_FLOATS 6
 #define TARGET_RGBA32F 2 /* path and flux: signed sums need a float target */
-#define SPHERE_STACKS 24
-#define SPHERE_SLICES 48
 /* Projection planes of the camera; with the shafts' forced clip z (seed VS) only w matters
  * in the shaft pass, and the final pass only uses directions. */
 #define CAM_NEAR 0.05
@@ -790,63 +788,23 @@ static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in
     return GR_OK;
 }
 
-/* Occluder triangles relative to P (float; double math before the cast). */
+/* Occluder triangles relative to P (float; the shared world-space mesh of scenegl in double
+ * before the cast). */
 static gr_status build_occluders(gr_shafts *r, const gr_scene *scene, gr_dvec3 P, size_t *nverts, gr_error *err)
 {
-    size_t need = 0;
-    for (int i = 0; i < scene->n_occluders; i++)
-        need += scene->occluders[i].type == GR_OCC_BOX ? 36 : (size_t)SPHERE_STACKS * SPHERE_SLICES * 6;
-    need *= 3;
-    if (need > r->occ_cap) {
-        float *nb = realloc(r->occ_cpu, need * sizeof *nb);
+    const size_t n = gr_occluder_mesh_count(scene);
+    if (n * 3 > r->occ_cap) {
+        float *nb = realloc(r->occ_cpu, n * 3 * sizeof *nb);
         if (!nb) return gr_fail(err, GR_E_NOMEM, "occluders: out of memory");
         r->occ_cpu = nb;
-        r->occ_cap = need;
+        r->occ_cap = n * 3;
     }
-    float *o = r->occ_cpu;
-    size_t n = 0;
-#define PUT(v) do { o[n * 3] = (float)((v).x - P.x); o[n * 3 + 1] = (float)((v).y - P.y); \
-                    o[n * 3 + 2] = (float)((v).z - P.z); n++; } while (0)
-    for (int i = 0; i < scene->n_occluders; i++) {
-        const gr_occluder *oc = &scene->occluders[i];
-        gr_dvec3 c = gr_d3(oc->center_m[0], oc->center_m[1], oc->center_m[2]);
-        if (oc->type == GR_OCC_BOX) {
-            /* Box yaw about +y, azimuth convention of scene.h (+z toward +x): local +z maps
-             * to (sin a, 0, cos a), local +x to (cos a, 0, -sin a). */
-            double ya = oc->yaw_deg * GR_PI / 180.0;
-            gr_dvec3 ax = gr_d3(cos(ya), 0, -sin(ya)), ay = gr_d3(0, 1, 0), az = gr_d3(sin(ya), 0, cos(ya));
-            gr_dvec3 corner[8];
-            for (int k = 0; k < 8; k++) {
-                double sx = (k & 1) ? 0.5 : -0.5, sy = (k & 2) ? 0.5 : -0.5, sz = (k & 4) ? 0.5 : -0.5;
-                gr_dvec3 p = gr_d3_madd(c, ax, sx * oc->size_m[0]);
-                p = gr_d3_madd(p, ay, sy * oc->size_m[1]);
-                corner[k] = gr_d3_madd(p, az, sz * oc->size_m[2]);
-            }
-            static const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
-                                            {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
-            for (int fi = 0; fi < 6; fi++) {
-                const int *q = faces[fi];
-                PUT(corner[q[0]]); PUT(corner[q[1]]); PUT(corner[q[2]]);
-                PUT(corner[q[0]]); PUT(corner[q[2]]); PUT(corner[q[3]]);
-            }
-        } else {
-            double rad = oc->radius_m;
-            for (int st = 0; st < SPHERE_STACKS; st++) {
-                double t0 = GR_PI * st / SPHERE_STACKS, t1 = GR_PI * (st + 1) / SPHERE_STACKS;
-                for (int sl = 0; sl < SPHERE_SLICES; sl++) {
-                    double p0 = 2.0 * GR_PI * sl / SPHERE_SLICES, p1 = 2.0 * GR_PI * (sl + 1) / SPHERE_SLICES;
-                    gr_dvec3 q[4] = {
-                        gr_d3_madd(c, gr_d3(sin(t0) * cos(p0), cos(t0), sin(t0) * sin(p0)), rad),
-                        gr_d3_madd(c, gr_d3(sin(t1) * cos(p0), cos(t1), sin(t1) * sin(p0)), rad),
-                        gr_d3_madd(c, gr_d3(sin(t1) * cos(p1), cos(t1), sin(t1) * sin(p1)), rad),
-                        gr_d3_madd(c, gr_d3(sin(t0) * cos(p1), cos(t0), sin(t0) * sin(p1)), rad)};
-                    PUT(q[0]); PUT(q[1]); PUT(q[2]);
-                    PUT(q[0]); PUT(q[2]); PUT(q[3]);
-                }
-            }
-        }
-    }
-#undef PUT
+    double *w = malloc((n ? n : 1) * 3 * sizeof *w);
+    if (!w) return gr_fail(err, GR_E_NOMEM, "occluders: out of memory");
+    gr_occluder_mesh(scene, w);
+    const double origin[3] = {P.x, P.y, P.z};
+    for (size_t i = 0; i < n * 3; i++) r->occ_cpu[i] = (float)(w[i] - origin[i % 3]);
+    free(w);
     *nverts = n;
     glBindVertexArray(r->vao_occ);
     glBindBuffer(GL_ARRAY_BUFFER, r->vbo_occ);
