@@ -21,6 +21,14 @@ static void fit_middle(char *dst, size_t cap, const char *src, size_t n)
     dst[cap - 1] = '\0';
 }
 
+/* The promise of one line: a file name, an attribute or a library's text quoted into a message
+ * may hold line breaks or other control bytes (found by fuzzing the EXR reader). */
+static void one_line(char *m)
+{
+    for (; *m; m++)
+        if ((unsigned char)*m < 0x20 || *m == 0x7f) *m = ' ';
+}
+
 gr_status gr_fail(gr_error *err, gr_status st, const char *fmt, ...)
 {
     if (err) {
@@ -36,6 +44,7 @@ gr_status gr_fail(gr_error *err, gr_status st, const char *fmt, ...)
             fit_middle(err->msg, sizeof err->msg, big, (size_t)n);
             free(big);
         }
+        one_line(err->msg);
         err->status = st;
     }
     return st;
@@ -54,6 +63,7 @@ gr_status gr_error_prefix(gr_error *err, const char *fmt, ...)
     char both[2 * GR_ERROR_MSG_MAX + 2];
     const int n = snprintf(both, sizeof both, "%s: %s", prefix, old);
     fit_middle(err->msg, sizeof err->msg, both, n < 0 ? 0 : (size_t)n < sizeof both ? (size_t)n : sizeof both - 1);
+    one_line(err->msg);
     return err->status;
 }
 

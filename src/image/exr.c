@@ -54,7 +54,13 @@ static gr_status exr_fail(gr_error *err, const char *path, exr_result_t rv, gr_s
                           const char *what)
 {
     const char *why = g_exr_msg[0] ? g_exr_msg : exr_get_default_error_message(rv);
-    return gr_fail(err, status_of(rv, fallback), "%s: %s: %s", path, what, why);
+    gr_status st = gr_fail(err, status_of(rv, fallback), "%s: %s: %s", path, what, why);
+    /* one line: OpenEXR's text, and a file name or attribute it quotes, may hold line breaks
+     * and other control bytes (found by fuzzing) */
+    if (err)
+        for (char *c = err->msg; *c; c++)
+            if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = ' ';
+    return st;
 }
 
 /* Attributes OpenEXR itself defines for the file structure: never metadata. */
