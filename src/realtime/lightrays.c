@@ -14,13 +14,13 @@
 
 #define MAX_RAYS 4096
 #define MAX_CELLS 2048
-#define LR(f) offsetof(gr_lightrays_settings, f)
+#define LR(f) offsetof(gr_light_rays_settings, f)
 static const char *const footprint_names[] = {"prism", "ribbon", NULL};
 
 static const gr_param params[] = {
     {.name = "rays", .type = GR_PT_INT, .offset = LR(rays), .min = 8, .max = MAX_RAYS, .def = 512, .unit = "texels",
      .doc = "texels per side of the sun's view of the water: rays^2 lines"},
-    {.name = "footprint", .type = GR_PT_ENUM, .offset = LR(footprint), .min = 0, .max = 1, .def = GR_LIGHTRAYS_PRISM,
+    {.name = "footprint", .type = GR_PT_ENUM, .offset = LR(footprint), .min = 0, .max = 1, .def = GR_LIGHT_RAYS_PRISM,
      .enum_names = footprint_names, .unit = "",
      .doc = "prism: each pixel's ray through the line's beam, integrated exactly; ribbon: a camera-facing sheet"},
     {.name = "line_width", .type = GR_PT_DOUBLE, .offset = LR(line_width), .min = 0, .max = 64, .flags = GR_PF_MIN_EXCL,
@@ -32,8 +32,8 @@ static const gr_param params[] = {
      .tune_lo = 5.0, .tune_hi = 200.0},
     {.name = "margin_m", .type = GR_PT_DOUBLE, .offset = LR(margin_m), .min = 0, .max = 1e4, .def = 1, .unit = "m",
      .doc = "border of the sun's view around the surface that lights the visible volume"},
-    GR_VOL_PARAMS_MEDIUM(gr_lightrays_settings),
-    GR_VOL_PARAMS_LIGHT(gr_lightrays_settings),
+    GR_VOL_PARAMS_MEDIUM(gr_light_rays_settings),
+    GR_VOL_PARAMS_LIGHT(gr_light_rays_settings),
 };
 #undef LR
 
@@ -192,7 +192,7 @@ typedef struct lr_window {
     double zr;       /* depth half range along I */
 } lr_window;
 
-static void make_window(const gr_scene *scene, const gr_frame *f, const gr_lightrays_settings *s, double t_max,
+static void make_window(const gr_scene *scene, const gr_frame *f, const gr_light_rays_settings *s, double t_max,
                         lr_window *w)
 {
     const double *I = f->sun_dir, *T = f->refr_dir;
@@ -269,7 +269,7 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
                            gr_technique_stats *stats, gr_error *err)
 {
     lr_state *r = state;
-    const gr_lightrays_settings *s = settings;
+    const gr_light_rays_settings *s = settings;
     gr_vol_prep prep;
     gr_status st = gr_vol_prepare("light_rays", r->gl, r->sg, NULL, &r->timer, scene, &s->vol, out, &prep, err);
     if (st != GR_OK) return st;
@@ -413,11 +413,11 @@ static gr_status lr_metadata(void *state, const gr_scene *scene, const void *set
     return GR_OK;
 }
 
-const gr_technique_class gr_lightrays_class = {
+const gr_technique_class gr_light_rays_class = {
     .name = "light_rays",
     .description = "seed 001 after Hu et al. 2010: refracted sun rays as lines from the surface, additive",
     .params = &table,
-    .settings_size = sizeof(gr_lightrays_settings),
+    .settings_size = sizeof(gr_light_rays_settings),
     .origin = "built-in",
     .gain_key = "intensity",
     .ladder = ladder,

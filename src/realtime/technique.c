@@ -21,7 +21,7 @@ static const gr_technique_class *const builtins[] = {
     &gr_radial_blur_local_class,
     &gr_slicing_class,
     &gr_froxel_class,
-    &gr_lightrays_class,
+    &gr_light_rays_class,
 };
 
 /* ---- registry ------------------------------------------------------------------------- */
