@@ -41,7 +41,8 @@ void main()
         float z = v_shadow_pos.z / v_shadow_pos.w;
         // Fetch shadowmap (point sampled, as the seed's sampler state).
         float sz = textureProj(u_shadow_map, v_shadow_pos).x;
-        float lit = (z - u_shadow_bias < sz) ? 1.0 : 0.0;
+        // (scenegl's map: depth 1 where no caster is stored, lit at any depth)
+        float lit = (sz >= 1.0 || z - u_shadow_bias < sz) ? 1.0 : 0.0;
         // Alpha 1 per fragment: in a float target it counts the shafts' surfaces crossed.
         o_color = vec4(v_intensity * lit * u_prescale, 1.0);
         return;

@@ -34,6 +34,8 @@ uniform float u_sun_radius_w; // flux: the sun's angular radius under water (rad
 uniform float u_half;         // flux: (N - 1) / 2
 uniform sampler2D u_corner_pos;  // flux: corner positions (viewer-relative) and transmittance
 uniform sampler2D u_corner_refr; // flux: corner refracted directions (shafts_corner.frag.glsl)
+uniform sampler2D u_shadow_map;  // path: the occluders' depth along the flat T (scenegl, [0,1])
+uniform float u_shadow_dz;       // path: metres per shadow depth unit; 0: shafts are not cut
 
 out vec3 v_intensity;   // seed: output.intensity (read as input.outScattering by its PS)
 out vec4 v_shadow_pos;  // seed: output.shadowmapPos
@@ -86,6 +88,19 @@ void surface(vec2 rest, out vec3 disp, out vec3 normal)
     normal = normalize(cross(t2, t1));
 }
 
+// Path and flux: length along the refracted direction rd from the surface point p (viewer-
+// relative) to the first occluder in the shadow map (docs/realtime-shafts.md "Occluder
+// shadows"): the map stores the casters' depth along the flat T, so the caster lies
+// (sz - z) dz metres along T below p; 1e30 where no caster is stored.
+float shadow_length(vec3 p, vec3 rd)
+{
+    if (u_shadow_dz <= 0.0) return 1e30;
+    vec4 sp = u_shadow_matrix * vec4(p, 1.0);
+    float sz = textureLod(u_shadow_map, sp.xy / sp.w, 0.0).x;
+    if (sz >= 1.0) return 1e30;
+    return max(sz - sp.z / sp.w, 0.0) * u_shadow_dz / max(dot(rd, u_refr_flat), 0.1);
+}
+
 void main()
 {
     if (u_variant == 2) {
@@ -117,7 +132,7 @@ void main()
         // each shaft carries its whole cell's flux (width^2 of the cell is drawn)
         v_ratio = a_top * trs / max(a_eff, 1e-12) / (u_width * u_width);
         v_tr = 1.0;
-        float lenf = a_bottom * u_length;
+        float lenf = min(a_bottom * u_length, texelFetch(u_corner_refr, 2 * cell + ivec2(own == 1 || own == 2 ? 1 : 0, own >= 2 ? 1 : 0), 0).w);
         vec3 posf = q[own] + rd[own] * lenf;
         v_len = lenf;
         v_intensity = vec3(0.0);
@@ -139,6 +154,7 @@ void main()
     float len = a_bottom * u_length;
     if (a_bottom > 0.0) {
         vec3 refr = refract(u_sun_dir, normal, u_eta);
+        len = min(len, shadow_length(pos, refr)); // path: the shaft ends at an occluder
         pos += refr * len;
     }
 

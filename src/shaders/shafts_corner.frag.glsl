@@ -15,9 +15,23 @@ uniform float u_eta;          // 1 / ior
 uniform float u_r0;           // Schlick R0
 uniform int u_wave_groups;
 uniform vec4 u_waves[MAX_WAVE_GROUPS * 5]; // as shafts.vert.glsl
+uniform mat4 u_shadow_matrix; // viewer-relative -> shadow texture [0,1]^3 (scenegl's map)
+uniform sampler2D u_shadow_map;
+uniform float u_shadow_dz;    // metres per shadow depth unit; 0: shafts are not cut
+uniform vec3 u_refr_flat;     // T of the flat surface
 
 layout(location = 0) out vec4 o_pos_tr; // corner position (viewer-relative), transmittance
-layout(location = 1) out vec4 o_refr;   // refracted direction
+layout(location = 1) out vec4 o_refr;   // refracted direction, length to the first occluder
+
+// as shafts.vert.glsl's shadow_length
+float shadow_length(vec3 p, vec3 rd)
+{
+    if (u_shadow_dz <= 0.0) return 1e30;
+    vec4 sp = u_shadow_matrix * vec4(p, 1.0);
+    float sz = textureLod(u_shadow_map, sp.xy / sp.w, 0.0).x;
+    if (sz >= 1.0) return 1e30;
+    return max(sz - sp.z / sp.w, 0.0) * u_shadow_dz / max(dot(rd, u_refr_flat), 0.1);
+}
 
 void main()
 {
@@ -51,6 +65,8 @@ void main()
     float m = 1.0 - clamp(dot(-u_sun_dir, n), 0.0, 1.0);
     float m2 = m * m;
     float tr = 1.0 - (u_r0 + (1.0 - u_r0) * (m2 * m2 * m));
-    o_pos_tr = vec4(u_origin + vec3(rest.x, 0.0, rest.y) + disp, tr);
-    o_refr = vec4(refract(u_sun_dir, n, u_eta), 0.0);
+    vec3 q = u_origin + vec3(rest.x, 0.0, rest.y) + disp;
+    vec3 rd = refract(u_sun_dir, n, u_eta);
+    o_pos_tr = vec4(q, tr);
+    o_refr = vec4(rd, shadow_length(q, rd));
 }
