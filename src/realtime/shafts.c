@@ -124,6 +124,16 @@ struct gr_shafts {
     GLuint prog_corner, corner_tex[2], corner_fbo;
     int corner_size;
     shaft_locs lk;
+    /* flux: the shaft lattice (one vertex per lattice point and level, one quad per boundary
+     * between regions) and the second pre-pass, irradiance per cell and slab */
+    GLuint vao_lat, vbo_lat, ibo_lat;
+    int lat_N, lat_slabs, lat_tiled, lat_M;
+    long long lat_nidx;
+    GLuint prog_flux, flux_tex, flux_fbo;
+    int flux_w, flux_h;
+    GLint lf_corner_pos, lf_corner_refr, lf_tiled, lf_cells, lf_slabs, lf_length, lf_width, lf_sun_dir, lf_refr_flat,
+        lf_sun_radius_w;
+    GLint ls_flux_e, ls_tiled, ls_lattice, ls_cells, ls_slabs, lk_tiled;
 
     GLuint vao_empty;
     GLuint target_tex, target_fbo;
@@ -311,7 +321,27 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
         return st;
     r->from_dir += nd;
     get_shaft_locs(r->prog_corner, &r->lk);
+    r->lk_tiled = glGetUniformLocation(r->prog_corner, "u_tiled");
+    if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_flux.frag.glsl", NULL, 0,
+                                &r->prog_flux, &nd, err)) != GR_OK)
+        return st;
+    r->from_dir += nd;
+    r->lf_corner_pos = glGetUniformLocation(r->prog_flux, "u_corner_pos");
+    r->lf_corner_refr = glGetUniformLocation(r->prog_flux, "u_corner_refr");
+    r->lf_tiled = glGetUniformLocation(r->prog_flux, "u_tiled");
+    r->lf_cells = glGetUniformLocation(r->prog_flux, "u_cells");
+    r->lf_slabs = glGetUniformLocation(r->prog_flux, "u_slabs");
+    r->lf_length = glGetUniformLocation(r->prog_flux, "u_length");
+    r->lf_width = glGetUniformLocation(r->prog_flux, "u_width");
+    r->lf_sun_dir = glGetUniformLocation(r->prog_flux, "u_sun_dir");
+    r->lf_refr_flat = glGetUniformLocation(r->prog_flux, "u_refr_flat");
+    r->lf_sun_radius_w = glGetUniformLocation(r->prog_flux, "u_sun_radius_w");
     get_shaft_locs(r->prog_shafts, &r->ls);
+    r->ls_flux_e = glGetUniformLocation(r->prog_shafts, "u_flux_e");
+    r->ls_tiled = glGetUniformLocation(r->prog_shafts, "u_tiled");
+    r->ls_lattice = glGetUniformLocation(r->prog_shafts, "u_lattice");
+    r->ls_cells = glGetUniformLocation(r->prog_shafts, "u_cells");
+    r->ls_slabs = glGetUniformLocation(r->prog_shafts, "u_slabs");
     r->loc_inv_vp = glGetUniformLocation(r->prog_final, "u_inv_view_proj");
     r->loc_texel = glGetUniformLocation(r->prog_final, "u_texel");
     r->loc_shafts = glGetUniformLocation(r->prog_final, "u_shafts");
@@ -324,6 +354,9 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
     glGenBuffers(1, &r->vbo_grid);
     glGenBuffers(1, &r->ibo_grid);
     glGenVertexArrays(1, &r->vao_empty);
+    glGenVertexArrays(1, &r->vao_lat);
+    glGenBuffers(1, &r->vbo_lat);
+    glGenBuffers(1, &r->ibo_lat);
     glGenQueries(GR_SHAFTS_NPASS, r->q_time);
     glGenQueries(1, &r->q_samples);
     /* Timer queries are core since 3.3; pipeline statistics need GL 4.6 or the ARB extension. */
@@ -361,6 +394,11 @@ void gr_shafts_destroy(gr_shafts *r)
         if (r->vbo_grid) glDeleteBuffers(1, &r->vbo_grid);
         if (r->ibo_grid) glDeleteBuffers(1, &r->ibo_grid);
         if (r->vao_empty) glDeleteVertexArrays(1, &r->vao_empty);
+        if (r->prog_flux) glDeleteProgram(r->prog_flux);
+        if (r->vao_lat) glDeleteVertexArrays(1, &r->vao_lat);
+        if (r->vbo_lat) glDeleteBuffers(1, &r->vbo_lat);
+        if (r->ibo_lat) glDeleteBuffers(1, &r->ibo_lat);
+        delete_tex_fbo(&r->flux_tex, &r->flux_fbo);
         if (r->q_time[0]) glDeleteQueries(GR_SHAFTS_NPASS, r->q_time);
         if (r->q_samples) glDeleteQueries(1, &r->q_samples);
         if (r->q_vs) glDeleteQueries(1, &r->q_vs);
@@ -494,10 +532,9 @@ static gr_status make_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h
     return gr_gl_check(what, err);
 }
 
-/* The flux pre-pass's two RGBA32F corner textures, 2 (N-1) texels per side. */
-static gr_status ensure_corners(gr_shafts *r, int N, gr_error *err)
+/* The flux pre-pass's two RGBA32F lattice textures, M texels per side. */
+static gr_status ensure_corners(gr_shafts *r, int N, int n, gr_error *err)
 {
-    int n = 2 * (N - 1);
     if (r->corner_size == n && r->corner_fbo) return GR_OK;
     if (r->corner_fbo) glDeleteFramebuffers(1, &r->corner_fbo);
     if (r->corner_tex[0]) glDeleteTextures(2, r->corner_tex);
@@ -521,6 +558,82 @@ static gr_status ensure_corners(gr_shafts *r, int N, gr_error *err)
         return gr_fail(err, GR_E_GL, "shafts.N = %d: flux corner target %dx%d incomplete (0x%04x)", N, n, n, (unsigned)fs);
     r->corner_size = n;
     return gr_gl_check("shafts.N: flux corner target", err);
+}
+
+/* Flux: the shaft lattice for N grid vertices, `slabs` depth slabs, tiled (shaft_width 1: the
+ * lattice points are the N grid lines per side) or not (M = 2 (N - 1): each cell's two
+ * corners). Vertices: (p, q, level / slabs) for every lattice point and level 0..slabs. Quads,
+ * each wound counter-clockwise seen from the side its normal points to (docs "flux"):
+ * x faces (normal +x) on every lattice line p, across each cell's z extent, per slab; z faces
+ * (normal +z) likewise; caps (normal down) of every cell at every level. The fragment shader
+ * finds a quad's two regions from gl_PrimitiveID / 2 in exactly this order. */
+static gr_status ensure_lattice(gr_shafts *r, int N, int slabs, int tiled, gr_error *err)
+{
+    if (r->lat_N == N && r->lat_slabs == slabs && r->lat_tiled == tiled) return GR_OK;
+    int C = N - 1, M = tiled ? N : 2 * (N - 1), L = slabs + 1;
+    size_t nv = (size_t)M * (size_t)M * (size_t)L;
+    size_t nq = 2 * (size_t)M * (size_t)C * (size_t)slabs + (size_t)L * (size_t)C * (size_t)C;
+    if (nv > 0x7fffffffu / 4 || nq * 6 > 0x7fffffffu)
+        return gr_fail(err, GR_E_INPUT, "shafts.N = %d, shafts.slabs = %d: flux lattice too large", N, slabs);
+    float *v = malloc(nv * 3 * sizeof *v);
+    GLuint *idx = malloc(nq * 6 * sizeof *idx);
+    if (!v || !idx) {
+        free(v);
+        free(idx);
+        return gr_fail(err, GR_E_NOMEM, "shafts.N = %d, shafts.slabs = %d: out of memory for the flux lattice", N, slabs);
+    }
+#define LV(p, q, b) ((GLuint)((((size_t)(b) * (size_t)M) + (size_t)(q)) * (size_t)M + (size_t)(p)))
+    for (int b = 0; b < L; b++)
+        for (int q = 0; q < M; q++)
+            for (int p = 0; p < M; p++) {
+                float *o = v + (size_t)LV(p, q, b) * 3;
+                o[0] = (float)p;
+                o[1] = (float)q;
+                o[2] = (float)((double)b / (double)slabs);
+            }
+    GLuint *o = idx;
+#define QUAD(a, b2, c, d) do { o[0] = (a); o[1] = (b2); o[2] = (c); o[3] = (a); o[4] = (c); o[5] = (d); o += 6; } while (0)
+    for (int b = 0; b < slabs; b++) /* x faces: (p, z0, b) (p, z1, b) (p, z1, b+1) (p, z0, b+1): normal +x */
+        for (int p = 0; p < M; p++)
+            for (int j = 0; j < C; j++) {
+                int z0 = tiled ? j : 2 * j;
+                QUAD(LV(p, z0, b), LV(p, z0 + 1, b), LV(p, z0 + 1, b + 1), LV(p, z0, b + 1));
+            }
+    for (int b = 0; b < slabs; b++) /* z faces: (x0, q, b) (x0, q, b+1) (x1, q, b+1) (x1, q, b): normal +z */
+        for (int q = 0; q < M; q++)
+            for (int i = 0; i < C; i++) {
+                int x0 = tiled ? i : 2 * i;
+                QUAD(LV(x0, q, b), LV(x0, q, b + 1), LV(x0 + 1, q, b + 1), LV(x0 + 1, q, b));
+            }
+    for (int b = 0; b < L; b++) /* caps: (x0, z0) (x1, z0) (x1, z1) (x0, z1): normal down */
+        for (int j = 0; j < C; j++)
+            for (int i = 0; i < C; i++) {
+                int x0 = tiled ? i : 2 * i, z0 = tiled ? j : 2 * j;
+                QUAD(LV(x0, z0, b), LV(x0 + 1, z0, b), LV(x0 + 1, z0 + 1, b), LV(x0, z0 + 1, b));
+            }
+#undef QUAD
+#undef LV
+    glBindVertexArray(r->vao_lat);
+    glBindBuffer(GL_ARRAY_BUFFER, r->vbo_lat);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 3 * sizeof *v), v, GL_STATIC_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->ibo_lat);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(nq * 6 * sizeof *idx), idx, GL_STATIC_DRAW);
+    GLsizei stride = (GLsizei)(3 * sizeof(float));
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, stride, (const void *)0);
+    glDisableVertexAttribArray(1);
+    glVertexAttrib2f(1, 0.0f, 0.0f);
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, stride, (const void *)(2 * sizeof(float)));
+    glBindVertexArray(0);
+    free(v);
+    free(idx);
+    r->lat_N = N;
+    r->lat_slabs = slabs;
+    r->lat_tiled = tiled;
+    r->lat_M = M;
+    r->lat_nidx = (long long)nq * 6;
+    return gr_gl_check("shafts.N: uploading the flux lattice", err);
 }
 
 static gr_status ensure_targets(gr_shafts *r, const frame_setup *f, gr_error *err)
@@ -648,7 +761,7 @@ static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in
     double cos_i = fabs(I.y), cos_t = fabs(f->T.y);
     f->fmt = s->variant == GR_SHAFTS_SEED ? s->target_format : TARGET_RGBA32F;
     f->caps = s->variant == GR_SHAFTS_SEED ? s->caps : 1; /* signed sums need closed shafts */
-    f->slabs = s->variant == GR_SHAFTS_FLUX ? s->slabs : 1;
+    f->slabs = 1; /* the per-shaft grid of seed and path; flux draws the lattice (ensure_lattice) */
     f->ratio = (float)(cos_i / fmax(cos_t, 1e-9) / (s->shaft_width * s->shaft_width));
     double alpha = 0.5 * scene->sun.angular_diameter_deg * GR_PI / 180.0;
     f->sun_radius_w = (float)(alpha * cos_i / (ior * fmax(cos_t, 1e-9)));
@@ -740,7 +853,25 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
     if ((st = ensure_grid(r, f->N, f->slabs, err)) != GR_OK) goto done;
     if ((st = ensure_targets(r, f, err)) != GR_OK) goto done;
-    if (f->s.variant == GR_SHAFTS_FLUX && (st = ensure_corners(r, f->N, err)) != GR_OK) goto done;
+    const int tiled = f->s.shaft_width >= 1.0;
+    if (f->s.variant == GR_SHAFTS_FLUX) {
+        int C = f->N - 1;
+        if ((long long)C * f->s.slabs > 16384) {
+            st = gr_fail(err, GR_E_INPUT, "shafts.slabs = %d: (N - 1) x slabs = %lld must be <= 16384", f->s.slabs,
+                         (long long)C * f->s.slabs);
+            goto done;
+        }
+        if ((st = ensure_lattice(r, f->N, f->s.slabs, tiled, err)) != GR_OK) goto done;
+        if ((st = ensure_corners(r, f->N, r->lat_M, err)) != GR_OK) goto done;
+        if (r->flux_w != C || r->flux_h != C * f->s.slabs || !r->flux_tex) {
+            r->flux_w = 0;
+            if ((st = make_target(&r->flux_tex, &r->flux_fbo, GL_R32F, C, C * f->s.slabs, 0, GL_NEAREST,
+                                  "shafts.slabs: flux irradiance target", err)) != GR_OK)
+                goto done;
+            r->flux_w = C;
+            r->flux_h = C * f->s.slabs;
+        }
+    }
     GLuint eye_depth_tex = 0;
     if (f->s.depth_test) {
         /* scenegl's eye depth of the occluders and seabed at the target's resolution */
@@ -776,7 +907,8 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     }
 
     /* Pass 2: shafts, additive, no depth test, no culling, into the reduced target. */
-    GLsizei n_idx = (GLsizei)(f->nshafts * f->slabs * (f->caps ? 36 : 24));
+    GLsizei n_idx = f->s.variant == GR_SHAFTS_FLUX ? (GLsizei)r->lat_nidx
+                                                   : (GLsizei)(f->nshafts * f->slabs * (f->caps ? 36 : 24));
     glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_SHAFTS]);
     glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
     if (r->have_pipeline_stats) {
@@ -800,26 +932,55 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     for (int k = 0; k < f->n_levels; k++) {
         if (f->lvl_weight[k] <= 0.0) continue;
         if (f->s.variant == GR_SHAFTS_FLUX) {
-            /* pre-pass: the level's corners, then back to the shaft pass's state */
+            /* pre-passes: the level's lattice points, then each cell's and slab's irradiance,
+             * then back to the shaft pass's state with the lattice bound */
             glDisable(GL_BLEND);
+            for (GLenum u = GL_TEXTURE2; u <= GL_TEXTURE4; u++) {
+                glActiveTexture(u);
+                glBindTexture(GL_TEXTURE_2D, 0);
+            }
+            glActiveTexture(GL_TEXTURE0);
             glBindFramebuffer(GL_FRAMEBUFFER, r->corner_fbo);
             glViewport(0, 0, r->corner_size, r->corner_size);
             set_shaft_uniforms(r->prog_corner, &r->lk, f, scene);
             glUniform3fv(r->lk.origin, 1, f->lvl_origin[k]);
             glUniform1f(r->lk.spacing, (float)f->lvl_S[k]);
+            glUniform1i(r->lk_tiled, tiled);
             if (f->groups > 0) glUniform4fv(r->lk.waves, f->groups * 5, f->lvl_waves[k]);
             glBindVertexArray(r->vao_empty);
             glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-            glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
-            glViewport(0, 0, f->tw, f->th);
-            glEnable(GL_BLEND);
-            set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
             glActiveTexture(GL_TEXTURE2);
             glBindTexture(GL_TEXTURE_2D, r->corner_tex[0]);
             glActiveTexture(GL_TEXTURE3);
             glBindTexture(GL_TEXTURE_2D, r->corner_tex[1]);
             glActiveTexture(GL_TEXTURE0);
-            glBindVertexArray(r->vao_grid);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->flux_fbo);
+            glViewport(0, 0, r->flux_w, r->flux_h);
+            glUseProgram(r->prog_flux);
+            glUniform1i(r->lf_corner_pos, 2);
+            glUniform1i(r->lf_corner_refr, 3);
+            glUniform1i(r->lf_tiled, tiled);
+            glUniform1i(r->lf_cells, f->N - 1);
+            glUniform1i(r->lf_slabs, f->s.slabs);
+            glUniform1f(r->lf_length, (float)f->s.shaft_length_m);
+            glUniform1f(r->lf_width, (float)f->s.shaft_width);
+            glUniform3f(r->lf_sun_dir, (float)scene->sun.dir[0], (float)scene->sun.dir[1], (float)scene->sun.dir[2]);
+            glUniform3f(r->lf_refr_flat, (float)f->T.x, (float)f->T.y, (float)f->T.z);
+            glUniform1f(r->lf_sun_radius_w, f->sun_radius_w);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+            glActiveTexture(GL_TEXTURE4);
+            glBindTexture(GL_TEXTURE_2D, r->flux_tex);
+            glActiveTexture(GL_TEXTURE0);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+            glViewport(0, 0, f->tw, f->th);
+            glEnable(GL_BLEND);
+            set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
+            glUniform1i(r->ls_flux_e, 4);
+            glUniform1i(r->ls_tiled, tiled);
+            glUniform1i(r->ls_lattice, r->lat_M);
+            glUniform1i(r->ls_cells, f->N - 1);
+            glUniform1i(r->ls_slabs, f->s.slabs);
+            glBindVertexArray(r->vao_lat);
         }
         /* stable_grid: each level drawn with its weight folded into the prescale */
         glUniform3fv(r->ls.origin, 1, f->lvl_origin[k]);
@@ -828,7 +989,7 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
         glUniform1f(r->ls.prescale, (float)(f->s.target_prescale * f->lvl_weight[k]));
         glDrawElements(GL_TRIANGLES, n_idx, GL_UNSIGNED_INT, (const void *)0);
     }
-    for (GLenum u = GL_TEXTURE1; u <= GL_TEXTURE3; u++) {
+    for (GLenum u = GL_TEXTURE1; u <= GL_TEXTURE4; u++) {
         glActiveTexture(u);
         glBindTexture(GL_TEXTURE_2D, 0);
     }
