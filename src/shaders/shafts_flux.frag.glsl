@@ -2,8 +2,8 @@
 // Flux variant, second pre-pass (docs/realtime-shafts.md "flux"): the irradiance across the
 // beam of every shaft (cell) and depth slab, texel (i, j + slab (N - 1)), as a multiple of
 // E_sun. Energy conservation: the flux through the shaft's top face, E_sun |A_top . I| T,
-// crosses its section across the flat T at every depth, blurred by the sun's disc (Steiner:
-// A + P r + pi r^2, r = alpha_w s); the slab takes the mean over its depth range. The lattice
+// crosses its section across the flat T at every depth, never smaller than the sun disc's blur
+// (Steiner: P r + pi r^2, r = alpha_w s); the slab takes the mean over its depth range. The lattice
 // points come from the corner pre-pass.
 
 uniform sampler2D u_corner_pos;  // lattice points (viewer-relative) and transmittance
@@ -53,10 +53,13 @@ void main()
             perim += length(ed - dot(ed, u_refr_flat) * u_refr_flat);
         }
         // the sun disc of angular radius alpha_w blurs every point into a disc of radius
-        // r = alpha_w s: the blurred section is the Minkowski sum, area A + P r + pi r^2
-        // (Steiner's formula), never 0 even at a line or point focus
+        // r = alpha_w s, which adds P r + pi r^2 to the section (Steiner's formula for the
+        // Minkowski sum): what a section shrunk to a line or a point focus still covers. A
+        // smooth maximum of the two, as in a tiled grid the neighbours' blur spills back in
+        // (on flat water E stays Phi / A to 0.1 %)
         float r = u_sun_radius_w * sm;
-        e += 1.0 / max(a_sec + perim * r + 3.14159265 * r * r, 1e-12);
+        float a_blur = perim * r + 3.14159265 * r * r;
+        e += 1.0 / max(sqrt(a_sec * a_sec + a_blur * a_blur), 1e-12);
     }
     // each shaft carries its whole cell's flux (width^2 of the cell is drawn)
     o_e = vec4(a_top * trs * (e / 8.0) / (u_width * u_width), 0.0, 0.0, 1.0);
