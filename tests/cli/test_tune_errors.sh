@@ -37,7 +37,12 @@ expect 2 "LO and HI must be finite numbers" tune "$s" -o "$o" --params shafts.K 
 expect 2 "not among the --params" tune "$s" -o "$o" --params shafts.K --bounds shafts.g=0:0.5
 expect 2 "--start" tune "$s" -o "$o" --params shafts.K --start shafts.K=x
 expect 2 "--starts" tune "$s" -o "$o" --params shafts.K --starts 0
-expect 2 "no --params" tune "$s" -o "$o"
+# without --params the technique's default list is tuned (docs/tuning.md); an unknown technique
+# is still refused before any work
+expect 2 "--technique no_such_technique: unknown technique" tune "$s" -o "$o" --technique no_such_technique
+expect 2 "--coarse" tune "$s" -o "$o" --params shafts.K --coarse x
+expect 2 "--seed" tune "$s" -o "$o" --params shafts.K --seed -1
+expect 2 "--method" tune "$s" -o "$o" --params shafts.K --method simplex
 # techniques by name
 expect 2 "--technique no_such_technique: unknown technique 'no_such_technique'" tune "$s" -o "$o" --params shafts.K --technique no_such_technique
 expect 2 "--technique no_such_technique: unknown technique" sweep "$s" -o "$o" --param shafts.K=0.5:1:3 --technique no_such_technique
