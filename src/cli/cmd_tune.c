@@ -325,7 +325,10 @@ static int tune_with(gr_args *args)
     oo.n_starts = n_starts;
     oo.screen = screen >= 0 ? screen : (4 * n_starts <= GR_OPT_MAX_STARTS ? 4 * n_starts : GR_OPT_MAX_STARTS);
     oo.seed = seed;
-    if (max_evals > 0) oo.max_evals = oo.polish = max_evals;
+    if (max_evals > 0) {
+        oo.max_evals = oo.polish = max_evals;
+        if (oo.screen_evals > max_evals) oo.screen_evals = max_evals; /* a small budget stays small */
+    }
     if (coarse >= 0) oo.coarse = coarse;
     if (coarse == 0) oo.polish = 0, oo.screen = 0; /* the fixed-lattice search of before */
     gr_opt_result res;
