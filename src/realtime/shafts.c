@@ -132,7 +132,7 @@ struct gr_shafts {
     GLuint prog_flux, flux_tex, flux_fbo;
     int flux_w, flux_h;
     GLint lf_corner_pos, lf_corner_refr, lf_tiled, lf_cells, lf_slabs, lf_length, lf_width, lf_sun_dir, lf_refr_flat,
-        lf_sun_radius_w;
+        lf_sun_radius_w, lf_shadow_matrix, lf_shadow_map, lf_shadow_bias, lf_shadows;
     GLint ls_flux_e, ls_tiled, ls_lattice, ls_cells, ls_slabs, lk_tiled;
 
     GLuint vao_empty;
@@ -336,6 +336,10 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
     r->lf_sun_dir = glGetUniformLocation(r->prog_flux, "u_sun_dir");
     r->lf_refr_flat = glGetUniformLocation(r->prog_flux, "u_refr_flat");
     r->lf_sun_radius_w = glGetUniformLocation(r->prog_flux, "u_sun_radius_w");
+    r->lf_shadow_matrix = glGetUniformLocation(r->prog_flux, "u_shadow_matrix");
+    r->lf_shadow_map = glGetUniformLocation(r->prog_flux, "u_shadow_map");
+    r->lf_shadow_bias = glGetUniformLocation(r->prog_flux, "u_shadow_bias");
+    r->lf_shadows = glGetUniformLocation(r->prog_flux, "u_shadows");
     get_shaft_locs(r->prog_shafts, &r->ls);
     r->ls_flux_e = glGetUniformLocation(r->prog_shafts, "u_flux_e");
     r->ls_tiled = glGetUniformLocation(r->prog_shafts, "u_tiled");
@@ -967,6 +971,10 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
             glUniform3f(r->lf_sun_dir, (float)scene->sun.dir[0], (float)scene->sun.dir[1], (float)scene->sun.dir[2]);
             glUniform3f(r->lf_refr_flat, (float)f->T.x, (float)f->T.y, (float)f->T.z);
             glUniform1f(r->lf_sun_radius_w, f->sun_radius_w);
+            glUniformMatrix4fv(r->lf_shadow_matrix, 1, GL_FALSE, f->shadow_matrix);
+            glUniform1i(r->lf_shadow_map, 0);
+            glUniform1f(r->lf_shadow_bias, f->shadow_bias_depth);
+            glUniform1i(r->lf_shadows, 1);
             glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
             glActiveTexture(GL_TEXTURE4);
             glBindTexture(GL_TEXTURE_2D, r->flux_tex);
