@@ -1125,6 +1125,11 @@ gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts
     float *data = NULL;
     if (!f) return gr_fail(err, GR_E_NOMEM, "shafts: out of memory");
     if ((st = setup_frame(scene, s, f, err)) != GR_OK) goto done;
+    if (f->s.variant == GR_SHAFTS_FLUX) {
+        /* flux draws the shared lattice (ensure_lattice), not the per-shaft grid captured here */
+        st = gr_fail(err, GR_E_INPUT, "shafts.variant = flux: the vertex capture takes the seed and path variants");
+        goto done;
+    }
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
     if (!r->prog_capture) {
         static const char *const varyings[] = {"v_world", "v_intensity"};
