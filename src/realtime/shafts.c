@@ -1399,6 +1399,7 @@ const gr_technique_class gr_shafts_class = {
     .origin = "built-in",
     .gain_key = "intensity", /* final pass: (bias + shafts) x intensity x phase (seed, second pass) */
     .ladder = shafts_ladder,
+    .tune_keys = "K,extinction,shaft_width,g", /* spacing, attenuation, gaps, phase: the beams' look */
     .n_ladder = (int)(sizeof shafts_ladder / sizeof shafts_ladder[0]),
     .check = tech_check,
     .resolve = tech_resolve,
