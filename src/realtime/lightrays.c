@@ -426,6 +426,7 @@ const gr_technique_class gr_light_rays_class = {
     .gain_key = "intensity",
     .ladder = ladder,
     .n_ladder = sizeof ladder / sizeof ladder[0],
+    .tune_keys = "extinction,g", /* the attenuation and the phase: line_width only sizes the cover */
     .check = lr_check,
     .create = lr_create,
     .destroy = lr_destroy,
