@@ -26,8 +26,9 @@ static void usage(FILE *f)
             "Finds the settings of a real-time technique (--technique, else the one the parameters\n"
             "name) that minimize the error against the ground truth (rendered\n"
             "once per frame and view, cached), averaged over the frames (--frames/--times) and views\n"
-            "(--view), with bounded Nelder-Mead restarted from several starting points spread over\n"
-            "the bounds (the scene's own settings are the first). Prints the best settings as a\n"
+            "(--view): a sample of the bounds, short Nelder-Mead runs from its best points, the\n"
+            "best of them (and the scene's own settings) continued, then a polish. Prints the best\n"
+            "settings as a\n"
             "snippet for the technique's scene section and the error before and after per frame and\n"
             "view; writes DIR/tune.json, DIR/trace.csv (every evaluation), DIR/compare.png\n"
             "(reference | before | after) and per-case reference/before/after PNGs.\n"
@@ -47,6 +48,8 @@ static void usage(FILE *f)
             "  --coarse M           first stage: M points of a shifted Halton sample over the box; the\n"
             "                       starts after the scene's settings are its best points, apart from\n"
             "                       each other (default 16 x parameters; 0: starts on a fixed lattice)\n"
+            "  --screen C           candidates screened by short local searches before the starts\n"
+            "                       continue (default 4 x --starts; 0 or <= --starts: none)\n"
             "  --method M           nelder-mead (default: local searches from the starts) or cmaes\n"
             "                       (CMA-ES runs with a doubling population, one per start)\n"
             "  --seed S             the sample's random shift (default 0; same seed, same search)\n"
@@ -173,7 +176,7 @@ static int tune_with(gr_args *args)
     gr_tune_cli c;
     gr_tune_cli_init(&c);
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
-    int n_params = 0, n_starts = 4, max_evals = 0, rc = 0, coarse = -1;
+    int n_params = 0, n_starts = 4, max_evals = 0, rc = 0, coarse = -1, screen = -1;
     unsigned long long seed = 0;
     gr_opt_method method = GR_OPT_NELDER_MEAD;
     const char *bounds[32], *starts[32], *params_spec = NULL;
@@ -190,7 +193,7 @@ static int tune_with(gr_args *args)
             return 0;
         }
         if (!strcmp(a, "--params") || !strcmp(a, "--bounds") || !strcmp(a, "--start") || !strcmp(a, "--starts") ||
-            !strcmp(a, "--max-evals") || !strcmp(a, "--coarse") || !strcmp(a, "--seed") || !strcmp(a, "--method")) {
+            !strcmp(a, "--max-evals") || !strcmp(a, "--coarse") || !strcmp(a, "--seed") || !strcmp(a, "--method") || !strcmp(a, "--screen")) {
             if ((rc = gr_args_value(args, &v)) != 0) return rc;
             if (!strcmp(a, "--params")) {
                 if (params_spec) return gr_cli_usage_error(cmd, "--params given twice");
@@ -208,6 +211,9 @@ static int tune_with(gr_args *args)
                 if (!strcmp(v, "nelder-mead")) method = GR_OPT_NELDER_MEAD;
                 else if (!strcmp(v, "cmaes")) method = GR_OPT_CMAES;
                 else return gr_cli_usage_error(cmd, "--method %s: expected nelder-mead or cmaes", v);
+            } else if (!strcmp(a, "--screen")) {
+                if (parse_count(v, 0, GR_OPT_MAX_STARTS, &screen))
+                    return gr_cli_usage_error(cmd, "--screen %s: expected an integer in [0, %d]", v, GR_OPT_MAX_STARTS);
             } else if (!strcmp(a, "--coarse")) {
                 if (parse_count(v, 0, 100000, &coarse))
                     return gr_cli_usage_error(cmd, "--coarse %s: expected an integer in [0, 100000]", v);
@@ -318,10 +324,14 @@ static int tune_with(gr_args *args)
     gr_tune_search_defaults(&oo, n_params, x0);
     oo.method = method;
     oo.n_starts = n_starts;
+    oo.screen = screen >= 0 ? screen : (4 * n_starts <= GR_OPT_MAX_STARTS ? 4 * n_starts : GR_OPT_MAX_STARTS);
     oo.seed = seed;
-    if (max_evals > 0) oo.max_evals = oo.polish = max_evals;
+    if (max_evals > 0) {
+        oo.max_evals = oo.polish = max_evals;
+        if (oo.screen_evals > max_evals) oo.screen_evals = max_evals; /* a small budget stays small */
+    }
     if (coarse >= 0) oo.coarse = coarse;
-    if (coarse == 0) oo.polish = 0; /* the fixed-lattice search of before */
+    if (coarse == 0) oo.polish = 0, oo.screen = 0; /* the fixed-lattice search of before */
     gr_opt_result res;
     double t_opt = (double)p->renders, render_s0 = p->render_s, metrics_s0 = p->metrics_s;
     if (gr_opt_minimize(n_params, lo, hi, traced_objective, &t, &oo, &res, &err) != GR_OK) goto fail;
@@ -405,6 +415,9 @@ static int tune_with(gr_args *args)
         cJSON_AddNumberToObject(root, "after", fa);
         cJSON_AddNumberToObject(root, "evaluations", res.evals);
         cJSON_AddNumberToObject(root, "sample_evaluations", res.coarse_evals);
+        cJSON_AddNumberToObject(root, "screened", res.n_screened);
+        cJSON_AddNumberToObject(root, "screen_evaluations", res.screen_evals);
+        cJSON_AddNumberToObject(root, "polish_evaluations", res.polish_evals);
         cJSON_AddNumberToObject(root, "seed", (double)seed);
         cJSON_AddNumberToObject(root, "starts_agreeing", agreeing);
         cJSON *sn = cJSON_Parse(snippet);
@@ -438,6 +451,9 @@ static int tune_with(gr_args *args)
     if (res.coarse_evals > 0)
         gr_sb_printf(&sum, "first stage: %d sample points (seed %llu), best error %.6g\n", res.coarse_evals, seed,
                      res.coarse_best);
+    if (res.n_screened > 0)
+        gr_sb_printf(&sum, "screening: %d candidates, %d evaluations; the %d best continue\n", res.n_screened,
+                     res.screen_evals, res.n_starts);
     gr_sb_printf(&sum, "starts:\n");
     for (int j = 0; j < res.n_starts; j++) {
         if (res.starts[j].coarse_rank >= 0)

@@ -169,5 +169,7 @@ void gr_tune_search_defaults(gr_opt_options *o, int n_params, const double *x0)
     o->max_evals = 60 + 40 * n_params;
     o->coarse = 16 * n_params;
     o->polish = o->max_evals;
+    o->screen = 4 * o->n_starts;
+    o->screen_evals = 20 + 10 * n_params;
     o->seed = 0;
 }

@@ -418,14 +418,17 @@ gr_status gr_opt_minimize(int n, const double *lo, const double *hi, gr_opt_fn f
     /* the starting points on the unit box; rank[j] >= 0 for those taken from the sample */
     double su[GR_OPT_MAX_STARTS][GR_OPT_MAX_DIM];
     int rank[GR_OPT_MAX_STARTS];
-    for (int j = 0; j < starts; j++) {
+    /* candidates: the starts, or with screening more of them, each screened by a short run */
+    int ncand = starts;
+    if (o->coarse > 0 && o->screen > starts) ncand = o->screen < GR_OPT_MAX_STARTS ? o->screen : GR_OPT_MAX_STARTS;
+    for (int j = 0; j < ncand; j++) {
         rank[j] = -1;
         if (j == 0 && o->x0) {
             for (int d = 0; d < n; d++) su[j][d] = (o->x0[d] - lo[d]) / (hi[d] - lo[d]);
             clamp_unit(n, su[j]);
         } else {
             /* the lattice over the starts that are not x0 */
-            int m = o->x0 ? starts - 1 : starts, k = o->x0 ? j - 1 : j;
+            int m = o->x0 ? ncand - 1 : ncand, k = o->x0 ? j - 1 : j;
             gr_opt_lattice_point(n, k, m, su[j]);
         }
     }
@@ -465,8 +468,8 @@ gr_status gr_opt_minimize(int n, const double *lo, const double *hi, gr_opt_fn f
             free(pu), free(pf), free(order);
             return gr_fail(err, GR_E_NOMEM, "optimizer: out of memory");
         }
-        for (double sep = o->min_sep > 0 ? o->min_sep : 0.25; chosen < starts; sep *= 0.5) {
-            for (int r = 0; r < m && chosen < starts; r++) {
+        for (double sep = o->min_sep > 0 ? o->min_sep : 0.25; chosen < ncand; sep *= 0.5) {
+            for (int r = 0; r < m && chosen < ncand; r++) {
                 if (used[order[r]]) continue;
                 const double *q = pu + (size_t)order[r] * GR_OPT_MAX_DIM;
                 int apart = 1;
@@ -484,12 +487,51 @@ gr_status gr_opt_minimize(int n, const double *lo, const double *hi, gr_opt_fn f
         }
         free(used), free(pu), free(pf), free(order);
     }
+    /* screening: a short Nelder-Mead run from every candidate; the best continue (x0 first) */
+    double orig[GR_OPT_MAX_STARTS][GR_OPT_MAX_DIM], fs[GR_OPT_MAX_STARTS];
+    int sev[GR_OPT_MAX_STARTS] = {0};
+    memcpy(orig, su, sizeof orig);
+    if (ncand > starts) {
+        const int sbudget = o->screen_evals > 0 ? o->screen_evals : 20 + 10 * n;
+        int order[GR_OPT_MAX_STARTS];
+        for (int j = 0; j < ncand; j++) {
+            int conv = 0;
+            c.evals = 0;
+            c.budget = sbudget;
+            c.xtol = xtol;
+            gr_status st = nelder_mead(&c, su[j], &fs[j], step, xtol, &conv);
+            sev[j] = c.evals;
+            res->screen_evals += c.evals;
+            res->evals += c.evals;
+            if (st != GR_OK) return st;
+            order[j] = j;
+        }
+        const int first = o->x0 ? 1 : 0;
+        for (int i = first + 1; i < ncand; i++) { /* stable sort of the others by screened value */
+            int t = order[i], k = i - 1;
+            while (k >= first && fs[order[k]] > fs[t]) order[k + 1] = order[k], k--;
+            order[k + 1] = t;
+        }
+        double tu[GR_OPT_MAX_STARTS][GR_OPT_MAX_DIM], to[GR_OPT_MAX_STARTS][GR_OPT_MAX_DIM];
+        int tr[GR_OPT_MAX_STARTS], te[GR_OPT_MAX_STARTS];
+        for (int j = 0; j < starts; j++) {
+            memcpy(tu[j], su[order[j]], sizeof tu[j]);
+            memcpy(to[j], orig[order[j]], sizeof to[j]);
+            tr[j] = rank[order[j]], te[j] = sev[order[j]];
+        }
+        for (int j = 0; j < starts; j++) {
+            memcpy(su[j], tu[j], sizeof su[j]);
+            memcpy(orig[j], to[j], sizeof orig[j]);
+            rank[j] = tr[j], sev[j] = te[j];
+        }
+        res->n_screened = ncand;
+    }
     for (int j = 0; j < starts; j++) {
         double u[GR_OPT_MAX_DIM], f = INFINITY;
         memcpy(u, su[j], sizeof u);
         gr_opt_start *s = &res->starts[j];
         s->coarse_rank = rank[j];
-        for (int d = 0; d < n; d++) s->x0[d] = lo[d] + u[d] * (hi[d] - lo[d]);
+        for (int d = 0; d < n; d++) s->x0[d] = lo[d] + orig[j][d] * (hi[d] - lo[d]);
         c.evals = 0;
         c.budget = budget;
         c.xtol = xtol;

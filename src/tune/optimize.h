@@ -47,6 +47,11 @@ typedef struct gr_opt_options {
     double min_sep;        /* separation of the starts chosen from the sample, max-norm on the
                               unit box (0: 0.25; halved until enough starts are found) */
     unsigned long long seed; /* the sample's random shift */
+    int screen;            /* with a first stage: this many candidates (x0 and the sample's best
+                              separated points, at most GR_OPT_MAX_STARTS) each get a short
+                              Nelder-Mead run of screen_evals; the n_starts best of them (x0's
+                              always) continue from where it ended (0 or <= n_starts: none) */
+    int screen_evals;      /* 0: 20 + 10 n */
     int polish;            /* last stage: at most this many evaluations of a compass search
                               (Kolda, Lewis & Torczon 2003) from the best point, steps from
                               init_step / 4 down to xtol, moving along box faces where Nelder-Mead's
@@ -54,7 +59,7 @@ typedef struct gr_opt_options {
 } gr_opt_options;
 
 typedef struct gr_opt_start {
-    double x0[GR_OPT_MAX_DIM];  /* starting point (caller units) */
+    double x0[GR_OPT_MAX_DIM];  /* starting point (caller units; with screening, the candidate's) */
     double x[GR_OPT_MAX_DIM];   /* best point found from it */
     double f;
     int evals;
@@ -72,6 +77,8 @@ typedef struct gr_opt_result {
     int evals;                  /* total (the first stage's included) */
     int coarse_evals;           /* the first stage's */
     double coarse_best;         /* the best sample value (INFINITY without a first stage) */
+    int screen_evals;           /* the screening runs' (all candidates) */
+    int n_screened;             /* candidates screened (0: no screening) */
     int polish_evals;           /* the last stage's */
     double polish_gain;         /* how much it lowered the best value */
     int n_starts;

@@ -12,7 +12,8 @@
  * rendered and stored when absent). Slow: 320 x 180 (about 1000 evaluations); the reduced
  * variant (GODRAYS_TEST_REDUCED=1) runs at 160 x 90 with the same checks.
  * GODRAYS_TUNE_DEFAULT_SIZE=WxH overrides the size (docs/tuning.md's 640 x 360 figures) and
- * GODRAYS_TUNE_OBJECTIVE=W another objective (the table of candidates there). */
+ * GODRAYS_TUNE_OBJECTIVE=W another objective, GODRAYS_TUNE_STARTS=N and GODRAYS_TUNE_SEED=S
+ * another search (the tables of candidates there). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -96,11 +97,19 @@ int main(void)
     }
     gr_opt_options o;
     gr_tune_search_defaults(&o, p->n_params, x0);
+    if (getenv("GODRAYS_TUNE_STARTS")) o.n_starts = atoi(getenv("GODRAYS_TUNE_STARTS"));
+    if (getenv("GODRAYS_TUNE_SEED")) o.seed = strtoull(getenv("GODRAYS_TUNE_SEED"), NULL, 10);
+    if (o.n_starts < 1 || o.n_starts > GR_OPT_MAX_STARTS) o.n_starts = 4;
     gr_opt_result res;
     CHECK_OK(gr_opt_minimize(p->n_params, lo, hi, gr_tune_objective, p, &o, &res, &err), err);
     printf("%s over %s: %d evaluations, objective %.4f; tuned:", objective, list, res.evals, res.f);
     for (int k = 0; k < p->n_params; k++) printf(" %s %.4g", p->params[k].key, res.x[k]);
     printf("\n");
+    for (int j = 0; j < res.n_starts; j++) {
+        printf("  start %d (sample rank %d): objective %.4f at", j, res.starts[j].coarse_rank, res.starts[j].f);
+        for (int k = 0; k < p->n_params; k++) printf(" %.4g", res.starts[j].x[k]);
+        printf(", %d evaluations\n", res.starts[j].evals);
+    }
 
     /* independent check on fresh renders: the scene's settings, the tuned ones, the glow */
     float *ang = malloc((size_t)w * h * sizeof(float));
