@@ -12,6 +12,7 @@
 #include "core/shaftgeom.h"
 #include "gl/gl.h"
 #include "realtime/frame.h"
+#include "realtime/readback.h"
 #include "realtime/scenegl.h"
 #include "realtime/shaders.h"
 
@@ -144,8 +145,7 @@ struct gr_shafts {
     GLuint q_time[GR_SHAFTS_NPASS], q_samples, q_vs, q_fs;
     int have_timer, have_pipeline_stats;
 
-    float *readback;
-    size_t readback_cap;
+    gr_readback rb;
     int rendered;
 };
 
@@ -413,7 +413,7 @@ void gr_shafts_destroy(gr_shafts *r)
         if (r->owns_gl) gr_gl_destroy(r->gl);
     }
     free(r->grid_cpu);
-    free(r->readback);
+    gr_readback_free(&r->rb);
     free(r->shader_dir);
     free(r);
 }
@@ -1029,26 +1029,8 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glEndQuery(GL_TIME_ELAPSED);
 
     /* Read the layer back (GL rows bottom-up; gr_image top row first). */
-    size_t need = (size_t)f->W * (size_t)f->H * 4;
-    if (need > r->readback_cap) {
-        float *nb = realloc(r->readback, need * sizeof *nb);
-        if (!nb) {
-            st = gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the readback");
-            goto unbind;
-        }
-        r->readback = nb;
-        r->readback_cap = need;
-    }
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, f->W, f->H, GL_RGBA, GL_FLOAT, r->readback);
-    for (int y = 0; y < f->H; y++) {
-        const float *src = r->readback + (size_t)(f->H - 1 - y) * (size_t)f->W * 4;
-        for (int x = 0; x < f->W; x++) {
-            float *px = gr_image_pixel(out, x, y);
-            for (int c = 0; c < 3; c++) px[ch[c]] = src[(size_t)x * 4 + (size_t)c];
-        }
-    }
+    if ((st = gr_readback_fbo(&r->rb, r->frame_fbo, f->W, f->H, "shafts layer", err)) != GR_OK) goto unbind;
+    gr_readback_to_rgb(&r->rb, out); /* NaN/Inf: gr_image_check_finite below */
     if (stats) {
         memset(stats, 0, sizeof *stats);
         /* Every pass ran between t0 and the synchronous readback: a GPU time longer than
@@ -1089,29 +1071,10 @@ gr_status gr_shafts_read_target(gr_shafts *r, gr_image **out, gr_error *err)
     if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "shafts: no render yet, no target to read");
     gr_status st = gr_gl_make_current(r->gl, err);
     if (st != GR_OK) return st;
-    gr_image *img = gr_image_create(r->target_w, r->target_h, 4, NULL);
-    float *tmp = malloc((size_t)r->target_w * (size_t)r->target_h * 4 * sizeof *tmp);
-    if (!img || !tmp) {
-        gr_image_destroy(img);
-        free(tmp);
-        return gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the target readback");
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, r->target_w, r->target_h, GL_RGBA, GL_FLOAT, tmp);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    size_t row = (size_t)r->target_w * 4;
-    for (int y = 0; y < r->target_h; y++)
-        memcpy(img->pixels + (size_t)y * row, tmp + (size_t)(r->target_h - 1 - y) * row, row * sizeof *tmp);
-    free(tmp);
-    st = gr_gl_check("shafts target readback", err);
-    if (st != GR_OK) {
-        gr_image_destroy(img);
+    if ((st = gr_readback_fbo(&r->rb, r->target_fbo, r->target_w, r->target_h, "shafts target", err)) != GR_OK)
         return st;
-    }
-    *out = img;
-    return GR_OK;
+    *out = gr_readback_image(&r->rb);
+    return *out ? GR_OK : gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the target image");
 }
 
 gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
