@@ -4,38 +4,17 @@
 # with one stderr line naming the setting (through the scene loader's table, file or --set),
 # nothing written; `tune` runs on each (tiny image, 1 start, few evaluations); `sweep`,
 # `pareto --quick` and `run` on light_rays.
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-cat >"$dir/s.json" <<'JSON'
-{"name": "small", "water": {"waves": [{"amplitude_m": 0.1, "wavelength_m": 8, "direction_deg": 30}]},
- "sun": {"elevation_deg": 60, "azimuth_deg": 30},
- "medium": {"absorption_per_m": [0.3, 0.06, 0.03], "scattering_per_m": 0.03, "g": 0.8},
- "camera": {"position_m": [0, -8, 0], "yaw_deg": 30, "pitch_deg": 60, "fov_deg": 60, "width": 48, "height": 27},
- "occluders": [{"type": "sphere", "center_m": [-1.5, -3.5, 6], "radius_m": 1.2}],
+. "$(dirname "$0")/lib.sh"
+small_scene "$dir/s.json" 48 27 '"occluders": [{"type": "sphere", "center_m": [-1.5, -3.5, 6], "radius_m": 1.2}],
  "slicing": {"slices": 16, "texture_size": 64, "grid": 32},
  "froxel": {"grid_x": 24, "grid_y": 14, "grid_z": 16, "texture_size": 64, "grid": 32},
- "light_rays": {"rays": 96}}
-JSON
-fail=0
+ "light_rays": {"rays": 96}'
 list=$("$bin" techniques) || { echo "FAIL: techniques exits $?"; fail=1; }
 for t in slicing froxel light_rays; do
   echo "$list" | grep -q "^$t\b\|^ *$t " || { echo "FAIL: techniques does not list $t"; fail=1; }
   "$bin" render $t "$dir/s.json" -o "$dir/$t.exr" >"$dir/out" 2>"$dir/err" || { echo "FAIL: render $t: $(cat "$dir/err")"; fail=1; }
   [ -s "$dir/$t.exr" ] || { echo "FAIL: render $t wrote no EXR"; fail=1; }
 done
-expect() {
-  want=$1; text=$2; shift 2
-  "$bin" "$@" >"$dir/out" 2>"$dir/err"
-  rc=$?
-  lines=$(wc -l <"$dir/err")
-  if [ "$rc" -ne "$want" ] || [ "$lines" -ne 1 ] || ! grep -qF -- "$text" "$dir/err" || [ -s "$dir/out" ]; then
-    echo "FAIL: $*: exit $rc (want $want), $lines stderr line(s) (want 1 containing '$text'):"
-    cat "$dir/err"; fail=1
-  else
-    echo "ok: $*: $(cat "$dir/err")"
-  fi
-}
 o="$dir/bad.exr"
 expect 2 "slicing.slices" render slicing "$dir/s.json" -o "$o" --set slicing.slices=0
 expect 2 "slicing.distribution" render slicing "$dir/s.json" -o "$o" --set slicing.distribution=cubic
