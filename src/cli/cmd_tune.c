@@ -21,13 +21,14 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays tune SCENE --params TECHNIQUE.KEY[,TECHNIQUE.KEY...] [options]\n"
+            "usage: godrays tune SCENE [--params TECHNIQUE.KEY[,TECHNIQUE.KEY...]] [options]\n"
             "\n"
             "Finds the settings of a real-time technique (--technique, else the one the parameters\n"
             "name) that minimize the error against the ground truth (rendered\n"
             "once per frame and view, cached), averaged over the frames (--frames/--times) and views\n"
-            "(--view), with bounded Nelder-Mead restarted from several starting points spread over\n"
-            "the bounds (the scene's own settings are the first). Prints the best settings as a\n"
+            "(--view): a sample of the bounds, short Nelder-Mead runs from its best points, the\n"
+            "best of them (and the scene's own settings) continued, then a polish. Prints the best\n"
+            "settings as a\n"
             "snippet for the technique's scene section and the error before and after per frame and\n"
             "view; writes DIR/tune.json, DIR/trace.csv (every evaluation), DIR/compare.png\n"
             "(reference | before | after) and per-case reference/before/after PNGs.\n"
@@ -35,13 +36,23 @@ static void usage(FILE *f)
             "docs/tuning.md.\n"
             "\n"
             "options:\n"
-            "  --params LIST        comma-separated TECHNIQUE.KEY settings to tune (at most %d)\n"
+            "  --params LIST        comma-separated TECHNIQUE.KEY settings to tune (at most %d; default:\n"
+            "                       the technique's own list, docs/tuning.md)\n"
+            "  (default objective: --objective " GR_TUNE_DEFAULT_OBJECTIVE "; --metric rmse for RMSE alone)\n"
             "  --bounds KEY=LO:HI   box of one parameter (repeatable; default: the setting's tuning box,\n"
             "                       `godrays techniques`)\n"
             "  --start KEY=V        first starting point of a parameter (repeatable; default: the\n"
             "                       scene's value, clamped into the box)\n"
             "  --starts N           starting points (default 4, at most %d)\n"
             "  --max-evals N        objective evaluations per start (default 60 + 40 x parameters)\n"
+            "  --coarse M           first stage: M points of a shifted Halton sample over the box; the\n"
+            "                       starts after the scene's settings are its best points, apart from\n"
+            "                       each other (default 16 x parameters; 0: starts on a fixed lattice)\n"
+            "  --screen C           candidates screened by short local searches before the starts\n"
+            "                       continue (default 4 x --starts; 0 or <= --starts: none)\n"
+            "  --method M           nelder-mead (default: local searches from the starts) or cmaes\n"
+            "                       (CMA-ES runs with a doubling population, one per start)\n"
+            "  --seed S             the sample's random shift (default 0; same seed, same search)\n"
             "%s"
             "  -h, --help           this help\n"
             "\n"
@@ -165,10 +176,16 @@ static int tune_with(gr_args *args)
     gr_tune_cli c;
     gr_tune_cli_init(&c);
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
-    int n_params = 0, n_starts = 4, max_evals = 0, rc = 0;
+    int n_params = 0, n_starts = 4, max_evals = 0, rc = 0, coarse = -1, screen = -1;
+    unsigned long long seed = 0;
+    gr_opt_method method = GR_OPT_NELDER_MEAD;
     const char *bounds[32], *starts[32], *params_spec = NULL;
     int n_bounds = 0, n_start_specs = 0;
     gr_error err = {GR_OK, ""};
+    /* tune's default is the weighted objective (sweep keeps rmse: a map of one error) */
+    c.metric = GR_TM_WEIGHTED;
+    if (gr_tune_weights_parse("--objective", GR_TUNE_DEFAULT_OBJECTIVE, c.weights, &err) != GR_OK)
+        return gr_cli_report(cmd, &err);
     for (; args->i < argc; args->i++) {
         const char *a = argv[args->i], *v = NULL;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -176,7 +193,7 @@ static int tune_with(gr_args *args)
             return 0;
         }
         if (!strcmp(a, "--params") || !strcmp(a, "--bounds") || !strcmp(a, "--start") || !strcmp(a, "--starts") ||
-            !strcmp(a, "--max-evals")) {
+            !strcmp(a, "--max-evals") || !strcmp(a, "--coarse") || !strcmp(a, "--seed") || !strcmp(a, "--method") || !strcmp(a, "--screen")) {
             if ((rc = gr_args_value(args, &v)) != 0) return rc;
             if (!strcmp(a, "--params")) {
                 if (params_spec) return gr_cli_usage_error(cmd, "--params given twice");
@@ -190,6 +207,20 @@ static int tune_with(gr_args *args)
             } else if (!strcmp(a, "--starts")) {
                 if (parse_count(v, 1, GR_OPT_MAX_STARTS, &n_starts))
                     return gr_cli_usage_error(cmd, "--starts %s: expected an integer in [1, %d]", v, GR_OPT_MAX_STARTS);
+            } else if (!strcmp(a, "--method")) {
+                if (!strcmp(v, "nelder-mead")) method = GR_OPT_NELDER_MEAD;
+                else if (!strcmp(v, "cmaes")) method = GR_OPT_CMAES;
+                else return gr_cli_usage_error(cmd, "--method %s: expected nelder-mead or cmaes", v);
+            } else if (!strcmp(a, "--screen")) {
+                if (parse_count(v, 0, GR_OPT_MAX_STARTS, &screen))
+                    return gr_cli_usage_error(cmd, "--screen %s: expected an integer in [0, %d]", v, GR_OPT_MAX_STARTS);
+            } else if (!strcmp(a, "--coarse")) {
+                if (parse_count(v, 0, 100000, &coarse))
+                    return gr_cli_usage_error(cmd, "--coarse %s: expected an integer in [0, 100000]", v);
+            } else if (!strcmp(a, "--seed")) {
+                char *end = NULL;
+                if (!v[0] || v[0] == '-' || (seed = strtoull(v, &end, 10), *end))
+                    return gr_cli_usage_error(cmd, "--seed %s: expected an integer >= 0", v);
             } else {
                 if (parse_count(v, 4, 1000000, &max_evals))
                     return gr_cli_usage_error(cmd, "--max-evals %s: expected an integer >= 4", v);
@@ -205,8 +236,17 @@ static int tune_with(gr_args *args)
         if (rc) return rc;
     }
     if ((rc = gr_args_need_scene(args)) != 0) return rc;
-    if (!params_spec) return gr_cli_usage_error(cmd, "no --params given (e.g. --params TECHNIQUE.KEY,TECHNIQUE.KEY)");
     if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    char default_params[1024];
+    if (!params_spec) {
+        /* the technique's own list (--technique, else the first registered) */
+        const gr_technique_class *cls = c.technique_name ? gr_technique_find(c.technique_name) : gr_technique_at(0);
+        if (!cls) return gr_cli_usage_error(cmd, "--technique %s: unknown technique", c.technique_name);
+        if (gr_tune_default_params(cls, default_params, sizeof default_params))
+            return gr_cli_usage_error(cmd, "no --params given and technique %s has no settings to tune by default",
+                                      cls->name);
+        params_spec = default_params;
+    }
     if (gr_tune_param_parse_list("--params", params_spec, params, GR_TUNE_MAX_PARAMS, &n_params, &err) != GR_OK)
         return gr_cli_report(cmd, &err);
     for (int b = 0; b < n_bounds; b++)
@@ -280,7 +320,18 @@ static int tune_with(gr_args *args)
     double fb = 0, fa = 0;
     if (gr_tune_evaluate(p, xb, &fb, before, sc_b, &err) != GR_OK) goto fail;
     traced t = {.p = p, .trace = trace, .progress = !c.quiet && isatty(2)};
-    gr_opt_options oo = {.n_starts = n_starts, .x0 = x0, .max_evals = max_evals};
+    gr_opt_options oo;
+    gr_tune_search_defaults(&oo, n_params, x0);
+    oo.method = method;
+    oo.n_starts = n_starts;
+    oo.screen = screen >= 0 ? screen : (4 * n_starts <= GR_OPT_MAX_STARTS ? 4 * n_starts : GR_OPT_MAX_STARTS);
+    oo.seed = seed;
+    if (max_evals > 0) {
+        oo.max_evals = oo.polish = max_evals;
+        if (oo.screen_evals > max_evals) oo.screen_evals = max_evals; /* a small budget stays small */
+    }
+    if (coarse >= 0) oo.coarse = coarse;
+    if (coarse == 0) oo.polish = 0, oo.screen = 0; /* the fixed-lattice search of before */
     gr_opt_result res;
     double t_opt = (double)p->renders, render_s0 = p->render_s, metrics_s0 = p->metrics_s;
     if (gr_opt_minimize(n_params, lo, hi, traced_objective, &t, &oo, &res, &err) != GR_OK) goto fail;
@@ -341,6 +392,8 @@ static int tune_with(gr_args *args)
             cJSON_AddNumberToObject(o, "f", res.starts[j].f);
             cJSON_AddNumberToObject(o, "evals", res.starts[j].evals);
             cJSON_AddBoolToObject(o, "converged", res.starts[j].converged);
+            cJSON_AddNumberToObject(o, "f0", res.starts[j].f0);
+            cJSON_AddNumberToObject(o, "sample_rank", res.starts[j].coarse_rank);
             cJSON_AddItemToArray(st, o);
         }
         cJSON *cs = cJSON_AddArrayToObject(root, "cases");
@@ -361,6 +414,11 @@ static int tune_with(gr_args *args)
         cJSON_AddNumberToObject(root, "before", fb);
         cJSON_AddNumberToObject(root, "after", fa);
         cJSON_AddNumberToObject(root, "evaluations", res.evals);
+        cJSON_AddNumberToObject(root, "sample_evaluations", res.coarse_evals);
+        cJSON_AddNumberToObject(root, "screened", res.n_screened);
+        cJSON_AddNumberToObject(root, "screen_evaluations", res.screen_evals);
+        cJSON_AddNumberToObject(root, "polish_evaluations", res.polish_evals);
+        cJSON_AddNumberToObject(root, "seed", (double)seed);
         cJSON_AddNumberToObject(root, "starts_agreeing", agreeing);
         cJSON *sn = cJSON_Parse(snippet);
         if (sn) cJSON_AddItemToObject(root, "snippet", sn);
@@ -390,15 +448,27 @@ static int tune_with(gr_args *args)
     for (int k = 0; k < n_params; k++)
         gr_sb_printf(&sum, "%-28s %12.5g %12.5g    [%g, %g]%s\n", params[k].key, xb[k], res.x[k], lo[k], hi[k],
                params[k].kind == GR_TK_RGB_SCALE ? " (scale)" : "");
+    if (res.coarse_evals > 0)
+        gr_sb_printf(&sum, "first stage: %d sample points (seed %llu), best error %.6g\n", res.coarse_evals, seed,
+                     res.coarse_best);
+    if (res.n_screened > 0)
+        gr_sb_printf(&sum, "screening: %d candidates, %d evaluations; the %d best continue\n", res.n_screened,
+                     res.screen_evals, res.n_starts);
     gr_sb_printf(&sum, "starts:\n");
     for (int j = 0; j < res.n_starts; j++) {
-        gr_sb_printf(&sum, "  %d: from (", j);
+        if (res.starts[j].coarse_rank >= 0)
+            gr_sb_printf(&sum, "  %d: sample #%d, from (", j, res.starts[j].coarse_rank + 1);
+        else
+            gr_sb_printf(&sum, "  %d: from (", j);
         for (int k = 0; k < n_params; k++) gr_sb_printf(&sum, "%s%.4g", k ? ", " : "", res.starts[j].x0[k]);
         gr_sb_printf(&sum, ") to (");
         for (int k = 0; k < n_params; k++) gr_sb_printf(&sum, "%s%.5g", k ? ", " : "", res.starts[j].x[k]);
         gr_sb_printf(&sum, ") error %.6g, %d evaluations%s\n", res.starts[j].f, res.starts[j].evals,
                res.starts[j].converged ? "" : " (budget reached)");
     }
+    if (res.polish_evals > 0)
+        gr_sb_printf(&sum, "polish (compass search from the best): %d evaluations, error lowered by %.3g\n",
+                     res.polish_evals, res.polish_gain);
     gr_sb_printf(&sum, "%d of %d starts reached the best value within 2 %%; their spread:", agreeing, res.n_starts);
     for (int k = 0; k < n_params; k++) gr_sb_printf(&sum, " %s %.2f %%", params[k].key, 100.0 * spread[k]);
     gr_sb_printf(&sum, " of the box\n");

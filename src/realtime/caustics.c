@@ -2,8 +2,10 @@
 #include "realtime/caustics.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "core/optics.h"
 #include "gl/gl.h"
@@ -270,15 +272,17 @@ void gr_vol_locations(unsigned p, gr_vol_locs *l)
 void gr_vol_set(const gr_vol_locs *l, const gr_vol_inputs *in)
 {
     const gr_frame *f = in->f;
-    float d[GR_CAUSTICS_MAX_DEPTHS];
-    for (int i = 0; i < in->cp->n_depths; i++) d[i] = (float)in->cp->depths_m[i];
-    double o[2];
-    gr_caustics_origin(in->caustics, o);
-    glUniform1i(l->caustics, 2);
-    glUniform1i(l->n_depths, in->cp->n_depths);
-    glUniform1fv(l->cdepth, in->cp->n_depths, d);
-    glUniform2f(l->corigin, (float)(o[0] - f->eye[0]), (float)(o[1] - f->eye[2]));
-    glUniform1f(l->patch, (float)in->cp->patch_m);
+    if (in->caustics) {
+        float d[GR_CAUSTICS_MAX_DEPTHS];
+        for (int i = 0; i < in->cp->n_depths; i++) d[i] = (float)in->cp->depths_m[i];
+        double o[2];
+        gr_caustics_origin(in->caustics, o);
+        glUniform1i(l->caustics, 2);
+        glUniform1i(l->n_depths, in->cp->n_depths);
+        glUniform1fv(l->cdepth, in->cp->n_depths, d);
+        glUniform2f(l->corigin, (float)(o[0] - f->eye[0]), (float)(o[1] - f->eye[2]));
+        glUniform1f(l->patch, (float)in->cp->patch_m);
+    }
     glUniform3f(l->refr, (float)f->refr_dir[0], (float)f->refr_dir[1], (float)f->refr_dir[2]);
     glUniform1f(l->rest, (float)(f->rest_height_m - f->eye[1]));
     /* light_vp * translate(eye): eye-relative positions */
@@ -294,11 +298,11 @@ void gr_vol_set(const gr_vol_locs *l, const gr_vol_inputs *in)
     glUniform1f(l->g, (float)in->g);
     glUniform3f(l->esun, (float)(f->sun_irradiance[0] * in->gain[0]), (float)(f->sun_irradiance[1] * in->gain[1]),
                 (float)(f->sun_irradiance[2] * in->gain[2]));
-    glUniform1f(l->texel, (float)(in->cp->patch_m / in->cp->size));
+    if (in->caustics) glUniform1f(l->texel, (float)(in->cp->patch_m / in->cp->size));
     /* the disc seen from below: Snell's law shrinks its angular radius to asin(sin(r) / n) */
     glUniform1f(l->sun_rw, in->sun_disc ? (float)asin(sin(f->sun_angular_radius_rad) / f->ior) : 0.0f);
     glActiveTexture(GL_TEXTURE2);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, gr_caustics_texture(in->caustics));
+    glBindTexture(GL_TEXTURE_2D_ARRAY, in->caustics ? gr_caustics_texture(in->caustics) : 0);
     glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_2D, in->shadow_tex);
     glActiveTexture(GL_TEXTURE0);
@@ -362,4 +366,124 @@ gr_status gr_vol_readback(unsigned fbo, int w, int h, gr_image *out, const char 
         }
     free(tmp);
     return gr_gl_check(what, err);
+}
+
+/* ---- the prelude of a volume technique's render ------------------------------------------- */
+
+double gr_vol_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+gr_status gr_vol_prepare(const char *name, gr_gl *gl, gr_scenegl *sg, gr_caustics *caus, gr_gl_timer *timer,
+                         const gr_scene *scene, const gr_vol_settings *s, const gr_image *out, gr_vol_prep *p,
+                         gr_error *err)
+{
+    memset(p, 0, sizeof *p);
+    p->t0_ms = gr_vol_now_ms();
+    gr_frame *f = &p->frame;
+    gr_frame_init(scene, f);
+    int W = f->width, H = f->height;
+    gr_status st;
+    if (out->width != W || out->height != H || gr_image_channel(out, "R") < 0 || gr_image_channel(out, "G") < 0 ||
+        gr_image_channel(out, "B") < 0)
+        return gr_fail(err, GR_E_INPUT, "%s: output image is %dx%d (needs %dx%d with R, G, B)", name, out->width,
+                       out->height, W, H);
+    if (!(f->rest_height_m - f->eye[1] > 0))
+        return gr_fail(err, GR_E_INPUT,
+                       "camera.position_m: y = %g is not below the water surface; %s needs an underwater viewer",
+                       f->eye[1], name);
+    if ((st = gr_gl_make_current(gl, err)) != GR_OK) return st;
+    timer->used = 0;
+    timer->n = 0;
+
+    gr_vol_inputs *in = &p->in;
+    gr_caustics_params *cp = &p->cp;
+    if (caus) {
+        cp->size = s->texture_size;
+        cp->grid = s->grid;
+        cp->patch_m = s->patch_m;
+        cp->n_depths = s->caustic_depths;
+        cp->fresnel = 1;
+        gr_caustics_depths(cp->n_depths, s->caustic_first_m, s->caustic_last_m, cp->depths_m);
+    }
+    in->f = f;
+    in->caustics = caus;
+    in->cp = cp;
+    if (scene->n_occluders > 0) {
+        gr_gl_timer_begin(timer, GR_VOL_PASS_SHADOW);
+        st = gr_scenegl_shadow_map(sg, scene, f, s->shadow_map_size, f->eye, s->shadow_extent_m, &in->shadow_tex,
+                                   in->light_vp, err);
+        gr_gl_timer_end(timer);
+        if (st != GR_OK) return st;
+    } else {
+        for (int i = 0; i < 16; i++) in->light_vp[i] = i % 5 == 0;
+    }
+    gr_gl_timer_begin(timer, GR_VOL_PASS_DEPTH);
+    st = gr_scenegl_eye_depth(sg, scene, f, W, H, &p->depth_tex, err);
+    gr_gl_timer_end(timer);
+    if (st != GR_OK) return st;
+    if (caus) {
+        gr_gl_timer_begin(timer, GR_VOL_PASS_CAUSTICS);
+        st = gr_caustics_build(caus, scene, f, cp, err);
+        gr_gl_timer_end(timer);
+        if (st != GR_OK) return st;
+    }
+    for (int c = 0; c < 3; c++) {
+        in->sigma_t[c] = s->extinction[c];
+        in->sigma_s[c] = scene->medium.scattering[c];
+        in->gain[c] = s->intensity[c];
+    }
+    in->g = s->g;
+    in->sun_disc = s->sun_disc;
+    p->t_max = gr_vol_t_max(scene);
+    return GR_OK;
+}
+
+gr_status gr_vol_target(unsigned *tex, unsigned *fbo, int *tw, int *th, int w, int h, const char *name,
+                        gr_error *err)
+{
+    if (*tex && *tw == w && *th == h) return GR_OK;
+    if (*fbo) glDeleteFramebuffers(1, fbo);
+    if (*tex) glDeleteTextures(1, tex);
+    *fbo = *tex = 0;
+    *tw = *th = 0;
+    glGenTextures(1, tex);
+    glBindTexture(GL_TEXTURE_2D, *tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
+    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (fs != GL_FRAMEBUFFER_COMPLETE)
+        return gr_fail(err, GR_E_GL, "camera.width/height: %s target %dx%d incomplete", name, w, h);
+    *tw = w;
+    *th = h;
+    char what[64];
+    snprintf(what, sizeof what, "%s target", name);
+    return gr_gl_check(what, err);
+}
+
+void gr_vol_stats(gr_technique_stats *stats, gr_gl_timer *timer, const char *const *names, int n,
+                  unsigned q_samples, double t0_ms)
+{
+    memset(stats, 0, sizeof *stats);
+    double wall_ns = (gr_vol_now_ms() - t0_ms) * 1e6;
+    stats->n_passes = n;
+    for (int p = 0; p < n; p++) {
+        snprintf(stats->pass_names[p], sizeof stats->pass_names[p], "%s", names[p]);
+        long long ns = gr_gl_timer_ns(timer, p);
+        stats->gpu_ns[p] = (ns >= 0 && (double)ns <= wall_ns) ? ns : -1;
+    }
+    stats->fragments = -1;
+    if (q_samples) {
+        GLuint64 k = 0;
+        glGetQueryObjectui64v(q_samples, GL_QUERY_RESULT, &k);
+        stats->fragments = (long long)k;
+    }
+    stats->wall_ms = gr_vol_now_ms() - t0_ms;
 }

@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "gl/gl.h"
 #include "realtime/caustics.h"
@@ -16,7 +15,6 @@
 #define MAX_SLICES 256
 
 #define LO_X GR_PF_MIN_EXCL
-#define FROM GR_PF_FROM_SCENE
 #define SL(f) offsetof(gr_froxel_settings, f)
 static const char *const dist_names[] = {"linear", "exponential", NULL};
 
@@ -35,32 +33,10 @@ static const gr_param params[] = {
      .doc = "sample each froxel at a deterministic noise depth instead of its middle"},
     {.name = "phase_per_pixel", .type = GR_PT_BOOL, .offset = SL(phase_per_pixel), .min = 0, .max = 1, .def = 0,
      .unit = "", .doc = "apply the HG phase per pixel (one directional light: constant along a ray) instead of per froxel"},
-    {.name = "texture_size", .type = GR_PT_INT, .offset = SL(texture_size), .min = 8, .max = 4096, .def = 512,
-     .unit = "texels", .doc = "caustic texture side (rendered at twice this, 2x2 box filtered)"},
-    {.name = "grid", .type = GR_PT_INT, .offset = SL(grid), .min = 2, .max = 2048, .def = 256, .unit = "cells",
-     .doc = "water grid cells per patch side (beam-traced triangles: 2 grid^2 per depth)"},
-    {.name = "patch_m", .type = GR_PT_DOUBLE, .offset = SL(patch_m), .min = 0, .max = 1e4, .flags = LO_X, .def = 24,
-     .unit = "m", .doc = "caustic patch side: the texture repeats with this period"},
-    {.name = "caustic_depths", .type = GR_PT_INT, .offset = SL(caustic_depths), .min = 1, .max = GR_CAUSTICS_MAX_DEPTHS,
-     .def = 8, .unit = "", .doc = "planes of the caustic stack"},
-    {.name = "caustic_first_m", .type = GR_PT_DOUBLE, .offset = SL(caustic_first_m), .min = 0, .max = 1e4,
-     .flags = LO_X, .def = 1, .unit = "m", .doc = "shallowest caustic plane below the rest height"},
-    {.name = "caustic_last_m", .type = GR_PT_DOUBLE, .offset = SL(caustic_last_m), .min = 0, .max = 1e4,
-     .flags = LO_X, .def = 25, .unit = "m", .doc = "deepest caustic plane (geometric spacing between)"},
-    {.name = "extinction", .type = GR_PT_RGB, .offset = SL(extinction), .min = 0, .max = 1e4, .flags = FROM,
-     .def = NAN, .unit = "1/m", .scene_source = "medium.extinction",
-     .doc = "sigma_t along the sun's and the view path; default: the medium's", .tune_lo = 0.5, .tune_hi = 2.0},
-    {.name = "g", .type = GR_PT_DOUBLE, .offset = SL(g), .min = -1, .max = 1, .flags = LO_X | GR_PF_MAX_EXCL | FROM,
-     .def = NAN, .unit = "", .scene_source = "medium.g", .doc = "HG asymmetry; default: the medium's",
-     .tune_lo = 0.5, .tune_hi = 0.98},
-    {.name = "sun_disc", .type = GR_PT_BOOL, .offset = SL(sun_disc), .min = 0, .max = 1, .def = 1, .unit = "",
-     .doc = "blur each caustic plane by the sun's disc (the mip level of its blur diameter)"},
-    {.name = "intensity", .type = GR_PT_RGB, .offset = SL(intensity), .min = 0, .max = 1e9, .def = 1, .unit = "",
-     .doc = "gain on the physical radiance (1: no fit)", .tune_lo = 0.2, .tune_hi = 5.0},
-    {.name = "shadow_map_size", .type = GR_PT_INT, .offset = SL(shadow_map_size), .min = 16, .max = 8192, .def = 1024,
-     .unit = "texels", .doc = "occluders' shadow map side"},
-    {.name = "shadow_extent_m", .type = GR_PT_DOUBLE, .offset = SL(shadow_extent_m), .min = 0, .max = 1e5,
-     .flags = LO_X, .def = 40, .unit = "m", .doc = "half side of the shadow map's square around the eye"},
+    GR_VOL_PARAMS_CAUSTICS(gr_froxel_settings),
+    GR_VOL_PARAMS_MEDIUM(gr_froxel_settings),
+    GR_VOL_PARAMS_SUN_DISC(gr_froxel_settings),
+    GR_VOL_PARAMS_LIGHT(gr_froxel_settings),
 };
 #undef SL
 
@@ -184,113 +160,40 @@ static gr_status ensure_volume(fx_state *r, int x, int y, int z, gr_error *err)
     return gr_gl_check("froxel.grid_x/grid_y/grid_z: froxel volume", err);
 }
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
 static gr_status fx_check(const gr_technique_class *cls, const void *settings, gr_error *err)
 {
     const gr_froxel_settings *s = settings;
     gr_status st = gr_param_validate(cls->params, settings, 1, err);
     if (st != GR_OK) return st;
-    if (!(s->caustic_last_m >= s->caustic_first_m))
+    if (!(s->vol.caustic_last_m >= s->vol.caustic_first_m))
         return gr_fail(err, GR_E_INPUT, "froxel.caustic_last_m = %g: must be >= froxel.caustic_first_m (%g)",
-                       s->caustic_last_m, s->caustic_first_m);
+                       s->vol.caustic_last_m, s->vol.caustic_first_m);
     return GR_OK;
 }
 
-static gr_status ensure_out(fx_state *r, int w, int h, gr_error *err)
-{
-    if (r->out_tex && r->out_w == w && r->out_h == h) return GR_OK;
-    if (r->out_fbo) glDeleteFramebuffers(1, &r->out_fbo);
-    if (r->out_tex) glDeleteTextures(1, &r->out_tex);
-    glGenTextures(1, &r->out_tex);
-    glBindTexture(GL_TEXTURE_2D, r->out_tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    glGenFramebuffers(1, &r->out_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, r->out_tex, 0);
-    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (fs != GL_FRAMEBUFFER_COMPLETE)
-        return gr_fail(err, GR_E_GL, "camera.width/height: froxel target %dx%d incomplete", w, h);
-    r->out_w = w;
-    r->out_h = h;
-    return gr_gl_check("froxel target", err);
-}
-
-enum { P_SHADOW, P_DEPTH, P_CAUSTICS, P_SCATTER, P_INTEGRATE, P_APPLY };
+enum { P_SCATTER = GR_VOL_PASS_OWN, P_INTEGRATE, P_APPLY };
 
 static gr_status fx_render(void *state, const gr_scene *scene, const void *settings, gr_image *out,
                            gr_technique_stats *stats, gr_error *err)
 {
     fx_state *r = state;
     const gr_froxel_settings *s = settings;
-    double t0 = now_ms();
-    gr_frame f;
-    gr_frame_init(scene, &f);
-    int W = f.width, H = f.height;
-    gr_status st;
-    if (out->width != W || out->height != H || gr_image_channel(out, "R") < 0 || gr_image_channel(out, "G") < 0 ||
-        gr_image_channel(out, "B") < 0)
-        return gr_fail(err, GR_E_INPUT, "froxel: output image is %dx%d (needs %dx%d with R, G, B)", out->width,
-                       out->height, W, H);
-    if (!(f.rest_height_m - f.eye[1] > 0))
-        return gr_fail(err, GR_E_INPUT, "camera.position_m: y = %g is not below the water surface; froxel needs an underwater viewer",
-                       f.eye[1]);
-    if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) return st;
-    if ((st = ensure_out(r, W, H, err)) != GR_OK) return st;
-    r->timer.used = 0;
-    r->timer.n = 0;
-
-    gr_vol_inputs in;
-    memset(&in, 0, sizeof in);
-    gr_caustics_params cp = {.size = s->texture_size, .grid = s->grid, .patch_m = s->patch_m,
-                             .n_depths = s->caustic_depths, .fresnel = 1};
-    gr_caustics_depths(cp.n_depths, s->caustic_first_m, s->caustic_last_m, cp.depths_m);
-    in.f = &f;
-    in.caustics = r->caus;
-    in.cp = &cp;
-    if (scene->n_occluders > 0) {
-        gr_gl_timer_begin(&r->timer, P_SHADOW);
-        st = gr_scenegl_shadow_map(r->sg, scene, &f, s->shadow_map_size, f.eye, s->shadow_extent_m, &in.shadow_tex,
-                                   in.light_vp, err);
-        gr_gl_timer_end(&r->timer);
-        if (st != GR_OK) return st;
-    } else {
-        for (int i = 0; i < 16; i++) in.light_vp[i] = i % 5 == 0;
-    }
-    unsigned depth_tex = 0;
-    gr_gl_timer_begin(&r->timer, P_DEPTH);
-    st = gr_scenegl_eye_depth(r->sg, scene, &f, W, H, &depth_tex, err);
-    gr_gl_timer_end(&r->timer);
+    gr_vol_prep prep;
+    gr_status st = gr_vol_prepare("froxel", r->gl, r->sg, r->caus, &r->timer, scene, &s->vol, out, &prep, err);
     if (st != GR_OK) return st;
-    gr_gl_timer_begin(&r->timer, P_CAUSTICS);
-    st = gr_caustics_build(r->caus, scene, &f, &cp, err);
-    gr_gl_timer_end(&r->timer);
-    if (st != GR_OK) return st;
+    const gr_frame *f = &prep.frame;
+    int W = f->width, H = f->height;
+    if ((st = gr_vol_target(&r->out_tex, &r->out_fbo, &r->out_w, &r->out_h, W, H, "froxel", err)) != GR_OK) return st;
     r->triangles = gr_caustics_triangles(r->caus);
-    for (int c = 0; c < 3; c++) {
-        in.sigma_t[c] = s->extinction[c];
-        in.sigma_s[c] = scene->medium.scattering[c];
-        in.gain[c] = s->intensity[c];
-    }
-    in.g = s->g;
-    in.sun_disc = s->sun_disc;
-
-    double tmax = gr_vol_t_max(scene);
-    double far = gr_vol_far_depth(scene, &f, tmax);
+    double tmax = prep.t_max;
+    double far = gr_vol_far_depth(scene, f, tmax);
     double b[MAX_SLICES + 1];
     int nz = s->grid_z;
     gr_vol_bounds(nz, s->distribution == GR_VOL_EXPONENTIAL, s->near_m, far, b);
     float bf[MAX_SLICES + 1];
     for (int i = 0; i <= nz; i++) bf[i] = (float)b[i];
     double rot[16], inv[16];
-    gr_frame_view_proj_rot(&f, rot);
+    gr_frame_view_proj_rot(f, rot);
     if (gr_mat4_inverse(rot, inv) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection");
     float m[16];
     gr_frame_matf(inv, m);
@@ -299,11 +202,11 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     /* pass: in-scattering per froxel */
     gr_gl_timer_begin(&r->timer, P_SCATTER);
     glUseProgram(r->prog_scatter);
-    gr_vol_set(&r->vl_s, &in);
+    gr_vol_set(&r->vl_s, &prep.in);
     glUniform3i(r->s_grid, s->grid_x, s->grid_y, nz);
     glUniform1fv(r->s_bounds, nz + 1, bf);
     glUniformMatrix4fv(r->s_inv, 1, GL_FALSE, m);
-    glUniform3f(r->s_fwd, (float)f.forward[0], (float)f.forward[1], (float)f.forward[2]);
+    glUniform3f(r->s_fwd, (float)f->forward[0], (float)f->forward[1], (float)f->forward[2]);
     glUniform1i(r->s_jitter, s->jitter);
     glUniform1i(r->s_phase, s->phase_per_pixel);
     glBindImageTexture(0, r->vol_tex[0], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
@@ -317,8 +220,8 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     glUniform3i(r->i_grid, s->grid_x, s->grid_y, nz);
     glUniform1fv(r->i_bounds, nz + 1, bf);
     glUniformMatrix4fv(r->i_inv, 1, GL_FALSE, m);
-    glUniform3f(r->i_fwd, (float)f.forward[0], (float)f.forward[1], (float)f.forward[2]);
-    glUniform3f(r->i_sigma, (float)in.sigma_t[0], (float)in.sigma_t[1], (float)in.sigma_t[2]);
+    glUniform3f(r->i_fwd, (float)f->forward[0], (float)f->forward[1], (float)f->forward[2]);
+    glUniform3f(r->i_sigma, (float)prep.in.sigma_t[0], (float)prep.in.sigma_t[1], (float)prep.in.sigma_t[2]);
     glBindImageTexture(0, r->vol_tex[0], 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glBindImageTexture(1, r->vol_tex[1], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute((GLuint)((s->grid_x + 7) / 8), (GLuint)((s->grid_y + 7) / 8), 1);
@@ -332,9 +235,9 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glUseProgram(r->prog);
-    gr_vol_set(&r->vl, &in);
+    gr_vol_set(&r->vl, &prep.in);
     glUniformMatrix4fv(r->l_inv, 1, GL_FALSE, m);
-    glUniform3f(r->l_fwd, (float)f.forward[0], (float)f.forward[1], (float)f.forward[2]);
+    glUniform3f(r->l_fwd, (float)f->forward[0], (float)f->forward[1], (float)f->forward[2]);
     glUniform1fv(r->l_bounds, nz + 1, bf);
     glUniform1i(r->l_nz, nz);
     glUniform1i(r->l_phase, s->phase_per_pixel);
@@ -343,7 +246,7 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     glUniform2f(r->l_size, (float)W, (float)H);
     glUniform1f(r->l_tmax, (float)tmax);
     glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, depth_tex);
+    glBindTexture(GL_TEXTURE_2D, prep.depth_tex);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_3D, r->vol_tex[1]);
     glActiveTexture(GL_TEXTURE0);
@@ -359,18 +262,7 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     if (st != GR_OK) return st;
     if (stats) {
         static const char *const names[6] = {"shadow", "eye_depth", "caustics", "scatter", "integrate", "apply"};
-        memset(stats, 0, sizeof *stats);
-        double wall_ns = (now_ms() - t0) * 1e6;
-        stats->n_passes = 6;
-        for (int p = 0; p < 6; p++) {
-            snprintf(stats->pass_names[p], sizeof stats->pass_names[p], "%s", names[p]);
-            long long ns = gr_gl_timer_ns(&r->timer, p);
-            stats->gpu_ns[p] = (ns >= 0 && (double)ns <= wall_ns) ? ns : -1;
-        }
-        GLuint64 n = 0;
-        glGetQueryObjectui64v(r->q_samples, GL_QUERY_RESULT, &n);
-        stats->fragments = (long long)n;
-        stats->wall_ms = now_ms() - t0;
+        gr_vol_stats(stats, &r->timer, names, 6, r->q_samples, prep.t0_ms);
     }
     return gr_image_check_finite(out, "froxel", err);
 }

@@ -7,6 +7,7 @@
 #ifndef GR_FROXEL_H
 #define GR_FROXEL_H
 
+#include "realtime/caustics.h"
 #include "realtime/technique.h"
 
 typedef struct gr_froxel_settings {
@@ -15,16 +16,7 @@ typedef struct gr_froxel_settings {
     double near_m;               /* exponential: the first depth slice's far face (m) */
     int jitter;                  /* sample each froxel at a per-froxel noise depth, not its middle */
     int phase_per_pixel;         /* HG phase per pixel (exact for one directional light), not per froxel */
-    int texture_size, grid;      /* caustic texture side, water grid cells per patch side */
-    double patch_m;
-    int caustic_depths;
-    double caustic_first_m, caustic_last_m;
-    double extinction[3];
-    double g;
-    int sun_disc;           /* blur the caustic planes by the sun's disc */
-    double intensity[3];
-    int shadow_map_size;
-    double shadow_extent_m;
+    gr_vol_settings vol;         /* caustic stack, extinction, g, sun disc, intensity, shadow map */
 } gr_froxel_settings;
 
 extern const gr_technique_class gr_froxel_class;

@@ -11,6 +11,7 @@
 #include "core/optics.h"
 #include "gl/gl.h"
 #include "realtime/frame.h"
+#include "realtime/readback.h"
 #include "realtime/scenegl.h"
 #include "realtime/shaders.h"
 
@@ -185,8 +186,7 @@ typedef struct rb_state {
     int out_w, out_h, acc_w, acc_h;
     GLuint q_samples;
     gr_gl_timer timer;
-    float *readback;
-    size_t readback_cap;
+    gr_readback rb;
     /* last render */
     int rendered;
     double sun_uv[2], fade;
@@ -240,7 +240,7 @@ static void rb_destroy(void *state)
     delete_tex_fbo(&r->light_tex, &r->light_fbo);
     delete_tex_fbo(&r->out_tex, &r->out_fbo);
     delete_tex_fbo(&r->acc_tex, &r->acc_fbo);
-    free(r->readback);
+    gr_readback_free(&r->rb);
     free(r->shader_dir);
     free(r);
 }
@@ -407,29 +407,11 @@ static void blur_pass(rb_state *r, const gr_radial_blur_settings *s, const doubl
 }
 
 /* Reads r->out_fbo (w x h) into out's R, G, B (top row first). */
-static gr_status read_out(rb_state *r, int w, int h, gr_image *out, const char *what, gr_error *err)
+static gr_status read_out(rb_state *r, gr_image *out, const char *what, gr_error *err)
 {
-    int ch[3] = {gr_image_channel(out, "R"), gr_image_channel(out, "G"), gr_image_channel(out, "B")};
-    size_t need = (size_t)w * (size_t)h * 4;
-    if (need > r->readback_cap) {
-        float *nb = realloc(r->readback, need * sizeof *nb);
-        if (!nb) return gr_fail(err, GR_E_NOMEM, "%s: out of memory for the readback", what);
-        r->readback = nb;
-        r->readback_cap = need;
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, r->readback);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    for (int y = 0; y < h; y++) {
-        const float *src = r->readback + (size_t)(h - 1 - y) * (size_t)w * 4;
-        for (int x = 0; x < w; x++) {
-            float *px = gr_image_pixel(out, x, y);
-            for (int c = 0; c < 3; c++) px[ch[c]] = src[(size_t)x * 4 + (size_t)c]; /* NaN/Inf: checked by the caller */
-        }
-    }
-    return gr_gl_check(what, err);
+    gr_status st = gr_readback_fbo(&r->rb, r->out_fbo, out->width, out->height, what, err);
+    if (st == GR_OK) gr_readback_to_rgb(&r->rb, out); /* NaN/Inf: checked by the harness */
+    return st;
 }
 
 /* ---- light selection (radial_blur_local) -------------------------------------------------- */
@@ -453,13 +435,8 @@ static gr_status select_lights(rb_state *r, const gr_radial_blur_settings *s, gr
     int cp = (int)lround(s->cell_size * h);
     if (cp < 1) cp = 1;
     int cw = (w + cp - 1) / cp, chh = (h + cp - 1) / cp;
-    size_t need = (size_t)w * h * 4;
-    if (need > r->readback_cap) {
-        float *nb = realloc(r->readback, need * sizeof *nb);
-        if (!nb) return gr_fail(err, GR_E_NOMEM, "radial_blur_local: out of memory for the light readback");
-        r->readback = nb;
-        r->readback_cap = need;
-    }
+    gr_status st = gr_readback_fbo(&r->rb, r->light_fbo, w, h, "radial_blur_local: light pass", err);
+    if (st != GR_OK) return st;
     cell *cells = malloc((size_t)cw * chh * sizeof *cells);
     double *cx = calloc((size_t)cw * chh * 2, sizeof *cx);
     unsigned char *taken = calloc((size_t)cw * chh, 1);
@@ -469,18 +446,13 @@ static gr_status select_lights(rb_state *r, const gr_radial_blur_settings *s, gr
         free(taken);
         return gr_fail(err, GR_E_NOMEM, "radial_blur_local: out of memory for the light cells");
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, r->light_fbo);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, r->readback);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     for (int i = 0; i < cw * chh; i++) {
         cells[i].sum = 0.0;
         cells[i].idx = i;
     }
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
-            const float *p = r->readback + ((size_t)y * w + x) * 4;
+            const float *p = r->rb.rgba + ((size_t)y * w + x) * 4; /* GL rows: y = 0 at the bottom */
             double lum = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
             if (!(lum > 0)) continue;
             int c = (y / cp) * cw + x / cp;
@@ -692,7 +664,7 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
         glDrawArrays(GL_TRIANGLES, 0, 3);
         gr_gl_timer_end(&r->timer);
     }
-    st = read_out(r, W, H, out, name, err);
+    st = read_out(r, out, name, err);
     glBindVertexArray(0);
     glUseProgram(0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -746,7 +718,7 @@ gr_status gr_radial_blur_blur_image(void *state, const gr_image *light, const do
     glBindTexture(GL_TEXTURE_2D, 0);
     free(px);
     blur_pass(r, s, sun_uv, scale, out->width, out->height);
-    st = read_out(r, out->width, out->height, out, "radial_blur (injected light)", err);
+    st = read_out(r, out, "radial_blur (injected light)", err);
     glBindVertexArray(0);
     glUseProgram(0);
     return st;
@@ -772,28 +744,10 @@ static gr_status rb_read_target(void *state, gr_image **out, gr_error *err)
     if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "radial blur: no render yet, no light pass to read");
     gr_status st = gr_gl_make_current(r->gl, err);
     if (st != GR_OK) return st;
-    int w = r->light_w, h = r->light_h;
-    gr_image *img = gr_image_create(w, h, 4, NULL);
-    float *tmp = malloc((size_t)w * h * 4 * sizeof *tmp);
-    if (!img || !tmp) {
-        gr_image_destroy(img);
-        free(tmp);
-        return gr_fail(err, GR_E_NOMEM, "radial blur: out of memory for the light pass readback");
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, r->light_fbo);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, tmp);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    size_t row = (size_t)w * 4;
-    for (int y = 0; y < h; y++) memcpy(img->pixels + (size_t)y * row, tmp + (size_t)(h - 1 - y) * row, row * sizeof *tmp);
-    free(tmp);
-    if ((st = gr_gl_check("radial blur light pass readback", err)) != GR_OK) {
-        gr_image_destroy(img);
+    if ((st = gr_readback_fbo(&r->rb, r->light_fbo, r->light_w, r->light_h, "radial blur light pass", err)) != GR_OK)
         return st;
-    }
-    *out = img;
-    return GR_OK;
+    *out = gr_readback_image(&r->rb);
+    return *out ? GR_OK : gr_fail(err, GR_E_NOMEM, "radial blur: out of memory for the light pass image");
 }
 
 /* ---- metadata ----------------------------------------------------------------------------- */

@@ -12,16 +12,13 @@
 #include "core/shaftgeom.h"
 #include "gl/gl.h"
 #include "realtime/frame.h"
+#include "realtime/readback.h"
 #include "realtime/scenegl.h"
 #include "realtime/shaders.h"
 
 #define MAX_WAVE_GROUPS 16 /* must match shafts.vert.glsl */
 #define GRID_FLOATS 6
 #define TARGET_RGBA32F 2 /* path and flux: signed sums need a float target */
-/* Projection planes of the camera; with the shafts' forced clip z (seed VS) only w matters
- * in the shaft pass, and the final pass only uses directions. */
-#define CAM_NEAR 0.05
-#define CAM_FAR 2000.0
 
 const char *const gr_shafts_pass_names[GR_SHAFTS_NPASS] = {"shadow", "shafts", "final"};
 
@@ -107,7 +104,7 @@ typedef struct shaft_locs {
     GLint origin, spacing, width, length, extinction, sun_dir, eta, r0;
     GLint view_proj, shadow_matrix, wave_groups, waves, shadow_map, shadow_bias;
     GLint variant, ratio, refr_flat, sun_radius_w, prescale, depth_test, eye_depth, target_size;
-    GLint half, corner_pos, corner_refr;
+    GLint half, corner_pos, corner_refr, shadow_dz;
 } shaft_locs;
 
 struct gr_shafts {
@@ -115,28 +112,31 @@ struct gr_shafts {
     int owns_gl;     /* 1: made by gr_shafts_create, destroyed with the renderer */
     char *shader_dir;
     int from_dir;
-    GLuint prog_shadow, prog_shafts, prog_final, prog_capture;
-    GLint loc_light_vp;
+    GLuint prog_shafts, prog_final, prog_capture;
     shaft_locs ls, lc;
     GLint loc_inv_vp, loc_texel, loc_shafts, loc_hgg, loc_refr_sun, loc_intensity, loc_bias;
 
     GLuint vao_grid, vbo_grid, ibo_grid;
     int grid_N, grid_slabs, grid_nshafts;
     float *grid_cpu; /* GRID_FLOATS floats per vertex: cell.xy, corner.xy, bottom, mid */
-    gr_scenegl *scenegl; /* eye depth for depth_test */
+    gr_scenegl *scenegl; /* the occluders' shadow map, eye depth for depth_test (shared) */
     /* flux pre-pass: one texel per shaft corner (2 (N-1) per side), position + transmittance
      * and refracted direction (shafts_corner.frag.glsl) */
     GLuint prog_corner, corner_tex[2], corner_fbo;
     int corner_size;
     shaft_locs lk;
-
-    GLuint vao_occ, vbo_occ;
-    float *occ_cpu;
-    size_t occ_cap; /* floats */
+    /* flux: the shaft lattice (one vertex per lattice point and level, one quad per boundary
+     * between regions) and the second pre-pass, irradiance per cell and slab */
+    GLuint vao_lat, vbo_lat, ibo_lat;
+    int lat_N, lat_slabs, lat_tiled, lat_M;
+    long long lat_nidx;
+    GLuint prog_flux, flux_tex, flux_fbo;
+    int flux_w, flux_h;
+    GLint lf_corner_pos, lf_corner_refr, lf_tiled, lf_cells, lf_slabs, lf_length, lf_width, lf_sun_dir, lf_refr_flat,
+        lf_sun_radius_w, lf_shadow_matrix, lf_shadow_map, lf_shadow_bias, lf_shadows;
+    GLint ls_flux_e, ls_tiled, ls_lattice, ls_cells, ls_slabs, lk_tiled;
 
     GLuint vao_empty;
-    GLuint shadow_tex, shadow_fbo;
-    int shadow_size;
     GLuint target_tex, target_fbo;
     int target_w, target_h, target_fmt;
     GLuint frame_tex, frame_fbo;
@@ -145,8 +145,7 @@ struct gr_shafts {
     GLuint q_time[GR_SHAFTS_NPASS], q_samples, q_vs, q_fs;
     int have_timer, have_pipeline_stats;
 
-    float *readback;
-    size_t readback_cap;
+    gr_readback rb;
     int rendered;
 };
 
@@ -169,8 +168,11 @@ typedef struct frame_setup {
     float ratio;      /* path: cos(theta_i) / cos(theta_t) / width^2 */
     float sun_radius_w;
     float final_intensity[3], final_hgg[3], final_bias;
-    float view_proj[16], inv_view_proj[16], shadow_matrix[16], light_vp[16];
-    float shadow_bias_depth;
+    gr_frame fr;      /* camera matrices, refracted sun (realtime/frame.h) */
+    float view_proj[16], inv_view_proj[16]; /* column-major, viewer-relative (rotation only) */
+    double shadow_half_m; /* half extent of the shared shadow map around P */
+    float shadow_matrix[16]; /* column-major: viewer-relative -> shadow texture [0,1]^3 */
+    float shadow_bias_depth, shadow_dz;  /* bias in depth units; metres per depth unit */
     float hgg[3];
 } frame_setup;
 
@@ -179,55 +181,6 @@ static double now_ms(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-/* ---- small double matrix helpers (row-major m[r * 4 + c]) ------------------------- */
-
-static void mat_mul(const double *a, const double *b, double *out)
-{
-    double t[16];
-    for (int r = 0; r < 4; r++)
-        for (int c = 0; c < 4; c++) {
-            double acc = 0.0;
-            for (int k = 0; k < 4; k++) acc += a[r * 4 + k] * b[k * 4 + c];
-            t[r * 4 + c] = acc;
-        }
-    memcpy(out, t, sizeof t);
-}
-
-/* Gauss-Jordan with partial pivoting; returns -1 if singular. */
-static int mat_inverse(const double *m, double *out)
-{
-    double a[4][8];
-    for (int r = 0; r < 4; r++)
-        for (int c = 0; c < 8; c++) a[r][c] = c < 4 ? m[r * 4 + c] : (c - 4 == r ? 1.0 : 0.0);
-    for (int c = 0; c < 4; c++) {
-        int piv = c;
-        for (int r = c + 1; r < 4; r++)
-            if (fabs(a[r][c]) > fabs(a[piv][c])) piv = r;
-        if (fabs(a[piv][c]) < 1e-300) return -1;
-        if (piv != c)
-            for (int k = 0; k < 8; k++) {
-                double t = a[c][k];
-                a[c][k] = a[piv][k];
-                a[piv][k] = t;
-            }
-        double inv = 1.0 / a[c][c];
-        for (int k = 0; k < 8; k++) a[c][k] *= inv;
-        for (int r = 0; r < 4; r++) {
-            if (r == c) continue;
-            double f = a[r][c];
-            for (int k = 0; k < 8; k++) a[r][k] -= f * a[c][k];
-        }
-    }
-    for (int r = 0; r < 4; r++)
-        for (int c = 0; c < 4; c++) out[r * 4 + c] = a[r][c + 4];
-    return 0;
-}
-
-static void mat_to_float(const double *m, float *out)
-{
-    for (int i = 0; i < 16; i++) out[i] = (float)m[i];
 }
 
 /* ---- settings ------------------------------------------------------------------- */
@@ -286,6 +239,7 @@ static void get_shaft_locs(GLuint prog, shaft_locs *l)
     l->half = glGetUniformLocation(prog, "u_half");
     l->corner_pos = glGetUniformLocation(prog, "u_corner_pos");
     l->corner_refr = glGetUniformLocation(prog, "u_corner_refr");
+    l->shadow_dz = glGetUniformLocation(prog, "u_shadow_dz");
 }
 
 static int has_extension(const char *name)
@@ -351,10 +305,8 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
 {
     gr_status st;
     int nd = 0;
-    if ((st = gr_shader_program(r->shader_dir, "shafts_shadow.vert.glsl", "shafts_shadow.frag.glsl", NULL, 0,
-                                &r->prog_shadow, &nd, err)) != GR_OK)
-        return st;
-    r->from_dir += nd;
+    /* the occluders' shadow map and eye depth are scenegl's, shared with every technique */
+    if ((st = gr_scenegl_create_dir(r->gl, r->shader_dir, &r->scenegl, err)) != GR_OK) return st;
     if ((st = gr_shader_program(r->shader_dir, "shafts.vert.glsl", "shafts.frag.glsl", NULL, 0,
                                 &r->prog_shafts, &nd, err)) != GR_OK)
         return st;
@@ -369,8 +321,31 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
         return st;
     r->from_dir += nd;
     get_shaft_locs(r->prog_corner, &r->lk);
-    r->loc_light_vp = glGetUniformLocation(r->prog_shadow, "u_light_view_proj");
+    r->lk_tiled = glGetUniformLocation(r->prog_corner, "u_tiled");
+    if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_flux.frag.glsl", NULL, 0,
+                                &r->prog_flux, &nd, err)) != GR_OK)
+        return st;
+    r->from_dir += nd;
+    r->lf_corner_pos = glGetUniformLocation(r->prog_flux, "u_corner_pos");
+    r->lf_corner_refr = glGetUniformLocation(r->prog_flux, "u_corner_refr");
+    r->lf_tiled = glGetUniformLocation(r->prog_flux, "u_tiled");
+    r->lf_cells = glGetUniformLocation(r->prog_flux, "u_cells");
+    r->lf_slabs = glGetUniformLocation(r->prog_flux, "u_slabs");
+    r->lf_length = glGetUniformLocation(r->prog_flux, "u_length");
+    r->lf_width = glGetUniformLocation(r->prog_flux, "u_width");
+    r->lf_sun_dir = glGetUniformLocation(r->prog_flux, "u_sun_dir");
+    r->lf_refr_flat = glGetUniformLocation(r->prog_flux, "u_refr_flat");
+    r->lf_sun_radius_w = glGetUniformLocation(r->prog_flux, "u_sun_radius_w");
+    r->lf_shadow_matrix = glGetUniformLocation(r->prog_flux, "u_shadow_matrix");
+    r->lf_shadow_map = glGetUniformLocation(r->prog_flux, "u_shadow_map");
+    r->lf_shadow_bias = glGetUniformLocation(r->prog_flux, "u_shadow_bias");
+    r->lf_shadows = glGetUniformLocation(r->prog_flux, "u_shadows");
     get_shaft_locs(r->prog_shafts, &r->ls);
+    r->ls_flux_e = glGetUniformLocation(r->prog_shafts, "u_flux_e");
+    r->ls_tiled = glGetUniformLocation(r->prog_shafts, "u_tiled");
+    r->ls_lattice = glGetUniformLocation(r->prog_shafts, "u_lattice");
+    r->ls_cells = glGetUniformLocation(r->prog_shafts, "u_cells");
+    r->ls_slabs = glGetUniformLocation(r->prog_shafts, "u_slabs");
     r->loc_inv_vp = glGetUniformLocation(r->prog_final, "u_inv_view_proj");
     r->loc_texel = glGetUniformLocation(r->prog_final, "u_texel");
     r->loc_shafts = glGetUniformLocation(r->prog_final, "u_shafts");
@@ -382,9 +357,10 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
     glGenVertexArrays(1, &r->vao_grid);
     glGenBuffers(1, &r->vbo_grid);
     glGenBuffers(1, &r->ibo_grid);
-    glGenVertexArrays(1, &r->vao_occ);
-    glGenBuffers(1, &r->vbo_occ);
     glGenVertexArrays(1, &r->vao_empty);
+    glGenVertexArrays(1, &r->vao_lat);
+    glGenBuffers(1, &r->vbo_lat);
+    glGenBuffers(1, &r->ibo_lat);
     glGenQueries(GR_SHAFTS_NPASS, r->q_time);
     glGenQueries(1, &r->q_samples);
     /* Timer queries are core since 3.3; pipeline statistics need GL 4.6 or the ARB extension. */
@@ -412,7 +388,6 @@ void gr_shafts_destroy(gr_shafts *r)
     if (!r) return;
     if (r->gl) {
         gr_gl_make_current(r->gl, NULL);
-        if (r->prog_shadow) glDeleteProgram(r->prog_shadow);
         if (r->prog_shafts) glDeleteProgram(r->prog_shafts);
         if (r->prog_final) glDeleteProgram(r->prog_final);
         if (r->prog_capture) glDeleteProgram(r->prog_capture);
@@ -422,22 +397,23 @@ void gr_shafts_destroy(gr_shafts *r)
         if (r->vao_grid) glDeleteVertexArrays(1, &r->vao_grid);
         if (r->vbo_grid) glDeleteBuffers(1, &r->vbo_grid);
         if (r->ibo_grid) glDeleteBuffers(1, &r->ibo_grid);
-        if (r->vao_occ) glDeleteVertexArrays(1, &r->vao_occ);
-        if (r->vbo_occ) glDeleteBuffers(1, &r->vbo_occ);
         if (r->vao_empty) glDeleteVertexArrays(1, &r->vao_empty);
+        if (r->prog_flux) glDeleteProgram(r->prog_flux);
+        if (r->vao_lat) glDeleteVertexArrays(1, &r->vao_lat);
+        if (r->vbo_lat) glDeleteBuffers(1, &r->vbo_lat);
+        if (r->ibo_lat) glDeleteBuffers(1, &r->ibo_lat);
+        delete_tex_fbo(&r->flux_tex, &r->flux_fbo);
         if (r->q_time[0]) glDeleteQueries(GR_SHAFTS_NPASS, r->q_time);
         if (r->q_samples) glDeleteQueries(1, &r->q_samples);
         if (r->q_vs) glDeleteQueries(1, &r->q_vs);
         if (r->q_fs) glDeleteQueries(1, &r->q_fs);
-        delete_tex_fbo(&r->shadow_tex, &r->shadow_fbo);
         delete_tex_fbo(&r->target_tex, &r->target_fbo);
         delete_tex_fbo(&r->frame_tex, &r->frame_fbo);
         gr_scenegl_destroy(r->scenegl);
         if (r->owns_gl) gr_gl_destroy(r->gl);
     }
     free(r->grid_cpu);
-    free(r->occ_cpu);
-    free(r->readback);
+    gr_readback_free(&r->rb);
     free(r->shader_dir);
     free(r);
 }
@@ -560,10 +536,9 @@ static gr_status make_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h
     return gr_gl_check(what, err);
 }
 
-/* The flux pre-pass's two RGBA32F corner textures, 2 (N-1) texels per side. */
-static gr_status ensure_corners(gr_shafts *r, int N, gr_error *err)
+/* The flux pre-pass's two RGBA32F lattice textures, M texels per side. */
+static gr_status ensure_corners(gr_shafts *r, int N, int n, gr_error *err)
 {
-    int n = 2 * (N - 1);
     if (r->corner_size == n && r->corner_fbo) return GR_OK;
     if (r->corner_fbo) glDeleteFramebuffers(1, &r->corner_fbo);
     if (r->corner_tex[0]) glDeleteTextures(2, r->corner_tex);
@@ -589,16 +564,85 @@ static gr_status ensure_corners(gr_shafts *r, int N, gr_error *err)
     return gr_gl_check("shafts.N: flux corner target", err);
 }
 
+/* Flux: the shaft lattice for N grid vertices, `slabs` depth slabs, tiled (shaft_width 1: the
+ * lattice points are the N grid lines per side) or not (M = 2 (N - 1): each cell's two
+ * corners). Vertices: (p, q, level / slabs) for every lattice point and level 0..slabs. Quads,
+ * each wound counter-clockwise seen from the side its normal points to (docs "flux"):
+ * x faces (normal +x) on every lattice line p, across each cell's z extent, per slab; z faces
+ * (normal +z) likewise; caps (normal down) of every cell at every level. The fragment shader
+ * finds a quad's two regions from gl_PrimitiveID / 2 in exactly this order. */
+static gr_status ensure_lattice(gr_shafts *r, int N, int slabs, int tiled, gr_error *err)
+{
+    if (r->lat_N == N && r->lat_slabs == slabs && r->lat_tiled == tiled) return GR_OK;
+    int C = N - 1, M = tiled ? N : 2 * (N - 1), L = slabs + 1;
+    size_t nv = (size_t)M * (size_t)M * (size_t)L;
+    size_t nq = 2 * (size_t)M * (size_t)C * (size_t)slabs + (size_t)L * (size_t)C * (size_t)C;
+    if (nv > 0x7fffffffu / 4 || nq * 6 > 0x7fffffffu)
+        return gr_fail(err, GR_E_INPUT, "shafts.N = %d, shafts.slabs = %d: flux lattice too large", N, slabs);
+    float *v = malloc(nv * 3 * sizeof *v);
+    GLuint *idx = malloc(nq * 6 * sizeof *idx);
+    if (!v || !idx) {
+        free(v);
+        free(idx);
+        return gr_fail(err, GR_E_NOMEM, "shafts.N = %d, shafts.slabs = %d: out of memory for the flux lattice", N, slabs);
+    }
+#define LV(p, q, b) ((GLuint)((((size_t)(b) * (size_t)M) + (size_t)(q)) * (size_t)M + (size_t)(p)))
+    for (int b = 0; b < L; b++)
+        for (int q = 0; q < M; q++)
+            for (int p = 0; p < M; p++) {
+                float *o = v + (size_t)LV(p, q, b) * 3;
+                o[0] = (float)p;
+                o[1] = (float)q;
+                o[2] = (float)((double)b / (double)slabs);
+            }
+    GLuint *o = idx;
+#define QUAD(a, b2, c, d) do { o[0] = (a); o[1] = (b2); o[2] = (c); o[3] = (a); o[4] = (c); o[5] = (d); o += 6; } while (0)
+    for (int b = 0; b < slabs; b++) /* x faces: (p, z0, b) (p, z1, b) (p, z1, b+1) (p, z0, b+1): normal +x */
+        for (int p = 0; p < M; p++)
+            for (int j = 0; j < C; j++) {
+                int z0 = tiled ? j : 2 * j;
+                QUAD(LV(p, z0, b), LV(p, z0 + 1, b), LV(p, z0 + 1, b + 1), LV(p, z0, b + 1));
+            }
+    for (int b = 0; b < slabs; b++) /* z faces: (x0, q, b) (x0, q, b+1) (x1, q, b+1) (x1, q, b): normal +z */
+        for (int q = 0; q < M; q++)
+            for (int i = 0; i < C; i++) {
+                int x0 = tiled ? i : 2 * i;
+                QUAD(LV(x0, q, b), LV(x0, q, b + 1), LV(x0 + 1, q, b + 1), LV(x0 + 1, q, b));
+            }
+    for (int b = 0; b < L; b++) /* caps: (x0, z0) (x1, z0) (x1, z1) (x0, z1): normal down */
+        for (int j = 0; j < C; j++)
+            for (int i = 0; i < C; i++) {
+                int x0 = tiled ? i : 2 * i, z0 = tiled ? j : 2 * j;
+                QUAD(LV(x0, z0, b), LV(x0 + 1, z0, b), LV(x0 + 1, z0 + 1, b), LV(x0, z0 + 1, b));
+            }
+#undef QUAD
+#undef LV
+    glBindVertexArray(r->vao_lat);
+    glBindBuffer(GL_ARRAY_BUFFER, r->vbo_lat);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 3 * sizeof *v), v, GL_STATIC_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->ibo_lat);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(nq * 6 * sizeof *idx), idx, GL_STATIC_DRAW);
+    GLsizei stride = (GLsizei)(3 * sizeof(float));
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, stride, (const void *)0);
+    glDisableVertexAttribArray(1);
+    glVertexAttrib2f(1, 0.0f, 0.0f);
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, stride, (const void *)(2 * sizeof(float)));
+    glBindVertexArray(0);
+    free(v);
+    free(idx);
+    r->lat_N = N;
+    r->lat_slabs = slabs;
+    r->lat_tiled = tiled;
+    r->lat_M = M;
+    r->lat_nidx = (long long)nq * 6;
+    return gr_gl_check("shafts.N: uploading the flux lattice", err);
+}
+
 static gr_status ensure_targets(gr_shafts *r, const frame_setup *f, gr_error *err)
 {
     gr_status st;
-    if (r->shadow_size != f->s.shadow_map_size || !r->shadow_tex) {
-        r->shadow_size = 0;
-        st = make_target(&r->shadow_tex, &r->shadow_fbo, GL_DEPTH_COMPONENT32F, f->s.shadow_map_size,
-                         f->s.shadow_map_size, 1, GL_NEAREST, "shafts.shadow_map_size: shadow map", err);
-        if (st != GR_OK) return st;
-        r->shadow_size = f->s.shadow_map_size;
-    }
     if (r->target_w != f->tw || r->target_h != f->th || r->target_fmt != f->fmt || !r->target_tex) {
         r->target_w = 0;
         GLenum ifmt = f->fmt == TARGET_RGBA32F ? GL_RGBA32F : f->fmt == GR_TARGET_RGBA16F ? GL_RGBA16F : GL_RGBA8;
@@ -664,7 +708,6 @@ static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in
     f->S = gr_shafts_spacing(s->K, depth, cam->fov_deg * GR_PI / 180.0, s->N);
     if (!(isfinite(f->P.x) && isfinite(f->P.z) && f->S > 0 && isfinite(f->S)))
         return gr_fail(err, GR_E_INPUT, "sun.elevation_deg: no finite recentering point P for this sun and camera");
-    gr_dvec3 orel = gr_d3_sub(f->P, f->eye);
     if (w->n_waves > MAX_WAVE_GROUPS * 4)
         return gr_fail(err, GR_E_INPUT, "water.waves: %d waves, the shafts renderer takes at most %d",
                        w->n_waves, MAX_WAVE_GROUPS * 4);
@@ -722,7 +765,7 @@ static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in
     double cos_i = fabs(I.y), cos_t = fabs(f->T.y);
     f->fmt = s->variant == GR_SHAFTS_SEED ? s->target_format : TARGET_RGBA32F;
     f->caps = s->variant == GR_SHAFTS_SEED ? s->caps : 1; /* signed sums need closed shafts */
-    f->slabs = s->variant == GR_SHAFTS_FLUX ? s->slabs : 1;
+    f->slabs = 1; /* the per-shaft grid of seed and path; flux draws the lattice (ensure_lattice) */
     f->ratio = (float)(cos_i / fmax(cos_t, 1e-9) / (s->shaft_width * s->shaft_width));
     double alpha = 0.5 * scene->sun.angular_diameter_deg * GR_PI / 180.0;
     f->sun_radius_w = (float)(alpha * cos_i / (ior * fmax(cos_t, 1e-9)));
@@ -737,81 +780,23 @@ static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in
     }
     f->final_bias = s->variant == GR_SHAFTS_SEED ? (float)s->bias : 0.0f;
 
-    /* Camera: view matrix without translation (positions are viewer-relative). */
-    double aspect = (double)f->W / (double)f->H;
-    double tf = 1.0 / tan(0.5 * cam->fov_deg * GR_PI / 180.0);
-    double view[16] = {cam->right[0], cam->right[1], cam->right[2], 0,
-                       cam->up[0], cam->up[1], cam->up[2], 0,
-                       -cam->forward[0], -cam->forward[1], -cam->forward[2], 0,
-                       0, 0, 0, 1};
-    double proj[16] = {tf / aspect, 0, 0, 0,
-                       0, tf, 0, 0,
-                       0, 0, (CAM_FAR + CAM_NEAR) / (CAM_NEAR - CAM_FAR), 2.0 * CAM_FAR * CAM_NEAR / (CAM_NEAR - CAM_FAR),
-                       0, 0, -1, 0};
+    /* Camera: frame.h's matrices without the eye translation (positions are viewer-relative). */
+    gr_frame_init(scene, &f->fr);
     double vp[16], ivp[16];
-    mat_mul(proj, view, vp);
-    if (mat_inverse(vp, ivp) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection matrix");
-    mat_to_float(vp, f->view_proj);
-    mat_to_float(ivp, f->inv_view_proj);
+    gr_frame_view_proj_rot(&f->fr, vp);
+    if (gr_mat4_inverse(vp, ivp) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection matrix");
+    gr_frame_matf(vp, f->view_proj);
+    gr_frame_matf(ivp, f->inv_view_proj);
 
-    /* Shadow map: orthographic along T, centred on P (decision in docs/realtime-shafts.md).
-     * Light frame e1, e2 across the beam, e3 = T along it; depth = e3.(x - P). */
-    gr_dvec3 e3 = gr_d3_norm(f->T);
-    gr_dvec3 a = fabs(e3.x) < 0.9 ? gr_d3(1, 0, 0) : gr_d3(0, 0, 1);
-    gr_dvec3 e1 = gr_d3_norm(gr_d3_cross(e3, a));
-    gr_dvec3 e2 = gr_d3_cross(e3, e1);
+    /* Shadow map: scenegl's, orthographic along T, centred on P, covering the grid's diagonal
+     * plus the waves' amplitude plus the extrusion's possible spread (docs: D13). */
     double half_grid = 0.5 * (double)s->N * f->lvl_S[f->n_levels - 1] * fmax(1.0, s->shaft_width)
                        + (s->stable_grid ? f->lvl_S[f->n_levels - 1] : 0.0);
-    double radius = sqrt(2.0) * half_grid + amp_sum + s->shaft_length_m * fmin(1.0, steep + 0.05);
-    double znear = -(radius + amp_sum + 1.0);
-    double zfar = s->shaft_length_m + radius + amp_sum + 1.0;
-    double lvp[16] = {e1.x / radius, e1.y / radius, e1.z / radius, 0,
-                      e2.x / radius, e2.y / radius, e2.z / radius, 0,
-                      2.0 * e3.x / (zfar - znear), 2.0 * e3.y / (zfar - znear), 2.0 * e3.z / (zfar - znear),
-                      -(zfar + znear) / (zfar - znear),
-                      0, 0, 0, 1};
-    mat_to_float(lvp, f->light_vp);
-    /* Viewer-relative -> P-relative, then light clip, then [0,1] texture space (GL: origin
-     * at the bottom-left, depth in [0,1]; no D3D y flip or half-texel offset). */
-    double to_p[16] = {1, 0, 0, -orel.x, 0, 1, 0, -orel.y, 0, 0, 1, -orel.z, 0, 0, 0, 1};
-    double bias[16] = {0.5, 0, 0, 0.5, 0, 0.5, 0, 0.5, 0, 0, 0.5, 0.5, 0, 0, 0, 1};
-    double sm[16];
-    mat_mul(lvp, to_p, sm);
-    mat_mul(bias, sm, sm);
-    mat_to_float(sm, f->shadow_matrix);
-    f->shadow_bias_depth = (float)(s->shadow_bias / (zfar - znear));
-
+    f->shadow_half_m = sqrt(2.0) * half_grid + amp_sum + s->shaft_length_m * fmin(1.0, steep + 0.05);
     /* Seed's packed Mie parameters HGg = (1 - g^2, 1 + g^2, 2 g). */
     f->hgg[0] = (float)(1.0 - s->g * s->g);
     f->hgg[1] = (float)(1.0 + s->g * s->g);
     f->hgg[2] = (float)(2.0 * s->g);
-    return GR_OK;
-}
-
-/* Occluder triangles relative to P (float; the shared world-space mesh of scenegl in double
- * before the cast). */
-static gr_status build_occluders(gr_shafts *r, const gr_scene *scene, gr_dvec3 P, size_t *nverts, gr_error *err)
-{
-    const size_t n = gr_occluder_mesh_count(scene);
-    if (n * 3 > r->occ_cap) {
-        float *nb = realloc(r->occ_cpu, n * 3 * sizeof *nb);
-        if (!nb) return gr_fail(err, GR_E_NOMEM, "occluders: out of memory");
-        r->occ_cpu = nb;
-        r->occ_cap = n * 3;
-    }
-    double *w = malloc((n ? n : 1) * 3 * sizeof *w);
-    if (!w) return gr_fail(err, GR_E_NOMEM, "occluders: out of memory");
-    gr_occluder_mesh(scene, w);
-    const double origin[3] = {P.x, P.y, P.z};
-    for (size_t i = 0; i < n * 3; i++) r->occ_cpu[i] = (float)(w[i] - origin[i % 3]);
-    free(w);
-    *nverts = n;
-    glBindVertexArray(r->vao_occ);
-    glBindBuffer(GL_ARRAY_BUFFER, r->vbo_occ);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(n * 3 * sizeof(float)), n ? r->occ_cpu : NULL, GL_STREAM_DRAW);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, (GLsizei)(3 * sizeof(float)), (const void *)0);
-    glBindVertexArray(0);
     return GR_OK;
 }
 
@@ -827,12 +812,14 @@ static void set_shaft_uniforms(GLuint prog, const shaft_locs *l, const frame_set
     glUniform3f(l->sun_dir, (float)scene->sun.dir[0], (float)scene->sun.dir[1], (float)scene->sun.dir[2]);
     glUniform1f(l->eta, (float)(1.0 / scene->medium.ior));
     glUniform1f(l->r0, (float)gr_fresnel_r0(1.0, scene->medium.ior));
-    glUniformMatrix4fv(l->view_proj, 1, GL_TRUE, f->view_proj);
-    glUniformMatrix4fv(l->shadow_matrix, 1, GL_TRUE, f->shadow_matrix);
+    glUniformMatrix4fv(l->view_proj, 1, GL_FALSE, f->view_proj);
+    glUniformMatrix4fv(l->shadow_matrix, 1, GL_FALSE, f->shadow_matrix);
     glUniform1i(l->wave_groups, f->groups);
     if (f->groups > 0) glUniform4fv(l->waves, f->groups * 5, f->waves);
     glUniform1i(l->shadow_map, 0);
     glUniform1f(l->shadow_bias, f->shadow_bias_depth);
+    /* path, flux: shafts end where the shadow map has a caster (0: no map, capture) */
+    glUniform1f(l->shadow_dz, s->variant == GR_SHAFTS_SEED ? 0.0f : f->shadow_dz);
     glUniform1i(l->variant, s->variant);
     glUniform1f(l->ratio, f->ratio);
     glUniform3f(l->refr_flat, (float)f->T.x, (float)f->T.y, (float)f->T.z);
@@ -870,45 +857,62 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
     if ((st = ensure_grid(r, f->N, f->slabs, err)) != GR_OK) goto done;
     if ((st = ensure_targets(r, f, err)) != GR_OK) goto done;
-    if (f->s.variant == GR_SHAFTS_FLUX && (st = ensure_corners(r, f->N, err)) != GR_OK) goto done;
+    const int tiled = f->s.shaft_width >= 1.0;
+    if (f->s.variant == GR_SHAFTS_FLUX) {
+        int C = f->N - 1;
+        if ((long long)C * f->s.slabs > 16384) {
+            st = gr_fail(err, GR_E_INPUT, "shafts.slabs = %d: (N - 1) x slabs = %lld must be <= 16384", f->s.slabs,
+                         (long long)C * f->s.slabs);
+            goto done;
+        }
+        if ((st = ensure_lattice(r, f->N, f->s.slabs, tiled, err)) != GR_OK) goto done;
+        if ((st = ensure_corners(r, f->N, r->lat_M, err)) != GR_OK) goto done;
+        if (r->flux_w != C || r->flux_h != C * f->s.slabs || !r->flux_tex) {
+            r->flux_w = 0;
+            if ((st = make_target(&r->flux_tex, &r->flux_fbo, GL_R32F, C, C * f->s.slabs, 0, GL_NEAREST,
+                                  "shafts.slabs: flux irradiance target", err)) != GR_OK)
+                goto done;
+            r->flux_w = C;
+            r->flux_h = C * f->s.slabs;
+        }
+    }
     GLuint eye_depth_tex = 0;
     if (f->s.depth_test) {
         /* scenegl's eye depth of the occluders and seabed at the target's resolution */
-        if (!r->scenegl && (st = gr_scenegl_create_dir(r->gl, r->shader_dir, &r->scenegl, err)) != GR_OK) goto done;
-        gr_frame fr;
-        gr_frame_init(scene, &fr);
         unsigned tex = 0;
-        if ((st = gr_scenegl_eye_depth(r->scenegl, scene, &fr, f->tw, f->th, &tex, err)) != GR_OK) goto done;
+        if ((st = gr_scenegl_eye_depth(r->scenegl, scene, &f->fr, f->tw, f->th, &tex, err)) != GR_OK) goto done;
         eye_depth_tex = tex;
     }
-    size_t n_occ = 0;
-    if ((st = build_occluders(r, scene, f->P, &n_occ, err)) != GR_OK) goto done;
-
-    /* Pass 1: shadow map of the occluders from P along T (seed: "from the point of view of
-     * the light source P"). Depth clamp keeps casters above the near plane. */
+    /* Pass 1: scenegl's shadow map of the occluders from P along T (seed: "from the point of
+     * view of the light source P"; docs: D13). */
     glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_SHADOW]);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->shadow_fbo);
-    glViewport(0, 0, f->s.shadow_map_size, f->s.shadow_map_size);
-    glDisable(GL_BLEND);
-    glDisable(GL_CULL_FACE);
-    glEnable(GL_DEPTH_TEST);
-    glEnable(GL_DEPTH_CLAMP);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glClearDepth(1.0);
-    glClear(GL_DEPTH_BUFFER_BIT);
-    if (n_occ > 0) {
-        glUseProgram(r->prog_shadow);
-        glUniformMatrix4fv(r->loc_light_vp, 1, GL_TRUE, f->light_vp);
-        glBindVertexArray(r->vao_occ);
-        glDrawArrays(GL_TRIANGLES, 0, (GLsizei)n_occ);
-    }
-    glDisable(GL_DEPTH_CLAMP);
-    glDisable(GL_DEPTH_TEST);
+    unsigned shadow_tex = 0;
+    double light_vp[16];
+    const double center[3] = {f->P.x, f->P.y, f->P.z};
+    st = gr_scenegl_shadow_map(r->scenegl, scene, &f->fr, f->s.shadow_map_size, center, f->shadow_half_m,
+                               &shadow_tex, light_vp, err);
     glEndQuery(GL_TIME_ELAPSED);
+    if (st != GR_OK) goto done;
+    {
+        /* viewer-relative -> world -> light clip -> [0,1]^3 texture space, in double (GL: origin
+         * at the bottom-left, no D3D y flip or half-texel offset); light_vp's z row is
+         * 2 T / dz, so a texture depth unit is dz metres */
+        const double *e = f->fr.eye;
+        double to_world[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, e[0], e[1], e[2], 1};
+        double bias[16] = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 0.5, 0.5, 0.5, 1};
+        double sm[16];
+        gr_mat4_mul(light_vp, to_world, sm);
+        gr_mat4_mul(bias, sm, sm);
+        gr_frame_matf(sm, f->shadow_matrix);
+        double zr = sqrt(light_vp[2] * light_vp[2] + light_vp[6] * light_vp[6] + light_vp[10] * light_vp[10]);
+        double dz = zr > 0 ? 2.0 / zr : 1.0;
+        f->shadow_dz = (float)dz;
+        f->shadow_bias_depth = (float)(f->s.shadow_bias / dz);
+    }
 
     /* Pass 2: shafts, additive, no depth test, no culling, into the reduced target. */
-    GLsizei n_idx = (GLsizei)(f->nshafts * f->slabs * (f->caps ? 36 : 24));
+    GLsizei n_idx = f->s.variant == GR_SHAFTS_FLUX ? (GLsizei)r->lat_nidx
+                                                   : (GLsizei)(f->nshafts * f->slabs * (f->caps ? 36 : 24));
     glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_SHAFTS]);
     glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
     if (r->have_pipeline_stats) {
@@ -927,31 +931,64 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, eye_depth_tex);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, r->shadow_tex);
+    glBindTexture(GL_TEXTURE_2D, shadow_tex);
     glBindVertexArray(r->vao_grid);
     for (int k = 0; k < f->n_levels; k++) {
         if (f->lvl_weight[k] <= 0.0) continue;
         if (f->s.variant == GR_SHAFTS_FLUX) {
-            /* pre-pass: the level's corners, then back to the shaft pass's state */
+            /* pre-passes: the level's lattice points, then each cell's and slab's irradiance,
+             * then back to the shaft pass's state with the lattice bound */
             glDisable(GL_BLEND);
+            for (GLenum u = GL_TEXTURE2; u <= GL_TEXTURE4; u++) {
+                glActiveTexture(u);
+                glBindTexture(GL_TEXTURE_2D, 0);
+            }
+            glActiveTexture(GL_TEXTURE0);
             glBindFramebuffer(GL_FRAMEBUFFER, r->corner_fbo);
             glViewport(0, 0, r->corner_size, r->corner_size);
             set_shaft_uniforms(r->prog_corner, &r->lk, f, scene);
             glUniform3fv(r->lk.origin, 1, f->lvl_origin[k]);
             glUniform1f(r->lk.spacing, (float)f->lvl_S[k]);
+            glUniform1i(r->lk_tiled, tiled);
             if (f->groups > 0) glUniform4fv(r->lk.waves, f->groups * 5, f->lvl_waves[k]);
             glBindVertexArray(r->vao_empty);
             glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-            glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
-            glViewport(0, 0, f->tw, f->th);
-            glEnable(GL_BLEND);
-            set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
             glActiveTexture(GL_TEXTURE2);
             glBindTexture(GL_TEXTURE_2D, r->corner_tex[0]);
             glActiveTexture(GL_TEXTURE3);
             glBindTexture(GL_TEXTURE_2D, r->corner_tex[1]);
             glActiveTexture(GL_TEXTURE0);
-            glBindVertexArray(r->vao_grid);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->flux_fbo);
+            glViewport(0, 0, r->flux_w, r->flux_h);
+            glUseProgram(r->prog_flux);
+            glUniform1i(r->lf_corner_pos, 2);
+            glUniform1i(r->lf_corner_refr, 3);
+            glUniform1i(r->lf_tiled, tiled);
+            glUniform1i(r->lf_cells, f->N - 1);
+            glUniform1i(r->lf_slabs, f->s.slabs);
+            glUniform1f(r->lf_length, (float)f->s.shaft_length_m);
+            glUniform1f(r->lf_width, (float)f->s.shaft_width);
+            glUniform3f(r->lf_sun_dir, (float)scene->sun.dir[0], (float)scene->sun.dir[1], (float)scene->sun.dir[2]);
+            glUniform3f(r->lf_refr_flat, (float)f->T.x, (float)f->T.y, (float)f->T.z);
+            glUniform1f(r->lf_sun_radius_w, f->sun_radius_w);
+            glUniformMatrix4fv(r->lf_shadow_matrix, 1, GL_FALSE, f->shadow_matrix);
+            glUniform1i(r->lf_shadow_map, 0);
+            glUniform1f(r->lf_shadow_bias, f->shadow_bias_depth);
+            glUniform1i(r->lf_shadows, 1);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+            glActiveTexture(GL_TEXTURE4);
+            glBindTexture(GL_TEXTURE_2D, r->flux_tex);
+            glActiveTexture(GL_TEXTURE0);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+            glViewport(0, 0, f->tw, f->th);
+            glEnable(GL_BLEND);
+            set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
+            glUniform1i(r->ls_flux_e, 4);
+            glUniform1i(r->ls_tiled, tiled);
+            glUniform1i(r->ls_lattice, r->lat_M);
+            glUniform1i(r->ls_cells, f->N - 1);
+            glUniform1i(r->ls_slabs, f->s.slabs);
+            glBindVertexArray(r->vao_lat);
         }
         /* stable_grid: each level drawn with its weight folded into the prescale */
         glUniform3fv(r->ls.origin, 1, f->lvl_origin[k]);
@@ -960,7 +997,7 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
         glUniform1f(r->ls.prescale, (float)(f->s.target_prescale * f->lvl_weight[k]));
         glDrawElements(GL_TRIANGLES, n_idx, GL_UNSIGNED_INT, (const void *)0);
     }
-    for (GLenum u = GL_TEXTURE1; u <= GL_TEXTURE3; u++) {
+    for (GLenum u = GL_TEXTURE1; u <= GL_TEXTURE4; u++) {
         glActiveTexture(u);
         glBindTexture(GL_TEXTURE_2D, 0);
     }
@@ -979,7 +1016,7 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glViewport(0, 0, f->W, f->H);
     glClear(GL_COLOR_BUFFER_BIT);
     glUseProgram(r->prog_final);
-    glUniformMatrix4fv(r->loc_inv_vp, 1, GL_TRUE, f->inv_view_proj);
+    glUniformMatrix4fv(r->loc_inv_vp, 1, GL_FALSE, f->inv_view_proj);
     glUniform2f(r->loc_texel, 1.0f / (float)f->tw, 1.0f / (float)f->th);
     glUniform1i(r->loc_shafts, 0);
     glUniform3fv(r->loc_hgg, 1, f->final_hgg);
@@ -992,26 +1029,8 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glEndQuery(GL_TIME_ELAPSED);
 
     /* Read the layer back (GL rows bottom-up; gr_image top row first). */
-    size_t need = (size_t)f->W * (size_t)f->H * 4;
-    if (need > r->readback_cap) {
-        float *nb = realloc(r->readback, need * sizeof *nb);
-        if (!nb) {
-            st = gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the readback");
-            goto unbind;
-        }
-        r->readback = nb;
-        r->readback_cap = need;
-    }
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, f->W, f->H, GL_RGBA, GL_FLOAT, r->readback);
-    for (int y = 0; y < f->H; y++) {
-        const float *src = r->readback + (size_t)(f->H - 1 - y) * (size_t)f->W * 4;
-        for (int x = 0; x < f->W; x++) {
-            float *px = gr_image_pixel(out, x, y);
-            for (int c = 0; c < 3; c++) px[ch[c]] = src[(size_t)x * 4 + (size_t)c];
-        }
-    }
+    if ((st = gr_readback_fbo(&r->rb, r->frame_fbo, f->W, f->H, "shafts layer", err)) != GR_OK) goto unbind;
+    gr_readback_to_rgb(&r->rb, out); /* NaN/Inf: gr_image_check_finite below */
     if (stats) {
         memset(stats, 0, sizeof *stats);
         /* Every pass ran between t0 and the synchronous readback: a GPU time longer than
@@ -1052,29 +1071,10 @@ gr_status gr_shafts_read_target(gr_shafts *r, gr_image **out, gr_error *err)
     if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "shafts: no render yet, no target to read");
     gr_status st = gr_gl_make_current(r->gl, err);
     if (st != GR_OK) return st;
-    gr_image *img = gr_image_create(r->target_w, r->target_h, 4, NULL);
-    float *tmp = malloc((size_t)r->target_w * (size_t)r->target_h * 4 * sizeof *tmp);
-    if (!img || !tmp) {
-        gr_image_destroy(img);
-        free(tmp);
-        return gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the target readback");
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, r->target_w, r->target_h, GL_RGBA, GL_FLOAT, tmp);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    size_t row = (size_t)r->target_w * 4;
-    for (int y = 0; y < r->target_h; y++)
-        memcpy(img->pixels + (size_t)y * row, tmp + (size_t)(r->target_h - 1 - y) * row, row * sizeof *tmp);
-    free(tmp);
-    st = gr_gl_check("shafts target readback", err);
-    if (st != GR_OK) {
-        gr_image_destroy(img);
+    if ((st = gr_readback_fbo(&r->rb, r->target_fbo, r->target_w, r->target_h, "shafts target", err)) != GR_OK)
         return st;
-    }
-    *out = img;
-    return GR_OK;
+    *out = gr_readback_image(&r->rb);
+    return *out ? GR_OK : gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the target image");
 }
 
 gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
@@ -1088,6 +1088,11 @@ gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts
     float *data = NULL;
     if (!f) return gr_fail(err, GR_E_NOMEM, "shafts: out of memory");
     if ((st = setup_frame(scene, s, f, err)) != GR_OK) goto done;
+    if (f->s.variant == GR_SHAFTS_FLUX) {
+        /* flux draws the shared lattice (ensure_lattice), not the per-shaft grid captured here */
+        st = gr_fail(err, GR_E_INPUT, "shafts.variant = flux: the vertex capture takes the seed and path variants");
+        goto done;
+    }
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
     if (!r->prog_capture) {
         static const char *const varyings[] = {"v_world", "v_intensity"};
@@ -1357,6 +1362,7 @@ const gr_technique_class gr_shafts_class = {
     .origin = "built-in",
     .gain_key = "intensity", /* final pass: (bias + shafts) x intensity x phase (seed, second pass) */
     .ladder = shafts_ladder,
+    .tune_keys = "K,extinction,shaft_width,g", /* spacing, attenuation, gaps, phase: the beams' look */
     .n_ladder = (int)(sizeof shafts_ladder / sizeof shafts_ladder[0]),
     .check = tech_check,
     .resolve = tech_resolve,

@@ -13,6 +13,7 @@
 #include "realtime/radial_blur.h"
 #include "realtime/slicing.h"
 #include "realtime/froxel.h"
+#include "realtime/lightrays.h"
 
 static const gr_technique_class *const builtins[] = {
     &gr_shafts_class,
@@ -20,6 +21,7 @@ static const gr_technique_class *const builtins[] = {
     &gr_radial_blur_local_class,
     &gr_slicing_class,
     &gr_froxel_class,
+    &gr_light_rays_class,
 };
 
 /* ---- registry ------------------------------------------------------------------------- */

@@ -66,6 +66,9 @@ struct gr_technique_class {
      * (NULL / 0: the scene's settings only). */
     const gr_technique_level *ladder;
     int n_ladder;
+    /* The settings `godrays tune` tunes when --params is not given, "KEY,KEY,..." (NULL: every
+     * setting with a tuning box except gain_key). */
+    const char *tune_keys;
 
     /* Checks across settings beyond each one's range (e.g. N >= 2 and a target that fits).
      * May be NULL. Errors name "NAME.KEY" and the reason (GR_E_INPUT). */

@@ -16,6 +16,7 @@
 #include "core/optics.h"
 #include "gl/gl.h"
 #include "realtime/frame.h"
+#include "realtime/readback.h"
 #include "realtime/scenegl.h"
 
 #define UT_MAX_SETTINGS 64
@@ -1286,8 +1287,7 @@ typedef struct ut_state {
     GLuint q_samples[UT_MAX_PASSES];
     gr_gl_timer timer;
     int timer_ready;
-    float *readback;
-    size_t readback_cap;
+    gr_readback rb;
     /* what the last render did, for metadata */
     long long samples[UT_MAX_PASSES];
     int last_w[UT_MAX_TARGETS], last_h[UT_MAX_TARGETS];
@@ -1388,7 +1388,7 @@ static void ut_destroy(void *state)
     if (s->q_samples[0]) glDeleteQueries(s->m->n_passes, s->q_samples);
     if (s->timer_ready) gr_gl_timer_free(&s->timer);
     gr_scenegl_destroy(s->sgl);
-    free(s->readback);
+    gr_readback_free(&s->rb);
     free(s);
 }
 
@@ -1676,21 +1676,7 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
     }
 
     /* read the output target back (GL rows bottom-up; gr_image top row first) */
-    size_t need = (size_t)W * (size_t)H * 4;
-    if (need > s->readback_cap) {
-        float *nb = realloc(s->readback, need * sizeof *nb);
-        if (!nb) {
-            st = gr_fail(err, GR_E_NOMEM, "%s: out of memory for the readback", m->name);
-            goto unbind;
-        }
-        s->readback = nb;
-        s->readback_cap = need;
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo[m->output]);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, W, H, GL_RGBA, GL_FLOAT, s->readback);
-    if ((st = gr_gl_check("readback", err)) != GR_OK) {
+    if ((st = gr_readback_fbo(&s->rb, s->fbo[m->output], W, H, "readback", err)) != GR_OK) {
         gr_error_prefix(err, "%s: output '%s'", m->name, m->targets[m->output].name);
         goto unbind;
     }
@@ -1705,22 +1691,9 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
             writers++;
         }
     }
-    size_t bad = 0, nonzero = 0;
-    for (int y = 0; y < H; y++) {
-        const float *src = s->readback + (size_t)(H - 1 - y) * (size_t)W * 4;
-        for (int x = 0; x < W; x++) {
-            float *px = gr_image_pixel(out, x, y);
-            for (int c = 0; c < 3; c++) {
-                float v = src[(size_t)x * 4 + (size_t)c];
-                if (!isfinite(v)) {
-                    bad++;
-                    v = 0;
-                }
-                if (v != 0) nonzero++;
-                px[ch[c]] = v;
-            }
-        }
-    }
+    size_t bad = gr_readback_to_rgb(&s->rb, out), nonzero = 0;
+    for (size_t i = 0; i < (size_t)W * H * 4 && !nonzero; i++)
+        nonzero = i % 4 != 3 && isfinite(s->rb.rgba[i]) && s->rb.rgba[i] != 0;
     /* Never a silently wrong image (docs/techniques.md "Errors"). */
     if (drawn == 0) {
         st = gr_fail(err, GR_E_RUNTIME, "%s: output '%s': its pass%s drew no fragment (check the draw's vertex count, gl_Position and discard)",

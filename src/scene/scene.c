@@ -227,15 +227,11 @@ static gr_status get_int(vctx *c, const cJSON *obj, const char *parent, const ch
     return GR_OK;
 }
 
-/* [x, y, z]: exactly three finite numbers. */
-static gr_status get_vec3(vctx *c, const cJSON *obj, const char *parent, const char *key, double out[3])
+/* The three numbers of an array already checked to hold three items; out is written only
+ * when all three are finite numbers. */
+static gr_status three_numbers(vctx *c, const cJSON *v, const char *p, double out[3])
 {
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    char p[320], pe[340], got[80];
-    if (!v) return GR_OK;
-    join(p, sizeof p, parent, key);
-    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
-        return vfail(c, p, "must be an array of 3 numbers, got %s", got_text(v, got, sizeof got));
+    char pe[340];
     double tmp[3];
     for (int i = 0; i < 3; i++) {
         snprintf(pe, sizeof pe, "%s[%d]", p, i);
@@ -246,10 +242,22 @@ static gr_status get_vec3(vctx *c, const cJSON *obj, const char *parent, const c
     return GR_OK;
 }
 
+/* [x, y, z]: exactly three finite numbers. */
+static gr_status get_vec3(vctx *c, const cJSON *obj, const char *parent, const char *key, double out[3])
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    char p[320], got[80];
+    if (!v) return GR_OK;
+    join(p, sizeof p, parent, key);
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
+        return vfail(c, p, "must be an array of 3 numbers, got %s", got_text(v, got, sizeof got));
+    return three_numbers(c, v, p, out);
+}
+
 /* RGB: [r, g, b] or one number for all three channels. */
 static gr_status rgb_value(vctx *c, const cJSON *v, const char *p, double out[3])
 {
-    char pe[340], got[80];
+    char got[80];
     if (cJSON_IsNumber(v)) {
         double d;
         gr_status st = number_value(c, v, p, &d);
@@ -259,14 +267,7 @@ static gr_status rgb_value(vctx *c, const cJSON *v, const char *p, double out[3]
     }
     if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
         return vfail(c, p, "must be [r, g, b] or one number, got %s", got_text(v, got, sizeof got));
-    double tmp[3];
-    for (int i = 0; i < 3; i++) {
-        snprintf(pe, sizeof pe, "%s[%d]", p, i);
-        gr_status st = number_value(c, cJSON_GetArrayItem(v, i), pe, &tmp[i]);
-        if (st) return st;
-    }
-    memcpy(out, tmp, sizeof tmp);
-    return GR_OK;
+    return three_numbers(c, v, p, out);
 }
 
 static gr_status get_rgb(vctx *c, const cJSON *obj, const char *parent, const char *key, double out[3])

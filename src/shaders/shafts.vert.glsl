@@ -6,11 +6,10 @@
 
 #define MAX_WAVE_GROUPS 16
 
-layout(location = 0) in vec2 a_cell;    // cell centre, in grid cells, relative to P
+layout(location = 0) in vec2 a_cell;    // cell centre, in grid cells, relative to P (flux: lattice point)
 layout(location = 1) in vec2 a_corner;  // corner of the shaft's cross-section, +-0.5 cell
 layout(location = 2) in float a_bottom; // fraction of the extrusion length: 0 top (seed: input.length = 0),
-                                        // 1 bottom; k / slabs for the flux variant's slab boundaries
-layout(location = 3) in float a_mid;    // flux: fraction of the length at the slab's middle
+                                        // 1 bottom; b / slabs for the flux variant's lattice levels
 
 uniform vec3 u_origin;        // P - viewer (m): seed `origin`, eq. 5.5.5a
 uniform float u_spacing;      // S (m): seed `spacing`, eq. 5.5.6
@@ -31,9 +30,10 @@ uniform int u_variant;        // 0 seed, 1 path, 2 flux (docs/realtime-shafts.md
 uniform float u_ratio;        // path: irradiance factor cos(theta_i) / cos(theta_t) / width^2 (flat water)
 uniform vec3 u_refr_flat;     // flux: T of the flat surface (cross-sections are taken across it)
 uniform float u_sun_radius_w; // flux: the sun's angular radius under water (rad), the regularizer
-uniform float u_half;         // flux: (N - 1) / 2
 uniform sampler2D u_corner_pos;  // flux: corner positions (viewer-relative) and transmittance
 uniform sampler2D u_corner_refr; // flux: corner refracted directions (shafts_corner.frag.glsl)
+uniform sampler2D u_shadow_map;  // path: the occluders' depth along the flat T (scenegl, [0,1])
+uniform float u_shadow_dz;       // path: metres per shadow depth unit; 0: shafts are not cut
 
 out vec3 v_intensity;   // seed: output.intensity (read as input.outScattering by its PS)
 out vec4 v_shadow_pos;  // seed: output.shadowmapPos
@@ -86,42 +86,34 @@ void surface(vec2 rest, out vec3 disp, out vec3 normal)
     normal = normalize(cross(t2, t1));
 }
 
+// Path: length along the refracted direction rd from the surface point p (viewer-relative)
+// to the first occluder in the shadow map (docs/realtime-shafts.md "Occluder shadows"): the
+// map stores the casters' depth along the flat T, so the caster lies (sz - z) dz metres
+// along T below p; 1e30 where no caster is stored.
+float shadow_length(vec3 p, vec3 rd)
+{
+    if (u_shadow_dz <= 0.0) return 1e30;
+    vec4 sp = u_shadow_matrix * vec4(p, 1.0);
+    float sz = textureLod(u_shadow_map, sp.xy / sp.w, 0.0).x;
+    if (sz >= 1.0) return 1e30;
+    return max(sz - sp.z / sp.w, 0.0) * u_shadow_dz / max(dot(rd, u_refr_flat), 0.1);
+}
+
 void main()
 {
     if (u_variant == 2) {
-        // Flux (docs: "flux"): the slab's irradiance across the beam is the flux through the
-        // shaft's top face, E_sun |A_top . I| T, over its cross-section across T at the slab's
-        // middle, regularized by the sun disc's blur area pi r^2, r = alpha_w s, as a smooth
-        // maximum sqrt(A^2 + (pi r^2)^2): the section where it is wide, the blur disc at a focus.
-        // The 4 corners come from the pre-pass; every vertex of a slab computes the same value.
-        ivec2 cell = ivec2(floor(a_cell + u_half));
-        vec3 q[4];
-        vec3 rd[4];
-        float trs = 0.0;
-        int own = 0;
-        for (int k = 0; k < 4; k++) {
-            ivec2 c = ivec2((k == 1 || k == 2) ? 1 : 0, (k >= 2) ? 1 : 0);
-            vec4 pt = texelFetch(u_corner_pos, 2 * cell + c, 0);
-            q[k] = pt.xyz;
-            trs += 0.25 * pt.w;
-            rd[k] = texelFetch(u_corner_refr, 2 * cell + c, 0).xyz;
-            if ((a_corner.x > 0.0) == (c.x == 1) && (a_corner.y > 0.0) == (c.y == 1)) own = k;
-        }
-        float smid = a_mid * u_length;
-        vec3 m0 = q[0] + rd[0] * smid, m1 = q[1] + rd[1] * smid, m2 = q[2] + rd[2] * smid, m3 = q[3] + rd[3] * smid;
-        float a_top = 0.5 * abs(dot(cross(q[2] - q[0], q[3] - q[1]), u_sun_dir));
-        float a_sec = 0.5 * abs(dot(cross(m2 - m0, m3 - m1), u_refr_flat));
-        float r = u_sun_radius_w * smid;
-        float a_disc = 3.14159265 * r * r;
-        float a_eff = sqrt(a_sec * a_sec + a_disc * a_disc);
-        // each shaft carries its whole cell's flux (width^2 of the cell is drawn)
-        v_ratio = a_top * trs / max(a_eff, 1e-12) / (u_width * u_width);
-        v_tr = 1.0;
-        float lenf = a_bottom * u_length;
-        vec3 posf = q[own] + rd[own] * lenf;
+        // Flux (docs: "flux"): a_cell is the lattice point (p, q), a_bottom the level's fraction
+        // of the length; the point, its refracted direction and the length to the first
+        // occluder come from the pre-pass, the slabs' irradiance is read per face (fragment).
+        vec4 pt = texelFetch(u_corner_pos, ivec2(a_cell), 0);
+        vec4 rl = texelFetch(u_corner_refr, ivec2(a_cell), 0);
+        float lenf = a_bottom * u_length; // occluders: each slab's lit fraction (shafts_flux.frag.glsl)
+        vec3 posf = pt.xyz + rl.xyz * lenf;
         v_len = lenf;
+        v_tr = 1.0;
+        v_ratio = 1.0;
         v_intensity = vec3(0.0);
-        v_shadow_pos = u_shadow_matrix * vec4(posf, 1.0);
+        v_shadow_pos = vec4(0.0);
         v_world = posf;
         gl_Position = u_view_proj * vec4(posf, 1.0);
         gl_Position.z = 0.01;
@@ -139,6 +131,15 @@ void main()
     float len = a_bottom * u_length;
     if (a_bottom > 0.0) {
         vec3 refr = refract(u_sun_dir, normal, u_eta);
+        // path: the whole shaft ends where its centre ray meets an occluder (one length for
+        // its 4 bottom corners keeps it a closed solid: docs "Occluder shadows")
+        if (u_shadow_dz > 0.0) {
+            vec2 rest_c = a_cell * u_spacing;
+            vec3 disp_c, normal_c;
+            surface(rest_c, disp_c, normal_c);
+            vec3 top_c = u_origin + vec3(rest_c.x, 0.0, rest_c.y) + disp_c;
+            len = min(len, shadow_length(top_c, refract(u_sun_dir, normal_c, u_eta)));
+        }
         pos += refr * len;
     }
 

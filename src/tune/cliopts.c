@@ -9,10 +9,11 @@
 
 const char gr_tune_cli_help[] =
     "  -o, --output DIR     report folder (default: out/SCENE_NAME/COMMAND)\n"
-    "  --metric M           rmse (default), relmse, ssim (scored as 1 - SSIM), msrmse (mean RMSE\n"
+    "  --metric M           rmse (sweep's default), relmse, ssim (scored as 1 - SSIM), msrmse (mean RMSE\n"
     "                       after blurs at 1, 4, 16 px), all on luminance Y; flip (mean HDR-FLIP)\n"
     "                       or structure (beam-structure score in [0, 1]): docs/metrics.md\n"
-    "  --objective W        a weighted sum instead, e.g. rmse=1,structure=1,flip=0.5: each class\n"
+    "  --objective W        a weighted sum instead (tune's default: " GR_TUNE_DEFAULT_OBJECTIVE "),\n"
+    "                       e.g. rmse=1,structure=1,flip=0.5: each class\n"
     "                       dimensionless (rmse, msrmse relative to the mean reference Y), the\n"
     "                       weights normalized to sum 1 (docs/tuning.md)\n"
     "  --technique NAME     the real-time technique (default: the one the parameters name, else\n"
@@ -157,4 +158,18 @@ gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_pa
     p->fit = c->fit;
     p->normalize = c->normalize;
     return gr_tune_problem_init(p, err);
+}
+
+void gr_tune_search_defaults(gr_opt_options *o, int n_params, const double *x0)
+{
+    memset(o, 0, sizeof *o);
+    o->method = GR_OPT_NELDER_MEAD;
+    o->n_starts = 4;
+    o->x0 = x0;
+    o->max_evals = 60 + 40 * n_params;
+    o->coarse = 16 * n_params;
+    o->polish = o->max_evals;
+    o->screen = 4 * o->n_starts;
+    o->screen_evals = 20 + 10 * n_params;
+    o->seed = 0;
 }

@@ -7,6 +7,7 @@
 
 #include "common/status.h"
 #include "tune/objective.h"
+#include "tune/optimize.h"
 #include "tune/session.h"
 
 typedef struct gr_tune_cli {
@@ -39,6 +40,12 @@ gr_status gr_tune_cli_finish(gr_tune_cli *c, gr_error *err);
  * normalization, and initialized (gr_tune_problem_free it). */
 gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_params, gr_tune_session *s,
                            gr_tune_problem *p, gr_error *err);
+
+/* `godrays tune`'s default search for n_params parameters from x0 (docs/tuning.md "The
+ * optimizer"): a first stage of 16 x n_params sample points (seed 0); 16 candidates (x0 and the
+ * sample's best separated points) screened by Nelder-Mead runs of 20 + 10 n evaluations; the
+ * 4 best (x0's always) continued for up to 60 + 40 n evaluations each; a polish of as many. */
+void gr_tune_search_defaults(gr_opt_options *o, int n_params, const double *x0);
 
 /* The help text of the shared options. */
 extern const char gr_tune_cli_help[];

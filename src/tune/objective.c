@@ -95,6 +95,7 @@ double gr_tune_value(const gr_tune_problem *p, const gr_metrics_set *set)
     double sum = 0.0, wsum = 0.0;
     for (int k = 0; k < GR_TM_WEIGHTED; k++) {
         if (!(p->weights[k] > 0.0)) continue;
+        if (k == GR_TM_STRUCTURE && !set->have_structure) continue; /* no vanishing point (no_vp) */
         double v = gr_tune_metric_value(set, (gr_tune_metric)k);
         if ((k == GR_TM_RMSE || k == GR_TM_MSRMSE) && mean_y > 0) v /= mean_y;
         sum += p->weights[k] * v, wsum += p->weights[k];
@@ -112,7 +113,7 @@ static void case_options(const gr_tune_problem *p, int i, gr_metrics_options *op
         fo->mode = GR_FLIP_HDR;
         opt->flip = fo;
     }
-    if (uses(p, GR_TM_STRUCTURE)) {
+    if (uses(p, GR_TM_STRUCTURE) && !p->no_vp[i]) {
         const gr_camera *c = &p->scenes[i]->camera;
         memset(so, 0, sizeof *so);
         so->vp_x = p->vp[i][0], so->vp_y = p->vp[i][1];
@@ -180,6 +181,14 @@ gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
         for (int i = 0; i < p->n_cases; i++) {
             const gr_camera *c = &p->scenes[i]->camera;
             gr_status st = gr_structure_scene_vp(p->scenes[i], c->width, c->height, &p->vp[i][0], &p->vp[i][1], err);
+            p->no_vp[i] = 0;
+            double others = 0.0;
+            for (int k = 0; k < GR_TM_WEIGHTED; k++)
+                if (k != GR_TM_STRUCTURE) others += p->weights[k];
+            if (st == GR_E_INPUT && p->metric == GR_TM_WEIGHTED && others > 0.0) {
+                p->no_vp[i] = 1; /* the other terms carry this case */
+                continue;
+            }
             if (st != GR_OK) {
                 gr_error_prefix(err, "tuning: case %d: structure metrics", i);
                 gr_tune_problem_free(p);

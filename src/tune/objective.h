@@ -39,6 +39,11 @@ double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m);
  * finite, at least one > 0). GR_E_USAGE naming flag and the bad part. */
 gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_TM_COUNT], gr_error *err);
 
+/* `godrays tune`'s default objective (docs/tuning.md "The default objective"): the relative
+ * RMSE of Y after the scale fit (the radiance error, dominated by the low frequencies: the
+ * glow) and the beam-structure score, equal weights. */
+#define GR_TUNE_DEFAULT_OBJECTIVE "rmse=1,structure=1"
+
 /* A camera view for tuning beyond the scene's own: same position and fov, other direction. */
 typedef struct gr_tune_view {
     double yaw_deg, pitch_deg;
@@ -68,6 +73,9 @@ typedef struct gr_tune_problem {
     /* filled by gr_tune_problem_init when FLIP or structure is needed: per case, the beams'
      * vanishing point and the angle to the sun per pixel (the structure de-glow) */
     double vp[GR_TUNE_MAX_CASES][2];
+    int no_vp[GR_TUNE_MAX_CASES];       /* 1: the case's god rays have no vanishing point on its
+                                           image (sun direction across the view); a weighted
+                                           objective then leaves its structure term out there */
     float *angles[GR_TUNE_MAX_CASES];
     double stderr_bound;                /* passed to the metrics (0: default) */
     /* filled by gr_tune_problem_init */

@@ -242,3 +242,30 @@ gr_status gr_tune_param_apply(const gr_tune_param *tp, const void *base, double 
     }
     return GR_OK;
 }
+
+int gr_tune_default_params(const gr_technique_class *cls, char *buf, size_t n)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+    if (cls->tune_keys) {
+        char keys[512];
+        if (strlen(cls->tune_keys) >= sizeof keys) return -1;
+        strcpy(keys, cls->tune_keys);
+        for (char *save = NULL, *t = strtok_r(keys, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+            int w = snprintf(buf + len, n - len, "%s%s.%s", len ? "," : "", cls->name, t);
+            if (w < 0 || (size_t)w >= n - len) return -1;
+            len += (size_t)w;
+        }
+    } else {
+        const gr_param_table *t = cls->params;
+        for (size_t i = 0; i < t->count; i++) {
+            const gr_param *p = &t->params[i];
+            if (!(p->tune_hi > p->tune_lo) || (p->type != GR_PT_DOUBLE && p->type != GR_PT_RGB)) continue;
+            if (cls->gain_key && !strcmp(p->name, cls->gain_key)) continue;
+            int w = snprintf(buf + len, n - len, "%s%s.%s", len ? "," : "", cls->name, p->name);
+            if (w < 0 || (size_t)w >= n - len) return -1;
+            len += (size_t)w;
+        }
+    }
+    return len ? 0 : -1;
+}

@@ -8,16 +8,11 @@
 #   test PNG read as code/255 (--no-linearize): 51, 102, 204 -> 0.2, 0.4, 0.8: B is off by 0.2
 #   mask: 1 in the 32 leftmost columns, 0 elsewhere (1536 pixels masked out)
 set -u
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY not set}
+. "$(dirname "$0")/lib.sh"
 out=${GODRAYS_TEST_OUT:-/tmp}/compare_cli
 rm -rf "$out"
 mkdir -p "$out"
 cd "$out" || exit 1
-fail=0
-ck() { # ck DESCRIPTION COMMAND...: records a failure if COMMAND fails
-    d=$1; shift
-    if "$@"; then echo "ok: $d"; else echo "FAIL: $d"; fail=1; fi
-}
 command -v oiiotool >/dev/null || { echo "FAIL: oiiotool not found (openimageio-tools)"; exit 1; }
 
 oiiotool --create 64x48 6 --chnames R,G,B,stderr.R,stderr.G,stderr.B \

@@ -3,35 +3,14 @@
 # finite EXR for each; bad settings (scene section or --set) exit 2 with one stderr line naming
 # the setting, through the scene loader; a shader that fails to compile exits 1 with its GLSL
 # log; nothing is written then.
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-cat >"$dir/s.json" <<'JSON'
-{"name": "small", "water": {"waves": [{"amplitude_m": 0.1, "wavelength_m": 8, "direction_deg": 30}]},
- "sun": {"elevation_deg": 60, "azimuth_deg": 30},
- "medium": {"absorption_per_m": [0.3, 0.06, 0.03], "scattering_per_m": 0.03, "g": 0.8},
- "camera": {"position_m": [0, -8, 0], "yaw_deg": 30, "pitch_deg": 60, "fov_deg": 60, "width": 64, "height": 36},
- "radial_blur": {"samples": 40, "decay": 0.95}}
-JSON
-fail=0
+. "$(dirname "$0")/lib.sh"
+small_scene "$dir/s.json" 64 36 '"radial_blur": {"samples": 40, "decay": 0.95}'
 list=$("$bin" techniques) || { echo "FAIL: techniques exits $?"; fail=1; }
 for t in radial_blur radial_blur_local; do
   echo "$list" | grep -q "^$t\b\|^ *$t " || { echo "FAIL: techniques does not list $t"; fail=1; }
   "$bin" render $t "$dir/s.json" -o "$dir/$t.exr" >"$dir/out" 2>"$dir/err" || { echo "FAIL: render $t: $(cat "$dir/err")"; fail=1; }
   [ -s "$dir/$t.exr" ] || { echo "FAIL: render $t wrote no EXR"; fail=1; }
 done
-expect() {
-  want=$1; text=$2; shift 2
-  "$bin" "$@" >"$dir/out" 2>"$dir/err"
-  rc=$?
-  lines=$(wc -l <"$dir/err")
-  if [ "$rc" -ne "$want" ] || [ "$lines" -ne 1 ] || ! grep -qF -- "$text" "$dir/err" || [ -s "$dir/out" ]; then
-    echo "FAIL: $*: exit $rc (want $want), $lines stderr line(s) (want 1 containing '$text'):"
-    cat "$dir/err"; fail=1
-  else
-    echo "ok: $*: $(cat "$dir/err")"
-  fi
-}
 o="$dir/bad.exr"
 expect 2 "radial_blur.decay" render radial_blur "$dir/s.json" -o "$o" --set radial_blur.decay=0
 expect 2 "radial_blur.decay" render radial_blur "$dir/s.json" -o "$o" --set radial_blur.decay=1.5

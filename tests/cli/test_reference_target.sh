@@ -6,18 +6,11 @@
 # godrays:passes). A target that is met prints nothing under --quiet. A 16x9 image with a
 # coarse surface and 8 march steps: 64 rounds of 8 passes take about 3 s on 2 cores.
 set -u
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
+. "$(dirname "$0")/lib.sh"
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
 cd "$dir" || exit 1
 scene="$src/data/scenes/default.json"
 tiny="--size 16x9 --surface-res 32 --steps 8 --quiet"
-fail=0
-ck() {
-    d=$1; shift
-    if "$@"; then echo "ok: $d"; else echo "FAIL: $d"; fail=1; fi
-}
 
 # 1. unreachable: 1e-6
 # shellcheck disable=SC2086

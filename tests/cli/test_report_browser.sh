@@ -12,7 +12,7 @@
 # Chromium is installed by scripts/setup.sh; without it the test is skipped with a message,
 # except in CI (CI=true), where a missing browser is a failure.
 set -u
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
+. "$(dirname "$0")/lib.sh"
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
 out=${GODRAYS_TEST_OUT:-/tmp}/report_browser
 browser=""
@@ -30,11 +30,6 @@ fi
 rm -rf "$out"
 mkdir -p "$out"
 cd "$out" || exit 1
-fail=0
-ck() {
-    d=$1; shift
-    if "$@"; then echo "ok: $d"; else echo "FAIL: $d"; fail=1; fi
-}
 GODRAYS_CACHE="$out/cache" "$bin" run "$src/data/scenes/default.json" -o report --size 160x90 \
     --set reference.surface_res=64 --set reference.sun_samples=2 --set reference.batches=2 \
     --set reference.steps=16 -q >run.txt 2>&1
@@ -49,7 +44,7 @@ grep -o '<img src="[^"]*"' report/index.html | sed 's/<img src="//; s/"$//' >src
 while read -r f; do ck "image file $f exists" [ -s "report/$f" ]; done <srcs.txt
 
 profile=$(mktemp -d)
-trap 'rm -rf "$profile"' EXIT
+trap 'rm -rf "$profile" "$dir"' EXIT
 # Flags from the project's notes (dependencies.md): no sandbox (root in CI), no GPU, nothing
 # fetched in the background. A fresh profile directory per run.
 flags="--headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking

@@ -11,18 +11,13 @@
 #  - a run written after them links DIR/sweep/index.html and DIR/tune/index.html (files that
 #    exist) and still gives the pareto command.
 set -u
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
+. "$(dirname "$0")/lib.sh"
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
 out=${GODRAYS_TEST_OUT:-/tmp}/report_links
 rm -rf "$out"
 mkdir -p "$out"
 cd "$out" || exit 1
 export GODRAYS_CACHE="$out/cache"
-fail=0
-ck() {
-    d=$1; shift
-    if "$@"; then echo "ok: $d"; else echo "FAIL: $d"; fail=1; fi
-}
 scene="$src/data/scenes/default.json"
 rep="rep x"
 small="--size 32x18 --set reference.surface_res=16 --set reference.sun_samples=1 --set reference.batches=2 --set reference.steps=4"

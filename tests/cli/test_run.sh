@@ -9,17 +9,12 @@
 #    $GODRAYS_CACHE only warns;
 #  - the default output folder out/<scene name>.
 set -u
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
+. "$(dirname "$0")/lib.sh"
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
 out=${GODRAYS_TEST_OUT:-/tmp}/run_cli
 rm -rf "$out"
 mkdir -p "$out"
 cd "$out" || exit 1
-fail=0
-ck() { # ck DESCRIPTION COMMAND...: records a failure if COMMAND fails
-    d=$1; shift
-    if "$@"; then echo "ok: $d"; else echo "FAIL: $d"; fail=1; fi
-}
 scene="$src/data/scenes/default.json"
 small="--size 160x90 --set reference.surface_res=64 --set reference.sun_samples=2 --set reference.batches=2 --set reference.steps=16"
 export GODRAYS_CACHE="$out/cache"

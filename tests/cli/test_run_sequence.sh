@@ -10,17 +10,12 @@
 #  - frame 0 of the sequence is the frame index.html compares (same rel. RMSE after the fit);
 #  - index.html links the sequence page; bad --frames/--times/--fps are usage errors (exit 2).
 set -u
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
+. "$(dirname "$0")/lib.sh"
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
 out=${GODRAYS_TEST_OUT:-/tmp}/run_sequence
 rm -rf "$out"
 mkdir -p "$out"
 cd "$out" || exit 1
-fail=0
-ck() {
-    d=$1; shift
-    if "$@"; then echo "ok: $d"; else echo "FAIL: $d"; fail=1; fi
-}
 scene="$src/data/scenes/default.json"
 small="--size 96x54 --set reference.surface_res=64 --set reference.sun_samples=2 --set reference.batches=2
        --set reference.steps=16"

@@ -7,25 +7,8 @@
 #    technique, a --technique-dir that cannot be loaded, an unknown option;
 #  - `render NAME` writes the EXR (its metadata names the technique and every setting) and its
 #    PNG preview, and `godrays shafts` is `render shafts`: the same pixels.
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
+. "$(dirname "$0")/lib.sh"
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-fail=0
-ck() { d=$1; shift; if "$@"; then echo "ok: $d"; else echo "FAIL: $d"; fail=1; fi; }
-# expect CODE TEXT ARGS...: exit CODE, exactly one stderr line containing TEXT, empty stdout
-expect() {
-  want=$1; text=$2; shift 2
-  "$bin" "$@" >"$dir/out" 2>"$dir/err"
-  rc=$?
-  lines=$(wc -l <"$dir/err")
-  if [ "$rc" -ne "$want" ] || [ "$lines" -ne 1 ] || ! grep -qF -- "$text" "$dir/err" || [ -s "$dir/out" ]; then
-    echo "FAIL: $*: exit $rc (want $want), $lines stderr line(s) (want 1 containing '$text'):"
-    cat "$dir/err"; fail=1
-  else
-    echo "ok: $*: $(cat "$dir/err")"
-  fi
-}
 
 "$bin" techniques >"$dir/list.txt" 2>"$dir/list.err"
 ck "techniques exits 0" [ $? -eq 0 ]

@@ -3,7 +3,7 @@
  * default settings, no scale fit, against the ground truth rendered here by the reference integrator (on flat
  * water its march samples the closed form of Oracle 1 exactly): relative RMSE (pooled RGB
  * RMSE over the mean of the reference) below 5 % for slicing and froxel (10 % for light
- * rays when registered), and the same scene rendered twice gives the same bytes. */
+ * rays, light_rays), and the same scene rendered twice gives the same bytes. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,7 +36,7 @@ int main(void)
     ref_render(s, NULL, &ref);
     gr_gl *gl = NULL;
     CHECK_OK(gr_gl_create(NULL, &gl, &err), err);
-    static const char *const names[3] = {"slicing", "froxel", "lightrays"};
+    static const char *const names[3] = {"slicing", "froxel", "light_rays"};
     static const double limit[3] = {0.05, 0.05, 0.10};
     for (int k = 0; k < 3; k++) {
         const gr_technique_class *cls = gr_technique_find(names[k]);

@@ -1,0 +1,436 @@
+/* Light rays as line primitives (seed 001, Hu et al. 2010; lightrays.h,
+ * docs/volume-techniques.md "Light rays"). */
+#include "realtime/lightrays.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/optics.h"
+#include "gl/gl.h"
+#include "realtime/frame.h"
+#include "realtime/scenegl.h"
+
+#define MAX_RAYS 4096
+#define MAX_CELLS 2048
+#define LR(f) offsetof(gr_light_rays_settings, f)
+static const char *const footprint_names[] = {"prism", "ribbon", NULL};
+
+static const gr_param params[] = {
+    {.name = "rays", .type = GR_PT_INT, .offset = LR(rays), .min = 8, .max = MAX_RAYS, .def = 512, .unit = "texels",
+     .doc = "texels per side of the sun's view of the water: rays^2 lines"},
+    {.name = "footprint", .type = GR_PT_ENUM, .offset = LR(footprint), .min = 0, .max = 1, .def = GR_LIGHT_RAYS_PRISM,
+     .enum_names = footprint_names, .unit = "",
+     .doc = "prism: each pixel's ray through the line's beam, integrated exactly; ribbon: a camera-facing sheet"},
+    {.name = "kernel", .type = GR_PT_INT, .offset = LR(kernel), .min = 1, .max = 8, .def = 1, .unit = "texels",
+     .doc = "each line's beam is kernel x kernel texels wide, with 1 / kernel^2 of the flux per area (smooths waves)"},
+    {.name = "line_width", .type = GR_PT_DOUBLE, .offset = LR(line_width), .min = 0, .max = 64, .flags = GR_PF_MIN_EXCL,
+     .def = 1, .unit = "px",
+     .doc = "pixels added to the prism's screen cover; the ribbon's least width", .tune_lo = 0.5, .tune_hi = 8.0},
+    {.name = "max_length_m", .type = GR_PT_DOUBLE, .offset = LR(max_length_m), .min = 0, .max = 1e4,
+     .flags = GR_PF_MIN_EXCL, .def = 200, .unit = "m",
+     .doc = "longest line from the surface (the seabed and the occluders end them first)",
+     .tune_lo = 5.0, .tune_hi = 200.0},
+    {.name = "margin_m", .type = GR_PT_DOUBLE, .offset = LR(margin_m), .min = 0, .max = 1e4, .def = 1, .unit = "m",
+     .doc = "border of the sun's view around the surface that lights the visible volume"},
+    GR_VOL_PARAMS_MEDIUM(gr_light_rays_settings),
+    GR_VOL_PARAMS_LIGHT(gr_light_rays_settings),
+};
+#undef LR
+
+static const gr_param_table table = {"light_rays", params, sizeof params / sizeof params[0]};
+
+static const gr_technique_level ladder[] = {
+    {"rays=128", 1},
+    {"rays=256", 0},
+    {"rays=512", 1},
+    {"rays=1024", 0},
+};
+
+typedef struct lr_state {
+    gr_gl *gl;
+    gr_scenegl *sg;
+    GLuint prog_surf, prog_lines, vao, out_tex, out_fbo;
+    GLuint surf_tex[2], surf_depth, surf_fbo;
+    int out_w, out_h, surf_n;
+    gr_vol_locs vl;
+    GLint s_cells, s_half, s_win, s_zr, s_c, s_e1, s_e2, s_sun, s_nw, s_wa, s_wamp;
+    GLint l_pos, l_nrm, l_rays, l_vp, l_sun, l_ior, l_area, l_footprint, l_pix, l_width, l_max, l_seabed, l_eye_depth,
+        l_size, l_tmax, l_fwd, l_h1, l_h2, l_inv, l_kernel;
+    gr_gl_timer timer;
+    GLuint q_samples;
+    int n_rays;
+    double window_m;
+} lr_state;
+
+static void lr_destroy(void *state)
+{
+    lr_state *r = state;
+    if (!r) return;
+    if (r->gl && gr_gl_make_current(r->gl, NULL) == GR_OK) {
+        if (r->prog_surf) glDeleteProgram(r->prog_surf);
+        if (r->prog_lines) glDeleteProgram(r->prog_lines);
+        if (r->vao) glDeleteVertexArrays(1, &r->vao);
+        if (r->out_fbo) glDeleteFramebuffers(1, &r->out_fbo);
+        if (r->out_tex) glDeleteTextures(1, &r->out_tex);
+        if (r->surf_fbo) glDeleteFramebuffers(1, &r->surf_fbo);
+        if (r->surf_tex[0]) glDeleteTextures(2, r->surf_tex);
+        if (r->surf_depth) glDeleteTextures(1, &r->surf_depth);
+        if (r->q_samples) glDeleteQueries(1, &r->q_samples);
+        gr_gl_timer_free(&r->timer);
+    }
+    gr_scenegl_destroy(r->sg);
+    free(r);
+}
+
+static gr_status lr_create(const gr_technique_class *cls, gr_gl *gl, const gr_technique_options *opts, void **state,
+                           gr_error *err)
+{
+    (void)cls;
+    *state = NULL;
+    const char *dir = opts ? opts->shader_dir : NULL;
+    lr_state *r = calloc(1, sizeof *r);
+    if (!r) return gr_fail(err, GR_E_NOMEM, "light_rays: out of memory");
+    r->gl = gl;
+    gr_status st;
+    if ((st = gr_scenegl_create_dir(gl, dir, &r->sg, err)) != GR_OK) goto fail;
+    const gr_vol_stage surf[2] = {{GL_VERTEX_SHADER, {"lightrays_surface.vert.glsl", NULL, NULL, NULL}},
+                                  {GL_FRAGMENT_SHADER, {"lightrays_surface.frag.glsl", NULL, NULL, NULL}}};
+    const gr_vol_stage lines[3] = {
+        {GL_VERTEX_SHADER, {"lightrays.vert.glsl", NULL, NULL, NULL}},
+        {GL_GEOMETRY_SHADER, {"volume_version.glsl", "volume_common.glsl", "lightrays.geom.glsl", NULL}},
+        {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "lightrays.frag.glsl"}}};
+    if ((st = gr_vol_program(dir, surf, 2, &r->prog_surf, err)) != GR_OK) goto fail;
+    if ((st = gr_vol_program(dir, lines, 3, &r->prog_lines, err)) != GR_OK) goto fail;
+    GLuint p = r->prog_surf;
+    r->s_cells = glGetUniformLocation(p, "u_cells");
+    r->s_half = glGetUniformLocation(p, "u_half");
+    r->s_win = glGetUniformLocation(p, "u_win");
+    r->s_zr = glGetUniformLocation(p, "u_zr");
+    r->s_c = glGetUniformLocation(p, "u_c");
+    r->s_e1 = glGetUniformLocation(p, "u_e1");
+    r->s_e2 = glGetUniformLocation(p, "u_e2");
+    r->s_sun = glGetUniformLocation(p, "u_sun_dir");
+    r->s_nw = glGetUniformLocation(p, "u_n_waves");
+    r->s_wa = glGetUniformLocation(p, "u_wa");
+    r->s_wamp = glGetUniformLocation(p, "u_wamp");
+    p = r->prog_lines;
+    gr_vol_locations(p, &r->vl);
+    r->l_pos = glGetUniformLocation(p, "u_pos");
+    r->l_nrm = glGetUniformLocation(p, "u_nrm");
+    r->l_rays = glGetUniformLocation(p, "u_rays");
+    r->l_vp = glGetUniformLocation(p, "u_vp_rot");
+    r->l_sun = glGetUniformLocation(p, "u_sun_dir");
+    r->l_ior = glGetUniformLocation(p, "u_ior");
+    r->l_area = glGetUniformLocation(p, "u_texel_area");
+    r->l_footprint = glGetUniformLocation(p, "u_footprint");
+    r->l_fwd = glGetUniformLocation(p, "u_fwd");
+    r->l_h1 = glGetUniformLocation(p, "u_h1");
+    r->l_h2 = glGetUniformLocation(p, "u_h2");
+    r->l_inv = glGetUniformLocation(p, "u_inv_vp_rot");
+    r->l_kernel = glGetUniformLocation(p, "u_kernel");
+    r->l_pix = glGetUniformLocation(p, "u_pix");
+    r->l_width = glGetUniformLocation(p, "u_line_width");
+    r->l_max = glGetUniformLocation(p, "u_max_len");
+    r->l_seabed = glGetUniformLocation(p, "u_seabed");
+    r->l_eye_depth = glGetUniformLocation(p, "u_eye_depth");
+    r->l_size = glGetUniformLocation(p, "u_size");
+    r->l_tmax = glGetUniformLocation(p, "u_tmax");
+    glGenVertexArrays(1, &r->vao);
+    glGenQueries(1, &r->q_samples);
+    gr_gl_timer_init(&r->timer);
+    if ((st = gr_gl_check("light_rays setup", err)) != GR_OK) goto fail;
+    *state = r;
+    return GR_OK;
+fail:
+    lr_destroy(r);
+    return st;
+}
+
+/* The sun's view of the surface: position and normal (RGBA32F) and a depth buffer, n x n. */
+static gr_status ensure_surface(lr_state *r, int n, gr_error *err)
+{
+    if (r->surf_fbo && r->surf_n == n) return GR_OK;
+    if (r->surf_fbo) glDeleteFramebuffers(1, &r->surf_fbo);
+    if (r->surf_tex[0]) glDeleteTextures(2, r->surf_tex);
+    if (r->surf_depth) glDeleteTextures(1, &r->surf_depth);
+    r->surf_fbo = r->surf_depth = r->surf_tex[0] = r->surf_tex[1] = 0;
+    r->surf_n = 0;
+    glGenTextures(2, r->surf_tex);
+    for (int i = 0; i < 2; i++) {
+        glBindTexture(GL_TEXTURE_2D, r->surf_tex[i]);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, n, n);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    glGenTextures(1, &r->surf_depth);
+    glBindTexture(GL_TEXTURE_2D, r->surf_depth);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT32F, n, n);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &r->surf_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->surf_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, r->surf_tex[0], 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, r->surf_tex[1], 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, r->surf_depth, 0);
+    const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, bufs);
+    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (fs != GL_FRAMEBUFFER_COMPLETE)
+        return gr_fail(err, GR_E_GL, "light_rays.rays: surface target %dx%d incomplete", n, n);
+    r->surf_n = n;
+    return gr_gl_check("light_rays.rays: surface target", err);
+}
+
+/* The light's window: the square (in the plane across the sun's direction I, frame e1, e2)
+ * that holds the surface points whose refracted rays can reach the visible volume. Points of
+ * the volume (rays through a 17 x 17 grid, 9 distances each, to the surface / seabed / cutoff)
+ * are carried back up the flat refracted sun to the rest plane and projected along I; the
+ * waves' displacement and tilt widen it by a margin. All eye-relative. */
+typedef struct lr_window {
+    double c[3], e1[3], e2[3];
+    double half_m;   /* the window's half side */
+    double mesh_m;   /* the grid's half side (covers the window after displacement) */
+    double zr;       /* depth half range along I */
+} lr_window;
+
+static void make_window(const gr_scene *scene, const gr_frame *f, const gr_light_rays_settings *s, double t_max,
+                        lr_window *w)
+{
+    const double *I = f->sun_dir, *T = f->refr_dir;
+    double a[3] = {0, 1, 0};
+    if (fabs(I[1]) > 0.9) a[0] = 1, a[1] = 0;
+    double e1[3] = {I[1] * a[2] - I[2] * a[1], I[2] * a[0] - I[0] * a[2], I[0] * a[1] - I[1] * a[0]};
+    double n1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    for (int k = 0; k < 3; k++) e1[k] /= n1;
+    double e2[3] = {I[1] * e1[2] - I[2] * e1[1], I[2] * e1[0] - I[0] * e1[2], I[0] * e1[1] - I[1] * e1[0]};
+    double rest = f->rest_height_m - f->eye[1], mu = -T[1];
+    double rot[16], ip[16];
+    gr_frame_view_proj_rot(f, rot);
+    int have_inv = gr_mat4_inverse(rot, ip) == 0;
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300}, dmax = 0.0;
+    for (int j = 0; j <= 16; j++)
+        for (int i = 0; i <= 16; i++) {
+            double dir[3] = {f->forward[0], f->forward[1], f->forward[2]};
+            if (have_inv) {
+                double clip[4] = {-1.0 + i / 8.0, -1.0 + j / 8.0, 1.0, 1.0}, q[4];
+                gr_mat4_apply(ip, clip, q);
+                double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+                for (int k = 0; k < 3; k++) dir[k] = q[k] / n;
+            }
+            double tend = t_max;
+            if (dir[1] > 1e-9) tend = fmin(tend, rest / dir[1]);
+            if (scene->has_seabed && dir[1] < -1e-9) tend = fmin(tend, (f->seabed_y - f->eye[1]) / dir[1]);
+            for (int m = 0; m <= 8; m++) {
+                double t = tend * m / 8.0, x[3] = {dir[0] * t, dir[1] * t, dir[2] * t};
+                double d = rest - x[1]; /* depth below the rest height */
+                if (d < 0) d = 0;
+                if (d / mu > s->max_length_m) continue; /* no line reaches it */
+                if (d > dmax) dmax = d;
+                double xs[3] = {x[0] - T[0] * d / mu, rest, x[2] - T[2] * d / mu};
+                double u = xs[0] * e1[0] + xs[1] * e1[1] + xs[2] * e1[2];
+                double v = xs[0] * e2[0] + xs[1] * e2[1] + xs[2] * e2[2];
+                lo[0] = fmin(lo[0], u), hi[0] = fmax(hi[0], u);
+                lo[1] = fmin(lo[1], v), hi[1] = fmax(hi[1], v);
+            }
+        }
+    if (!(hi[0] >= lo[0])) lo[0] = hi[0] = lo[1] = hi[1] = 0.0;
+    /* waves: displacement up to sum A (both ways), tilted rays drift by about slope (1 - 1/n)
+     * per metre of depth */
+    double amp = 0.0, slope = 0.0;
+    for (int i = 0; i < scene->water.n_waves; i++) {
+        amp += scene->water.waves[i].amplitude_m;
+        slope += scene->water.waves[i].amplitude_m * f->waves_a[i][2];
+    }
+    double margin = s->margin_m + 2.0 * amp / fabs(I[1]) + fmin(slope, 1.0) * (1.0 - 1.0 / f->ior) * dmax / mu;
+    double cu = 0.5 * (lo[0] + hi[0]), cv = 0.5 * (lo[1] + hi[1]);
+    w->half_m = 0.5 * fmax(hi[0] - lo[0], hi[1] - lo[1]) + margin;
+    if (!(w->half_m > 0.01)) w->half_m = 0.01;
+    /* the centre: the rest-plane point whose projection along I is (cu, cv) */
+    double q[3];
+    for (int k = 0; k < 3; k++) q[k] = e1[k] * cu + e2[k] * cv;
+    double t = (rest - q[1]) / I[1];
+    for (int k = 0; k < 3; k++) {
+        w->c[k] = q[k] + I[k] * t;
+        w->e1[k] = e1[k];
+        w->e2[k] = e2[k];
+    }
+    w->mesh_m = w->half_m + 2.0 * amp / fabs(I[1]) + 2.0 * amp;
+    double horiz = sqrt(I[0] * I[0] + I[2] * I[2]) / fabs(I[1]);
+    w->zr = 1.5 * w->mesh_m * horiz + 4.0 * (amp + 1.0) / fabs(I[1]);
+}
+
+static gr_status lr_check(const gr_technique_class *cls, const void *settings, gr_error *err)
+{
+    return gr_param_validate(cls->params, settings, 1, err);
+}
+
+enum { P_SURFACE = GR_VOL_PASS_CAUSTICS, P_LINES };
+
+static gr_status lr_render(void *state, const gr_scene *scene, const void *settings, gr_image *out,
+                           gr_technique_stats *stats, gr_error *err)
+{
+    lr_state *r = state;
+    const gr_light_rays_settings *s = settings;
+    gr_vol_prep prep;
+    gr_status st = gr_vol_prepare("light_rays", r->gl, r->sg, NULL, &r->timer, scene, &s->vol, out, &prep, err);
+    if (st != GR_OK) return st;
+    const gr_frame *f = &prep.frame;
+    int W = f->width, H = f->height, N = s->rays;
+    if ((st = gr_vol_target(&r->out_tex, &r->out_fbo, &r->out_w, &r->out_h, W, H, "light_rays", err)) != GR_OK)
+        return st;
+    if ((st = ensure_surface(r, N, err)) != GR_OK) return st;
+    lr_window win;
+    make_window(scene, f, s, prep.t_max, &win);
+    int cells = (int)ceil(N * win.mesh_m / win.half_m);
+    if (cells > MAX_CELLS) cells = MAX_CELLS;
+
+    /* pass 1: the surface from the sun */
+    float wa[GR_MAX_WAVES * 4], wamp[GR_MAX_WAVES];
+    memset(wa, 0, sizeof wa);
+    memset(wamp, 0, sizeof wamp);
+    for (int i = 0; i < scene->water.n_waves; i++) {
+        const gr_wave *wv = &scene->water.waves[i];
+        double dx = f->waves_a[i][0], dz = f->waves_a[i][1], k = f->waves_a[i][2];
+        /* phase = k dir . (eye + x) - w t + phi0 (seed eq. 5.5.7): the constant in double */
+        double cst = fmod(k * (dx * f->eye[0] + dz * f->eye[2]) - wv->omega_rad_s * f->time_s + wv->phase_rad,
+                          2.0 * GR_PI);
+        wa[i * 4 + 0] = (float)dx;
+        wa[i * 4 + 1] = (float)dz;
+        wa[i * 4 + 2] = (float)k;
+        wa[i * 4 + 3] = (float)cst;
+        wamp[i] = (float)wv->amplitude_m;
+    }
+    gr_gl_timer_begin(&r->timer, P_SURFACE);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->surf_fbo);
+    glViewport(0, 0, N, N);
+    glClearColor(0, 0, 0, 0);
+    glClearDepth(1.0);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glUseProgram(r->prog_surf);
+    glUniform1i(r->s_cells, cells);
+    glUniform1f(r->s_half, (float)win.mesh_m);
+    glUniform1f(r->s_win, (float)win.half_m);
+    glUniform1f(r->s_zr, (float)win.zr);
+    glUniform3f(r->s_c, (float)win.c[0], (float)win.c[1], (float)win.c[2]);
+    glUniform3f(r->s_e1, (float)win.e1[0], (float)win.e1[1], (float)win.e1[2]);
+    glUniform3f(r->s_e2, (float)win.e2[0], (float)win.e2[1], (float)win.e2[2]);
+    glUniform3f(r->s_sun, (float)f->sun_dir[0], (float)f->sun_dir[1], (float)f->sun_dir[2]);
+    glUniform1i(r->s_nw, scene->water.n_waves);
+    glUniform4fv(r->s_wa, GR_MAX_WAVES, wa);
+    glUniform1fv(r->s_wamp, GR_MAX_WAVES, wamp);
+    glBindVertexArray(r->vao);
+    glDrawArrays(GL_TRIANGLES, 0, cells * cells * 6);
+    glDisable(GL_DEPTH_TEST);
+    gr_gl_timer_end(&r->timer);
+
+    /* pass 2: one ribbon per texel into the eye's view, additive */
+    double rot[16], inv[16];
+    gr_frame_view_proj_rot(f, rot);
+    if (gr_mat4_inverse(rot, inv) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection");
+    float m[16], mi[16];
+    gr_frame_matf(rot, m);
+    gr_frame_matf(inv, mi);
+    double texel = 2.0 * win.half_m / N, h[2][3];
+    /* the texel's edges carried along the sun to the rest plane: h = a - I a.y / I.y */
+    for (int k = 0; k < 3; k++) {
+        h[0][k] = texel * (win.e1[k] - f->sun_dir[k] * win.e1[1] / f->sun_dir[1]);
+        h[1][k] = texel * (win.e2[k] - f->sun_dir[k] * win.e2[1] / f->sun_dir[1]);
+    }
+    gr_gl_timer_begin(&r->timer, P_LINES);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    glViewport(0, 0, W, H);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glUseProgram(r->prog_lines);
+    gr_vol_set(&r->vl, &prep.in);
+    glUniform1i(r->l_pos, 5);
+    glUniform1i(r->l_nrm, 6);
+    glUniform1i(r->l_rays, N);
+    glUniformMatrix4fv(r->l_vp, 1, GL_FALSE, m);
+    glUniform3f(r->l_sun, (float)f->sun_dir[0], (float)f->sun_dir[1], (float)f->sun_dir[2]);
+    glUniform1f(r->l_ior, (float)f->ior);
+    glUniform1f(r->l_area, (float)(texel * texel));
+    glUniform1i(r->l_footprint, s->footprint);
+    glUniform1f(r->l_kernel, (float)s->kernel);
+    glUniform3f(r->l_fwd, (float)f->forward[0], (float)f->forward[1], (float)f->forward[2]);
+    glUniform3f(r->l_h1, (float)h[0][0], (float)h[0][1], (float)h[0][2]);
+    glUniform3f(r->l_h2, (float)h[1][0], (float)h[1][1], (float)h[1][2]);
+    glUniformMatrix4fv(r->l_inv, 1, GL_FALSE, mi);
+    glUniform1f(r->l_pix, (float)(2.0 * tan(0.5 * f->fov_y_rad) / H));
+    glUniform1f(r->l_width, (float)s->line_width);
+    glUniform1f(r->l_max, (float)s->max_length_m);
+    glUniform1f(r->l_seabed, scene->has_seabed ? (float)(f->seabed_y - f->eye[1]) : -1e30f);
+    glUniform1i(r->l_eye_depth, 1);
+    glUniform2f(r->l_size, (float)W, (float)H);
+    glUniform1f(r->l_tmax, (float)prep.t_max);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, prep.depth_tex);
+    glActiveTexture(GL_TEXTURE5);
+    glBindTexture(GL_TEXTURE_2D, r->surf_tex[0]);
+    glActiveTexture(GL_TEXTURE6);
+    glBindTexture(GL_TEXTURE_2D, r->surf_tex[1]);
+    glActiveTexture(GL_TEXTURE0);
+    glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
+    glDrawArrays(GL_POINTS, 0, N * N);
+    glEndQuery(GL_SAMPLES_PASSED);
+    glDisable(GL_BLEND);
+    gr_gl_timer_end(&r->timer);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    r->n_rays = N;
+    r->window_m = 2.0 * win.half_m;
+    st = gr_vol_readback(r->out_fbo, W, H, out, "light_rays readback", err);
+    if (st != GR_OK) return st;
+    if (stats) {
+        static const char *const names[4] = {"shadow", "eye_depth", "surface", "lines"};
+        gr_vol_stats(stats, &r->timer, names, 4, r->q_samples, prep.t0_ms);
+    }
+    return gr_image_check_finite(out, "light_rays", err);
+}
+
+static void lr_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)
+{
+    const lr_state *r = state;
+    (void)stats;
+    snprintf(buf, n, "%d x %d lines over a %.1f m window (%.1f cm a texel)", r->n_rays, r->n_rays, r->window_m,
+             100.0 * r->window_m / (r->n_rays > 0 ? r->n_rays : 1));
+}
+
+static gr_status lr_metadata(void *state, const gr_scene *scene, const void *settings,
+                             const gr_technique_stats *stats, gr_metadata *meta, gr_error *err)
+{
+    const lr_state *r = state;
+    (void)scene, (void)settings, (void)stats;
+    if (gr_meta_set_double(meta, "godrays:light_rays_window_m", r->window_m) != GR_OK ||
+        gr_meta_set_int(meta, "godrays:light_rays_lines", (long long)r->n_rays * r->n_rays) != GR_OK)
+        return gr_fail(err, GR_E_NOMEM, "light_rays: out of memory for the metadata");
+    return GR_OK;
+}
+
+const gr_technique_class gr_light_rays_class = {
+    .name = "light_rays",
+    .description = "seed 001 after Hu et al. 2010: refracted sun rays as lines from the surface, additive",
+    .params = &table,
+    .settings_size = sizeof(gr_light_rays_settings),
+    .origin = "built-in",
+    .gain_key = "intensity",
+    .ladder = ladder,
+    .n_ladder = sizeof ladder / sizeof ladder[0],
+    .tune_keys = "extinction,g", /* the attenuation and the phase: line_width only sizes the cover */
+    .check = lr_check,
+    .create = lr_create,
+    .destroy = lr_destroy,
+    .render = lr_render,
+    .metadata = lr_metadata,
+    .summary = lr_summary,
+};
