@@ -105,6 +105,84 @@ double gr_beam_disc_triangle(const double v[6])
     return fabs(a) / GR_PI;
 }
 
+/* ---- the same areas without libm calls (the march's hot loop; docs/reference.md 2.4,
+ * "Fast kernel areas") ----
+ * acos by Abramowitz & Stegun 4.4.46: acos(x) = sqrt(1 - x) sum_k a_k x^k on [0, 1], |error|
+ * <= 2e-8 rad; acos(-x) = pi - acos(x). */
+static inline double acos_fast(double x)
+{
+    double ax = fabs(x);
+    double p = -0.0012624911;
+    p = p * ax + 0.0066700901;
+    p = p * ax - 0.0170881256;
+    p = p * ax + 0.0308918810;
+    p = p * ax - 0.0501743046;
+    p = p * ax + 0.0889789874;
+    p = p * ax - 0.2145988016;
+    p = p * ax + 1.5707963050;
+    double r = sqrt(1.0 - ax) * p;
+    return x >= 0.0 ? r : GR_PI - r;
+}
+
+double gr_beam_disc_halfplane_fast(double s)
+{
+    if (s >= 1.0) return 1.0;
+    if (s <= -1.0) return 0.0;
+    return 1.0 - (acos_fast(s) - s * sqrt(1.0 - s * s)) / GR_PI;
+}
+
+/* atan2 in float: octant reduction to a = min / max in [0, 1], then a further reduction past
+ * tan(pi/8) (atan a = pi/4 + atan((a - 1) / (a + 1))) and Cephes' atanf polynomial on
+ * [0, tan(pi/8)] (relative error ~1e-7); measured against libm in unit.ref_kernel. */
+static inline float atan2_fast(float y, float x)
+{
+    float ax = fabsf(x), ay = fabsf(y);
+    float mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
+    if (!(mx > 0.0f)) return 0.0f;
+    float a = mn / mx, base = 0.0f;
+    if (a > 0.41421356f) {
+        a = (a - 1.0f) / (a + 1.0f);
+        base = 0.78539816f;
+    }
+    float z = a * a;
+    float r = base + ((((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * a + a);
+    if (ay > ax) r = 1.57079633f - r;
+    if (x < 0.0f) r = 3.14159265f - r;
+    return y < 0.0f ? -r : r;
+}
+
+/* disc_wedge with atan2_fast */
+static double disc_wedge_fast(double ax, double ay, double bx, double by)
+{
+    double dx = bx - ax, dy = by - ay;
+    double A = dx * dx + dy * dy, B = ax * dx + ay * dy, C = ax * ax + ay * ay - 1.0;
+    double t0 = 1.0, t1 = 0.0;
+    double disc = B * B - A * C;
+    if (A > 0.0 && disc > 0.0) {
+        double sq = sqrt(disc);
+        double q = B >= 0.0 ? -(B + sq) : -(B - sq);
+        double r0 = q / A, r1 = q != 0.0 ? C / q : r0;
+        if (r0 > r1) { double x = r0; r0 = r1; r1 = x; }
+        t0 = r0 > 0.0 ? r0 : 0.0;
+        t1 = r1 < 1.0 ? r1 : 1.0;
+    }
+    if (!(t0 < t1)) return 0.5 * atan2_fast((float)(ax * by - ay * bx), (float)(ax * bx + ay * by));
+    double px = ax + t0 * dx, py = ay + t0 * dy, qx = ax + t1 * dx, qy = ay + t1 * dy;
+    double area = 0.5 * (px * qy - py * qx);
+    if (t0 > 0.0) area += 0.5 * atan2_fast((float)(ax * py - ay * px), (float)(ax * px + ay * py));
+    if (t1 < 1.0) area += 0.5 * atan2_fast((float)(qx * by - qy * bx), (float)(qx * bx + qy * by));
+    return area;
+}
+
+double gr_beam_disc_triangle_fast(const double v[6])
+{
+    double a = disc_wedge_fast(v[0], v[1], v[2], v[3]) + disc_wedge_fast(v[2], v[3], v[4], v[5]) +
+               disc_wedge_fast(v[4], v[5], v[0], v[1]);
+    return fabs(a) / GR_PI;
+}
+
+float gr_beam_atan2_fast(float y, float x) { return atan2_fast(y, x); }
+
 /* Jacobian of the refracted ray's horizontal slope (T_x / T_y, T_z / T_y) with respect to
  * the sun direction's angular offset along e1 and e2 (rad), for the surface normal n:
  * central differences of Snell's law in double (step 1e-5 rad: truncation ~1e-10,
@@ -268,7 +346,7 @@ static void beam_test(const gr_beams *b, uint32_t prim, lookup_state *s)
             if (!(cut & (cut - 1u))) {
                 /* one edge crosses the disc: the segment formula, from the centre's distance */
                 int i = cut == 1u ? 0 : cut == 2u ? 1 : 2;
-                frac = gr_beam_disc_halfplane((double)fa[i] / (double)ext[i]);
+                frac = gr_beam_disc_halfplane_fast((double)fa[i] / (double)ext[i]);
             } else {
                 /* the cross-section's vertices in kernel units, c = M^-1 (V - p) / dd */
                 double im = 1.0 / ((double)detM * dd), v[6];
@@ -277,14 +355,15 @@ static void beam_test(const gr_beams *b, uint32_t prim, lookup_state *s)
                     v[2 * i] = (M[3] * vx[i] - M[1] * vz[i]) * im;
                     v[2 * i + 1] = (M[0] * vz[i] - M[2] * vx[i]) * im;
                 }
-                frac = gr_beam_disc_triangle(v);
+                frac = gr_beam_disc_triangle_fast(v);
             }
             if (!(frac > 0.0)) return;
             /* exact: flux area(tri n K) / (|A| area(K)) <= flux / area(K); the bound is the
              * limit of a cross-section collapsed inside the kernel and guards rounding. |A|
              * in double from the same float edges as the kernel-unit vertices above. */
             double cap = (double)bt->phi / areaK, a2 = fabs((double)e1u * e2w - (double)e1w * e2u);
-            e_h = a2 > 0.0 ? (float)fmin((double)bt->phi * frac / (0.5 * a2), cap) : (float)cap;
+            double ex = a2 > 0.0 ? (double)bt->phi * frac / (0.5 * a2) : cap;
+            e_h = (float)(ex < cap ? ex : cap); /* not fmin: a libm call in this loop */
         }
     }
     /* T and the path length at the nearest point of the cross-section (clamped barycentrics) */

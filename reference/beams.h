@@ -113,5 +113,10 @@ int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 
  * v = {x0, y0, x1, y1, x2, y2} (either orientation). */
 double gr_beam_disc_halfplane(double s);
 double gr_beam_disc_triangle(const double v[6]);
+/* The same two without libm calls, as the lookups use them (polynomial acos and atan2,
+ * errors below 1e-6 of the disc: docs/reference.md 2.4), and their atan2 for the test. */
+double gr_beam_disc_halfplane_fast(double s);
+double gr_beam_disc_triangle_fast(const double v[6]);
+float gr_beam_atan2_fast(float y, float x);
 
 #endif

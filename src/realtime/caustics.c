@@ -10,6 +10,7 @@
 #include "core/optics.h"
 #include "gl/gl.h"
 #include "gl/glctx.h"
+#include "realtime/readback.h"
 #include "realtime/shaders.h"
 
 struct gr_caustics {
@@ -350,22 +351,11 @@ void gr_vol_bounds(int n, int exponential, double near_m, double far_m, double *
 
 gr_status gr_vol_readback(unsigned fbo, int w, int h, gr_image *out, const char *what, gr_error *err)
 {
-    int ch[3] = {gr_image_channel(out, "R"), gr_image_channel(out, "G"), gr_image_channel(out, "B")};
-    float *tmp = malloc((size_t)w * h * 4 * sizeof *tmp);
-    if (!tmp) return gr_fail(err, GR_E_NOMEM, "%s: out of memory for the readback", what);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, tmp);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            const float *s = tmp + ((size_t)(h - 1 - y) * w + x) * 4;
-            float *d = out->pixels + ((size_t)y * w + x) * (size_t)out->nchannels;
-            for (int c = 0; c < 3; c++) d[ch[c]] = s[c];
-        }
-    free(tmp);
-    return gr_gl_check(what, err);
+    gr_readback rb = {0};
+    gr_status st = gr_readback_fbo(&rb, fbo, w, h, what, err);
+    if (st == GR_OK) gr_readback_to_rgb(&rb, out); /* NaN/Inf: checked by the harness */
+    gr_readback_free(&rb);
+    return st;
 }
 
 /* ---- the prelude of a volume technique's render ------------------------------------------- */

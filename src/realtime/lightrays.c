@@ -23,6 +23,8 @@ static const gr_param params[] = {
     {.name = "footprint", .type = GR_PT_ENUM, .offset = LR(footprint), .min = 0, .max = 1, .def = GR_LIGHT_RAYS_PRISM,
      .enum_names = footprint_names, .unit = "",
      .doc = "prism: each pixel's ray through the line's beam, integrated exactly; ribbon: a camera-facing sheet"},
+    {.name = "kernel", .type = GR_PT_INT, .offset = LR(kernel), .min = 1, .max = 8, .def = 1, .unit = "texels",
+     .doc = "each line's beam is kernel x kernel texels wide, with 1 / kernel^2 of the flux per area (smooths waves)"},
     {.name = "line_width", .type = GR_PT_DOUBLE, .offset = LR(line_width), .min = 0, .max = 64, .flags = GR_PF_MIN_EXCL,
      .def = 1, .unit = "px",
      .doc = "pixels added to the prism's screen cover; the ribbon's least width", .tune_lo = 0.5, .tune_hi = 8.0},
@@ -55,7 +57,7 @@ typedef struct lr_state {
     gr_vol_locs vl;
     GLint s_cells, s_half, s_win, s_zr, s_c, s_e1, s_e2, s_sun, s_nw, s_wa, s_wamp;
     GLint l_pos, l_nrm, l_rays, l_vp, l_sun, l_ior, l_area, l_footprint, l_pix, l_width, l_max, l_seabed, l_eye_depth,
-        l_size, l_tmax, l_fwd, l_h1, l_h2, l_inv;
+        l_size, l_tmax, l_fwd, l_h1, l_h2, l_inv, l_kernel;
     gr_gl_timer timer;
     GLuint q_samples;
     int n_rays;
@@ -127,6 +129,7 @@ static gr_status lr_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     r->l_h1 = glGetUniformLocation(p, "u_h1");
     r->l_h2 = glGetUniformLocation(p, "u_h2");
     r->l_inv = glGetUniformLocation(p, "u_inv_vp_rot");
+    r->l_kernel = glGetUniformLocation(p, "u_kernel");
     r->l_pix = glGetUniformLocation(p, "u_pix");
     r->l_width = glGetUniformLocation(p, "u_line_width");
     r->l_max = glGetUniformLocation(p, "u_max_len");
@@ -358,6 +361,7 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
     glUniform1f(r->l_ior, (float)f->ior);
     glUniform1f(r->l_area, (float)(texel * texel));
     glUniform1i(r->l_footprint, s->footprint);
+    glUniform1f(r->l_kernel, (float)s->kernel);
     glUniform3f(r->l_fwd, (float)f->forward[0], (float)f->forward[1], (float)f->forward[2]);
     glUniform3f(r->l_h1, (float)h[0][0], (float)h[0][1], (float)h[0][2]);
     glUniform3f(r->l_h2, (float)h[1][0], (float)h[1][1], (float)h[1][2]);
@@ -422,6 +426,7 @@ const gr_technique_class gr_light_rays_class = {
     .gain_key = "intensity",
     .ladder = ladder,
     .n_ladder = sizeof ladder / sizeof ladder[0],
+    .tune_keys = "extinction,g", /* the attenuation and the phase: line_width only sizes the cover */
     .check = lr_check,
     .create = lr_create,
     .destroy = lr_destroy,

@@ -12,6 +12,7 @@
 #include "core/shaftgeom.h"
 #include "gl/gl.h"
 #include "realtime/frame.h"
+#include "realtime/readback.h"
 #include "realtime/scenegl.h"
 #include "realtime/shaders.h"
 
@@ -132,7 +133,7 @@ struct gr_shafts {
     GLuint prog_flux, flux_tex, flux_fbo;
     int flux_w, flux_h;
     GLint lf_corner_pos, lf_corner_refr, lf_tiled, lf_cells, lf_slabs, lf_length, lf_width, lf_sun_dir, lf_refr_flat,
-        lf_sun_radius_w;
+        lf_sun_radius_w, lf_shadow_matrix, lf_shadow_map, lf_shadow_bias, lf_shadows;
     GLint ls_flux_e, ls_tiled, ls_lattice, ls_cells, ls_slabs, lk_tiled;
 
     GLuint vao_empty;
@@ -144,8 +145,7 @@ struct gr_shafts {
     GLuint q_time[GR_SHAFTS_NPASS], q_samples, q_vs, q_fs;
     int have_timer, have_pipeline_stats;
 
-    float *readback;
-    size_t readback_cap;
+    gr_readback rb;
     int rendered;
 };
 
@@ -336,6 +336,10 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
     r->lf_sun_dir = glGetUniformLocation(r->prog_flux, "u_sun_dir");
     r->lf_refr_flat = glGetUniformLocation(r->prog_flux, "u_refr_flat");
     r->lf_sun_radius_w = glGetUniformLocation(r->prog_flux, "u_sun_radius_w");
+    r->lf_shadow_matrix = glGetUniformLocation(r->prog_flux, "u_shadow_matrix");
+    r->lf_shadow_map = glGetUniformLocation(r->prog_flux, "u_shadow_map");
+    r->lf_shadow_bias = glGetUniformLocation(r->prog_flux, "u_shadow_bias");
+    r->lf_shadows = glGetUniformLocation(r->prog_flux, "u_shadows");
     get_shaft_locs(r->prog_shafts, &r->ls);
     r->ls_flux_e = glGetUniformLocation(r->prog_shafts, "u_flux_e");
     r->ls_tiled = glGetUniformLocation(r->prog_shafts, "u_tiled");
@@ -409,7 +413,7 @@ void gr_shafts_destroy(gr_shafts *r)
         if (r->owns_gl) gr_gl_destroy(r->gl);
     }
     free(r->grid_cpu);
-    free(r->readback);
+    gr_readback_free(&r->rb);
     free(r->shader_dir);
     free(r);
 }
@@ -967,6 +971,10 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
             glUniform3f(r->lf_sun_dir, (float)scene->sun.dir[0], (float)scene->sun.dir[1], (float)scene->sun.dir[2]);
             glUniform3f(r->lf_refr_flat, (float)f->T.x, (float)f->T.y, (float)f->T.z);
             glUniform1f(r->lf_sun_radius_w, f->sun_radius_w);
+            glUniformMatrix4fv(r->lf_shadow_matrix, 1, GL_FALSE, f->shadow_matrix);
+            glUniform1i(r->lf_shadow_map, 0);
+            glUniform1f(r->lf_shadow_bias, f->shadow_bias_depth);
+            glUniform1i(r->lf_shadows, 1);
             glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
             glActiveTexture(GL_TEXTURE4);
             glBindTexture(GL_TEXTURE_2D, r->flux_tex);
@@ -1021,26 +1029,8 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glEndQuery(GL_TIME_ELAPSED);
 
     /* Read the layer back (GL rows bottom-up; gr_image top row first). */
-    size_t need = (size_t)f->W * (size_t)f->H * 4;
-    if (need > r->readback_cap) {
-        float *nb = realloc(r->readback, need * sizeof *nb);
-        if (!nb) {
-            st = gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the readback");
-            goto unbind;
-        }
-        r->readback = nb;
-        r->readback_cap = need;
-    }
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, f->W, f->H, GL_RGBA, GL_FLOAT, r->readback);
-    for (int y = 0; y < f->H; y++) {
-        const float *src = r->readback + (size_t)(f->H - 1 - y) * (size_t)f->W * 4;
-        for (int x = 0; x < f->W; x++) {
-            float *px = gr_image_pixel(out, x, y);
-            for (int c = 0; c < 3; c++) px[ch[c]] = src[(size_t)x * 4 + (size_t)c];
-        }
-    }
+    if ((st = gr_readback_fbo(&r->rb, r->frame_fbo, f->W, f->H, "shafts layer", err)) != GR_OK) goto unbind;
+    gr_readback_to_rgb(&r->rb, out); /* NaN/Inf: gr_image_check_finite below */
     if (stats) {
         memset(stats, 0, sizeof *stats);
         /* Every pass ran between t0 and the synchronous readback: a GPU time longer than
@@ -1081,29 +1071,10 @@ gr_status gr_shafts_read_target(gr_shafts *r, gr_image **out, gr_error *err)
     if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "shafts: no render yet, no target to read");
     gr_status st = gr_gl_make_current(r->gl, err);
     if (st != GR_OK) return st;
-    gr_image *img = gr_image_create(r->target_w, r->target_h, 4, NULL);
-    float *tmp = malloc((size_t)r->target_w * (size_t)r->target_h * 4 * sizeof *tmp);
-    if (!img || !tmp) {
-        gr_image_destroy(img);
-        free(tmp);
-        return gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the target readback");
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, r->target_w, r->target_h, GL_RGBA, GL_FLOAT, tmp);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    size_t row = (size_t)r->target_w * 4;
-    for (int y = 0; y < r->target_h; y++)
-        memcpy(img->pixels + (size_t)y * row, tmp + (size_t)(r->target_h - 1 - y) * row, row * sizeof *tmp);
-    free(tmp);
-    st = gr_gl_check("shafts target readback", err);
-    if (st != GR_OK) {
-        gr_image_destroy(img);
+    if ((st = gr_readback_fbo(&r->rb, r->target_fbo, r->target_w, r->target_h, "shafts target", err)) != GR_OK)
         return st;
-    }
-    *out = img;
-    return GR_OK;
+    *out = gr_readback_image(&r->rb);
+    return *out ? GR_OK : gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the target image");
 }
 
 gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
@@ -1117,6 +1088,11 @@ gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts
     float *data = NULL;
     if (!f) return gr_fail(err, GR_E_NOMEM, "shafts: out of memory");
     if ((st = setup_frame(scene, s, f, err)) != GR_OK) goto done;
+    if (f->s.variant == GR_SHAFTS_FLUX) {
+        /* flux draws the shared lattice (ensure_lattice), not the per-shaft grid captured here */
+        st = gr_fail(err, GR_E_INPUT, "shafts.variant = flux: the vertex capture takes the seed and path variants");
+        goto done;
+    }
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
     if (!r->prog_capture) {
         static const char *const varyings[] = {"v_world", "v_intensity"};

@@ -1,6 +1,6 @@
 /* Seed 000's real-time underwater god-ray shafts (Lanza, ShaderX^5 ch. 5.5) as an OpenGL
  * pipeline through a headless EGL context: (1) shadow map of the occluders from P along the
- * refracted sun, (2) an N x N grid of extruded shafts blended additively into a reduced
+ * refracted sun (scenegl's), (2) an N x N grid of extruded shafts blended additively into a reduced
  * render target, (3) a full-screen pass (4 bilinear taps, HG phase, bias, intensity) giving
  * the god-ray layer in linear float at the frame's resolution.
  * The renderer keeps its context, programs and buffers alive across renders: create it
@@ -116,6 +116,7 @@ gr_status gr_shafts_read_target(gr_shafts *r, gr_image **out, gr_error *err);
 
 /* Runs the shaft vertex shader alone over every grid vertex (8 per shaft) with transform
  * feedback and returns what it computed; *out is malloc'd (caller frees), *count = 8 (N-1)^2.
+ * The seed and path variants only (flux draws a shared lattice: GR_E_INPUT).
  * stats (may be NULL) receives the placement (P, T, S). */
 gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
                             gr_shafts_vertex **out, int *count, gr_shafts_stats *stats,

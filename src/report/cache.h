@@ -25,8 +25,9 @@
 #define GR_CACHE_KEY_LEN 33          /* 16 + 1 + 16 hex characters */
 #define GR_CACHE_META_KEY "godrays:cache_key"
 /* Bumped when what an entry holds changes, so older entries are rendered again: 2 = bias.R/G/B
- * channels, godrays:stderr_dof, the three-level bias probe, a checksum of the pixels. */
-#define GR_CACHE_FORMAT "godrays-reference-cache-2"
+ * channels, godrays:stderr_dof, the three-level bias probe, a checksum of the pixels; 3 = the
+ * lookups' libm-free disc areas (pixels differ in the last bits). */
+#define GR_CACHE_FORMAT "godrays-reference-cache-3"
 /* FNV-1a 64 of the pixel bytes (16 hex digits), checked on every read (docs/reliability.md) */
 #define GR_CACHE_META_CHECKSUM "godrays:pixel_fnv1a64"
 

