@@ -74,8 +74,9 @@ double gr_beam_disc_halfplane(double s)
 }
 
 /* Signed area of the unit disc n triangle(0, a, b) (the sign of cross(a, b)): the parts of
- * the segment ab inside the disc contribute triangles, the parts outside circular sectors. */
-static double disc_wedge(double ax, double ay, double bx, double by)
+ * the segment ab inside the disc contribute triangles, the parts outside circular sectors,
+ * whose angles come from at2 (atan2f, or atan2_fast in the lookups). */
+static inline double disc_wedge_with(double ax, double ay, double bx, double by, float (*at2)(float, float))
 {
     double dx = bx - ax, dy = by - ay;
     double A = dx * dx + dy * dy, B = ax * dx + ay * dy, C = ax * ax + ay * ay - 1.0;
@@ -91,12 +92,17 @@ static double disc_wedge(double ax, double ay, double bx, double by)
         t1 = r1 < 1.0 ? r1 : 1.0;
     }
     /* sectors: float atan2 (1e-7 of the disc's area, far below any other error here) */
-    if (!(t0 < t1)) return 0.5 * atan2f((float)(ax * by - ay * bx), (float)(ax * bx + ay * by)); /* all outside */
+    if (!(t0 < t1)) return 0.5 * at2((float)(ax * by - ay * bx), (float)(ax * bx + ay * by)); /* all outside */
     double px = ax + t0 * dx, py = ay + t0 * dy, qx = ax + t1 * dx, qy = ay + t1 * dy;
     double area = 0.5 * (px * qy - py * qx);
-    if (t0 > 0.0) area += 0.5 * atan2f((float)(ax * py - ay * px), (float)(ax * px + ay * py));
-    if (t1 < 1.0) area += 0.5 * atan2f((float)(qx * by - qy * bx), (float)(qx * bx + qy * by));
+    if (t0 > 0.0) area += 0.5 * at2((float)(ax * py - ay * px), (float)(ax * px + ay * py));
+    if (t1 < 1.0) area += 0.5 * at2((float)(qx * by - qy * bx), (float)(qx * bx + qy * by));
     return area;
+}
+
+static double disc_wedge(double ax, double ay, double bx, double by)
+{
+    return disc_wedge_with(ax, ay, bx, by, atan2f);
 }
 
 double gr_beam_disc_triangle(const double v[6])
@@ -154,24 +160,7 @@ static inline float atan2_fast(float y, float x)
 /* disc_wedge with atan2_fast */
 static double disc_wedge_fast(double ax, double ay, double bx, double by)
 {
-    double dx = bx - ax, dy = by - ay;
-    double A = dx * dx + dy * dy, B = ax * dx + ay * dy, C = ax * ax + ay * ay - 1.0;
-    double t0 = 1.0, t1 = 0.0;
-    double disc = B * B - A * C;
-    if (A > 0.0 && disc > 0.0) {
-        double sq = sqrt(disc);
-        double q = B >= 0.0 ? -(B + sq) : -(B - sq);
-        double r0 = q / A, r1 = q != 0.0 ? C / q : r0;
-        if (r0 > r1) { double x = r0; r0 = r1; r1 = x; }
-        t0 = r0 > 0.0 ? r0 : 0.0;
-        t1 = r1 < 1.0 ? r1 : 1.0;
-    }
-    if (!(t0 < t1)) return 0.5 * atan2_fast((float)(ax * by - ay * bx), (float)(ax * bx + ay * by));
-    double px = ax + t0 * dx, py = ay + t0 * dy, qx = ax + t1 * dx, qy = ay + t1 * dy;
-    double area = 0.5 * (px * qy - py * qx);
-    if (t0 > 0.0) area += 0.5 * atan2_fast((float)(ax * py - ay * px), (float)(ax * px + ay * py));
-    if (t1 < 1.0) area += 0.5 * atan2_fast((float)(qx * by - qy * bx), (float)(qx * bx + qy * by));
-    return area;
+    return disc_wedge_with(ax, ay, bx, by, atan2_fast);
 }
 
 double gr_beam_disc_triangle_fast(const double v[6])
