@@ -24,31 +24,13 @@
 
 #include "realtime/shafts.h"
 #include "scene/scene.h"
+#include "shafts_test.h"
 #include "tune/truth.h"
 
 static int reduced(void)
 {
     const char *v = getenv("GODRAYS_TEST_REDUCED");
     return v && v[0] && strcmp(v, "0") != 0;
-}
-
-static gr_scene *load(const char *name, int w, int h, const char *const *extra, int n_extra)
-{
-    const char *src = getenv("GODRAYS_SOURCE_DIR");
-    char path[4096], sw[64], sh[64];
-    snprintf(path, sizeof path, "%s/data/scenes/%s", src ? src : GR_SOURCE_DIR, name);
-    snprintf(sw, sizeof sw, "camera.width=%d", w);
-    snprintf(sh, sizeof sh, "camera.height=%d", h);
-    const char *sets[16] = {sw, sh};
-    int n = 2;
-    for (int i = 0; i < n_extra; i++) sets[n++] = extra[i];
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err;
-    if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
-        fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
-        exit(1);
-    }
-    return s;
 }
 
 static double y_of(const gr_image *img, size_t q, const int *ch)
@@ -108,7 +90,7 @@ static void cost(gr_shafts *r, int w, int h, const char *const *sa, int na, cons
                  double gpu[2], double cpu[2], long long frags[2])
 {
     gr_error err = {0};
-    gr_scene *sc[2] = {load("default.json", w, h, sa, na), load("default.json", w, h, sb, nb)};
+    gr_scene *sc[2] = {shafts_test_data_scene("default.json", w, h, sa, na), shafts_test_data_scene("default.json", w, h, sb, nb)};
     gr_image *img = gr_image_create(w, h, 3, NULL);
     double t[2][COST_FRAMES], c[2] = {0.0, 0.0};
     gr_shafts_stats st;
@@ -134,7 +116,7 @@ static void cost(gr_shafts *r, int w, int h, const char *const *sa, int na, cons
 static double measure(gr_shafts *r, const char *scene, int w, int h, const char *const *sets, int n, int fit)
 {
     gr_error err = {0};
-    gr_scene *s = load(scene, w, h, sets, n);
+    gr_scene *s = shafts_test_data_scene(scene, w, h, sets, n);
     gr_image *truth = NULL, *img = gr_image_create(w, h, 3, NULL);
     gr_truth_info info;
     double e = -1.0;

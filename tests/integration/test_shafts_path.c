@@ -13,23 +13,12 @@
 
 #include "realtime/shafts.h"
 #include "scene/scene.h"
+#include "shafts_test.h"
 #include "tune/truth.h"
 
 static gr_scene *load(const char *const *extra, int n_extra)
 {
-    const char *src = getenv("GODRAYS_SOURCE_DIR");
-    char path[4096];
-    snprintf(path, sizeof path, "%s/data/scenes/flat.json", src ? src : GR_SOURCE_DIR);
-    const char *sets[16] = {"camera.width=320", "camera.height=180"};
-    int n = 2;
-    for (int i = 0; i < n_extra; i++) sets[n++] = extra[i];
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err;
-    if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
-        fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
-        exit(1);
-    }
-    return s;
+    return shafts_test_data_scene("flat.json", 320, 180, extra, n_extra);
 }
 
 /* RMSE over R, G, B divided by the truth's mean */

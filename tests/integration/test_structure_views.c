@@ -12,6 +12,7 @@
  * absent: about 20 s each at 320 x 180 on 2 quiet cores). Slow: the reduced variant
  * (GODRAYS_TEST_REDUCED=1) runs at 160 x 90 and checks the same properties. */
 #include "check.h"
+#include "glow_test.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -52,30 +53,12 @@ static gr_scene *load(int w, int h, int side, int beams)
 /* the truth's mean colour per bin of the angle to the refracted sun, as an image */
 static gr_image *glow_of(const gr_scene *s, const gr_image *truth)
 {
-    const int w = truth->width, h = truth->height, nb = 400;
-    const double bw = 0.5;
+    const int w = truth->width, h = truth->height;
     double dir[3];
     gr_profile_sun_view_dir(s, dir);
     float *ang = malloc((size_t)w * h * sizeof(float));
     gr_profile_angles(&s->camera, dir, ang);
-    gr_radial_profile pr;
-    gr_error err;
-    gr_image *g = gr_image_create(w, h, 3, NULL);
-    CHECK_OK(gr_radial_profile_compute(truth, ang, NULL, nb, bw, 1.0, &pr, &err), err);
-    for (size_t q = 0; q < (size_t)w * h; q++) {
-        const double x = ang[q] / bw - 0.5;
-        int i0 = (int)floor(x);
-        double fr = x - i0;
-        if (i0 < 0) i0 = 0, fr = 0.0;
-        if (i0 > nb - 2) i0 = nb - 2, fr = 1.0;
-        for (int c = 0; c < 3; c++) {
-            double v0 = pr.mean[c][i0], v1 = pr.mean[c][i0 + 1];
-            if (isnan(v0)) v0 = v1;
-            if (isnan(v1)) v1 = v0;
-            g->pixels[3 * q + (size_t)c] = (float)((1.0 - fr) * v0 + fr * v1);
-        }
-    }
-    gr_radial_profile_free(&pr);
+    gr_image *g = glow_test_image(truth, ang);
     free(ang);
     return g;
 }

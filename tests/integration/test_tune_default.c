@@ -19,38 +19,12 @@
 #include <string.h>
 
 #include "check.h"
+#include "glow_test.h"
 #include "compare/structure.h"
 #include "report/profile.h"
 #include "tune/cliopts.h"
 #include "tune/truth.h"
 #include "tune_test.h"
-
-/* the truth's mean colour per bin of the angle to the refracted sun, as an image */
-static gr_image *glow_of(const gr_scene *s, const gr_image *truth, const float *ang)
-{
-    const int w = truth->width, h = truth->height, nb = 400;
-    const double bw = 0.5;
-    gr_radial_profile pr;
-    gr_error err;
-    gr_image *g = gr_image_create(w, h, 3, NULL);
-    CHECK_OK(gr_radial_profile_compute(truth, ang, NULL, nb, bw, 1.0, &pr, &err), err);
-    for (size_t q = 0; q < (size_t)w * h; q++) {
-        const double x = ang[q] / bw - 0.5;
-        int i0 = (int)floor(x);
-        double fr = x - i0;
-        if (i0 < 0) i0 = 0, fr = 0.0;
-        if (i0 > nb - 2) i0 = nb - 2, fr = 1.0;
-        for (int c = 0; c < 3; c++) {
-            double v0 = pr.mean[c][i0], v1 = pr.mean[c][i0 + 1];
-            if (isnan(v0)) v0 = v1;
-            if (isnan(v1)) v1 = v0;
-            g->pixels[3 * q + (size_t)c] = (float)((1.0 - fr) * v0 + fr * v1);
-        }
-    }
-    gr_radial_profile_free(&pr);
-    (void)s;
-    return g;
-}
 
 /* docs/metrics.md: S = ((1 - corr) / 2 + min(|ln ratio|, 3) / 3 + min(LSD, 3) / 3) / 3 */
 static double score_of(const gr_structure_compare *c)
@@ -124,7 +98,7 @@ int main(void)
     CHECK_OK(gr_technique_render(r, s, st.bytes, img[0], NULL, &err), err);
     CHECK_OK(gr_tune_settings_at(p, res.x, st.bytes, &err), err);
     CHECK_OK(gr_technique_render(r, s, st.bytes, img[1], NULL, &err), err);
-    gr_image *glow = glow_of(s, truth, ang);
+    gr_image *glow = glow_test_image(truth, ang);
     const gr_image *tests[3] = {img[0], img[1], glow};
     const char *names[3] = {"scene's settings", "tuned (default)", "featureless glow"};
     gr_structure_compare sc[3];
