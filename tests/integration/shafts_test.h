@@ -23,28 +23,6 @@ static inline gr_scene *shafts_test_scene(const char *json, const char *const *s
     return s;
 }
 
-/* Loads data/scenes/NAME (e.g. "default.json") at w x h with optional "key=value" overrides
- * (at most 14); exits the test on failure. */
-static inline gr_scene *shafts_test_data_scene(const char *name, int w, int h, const char *const *extra, int n_extra)
-{
-    const char *src = getenv("GODRAYS_SOURCE_DIR");
-    char path[4096], sw[64], sh[64];
-    snprintf(path, sizeof path, "%s/data/scenes/%s", src ? src : GR_SOURCE_DIR, name);
-    snprintf(sw, sizeof sw, "camera.width=%d", w);
-    snprintf(sh, sizeof sh, "camera.height=%d", h);
-    const char *sets[16] = {sw, sh};
-    int n = 2;
-    for (int i = 0; i < n_extra && n < 16; i++) sets[n++] = extra[i];
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err;
-    gr_technique_count(); /* the built-in techniques' sections ("shafts") */
-    if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
-        fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
-        exit(1);
-    }
-    return s;
-}
-
 static inline gr_shafts *shafts_test_renderer(void)
 {
     gr_error err;

@@ -6,21 +6,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene_test.h"
 #include "shafts_test.h"
 
 static gr_scene *load_default(const char *const *sets, int n)
 {
-    const char *src = getenv("GODRAYS_SOURCE_DIR");
-    char path[4096];
-    snprintf(path, sizeof path, "%s/data/scenes/default.json", src ? src : GR_SOURCE_DIR);
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err;
-    gr_technique_count(); /* the built-in techniques' sections ("shafts") */
-    if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
-        fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
-        exit(1);
-    }
-    return s;
+    return test_scene_file("default.json", sets, n);
 }
 
 static int same(const gr_image *a, const gr_image *b)

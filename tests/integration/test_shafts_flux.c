@@ -24,7 +24,7 @@
 
 #include "realtime/shafts.h"
 #include "scene/scene.h"
-#include "shafts_test.h"
+#include "scene_test.h"
 #include "tune/truth.h"
 
 static int reduced(void)
@@ -90,7 +90,7 @@ static void cost(gr_shafts *r, int w, int h, const char *const *sa, int na, cons
                  double gpu[2], double cpu[2], long long frags[2])
 {
     gr_error err = {0};
-    gr_scene *sc[2] = {shafts_test_data_scene("default.json", w, h, sa, na), shafts_test_data_scene("default.json", w, h, sb, nb)};
+    gr_scene *sc[2] = {test_data_scene("default.json", w, h, sa, na), test_data_scene("default.json", w, h, sb, nb)};
     gr_image *img = gr_image_create(w, h, 3, NULL);
     double t[2][COST_FRAMES], c[2] = {0.0, 0.0};
     gr_shafts_stats st;
@@ -116,7 +116,7 @@ static void cost(gr_shafts *r, int w, int h, const char *const *sa, int na, cons
 static double measure(gr_shafts *r, const char *scene, int w, int h, const char *const *sets, int n, int fit)
 {
     gr_error err = {0};
-    gr_scene *s = shafts_test_data_scene(scene, w, h, sets, n);
+    gr_scene *s = test_data_scene(scene, w, h, sets, n);
     gr_image *truth = NULL, *img = gr_image_create(w, h, 3, NULL);
     gr_truth_info info;
     double e = -1.0;

@@ -13,12 +13,12 @@
 
 #include "realtime/shafts.h"
 #include "scene/scene.h"
-#include "shafts_test.h"
+#include "scene_test.h"
 #include "tune/truth.h"
 
 static gr_scene *load(const char *const *extra, int n_extra)
 {
-    return shafts_test_data_scene("flat.json", 320, 180, extra, n_extra);
+    return test_data_scene("flat.json", 320, 180, extra, n_extra);
 }
 
 /* RMSE over R, G, B divided by the truth's mean */

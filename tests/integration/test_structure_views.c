@@ -12,6 +12,7 @@
  * absent: about 20 s each at 320 x 180 on 2 quiet cores). Slow: the reduced variant
  * (GODRAYS_TEST_REDUCED=1) runs at 160 x 90 and checks the same properties. */
 #include "check.h"
+#include "scene_test.h"
 #include "glow_test.h"
 
 #include <stdlib.h>
@@ -31,23 +32,11 @@ static int reduced(void)
 
 static gr_scene *load(int w, int h, int side, int beams)
 {
-    const char *src = getenv("GODRAYS_SOURCE_DIR");
-    char path[4096], sw[64], sh[64];
-    snprintf(path, sizeof path, "%s/data/scenes/default.json", src ? src : GR_SOURCE_DIR);
-    snprintf(sw, sizeof sw, "camera.width=%d", w);
-    snprintf(sh, sizeof sh, "camera.height=%d", h);
-    const char *sets[8] = {sw, sh};
-    int n = 2;
+    const char *sets[8];
+    int n = 0;
     if (side) sets[n++] = "camera.yaw_deg=120", sets[n++] = "camera.pitch_deg=20";
     if (beams) sets[n++] = "shafts.shaft_width=0.4", sets[n++] = "shafts.target_format=rgba16f", sets[n++] = "shafts.g=0.5";
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err;
-    gr_technique_count(); /* the built-in techniques' sections ("shafts") */
-    if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
-        fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
-        exit(1);
-    }
-    return s;
+    return test_data_scene("default.json", w, h, sets, n);
 }
 
 /* the truth's mean colour per bin of the angle to the refracted sun, as an image */

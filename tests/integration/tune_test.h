@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "scene_test.h"
 #include "realtime/shafts.h"
 #include "scene/scene.h"
 #include "tune/objective.h"
@@ -14,22 +15,7 @@
 /* The default scene (data/scenes/default.json) at w x h plus overrides; exits on failure. */
 static inline gr_scene *tune_test_default_scene(int w, int h, const char *const *extra, int n_extra)
 {
-    const char *src = getenv("GODRAYS_SOURCE_DIR");
-    char path[4096], sw[64], sh[64];
-    snprintf(path, sizeof path, "%s/data/scenes/default.json", src ? src : GR_SOURCE_DIR);
-    snprintf(sw, sizeof sw, "camera.width=%d", w);
-    snprintf(sh, sizeof sh, "camera.height=%d", h);
-    const char *sets[18] = {sw, sh};
-    int n = 2;
-    for (int i = 0; i < n_extra && n < 18; i++) sets[n++] = extra[i];
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err;
-    gr_technique_count(); /* the built-in techniques' sections ("shafts") */
-    if (!s || gr_scene_load_file(path, sets, n, s, &err) != GR_OK) {
-        fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
-        exit(1);
-    }
-    return s;
+    return test_data_scene("default.json", w, h, extra, n_extra);
 }
 
 /* The context of tune_test_renderer's instances (one per test process). */
