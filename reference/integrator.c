@@ -1,5 +1,6 @@
 #include "reference/integrator.h"
 
+#include <limits.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -31,7 +32,20 @@
 typedef gr_rng ref_rng;
 static inline ref_rng rng_make(uint64_t seed, uint64_t stream, uint64_t index) { return gr_rng_make(seed, stream, index); }
 static inline double rng_u(ref_rng *r) { return gr_rng_double(r); } /* [0, 1) */
-enum { STREAM_PASS = 1, STREAM_PIXEL0 = 16 };
+/* streams under the render's seed: 1 the passes (index: pass), 4 the step pilot's rays (index:
+ * pilot pixel), 16 + pixel the camera samples (index: sample); 2 and 3 are the benchmarks'
+ * (seed 42). The pilot's numbers are thus independent of every number of the estimate. */
+enum { STREAM_PASS = 1, STREAM_PILOT = 4, STREAM_PIXEL0 = 16 };
+/* The step pilot's beam set: a pass index no render reaches (rounds x passes <= 64 x 4096),
+ * so its grid offset is independent of the render's passes (docs/reference.md 2.5). */
+#define PILOT_PASS INT_MAX
+/* The step pilot (docs/reference.md 2.5): one ray per PILOT_STRIDE x PILOT_STRIDE block of
+ * pixels; a pixel's step noise from the mean over the (2 PILOT_RADIUS + 1)^2 pilot pixels
+ * around it; the image mean that normalizes it from every PILOT_MEAN_STRIDE-th pilot pixel
+ * in x and y (so every part of a split render computes the same mean). */
+enum { PILOT_STRIDE = 2, PILOT_RADIUS = 2, PILOT_MEAN_STRIDE = 4 };
+/* the exponent of the step-noise model V(n) = V(n0) (n0 / n)^alpha (docs/reference.md 2.5) */
+#define PILOT_ALPHA 2.0
 /* the surface-bias probe's pixel grid and passes (surface_bias_probe) */
 enum { PROBE_STRIDE = 5, PROBE_PASSES = 4 };
 
@@ -83,6 +97,12 @@ struct gr_ref_renderer {
     int bias_pw, bias_ph, bias_poff;
     double bias_block_p95;    /* 95th percentile of |block bias| / max(block mean, image mean) */
     int bias_blocks;
+    /* adaptive steps (docs/reference.md 2.5): march steps per image pixel (NULL: r->set.steps
+     * everywhere), set by the pilot for the rows [row0, row1); their statistics */
+    int *steps_px;
+    int pilot_n0;             /* the pilot's steps (0: no pilot) */
+    double steps_sum, steps_pixels, pilot_s;
+    int steps_min, steps_max;
 };
 
 void gr_ref_options_default(gr_ref_options *o)
@@ -296,6 +316,7 @@ void gr_ref_destroy(gr_ref_renderer *r)
     if (!r) return;
     gr_beams_destroy(r->beams);
     free(r->bias_px);
+    free(r->steps_px);
     gr_ref_geometry_destroy(r->geom);
     gr_rtc_destroy(r->rtc);
     free(r);
@@ -497,8 +518,6 @@ static void pixel_stratum(int j, int n, ref_rng *g, double *jx, double *jy)
     *jy = (iy + rng_u(g)) / ny;
 }
 
-/* One camera sample: L (RGB) along the ray through the jittered pixel position; the
- * sample is stratum j of the n camera samples its batch takes in this round. */
 /* Per-thread scratch memory of the march. */
 typedef struct ref_scratch {
     gr_beam_hits hits;   /* grow as needed */
@@ -532,15 +551,15 @@ static int scratch_alloc(ref_scratch *sc, int steps)
     return -1;
 }
 
-/* Returns 0, or -1 when out of memory (a growing hit list). */
-static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, ref_rng *g, double L[3],
-                         double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
+/* L (RGB) along the camera ray through the image point (fx, fy) (pixels), marched with n
+ * steps (n <= the scratch's). With ck, ck[k] receives the RGB mean of march point k's
+ * contribution to L (the step pilot). Returns 0, or -1 when out of memory (a growing hit list). */
+static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, ref_rng *g, double L[3], double *trans,
+                      double *len, ref_counters *cnt, ref_scratch *sc, double *ck)
 {
     const gr_camera *c = &r->scene.camera;
     double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), aspect = (double)c->width / (double)c->height;
-    double jx, jy;
-    pixel_stratum(j, n_strata, g, &jx, &jy);
-    gr_dvec3 dd = cam_dir(r, (2.0 * (px + jx) / c->width - 1.0) * tf * aspect, (1.0 - 2.0 * (py + jy) / c->height) * tf);
+    gr_dvec3 dd = cam_dir(r, (2.0 * fx / c->width - 1.0) * tf * aspect, (1.0 - 2.0 * fy / c->height) * tf);
     gr_vec3 d = gr_d3_to_f(dd), o = r->cam;
     L[0] = L[1] = L[2] = 0.0;
     /* where the camera ray ends: occluder or seabed, the water surface, the cutoff */
@@ -555,8 +574,9 @@ static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_
     if (!(D > 0.0f)) D = 0.0f;
     *len = D;
     *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
+    if (ck)
+        for (int k = 0; k < n; k++) ck[k] = 0.0;
     if (D == 0.0f) return 0;
-    int n = r->set.steps;
     /* March density ~ exp(-lam t) on [0, D], lam = sig_ref (1 - w_y / mu_t0): the camera
      * ray's extinction times the sunlight's extinction down to the point on flat water, so
      * the flat-water integrand is sampled exactly in proportion (Oracle 1) and the waves
@@ -599,11 +619,23 @@ static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_
                 double ex = r->sig_t[ch] * ((double)l->path + t) - lam * t;
                 /* float exp where its range suffices (per-sample work), double below that */
                 double tr = ex < 80.0 ? (double)expf((float)-ex) : ex < REF_EXP_LIMIT ? exp(-ex) : 0.0;
-                L[ch] += r->sig_s[ch] * r->E[ch] * base * tr;
+                double v = r->sig_s[ch] * r->E[ch] * base * tr;
+                L[ch] += v;
+                if (ck) ck[k] += v / 3.0;
             }
         }
     }
     return 0;
+}
+
+/* One camera sample of pixel (px, py) with n march steps: stratum j of the n_strata camera
+ * samples its batch takes in this round, jittered within it. */
+static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, int n, ref_rng *g, double L[3],
+                         double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
+{
+    double jx, jy;
+    pixel_stratum(j, n_strata, g, &jx, &jy);
+    return render_ray(r, px + jx, py + jy, n, g, L, trans, len, cnt, sc, NULL);
 }
 
 static void *worker(void *arg)
@@ -635,6 +667,7 @@ static void *worker(void *arg)
             size_t pix = (size_t)py * (size_t)job->img_w + (size_t)px; /* the image pixel: its RNG stream */
             size_t ai = (size_t)y * acc->W + x;
             double *sum = acc->sum + (ai * acc->B + job->batch) * 3;
+            int n = r->steps_px ? r->steps_px[pix] : r->set.steps; /* the pixel's steps (adaptive: the pilot's) */
             for (int s = 0; s < r->spp_pass; s++) {
                 /* Ctrl-C within about a second even at thousands of samples per pixel per pass:
                  * a volatile read every 16 samples (the row then stays unfinished: partial) */
@@ -642,7 +675,7 @@ static void *worker(void *arg)
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
-                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, &g, L, &tr, &len,
+                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, n, &g, L, &tr, &len,
                                   &cnt, &sc) != 0) {
                     oom = 1;
                     break;
@@ -917,6 +950,14 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     /* per-block bias next to the mean's (bias.R/G/B channels; 10 x 10 pixel blocks) */
     SET(gr_meta_set_double(m, "godrays:bias_block_p95_rel", r->bias_px ? finite_or(r->bias_block_p95, -1.0) : (r->flat ? 0.0 : -1.0)));
     SET(gr_meta_set_int(m, "godrays:stderr_dof", r->batches - 1));
+    /* adaptive steps (docs/reference.md 2.5): march steps per camera ray over the pixels, the
+     * pilot's steps (0: no pilot, the same steps everywhere) and its share of the wall time */
+    SET(gr_meta_set_double(m, "godrays:steps_mean", r->steps_pixels > 0.0 ? r->steps_sum / r->steps_pixels : -1.0));
+    SET(gr_meta_set_int(m, "godrays:steps_min", r->steps_min));
+    SET(gr_meta_set_int(m, "godrays:steps_max", r->steps_max));
+    SET(gr_meta_set_int(m, "godrays:pilot_steps", r->pilot_n0));
+    SET(gr_meta_set_double(m, "godrays:pilot_s", r->pilot_s));
+    SET(gr_meta_set_double(m, "godrays:pilot_share", out->wall_s > 0.0 ? r->pilot_s / out->wall_s : 0.0));
     SET(gr_meta_set_string(m, "godrays:bias_note",
                            "bias_surface_rel_est = mean |pixel bias| / image mean from the surface tessellation "
                            "(measured here with order 2, see bias_surface_probe; bound = max(2x the estimate, the figure with "
@@ -984,6 +1025,191 @@ static gr_status march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
     if (atomic_load(&job.stop) == 2) return gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
     *complete = atomic_load(&job.rows_done) >= y1 - y0;
     return GR_OK;
+}
+
+/* ---- adaptive steps: the step pilot (docs/reference.md 2.5, "Adaptive steps") ---- */
+
+typedef struct pilot_job {
+    gr_ref_renderer *r;
+    int pw, ph;         /* the pilot grid: one ray per PILOT_STRIDE^2 block of pixels */
+    int jb0, jb1;       /* pilot rows needed in full (a part's rows and their neighbours) */
+    int n0;             /* the pilot's steps (even) */
+    double *pl, *pv;    /* per pilot pixel: L (RGB mean), the step-noise variance estimate V */
+    atomic_int next_row, rows_done, stop;
+    atomic_llong queries, shadow_rays;
+} pilot_job;
+
+/* Pilot rows [jb0, jb1) in full; elsewhere every PILOT_MEAN_STRIDE-th row and column (the
+ * image mean). Each pilot pixel's ray is keyed by (seed, STREAM_PILOT, its index), so every
+ * part computes the same values. */
+static void *pilot_worker(void *arg)
+{
+#if defined(__SSE2__)
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#endif
+    pilot_job *job = arg;
+    const gr_ref_renderer *r = job->r;
+    const int W = r->scene.camera.width, H = r->scene.camera.height, n0 = job->n0;
+    ref_scratch sc;
+    ref_counters cnt = {0, 0, 0};
+    double *ck = malloc((size_t)n0 * sizeof *ck);
+    if (!ck || scratch_alloc(&sc, n0) != 0) {
+        free(ck);
+        atomic_store(&job->stop, 2);
+        return NULL;
+    }
+    for (;;) {
+        if (atomic_load(&job->stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
+        int j = atomic_fetch_add(&job->next_row, 1);
+        if (j >= job->ph) break;
+        int full = j >= job->jb0 && j < job->jb1, oom = 0;
+        for (int i = 0; i < job->pw && (full || j % PILOT_MEAN_STRIDE == 0); i++) {
+            if (!full && i % PILOT_MEAN_STRIDE) continue;
+            size_t q = (size_t)j * job->pw + i;
+            ref_rng g = rng_make(r->set.seed, STREAM_PILOT, q);
+            /* uniform over the pilot pixel's block of image pixels */
+            int bw = W - i * PILOT_STRIDE < PILOT_STRIDE ? W - i * PILOT_STRIDE : PILOT_STRIDE;
+            int bh = H - j * PILOT_STRIDE < PILOT_STRIDE ? H - j * PILOT_STRIDE : PILOT_STRIDE;
+            double fx = i * PILOT_STRIDE + bw * rng_u(&g), fy = j * PILOT_STRIDE + bh * rng_u(&g);
+            double L[3], tr, len;
+            if (render_ray(r, fx, fy, n0, &g, L, &tr, &len, &cnt, &sc, ck) != 0) { oom = 1; break; }
+            /* collapsed strata: the strata 2i and 2i + 1 merged into one holding two samples,
+             * whose variance (c_2i - c_2i+1)^2 estimates without bias and that of the stratified
+             * pair at most (docs/reference.md 2.5) */
+            double v = 0.0;
+            for (int k = 0; k + 1 < n0; k += 2) v += (ck[k] - ck[k + 1]) * (ck[k] - ck[k + 1]);
+            job->pl[q] = (L[0] + L[1] + L[2]) / 3.0;
+            job->pv[q] = v;
+        }
+        if (oom) { atomic_store(&job->stop, 2); break; }
+        if (r->opt.interrupt && *r->opt.interrupt) break;
+        atomic_fetch_add(&job->rows_done, 1);
+    }
+    atomic_fetch_add(&job->queries, cnt.queries);
+    atomic_fetch_add(&job->shadow_rays, cnt.shadow_rays);
+    scratch_free(&sc);
+    free(ck);
+    return NULL;
+}
+
+/* The steps of each pixel of the rows [row0, row1) from the pilot (docs/reference.md 2.5):
+ * with V and L the means of the pilot's variances and values over the pilot neighbourhood,
+ * norm = max(L, pilot image mean), N camera samples per pixel in a round, the
+ * step noise V (n0 / n)^alpha / N of the finished pixel is at most (step_error norm)^2 for
+ * n = n0 (V / (N step_error^2 norm^2))^(1 / alpha), clamped to [min_steps, steps]. */
+static void pilot_steps_map(gr_ref_renderer *r, const pilot_job *job)
+{
+    const int W = r->scene.camera.width, pw = job->pw, ph = job->ph;
+    double msum = 0.0;
+    long long mn = 0;
+    for (int j = 0; j < ph; j += PILOT_MEAN_STRIDE)
+        for (int i = 0; i < pw; i += PILOT_MEAN_STRIDE) {
+            msum += job->pl[(size_t)j * pw + i];
+            mn++;
+        }
+    double mean = mn ? msum / (double)mn : 0.0;
+    double N = (double)r->passes_per_round * r->spp_pass, tau = r->set.step_error;
+    int nmax = r->set.steps, nmin = r->set.min_steps < nmax ? r->set.min_steps : nmax;
+    r->steps_sum = r->steps_pixels = 0.0;
+    r->steps_min = INT_MAX;
+    r->steps_max = 0;
+    for (int py = r->opt.row0; py < r->opt.row1; py++)
+        for (int px = 0; px < W; px++) {
+            int i0 = px / PILOT_STRIDE, j0 = py / PILOT_STRIDE, nq = 0;
+            double vsum = 0.0, lsum = 0.0;
+            for (int j = j0 - PILOT_RADIUS; j <= j0 + PILOT_RADIUS; j++)
+                for (int i = i0 - PILOT_RADIUS; i <= i0 + PILOT_RADIUS; i++) {
+                    if (i < 0 || j < 0 || i >= pw || j >= ph) continue;
+                    size_t q = (size_t)j * pw + i;
+                    vsum += job->pv[q];
+                    lsum += job->pl[q];
+                    nq++;
+                }
+            double v = vsum / nq, norm = fmax(lsum / nq, mean);
+            double n = job->n0 * pow(v / (N * tau * tau * norm * norm), 1.0 / PILOT_ALPHA);
+            int ni;
+            if (v == 0.0) ni = nmin;
+            else if (!(n < (double)nmax)) ni = nmax; /* also NaN: the most steps */
+            else ni = n > nmin ? (int)ceil(n) : nmin;
+            r->steps_px[(size_t)py * W + px] = ni;
+            r->steps_sum += ni;
+            r->steps_pixels += 1.0;
+            if (ni < r->steps_min) r->steps_min = ni;
+            if (ni > r->steps_max) r->steps_max = ni;
+        }
+}
+
+/* Adaptive steps: the pilot rays and the steps map, or r->steps_px = NULL (fixed steps:
+ * adaptive_steps off, or steps no more than min_steps). *complete = 0 when interrupted. */
+static gr_status step_pilot(gr_ref_renderer *r, pthread_t *th, gr_progress *prog, int *complete, gr_error *err)
+{
+    const int W = r->scene.camera.width, H = r->scene.camera.height;
+    free(r->steps_px);
+    r->steps_px = NULL;
+    r->pilot_n0 = 0;
+    r->pilot_s = 0.0;
+    r->steps_min = r->steps_max = r->set.steps;
+    r->steps_pixels = (double)W * (r->opt.row1 - r->opt.row0);
+    r->steps_sum = r->steps_pixels * r->set.steps;
+    *complete = 1;
+    if (!r->set.adaptive_steps || r->set.steps <= r->set.min_steps) return GR_OK;
+    double t0 = mono_s();
+    pilot_job job;
+    memset(&job, 0, sizeof job);
+    job.r = r;
+    job.n0 = (r->set.pilot_steps < r->set.steps ? r->set.pilot_steps : r->set.steps) & ~1;
+    if (job.n0 < 2) job.n0 = 2;
+    job.pw = (W + PILOT_STRIDE - 1) / PILOT_STRIDE;
+    job.ph = (H + PILOT_STRIDE - 1) / PILOT_STRIDE;
+    job.jb0 = r->opt.row0 / PILOT_STRIDE - PILOT_RADIUS;
+    if (job.jb0 < 0) job.jb0 = 0;
+    job.jb1 = (r->opt.row1 - 1) / PILOT_STRIDE + PILOT_RADIUS + 1;
+    if (job.jb1 > job.ph) job.jb1 = job.ph;
+    size_t nq = (size_t)job.pw * job.ph;
+    job.pl = calloc(nq, sizeof *job.pl);
+    job.pv = calloc(nq, sizeof *job.pv);
+    r->steps_px = calloc((size_t)W * H, sizeof *r->steps_px);
+    if (!job.pl || !job.pv || !r->steps_px) {
+        free(job.pl); free(job.pv);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the step pilot (%dx%d)", W, H);
+    }
+    gr_status st = gr_ref_prepare_pass(r, PILOT_PASS, err);
+    if (st == GR_E_INTERRUPTED) { *complete = 0; st = GR_OK; goto out; }
+    if (st != GR_OK) goto out;
+    atomic_init(&job.next_row, 0);
+    atomic_init(&job.rows_done, 0);
+    atomic_init(&job.stop, 0);
+    atomic_init(&job.queries, 0);
+    atomic_init(&job.shadow_rays, 0);
+    int started = 0;
+    for (int i = 0; i < r->threads; i++) {
+        if (pthread_create(&th[i], NULL, pilot_worker, &job) != 0) break;
+        started++;
+    }
+    if (!started) {
+        st = gr_fail(err, GR_E_RUNTIME, "reference: could not start worker threads (reference.threads = %d)", r->threads);
+        goto out;
+    }
+    for (;;) {
+        int done = atomic_load(&job.rows_done);
+        gr_progress_update(prog, 0.0, "step pilot");
+        if (done >= job.ph || atomic_load(&job.stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
+        double waited = mono_s() - t0;
+        struct timespec ts = {0, waited < 0.05 ? 500 * 1000 : 20 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+    }
+    for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
+    if (atomic_load(&job.stop) == 2) { st = gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread"); goto out; }
+    if (atomic_load(&job.rows_done) < job.ph) { *complete = 0; free(r->steps_px); r->steps_px = NULL; goto out; }
+    r->pilot_n0 = job.n0;
+    pilot_steps_map(r, &job);
+
+out:
+    free(job.pl);
+    free(job.pv);
+    r->pilot_s = mono_s() - t0;
+    return st;
 }
 
 /* Surface-bias probe (docs/reference.md, section 4). Every PROBE_STRIDE-th pixel in x and y
@@ -1189,6 +1415,7 @@ static gr_status finish_result(gr_ref_renderer *r, const ref_accum *acc, const r
     out->shadow_rays_per_s = tot->march_s > 0.0 ? (double)tot->shadows / tot->march_s : 0.0;
     out->beam_build_s = r->beam_build_s;
     out->bias_surface_rel = r->bias_rel;
+    out->steps_mean = r->steps_pixels > 0.0 ? r->steps_sum / r->steps_pixels : -1.0;
     out->rounds = P > 0 ? (out->passes + P - 1) / P : 0;
     out->max_rounds = r->set.target_error > 0.0 ? r->opt.max_rounds : 1;
     /* preview: the 99th percentile of the brightest channel maps to 0.8 */
@@ -1282,6 +1509,10 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     int probe = r->set.bias_probe && !r->flat && r->opt.batch0 == 0; /* a part: the one with batch 0 */
     double mainw = probe ? 0.95 : 1.0; /* share of the progress bar for the main passes */
     ref_march_totals tot = {0.0, 0, 0, 0};
+    /* adaptive steps: the pilot sets every pixel's steps before the first pass */
+    int pilot_done = 1;
+    st = step_pilot(r, th, prog, &pilot_done, err);
+    if (st == GR_OK && !pilot_done) out->partial = 1;
     for (int round = 0; round < rounds && st == GR_OK && !out->partial; round++) {
         for (int pp = 0; pp < P && st == GR_OK; pp++, pass++) {
             if (pass % acc.B < r->opt.batch0 || pass % acc.B >= r->opt.batch1) continue; /* another part's batch */
@@ -1337,6 +1568,12 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         keep->queries = tot.queries;
         keep->shadows = tot.shadows;
         keep->overflows = 0; /* nothing overflows: the hit list grows */
+        keep->steps_sum = r->steps_sum;
+        keep->steps_pixels = r->steps_pixels;
+        keep->steps_min = r->steps_min;
+        keep->steps_max = r->steps_max;
+        keep->pilot_steps = r->pilot_n0;
+        keep->pilot_s = r->pilot_s;
         out->sums = keep;
         keep = NULL;
     }
@@ -1375,6 +1612,12 @@ gr_status gr_ref_assemble(gr_ref_renderer *r, const gr_ref_sums *sums, double wa
     r->main_beams.cell_m = sums->beam_cell_m;
     r->main_beams.prims = (size_t)sums->beam_prims;
     r->beam_build_s = sums->beam_build_s;
+    r->steps_sum = sums->steps_sum;
+    r->steps_pixels = sums->steps_pixels;
+    r->steps_min = sums->steps_min;
+    r->steps_max = sums->steps_max;
+    r->pilot_n0 = sums->pilot_steps;
+    r->pilot_s = sums->pilot_s;
     out->passes = sums->passes;
     ref_march_totals tot = {sums->march_s, sums->queries, sums->shadows, -1};
     gr_status st = finish_result(r, &acc, &tot, wall_s, out, err);

@@ -72,6 +72,11 @@ typedef struct gr_ref_sums {
     long long beam_prims;
     double beam_build_s, march_s;
     long long queries, shadows, overflows;
+    /* adaptive steps (docs/reference.md 2.5): the sum of the pixels' march steps over the
+     * pixels counted, their extremes, the pilot's steps (0: none) and time */
+    double steps_sum, steps_pixels;
+    int steps_min, steps_max, pilot_steps;
+    double pilot_s;
 } gr_ref_sums;
 /* Zeroed sums; probe_levels accumulators of probe_w x probe_h (0: none). NULL if no memory. */
 gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_levels, int probe_w, int probe_h);
@@ -97,6 +102,7 @@ typedef struct gr_ref_result {
                                measured by the probe (0 on flat water, -1 if not estimated) */
     double bias_block_p95;  /* 95th percentile over 10x10-pixel blocks of |block bias| / max(block
                                mean, image mean) (-1 if not estimated) */
+    double steps_mean;      /* march steps per camera ray, mean over the pixels (adaptive steps) */
     int target_met;         /* --target-error: 1 when met (Student t, batches - 1 dof); 1 if off */
     gr_ref_sums *sums;      /* with gr_ref_options.keep_sums: the raw sums (freed with the result) */
 } gr_ref_result;

@@ -30,7 +30,11 @@ static void usage(FILE *f)
             "options (defaults: the scene's \"reference\" section):\n"
             "  -o, --output FILE      EXR to write (required); the PNG preview beside it\n"
             "  --spp N                camera samples per pixel in each batch\n"
-            "  --steps N              stratified march steps per camera ray\n"
+            "  --steps N              stratified march steps per camera ray (with adaptive steps,\n"
+            "                         the default: the most a pixel takes)\n"
+            "  --step-error E         adaptive steps: each pixel's step noise at most E times\n"
+            "                         max(pixel, image mean) (reference.step_error)\n"
+            "  --fixed-steps          --steps in every pixel (reference.adaptive_steps = false)\n"
             "  --surface-res N        surface tessellation (N x N cells over the lit patch)\n"
             "  --sun-samples N        directions sampled inside the sun's disc\n"
             "  --batches N            independent batches for the error bars\n"
@@ -108,7 +112,7 @@ static int reference_with(gr_args *args)
         {"--spp", "reference.spp"}, {"--steps", "reference.steps"}, {"--surface-res", "reference.surface_res"},
         {"--sun-samples", "reference.sun_samples"}, {"--batches", "reference.batches"}, {"--seed", "reference.seed"},
         {"--threads", "reference.threads"}, {"--target-error", "reference.target_error"},
-        {"--cutoff", "reference.transmittance_cutoff"}};
+        {"--cutoff", "reference.transmittance_cutoff"}, {"--step-error", "reference.step_error"}};
     const char *cmd = "reference", *out_path = NULL;
     gr_scene *scene = NULL;
     int quiet = 0, aov = 0, preview = 1, bench = 0, rc = 0;
@@ -125,6 +129,10 @@ static int reference_with(gr_args *args)
         if (!strcmp(a, "--aov")) { aov = 1; continue; }
         if (!strcmp(a, "--bench")) { bench = 1; continue; }
         if (!strcmp(a, "--no-preview")) { preview = 0; continue; }
+        if (!strcmp(a, "--fixed-steps")) {
+            if ((rc = gr_args_add_set(args, "reference.adaptive_steps=false")) != 0) return rc;
+            continue;
+        }
         size_t k = 0;
         while (k < sizeof qflags / sizeof qflags[0] && strcmp(a, qflags[k].flag)) k++;
         if (k < sizeof qflags / sizeof qflags[0]) rc = gr_args_take_setting(args, qflags[k].key);
@@ -252,9 +260,10 @@ static int reference_with(gr_args *args)
         snprintf(bias, sizeof bias, "not estimated");
     if (!quiet)
         fprintf(stderr,
-                "godrays reference: wrote %s (%dx%d, %d spp, %.1f s%s): rel. std. error of the mean %.3g%%, "
+                "godrays reference: wrote %s (%dx%d, %d spp, %.1f march steps per ray on average, %.1f s%s): rel. std. "
+                "error of the mean %.3g%%, "
                 "of the p95 pixel %.3g%%, %.1f%% of pixels within 1%%; surface bias %s\n",
-                out_path, res.image->width, res.image->height, res.spp, res.wall_s, res.partial ? ", PARTIAL" : "",
+                out_path, res.image->width, res.image->height, res.spp, res.steps_mean, res.wall_s, res.partial ? ", PARTIAL" : "",
                 100.0 * res.rel_se_mean, 100.0 * res.rel_se_p95, 100.0 * res.frac_se_1pct, bias);
     if (res.partial) {
         fprintf(stderr, "godrays reference: interrupted; %s holds the partial result (godrays:partial = 1)\n", out_path);

@@ -123,6 +123,13 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
         cJSON_AddNumberToObject(h, "queries", (double)s->queries);
         cJSON_AddNumberToObject(h, "shadows", (double)s->shadows);
         cJSON_AddNumberToObject(h, "overflows", (double)s->overflows);
+        /* adaptive steps: the part's rows' steps and its pilot (docs/reference.md 2.5) */
+        cJSON_AddNumberToObject(h, "steps_sum", s->steps_sum);
+        cJSON_AddNumberToObject(h, "steps_pixels", s->steps_pixels);
+        cJSON_AddNumberToObject(h, "steps_min", s->steps_min);
+        cJSON_AddNumberToObject(h, "steps_max", s->steps_max);
+        cJSON_AddNumberToObject(h, "pilot_steps", s->pilot_steps);
+        cJSON_AddNumberToObject(h, "pilot_s", s->pilot_s);
         cJSON *pv = cJSON_AddObjectToObject(h, "provenance");
         if (pv) {
             cJSON_AddStringToObject(pv, "host", host);
@@ -412,6 +419,17 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
             sums->queries += (long long)num(p->h, "queries", &ok);
             sums->shadows += (long long)num(p->h, "shadows", &ok);
             sums->overflows += (long long)num(p->h, "overflows", &ok);
+            /* adaptive steps: every part with the same rows has the same steps (the pilot depends
+             * on the seed and the pixel only): count each row range once, from its batch-0 part */
+            if (p->b0 == 0) {
+                int smin = (int)num(p->h, "steps_min", &ok), smax = (int)num(p->h, "steps_max", &ok);
+                if (sums->steps_pixels == 0.0 || smin < sums->steps_min) sums->steps_min = smin;
+                if (smax > sums->steps_max) sums->steps_max = smax;
+                sums->steps_sum += num(p->h, "steps_sum", &ok);
+                sums->steps_pixels += num(p->h, "steps_pixels", &ok);
+            }
+            sums->pilot_steps = (int)num(p->h, "pilot_steps", &ok);
+            sums->pilot_s += num(p->h, "pilot_s", &ok);
             const cJSON *pv = cJSON_GetObjectItemCaseSensitive(p->h, "provenance");
             if (pv) wall += num(pv, "wall_s", &ok);
         }

@@ -19,7 +19,7 @@ static const gr_param reference_params[] = {
     {.name = "spp", .type = GR_PT_INT, .offset = REF(spp), .min = 1, .max = 1 << 20, .def = 1,
      .unit = "", .doc = "camera samples per pixel in each batch"},
     {.name = "steps", .type = GR_PT_INT, .offset = REF(steps), .min = 1, .max = 1 << 16, .def = 64,
-     .unit = "", .doc = "stratified, jittered march steps along each camera ray"},
+     .unit = "", .doc = "stratified, jittered march steps along each camera ray (with adaptive_steps: the most a pixel takes)"},
     {.name = "surface_res", .type = GR_PT_INT, .offset = REF(surface_res), .min = 2, .max = 16384,
      .def = 256, .unit = "", .doc = "surface tessellation: cells along each axis of the lit patch"},
     {.name = "sun_samples", .type = GR_PT_INT, .offset = REF(sun_samples), .min = 1, .max = 4096,
@@ -47,6 +47,15 @@ static const gr_param reference_params[] = {
      .doc = "sun-disc average: analytic convolution of each beam's footprint, or one sampled direction per pass"},
     {.name = "bias_probe", .type = GR_PT_BOOL, .offset = REF(bias_probe), .min = 0, .max = 1, .def = 1,
      .unit = "", .doc = "estimate the surface-tessellation bias: every 5th pixel re-rendered at surface_res and surface_res/2 (Richardson), about 5 % more time"},
+    {.name = "adaptive_steps", .type = GR_PT_BOOL, .offset = REF(adaptive_steps), .min = 0, .max = 1, .def = 1,
+     .unit = "", .doc = "march steps per pixel from a pilot ray (between min_steps and steps) to meet step_error; false: steps everywhere"},
+    {.name = "step_error", .type = GR_PT_DOUBLE, .offset = REF(step_error), .min = 0, .max = 1, .flags = LO_X | HI_X,
+     .def = 0.008, .unit = "",
+     .doc = "adaptive steps: target standard error of the step noise, relative to max(pixel, image mean)"},
+    {.name = "min_steps", .type = GR_PT_INT, .offset = REF(min_steps), .min = 1, .max = 1 << 16, .def = 8,
+     .unit = "", .doc = "adaptive steps: the fewest march steps a pixel takes"},
+    {.name = "pilot_steps", .type = GR_PT_INT, .offset = REF(pilot_steps), .min = 2, .max = 1 << 16, .def = 32,
+     .unit = "", .doc = "adaptive steps: march steps of the pilot ray per pixel that sets the steps"},
 };
 #undef REF
 

@@ -10,7 +10,8 @@
 /* Ground-truth integrator (reference/). */
 typedef struct gr_reference_settings {
     int spp;                      /* camera samples per pixel (per batch group, see batches) */
-    int steps;                    /* stratified, jittered march steps along each camera ray */
+    int steps;                    /* stratified, jittered march steps along each camera ray;
+                                     with adaptive_steps the most any pixel takes */
     int surface_res;              /* surface tessellation: cells along each axis of the lit patch */
     int sun_samples;              /* passes per round (grid offsets; sun directions if sampled) */
     int batches;                  /* independent batches for the standard-error estimate */
@@ -24,6 +25,11 @@ typedef struct gr_reference_settings {
     int sun_disc;                 /* gr_sun_disc_mode: how the sun's disc is averaged */
     int bias_probe;               /* 1: estimate the surface-tessellation bias from a pixel
                                      subsample rendered again at half the surface_res */
+    int adaptive_steps;           /* 1: steps per pixel from a pilot (docs/reference.md 2.5) */
+    double step_error;            /* adaptive steps: the step noise's target, relative to
+                                     max(pixel, image mean), after the whole render */
+    int min_steps;                /* adaptive steps: the fewest a pixel takes */
+    int pilot_steps;              /* adaptive steps: march steps of the pilot rays */
 } gr_reference_settings;
 
 /* reference.sun_disc: the disc average by the analytic convolution of each beam's footprint

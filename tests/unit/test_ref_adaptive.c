@@ -1,0 +1,215 @@
+/* Adaptive march steps (docs/reference.md 2.5, "Adaptive steps"), checked with real renders:
+ * (a) unbiased: an adaptive render and a fixed-steps render of a wavy scene, with other seeds,
+ *     agree in the image mean and in every block's mean within their combined error bars
+ *     (Student t with the batches' 7 degrees of freedom, not a normal z);
+ * (b) the allocation does what it says: in a narrow view where step noise dominates, more
+ *     pixels are within 1 % than with fixed steps at the same march points per pixel (the
+ *     pilot's included), counted from the metadata;
+ * (c) flat water (Oracle 1: the march samples the integrand of the least attenuated channel
+ *     in proportion) takes the fewest steps everywhere and still equals the closed form
+ *     written here (that channel exactly, the others within their error bars);
+ * (d) the steps stay within [min_steps, steps], vary across the image, and the same seed
+ *     gives the same bytes with 1 and 2 threads (the farm merge: tests/integration/test_merge.c). */
+#include <math.h>
+#include "check.h"
+#include "core/optics.h"
+#include "test_ref_util.h"
+
+/* the default scene's waves, sun, water and camera (data/scenes/default.json) */
+#define WAVES                                                                                                         \
+    "\"water\":{\"waves\":[{\"amplitude_m\":0.115,\"wavelength_m\":12,\"direction_deg\":40},"                         \
+    "{\"amplitude_m\":0.079,\"wavelength_m\":9,\"direction_deg\":25,\"phase_rad\":1.3},"                              \
+    "{\"amplitude_m\":0.056,\"wavelength_m\":7,\"direction_deg\":58,\"phase_rad\":2.9},"                              \
+    "{\"amplitude_m\":0.044,\"wavelength_m\":5.5,\"direction_deg\":32,\"phase_rad\":4.4},"                            \
+    "{\"amplitude_m\":0.029,\"wavelength_m\":4,\"direction_deg\":70,\"phase_rad\":0.7},"                              \
+    "{\"amplitude_m\":0.028,\"wavelength_m\":2.4,\"direction_deg\":12,\"phase_rad\":3.6},"                            \
+    "{\"amplitude_m\":0.019,\"wavelength_m\":1.6,\"direction_deg\":50,\"phase_rad\":5.5},"                            \
+    "{\"amplitude_m\":0.012,\"wavelength_m\":1.0,\"direction_deg\":85,\"phase_rad\":2.2}]}"
+#define MEDIUM "\"medium\":{\"absorption_per_m\":[0.342,0.0585,0.0212],\"scattering_per_m\":[0.041,0.049,0.062],\"g\":0.9}"
+
+/* Student's t, 7 degrees of freedom, two-sided 99.8 % (P(|T| <= t) = 0.998; standard table):
+ * the family of 17 comparisons in (a) then fails by chance with probability below 4 %. */
+#define T7_9990 4.785
+
+static double meta(const gr_ref_result *r, const char *key)
+{
+    const gr_meta_item *m = gr_meta_get(&r->meta, key);
+    return m ? m->num : NAN;
+}
+
+static gr_scene *wavy(int w, int h, double fov, int steps, int adaptive, int seed, int surface_res, double step_error)
+{
+    return ref_scene("{" WAVES ",\"sun\":{\"elevation_deg\":60,\"azimuth_deg\":30}," MEDIUM ","
+                     "\"camera\":{\"position_m\":[0,-8,0],\"yaw_deg\":30,\"pitch_deg\":60,\"fov_deg\":%g,"
+                     "\"width\":%d,\"height\":%d},\"seabed\":{\"depth_m\":25},"
+                     "\"reference\":{\"steps\":%d,\"adaptive_steps\":%s,\"seed\":%d,\"surface_res\":%d,"
+                     "\"bias_probe\":false,\"sun_samples\":8,\"batches\":8,\"step_error\":%g}}",
+                     fov, w, h, steps, adaptive ? "true" : "false", seed, surface_res, step_error);
+}
+
+/* Per-block means and their standard errors from the raw per-batch sums (RGB mean). */
+enum { NBX = 4, NBY = 4 };
+static void block_stats(const gr_ref_sums *s, double m[NBX * NBY], double se[NBX * NBY])
+{
+    int B = s->B;
+    for (int by = 0; by < NBY; by++)
+        for (int bx = 0; bx < NBX; bx++) {
+            double a = 0.0, a2 = 0.0;
+            for (int b = 0; b < B; b++) {
+                double v = 0.0;
+                int n = 0;
+                for (int y = by * s->H / NBY; y < (by + 1) * s->H / NBY; y++)
+                    for (int x = bx * s->W / NBX; x < (bx + 1) * s->W / NBX; x++, n++) {
+                        size_t p = (size_t)y * s->W + x;
+                        const double *q = s->sum + (p * B + b) * 3;
+                        v += (q[0] + q[1] + q[2]) / (3.0 * s->count[p * B + b]);
+                    }
+                v /= n;
+                a += v;
+                a2 += v * v;
+            }
+            a /= B;
+            m[by * NBX + bx] = a;
+            se[by * NBX + bx] = sqrt(fmax(0.0, (a2 - B * a * a) / (B - 1)) / B);
+        }
+}
+
+static void test_unbiased(int reduced)
+{
+    int w = reduced ? 48 : 80, h = reduced ? 27 : 45;
+    gr_ref_options o;
+    gr_ref_options_default(&o);
+    o.keep_sums = 1;
+    gr_scene *sa = wavy(w, h, 60.0, 96, 1, 21, 96, 0.008), *sf = wavy(w, h, 60.0, 96, 0, 22, 96, 0.008);
+    gr_ref_result ra, rf;
+    ref_render(sa, &o, &ra);
+    ref_render(sf, &o, &rf);
+    double ma = meta(&ra, "godrays:image_mean"), mf = meta(&rf, "godrays:image_mean");
+    double sea = ra.rel_se_mean * ma, sef = rf.rel_se_mean * mf;
+    double z = (ma - mf) / sqrt(sea * sea + sef * sef);
+    printf("(a) image mean: adaptive %.6f +- %.6f (%.1f steps), fixed 96 %.6f +- %.6f: t = %.2f\n", ma, sea,
+           ra.steps_mean, mf, sef, z);
+    CHECK_MSG(fabs(z) <= T7_9990, "image means differ by %.2f combined standard errors", z);
+    CHECK_MSG(ra.steps_mean < 0.8 * 96, "the adaptive render must take fewer steps (%.1f)", ra.steps_mean);
+    double ba[NBX * NBY], bsa[NBX * NBY], bf[NBX * NBY], bsf[NBX * NBY];
+    block_stats(ra.sums, ba, bsa);
+    block_stats(rf.sums, bf, bsf);
+    double worst = 0.0;
+    for (int k = 0; k < NBX * NBY; k++) {
+        double t = (ba[k] - bf[k]) / sqrt(bsa[k] * bsa[k] + bsf[k] * bsf[k]);
+        if (fabs(t) > fabs(worst)) worst = t;
+        CHECK_MSG(fabs(t) <= T7_9990, "block %d: adaptive %.6f +- %.6f, fixed %.6f +- %.6f (t = %.2f)", k, ba[k], bsa[k],
+                  bf[k], bsf[k], t);
+    }
+    printf("(a) %d blocks: largest |t| %.2f (limit %.3f, Student t, 7 dof, two-sided 99.8 %%)\n", NBX * NBY, fabs(worst),
+           T7_9990);
+    /* (d) the steps: within [min_steps, steps], not all equal */
+    CHECK(meta(&ra, "godrays:steps_min") >= sa->reference.min_steps);
+    CHECK(meta(&ra, "godrays:steps_max") <= 96);
+    CHECK(meta(&ra, "godrays:steps_min") < meta(&ra, "godrays:steps_max"));
+    CHECK(meta(&ra, "godrays:pilot_steps") == sa->reference.pilot_steps);
+    CHECK(meta(&rf, "godrays:steps_mean") == 96 && meta(&rf, "godrays:pilot_steps") == 0);
+    gr_ref_result_free(&ra);
+    gr_ref_result_free(&rf);
+    free(sa);
+    free(sf);
+}
+
+/* (b) A narrow view (0.1 deg pixels, as at 640x360 with the default 60 deg) into the sun's
+ * caustics, where step noise dominates the error bars. */
+static void test_allocation(int reduced)
+{
+    (void)reduced; /* smaller views leave too few pixels above the 1 % line to tell */
+    int w = 64, h = 36, seed = getenv("XSEED") ? atoi(getenv("XSEED")) : 5;
+    double fov = 0.1 * w;
+    double tau = getenv("XT") ? atof(getenv("XT")) : 0.008;
+    gr_scene *sa = wavy(w, h, fov, 192, 1, seed, 96, tau);
+    gr_ref_result ra, rf;
+    ref_render(sa, NULL, &ra);
+    /* march points per camera ray, the pilot's (one ray per 2 x 2 pixels, per round of
+     * passes x spp camera rays) included */
+    double spp = (double)ra.passes * meta(&ra, "godrays:spp_per_pass");
+    double points = ra.steps_mean + meta(&ra, "godrays:pilot_steps") / 4.0 / spp;
+    int nf = (int)ceil(points);
+    gr_scene *sf = wavy(w, h, fov, nf, 0, seed, 96, tau);
+    ref_render(sf, NULL, &rf);
+    printf("(b) pixels within 1 %%: adaptive %.1f %% (%.1f steps per ray, %.2f with the pilot), fixed %d steps %.1f %%\n",
+           100.0 * ra.frac_se_1pct, ra.steps_mean, points, nf, 100.0 * rf.frac_se_1pct);
+    CHECK_MSG(ra.frac_se_1pct > rf.frac_se_1pct + 0.02, "adaptive %.3f, fixed %.3f at equal points", ra.frac_se_1pct,
+              rf.frac_se_1pct);
+    gr_ref_result_free(&ra);
+    gr_ref_result_free(&rf);
+    free(sa);
+    free(sf);
+}
+
+/* (c) Flat water, no occluders: the pilot sees no step noise worth a step above min_steps,
+ * and the image is Oracle 1's closed form (as in unit.ref_flat, written here for one ray). */
+static void test_flat(void)
+{
+    gr_scene *s = ref_scene("{\"sun\":{\"elevation_deg\":60,\"azimuth_deg\":30,\"angular_diameter_deg\":0}," MEDIUM ","
+                            "\"camera\":{\"position_m\":[0,-8,0],\"yaw_deg\":30,\"pitch_deg\":-60,\"fov_deg\":0.01,"
+                            "\"width\":3,\"height\":3},"
+                            "\"reference\":{\"steps\":96,\"bias_probe\":false,\"sun_samples\":8,\"batches\":8}}");
+    gr_ref_result r;
+    ref_render(s, NULL, &r);
+    CHECK_MSG(meta(&r, "godrays:steps_max") == s->reference.min_steps, "flat water: steps %g to %g, expected %d",
+              meta(&r, "godrays:steps_min"), meta(&r, "godrays:steps_max"), s->reference.min_steps);
+    /* Oracle 1 along the centre ray (the scene's sun and view directions): the refracted
+     * direction T, exact Fresnel, HG phase, the two extinctions, integrated by Simpson's rule
+     * to the cutoff (no seabed) */
+    gr_dvec3 I = gr_d3(s->sun.dir[0], s->sun.dir[1], s->sun.dir[2]);
+    gr_dvec3 T = gr_refract_d(I, gr_d3(0, 1, 0), 1.0 / 1.333);
+    double ft = 1.0 - gr_fresnel_exact(-I.y, 1.0, 1.333), e_perp = ft * -I.y / -T.y;
+    gr_dvec3 w = gr_d3(s->camera.forward[0], s->camera.forward[1], s->camera.forward[2]);
+    double sa[3] = {0.342, 0.0585, 0.0212}, ss[3] = {0.041, 0.049, 0.062};
+    double ph = gr_hg_phase(-gr_d3_dot(T, w), 0.9);
+    const float *px = gr_image_pixel(r.image, 1, 1);
+    for (int c = 0; c < 3; c++) {
+        double st = sa[c] + ss[c], smin = 0.0212 + 0.062, D = -log(1e-3) / smin, L = 0.0;
+        int n = 20000;
+        for (int i = 0; i <= n; i++) {
+            double t = D * i / n, y = -8.0 + t * w.y;
+            double f = ss[c] * ph * e_perp * exp(-st * (-y / -T.y)) * exp(-st * t);
+            L += f * (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0));
+        }
+        L *= D / n / 3.0;
+        /* the least attenuated channel (B) is sampled in proportion: exact per march point; the
+         * others keep the step noise the pilot allows (its target is on the RGB mean) and must
+         * lie within their own error bars (Student t, 7 dof, 99.8 %) */
+        double tol = c == 2 ? 1e-4 * L : T7_9990 * px[3 + c] + 1e-4 * L;
+        printf("(c) flat water, channel %d: %.7g +- %.2g, closed form %.7g\n", c, px[c], px[3 + c], L);
+        CHECK_NEAR(px[c], L, tol);
+    }
+    gr_ref_result_free(&r);
+    free(s);
+}
+
+/* (d) the same bytes with 1 and 2 threads (the pilot's rays are keyed per pixel) */
+static void test_threads(void)
+{
+    gr_ref_result a, b;
+    gr_scene *s1 = wavy(24, 16, 60.0, 48, 1, 3, 64, 0.008), *s2 = wavy(24, 16, 60.0, 48, 1, 3, 64, 0.008);
+    s1->reference.threads = 1;
+    s2->reference.threads = 2;
+    ref_render(s1, NULL, &a);
+    ref_render(s2, NULL, &b);
+    size_t n = (size_t)a.image->width * a.image->height * a.image->nchannels * sizeof(float);
+    CHECK_MSG(memcmp(a.image->pixels, b.image->pixels, n) == 0, "1 and 2 threads must give the same bytes");
+    CHECK(meta(&a, "godrays:steps_mean") == meta(&b, "godrays:steps_mean"));
+    CHECK(meta(&a, "godrays:steps_min") < meta(&a, "godrays:steps_max"));
+    gr_ref_result_free(&a);
+    gr_ref_result_free(&b);
+    free(s1);
+    free(s2);
+}
+
+int main(void)
+{
+    int reduced = ref_reduced();
+    test_flat();
+    test_threads();
+    test_unbiased(reduced);
+    test_allocation(reduced);
+    CHECK_DONE();
+}
