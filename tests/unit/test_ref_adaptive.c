@@ -1,7 +1,7 @@
 /* Adaptive march steps (docs/reference.md 2.5, "Adaptive steps"), checked with real renders:
- * (a) unbiased: an adaptive render and a fixed-steps render of a wavy scene, with other seeds,
- *     agree in the image mean and in every block's mean within their combined error bars
- *     (Student t with the batches' 7 degrees of freedom, not a normal z);
+ * (a) unbiased: an adaptive render and a fixed-steps render of a wavy scene agree in the
+ *     image mean and in every block's mean: their batch-by-batch differences have mean zero
+ *     within their error bar (Student t with the batches' 7 degrees of freedom, not a normal z);
  * (b) the allocation does what it says: in a narrow view where step noise dominates, more
  *     pixels are within 1 % than with fixed steps at the same march points per pixel (the
  *     pilot's included), counted from the metadata;
@@ -47,62 +47,77 @@ static gr_scene *wavy(int w, int h, double fov, int steps, int adaptive, int see
                      fov, w, h, steps, adaptive ? "true" : "false", seed, surface_res, step_error);
 }
 
-/* Per-block means and their standard errors from the raw per-batch sums (RGB mean). */
-enum { NBX = 4, NBY = 4 };
-static void block_stats(const gr_ref_sums *s, double m[NBX * NBY], double se[NBX * NBY])
+/* Per-batch means (RGB mean) of the image (k = NB) and of NBX x NBY blocks (k < NB) from the
+ * raw per-batch sums: m[k * B + b]. */
+enum { NBX = 4, NBY = 4, NB = NBX * NBY };
+static void batch_means(const gr_ref_sums *s, double *m)
 {
     int B = s->B;
-    for (int by = 0; by < NBY; by++)
-        for (int bx = 0; bx < NBX; bx++) {
-            double a = 0.0, a2 = 0.0;
-            for (int b = 0; b < B; b++) {
-                double v = 0.0;
-                int n = 0;
-                for (int y = by * s->H / NBY; y < (by + 1) * s->H / NBY; y++)
-                    for (int x = bx * s->W / NBX; x < (bx + 1) * s->W / NBX; x++, n++) {
-                        size_t p = (size_t)y * s->W + x;
-                        const double *q = s->sum + (p * B + b) * 3;
-                        v += (q[0] + q[1] + q[2]) / (3.0 * s->count[p * B + b]);
-                    }
-                v /= n;
-                a += v;
-                a2 += v * v;
+    for (int k = 0; k <= NB; k++)
+        for (int b = 0; b < B; b++) {
+            int x0 = 0, x1 = s->W, y0 = 0, y1 = s->H;
+            if (k < NB) {
+                x0 = (k % NBX) * s->W / NBX; x1 = (k % NBX + 1) * s->W / NBX;
+                y0 = (k / NBX) * s->H / NBY; y1 = (k / NBX + 1) * s->H / NBY;
             }
-            a /= B;
-            m[by * NBX + bx] = a;
-            se[by * NBX + bx] = sqrt(fmax(0.0, (a2 - B * a * a) / (B - 1)) / B);
+            double v = 0.0;
+            int n = 0;
+            for (int y = y0; y < y1; y++)
+                for (int x = x0; x < x1; x++, n++) {
+                    size_t p = (size_t)y * s->W + x;
+                    const double *q = s->sum + (p * B + b) * 3;
+                    v += (q[0] + q[1] + q[2]) / (3.0 * s->count[p * B + b]);
+                }
+            m[k * B + b] = v / n;
         }
 }
 
+/* (a) The same seed for both renders: their batches share the passes' grid offsets and the
+ * camera jitter, so batch b's difference d_b = adaptive_b - fixed_b keeps the step noise and
+ * any bias of the adaptive steps, not the far larger noise of the passes. Batches are
+ * independent and identically distributed (each its own passes), so mean(d) / (sd(d) /
+ * sqrt(B)) follows Student's t with B - 1 = 7 degrees of freedom if the adaptive render is
+ * unbiased. (The pilot's random numbers are its own stream: the same seed does not tie them
+ * to the estimate's.) */
 static void test_unbiased(int reduced)
 {
     int w = reduced ? 48 : 80, h = reduced ? 27 : 45;
+    int seed = 21;
     gr_ref_options o;
     gr_ref_options_default(&o);
     o.keep_sums = 1;
-    gr_scene *sa = wavy(w, h, 60.0, 96, 1, 21, 96, 0.008), *sf = wavy(w, h, 60.0, 96, 0, 22, 96, 0.008);
+    gr_scene *sa = wavy(w, h, 60.0, 96, 1, seed, 96, 0.008), *sf = wavy(w, h, 60.0, 96, 0, seed, 96, 0.008);
     gr_ref_result ra, rf;
     ref_render(sa, &o, &ra);
     ref_render(sf, &o, &rf);
-    double ma = meta(&ra, "godrays:image_mean"), mf = meta(&rf, "godrays:image_mean");
-    double sea = ra.rel_se_mean * ma, sef = rf.rel_se_mean * mf;
-    double z = (ma - mf) / sqrt(sea * sea + sef * sef);
-    printf("(a) image mean: adaptive %.6f +- %.6f (%.1f steps), fixed 96 %.6f +- %.6f: t = %.2f\n", ma, sea,
-           ra.steps_mean, mf, sef, z);
-    CHECK_MSG(fabs(z) <= T7_9990, "image means differ by %.2f combined standard errors", z);
-    CHECK_MSG(ra.steps_mean < 0.8 * 96, "the adaptive render must take fewer steps (%.1f)", ra.steps_mean);
-    double ba[NBX * NBY], bsa[NBX * NBY], bf[NBX * NBY], bsf[NBX * NBY];
-    block_stats(ra.sums, ba, bsa);
-    block_stats(rf.sums, bf, bsf);
+    int B = ra.sums->B;
+    double *ma = malloc((NB + 1) * B * sizeof *ma), *mf = malloc((NB + 1) * B * sizeof *mf);
+    batch_means(ra.sums, ma);
+    batch_means(rf.sums, mf);
     double worst = 0.0;
-    for (int k = 0; k < NBX * NBY; k++) {
-        double t = (ba[k] - bf[k]) / sqrt(bsa[k] * bsa[k] + bsf[k] * bsf[k]);
-        if (fabs(t) > fabs(worst)) worst = t;
-        CHECK_MSG(fabs(t) <= T7_9990, "block %d: adaptive %.6f +- %.6f, fixed %.6f +- %.6f (t = %.2f)", k, ba[k], bsa[k],
-                  bf[k], bsf[k], t);
+    for (int k = 0; k <= NB; k++) {
+        double a = 0.0, a2 = 0.0, f = 0.0;
+        for (int b = 0; b < B; b++) {
+            double d = ma[k * B + b] - mf[k * B + b];
+            a += d;
+            a2 += d * d;
+            f += mf[k * B + b];
+        }
+        a /= B;
+        f /= B;
+        double se = sqrt(fmax(0.0, (a2 - B * a * a) / (B - 1)) / B), t = se > 0.0 ? a / se : (a == 0.0 ? 0.0 : INFINITY);
+        if (k == NB)
+            printf("(a) image mean: fixed 96 steps %.6f, adaptive (%.1f steps) - fixed %+.2e +- %.1e (t = %.2f)\n", f,
+                   ra.steps_mean, a, se, t);
+        else if (fabs(t) > fabs(worst))
+            worst = t;
+        CHECK_MSG(fabs(t) <= T7_9990, "%s %d: adaptive - fixed = %.3g +- %.2g (t = %.2f, mean %.6f)",
+                  k == NB ? "image" : "block", k, a, se, t, f);
     }
-    printf("(a) %d blocks: largest |t| %.2f (limit %.3f, Student t, 7 dof, two-sided 99.8 %%)\n", NBX * NBY, fabs(worst),
-           T7_9990);
+    printf("(a) %d blocks: largest |t| %.2f (limit %.3f, Student t, 7 dof, two-sided 99.8 %%)\n", NB, fabs(worst), T7_9990);
+    free(ma);
+    free(mf);
+    CHECK_MSG(ra.steps_mean < 0.8 * 96, "the adaptive render must take fewer steps (%.1f)", ra.steps_mean);
     /* (d) the steps: within [min_steps, steps], not all equal */
     CHECK(meta(&ra, "godrays:steps_min") >= sa->reference.min_steps);
     CHECK(meta(&ra, "godrays:steps_max") <= 96);
@@ -120,9 +135,11 @@ static void test_unbiased(int reduced)
 static void test_allocation(int reduced)
 {
     (void)reduced; /* smaller views leave too few pixels above the 1 % line to tell */
-    int w = 64, h = 36, seed = getenv("XSEED") ? atoi(getenv("XSEED")) : 5;
+    int w = 64, h = 36, seed = 5;
     double fov = 0.1 * w;
-    double tau = getenv("XT") ? atof(getenv("XT")) : 0.008;
+    /* the default target (below the 1 % line: a target above it aims the noisy pixels just
+     * above the line, where fixed steps leave many below) */
+    double tau = 0.008;
     gr_scene *sa = wavy(w, h, fov, 192, 1, seed, 96, tau);
     gr_ref_result ra, rf;
     ref_render(sa, NULL, &ra);
