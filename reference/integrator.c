@@ -962,8 +962,8 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
                            "bias_surface_rel_est = mean |pixel bias| / image mean from the surface tessellation "
                            "(measured here with order 2, see bias_surface_probe; bound = max(2x the estimate, the figure with "
                            "the measured order, bias_surface_rel_measured_order); bias.* channels and bias_block_p95_rel "
-                           "use the measured order; march steps: "
-                           "unbiased (jittered strata), noise only; sun disc: convolved to first order, error "
+                           "use the measured order; march steps: unbiased (jittered strata; per-pixel counts "
+                           "from an independent pilot), noise only; sun disc: convolved to first order, error "
                            "below 0.3 % L1 (sun_disc = sample: unbiased); cutoff tail <= transmittance_cutoff * "
                            "S_max / sigma_t (docs/reference.md)"));
     SET(gr_meta_set_string(m, "godrays:error_bars",
@@ -1200,12 +1200,20 @@ static gr_status step_pilot(gr_ref_renderer *r, pthread_t *th, gr_progress *prog
         nanosleep(&ts, NULL);
     }
     for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
-    if (atomic_load(&job.stop) == 2) { st = gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread"); goto out; }
-    if (atomic_load(&job.rows_done) < job.ph) { *complete = 0; free(r->steps_px); r->steps_px = NULL; goto out; }
+    if (atomic_load(&job.stop) == 2) {
+        st = gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
+        goto out;
+    }
+    if (atomic_load(&job.rows_done) < job.ph) { *complete = 0; goto out; } /* interrupted: partial */
     r->pilot_n0 = job.n0;
     pilot_steps_map(r, &job);
-
 out:
+    if (st != GR_OK || !*complete) { /* no steps map: nothing is rendered after this */
+        free(r->steps_px);
+        r->steps_px = NULL;
+        r->steps_sum = r->steps_pixels = 0.0; /* steps_mean -1: none taken */
+        r->steps_min = r->steps_max = 0;
+    }
     free(job.pl);
     free(job.pv);
     r->pilot_s = mono_s() - t0;

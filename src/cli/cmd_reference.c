@@ -263,7 +263,8 @@ static int reference_with(gr_args *args)
                 "godrays reference: wrote %s (%dx%d, %d spp, %.1f march steps per ray on average, %.1f s%s): rel. std. "
                 "error of the mean %.3g%%, "
                 "of the p95 pixel %.3g%%, %.1f%% of pixels within 1%%; surface bias %s\n",
-                out_path, res.image->width, res.image->height, res.spp, res.steps_mean, res.wall_s, res.partial ? ", PARTIAL" : "",
+                out_path, res.image->width, res.image->height, res.spp, res.steps_mean > 0.0 ? res.steps_mean : 0.0, res.wall_s,
+                res.partial ? ", PARTIAL" : "",
                 100.0 * res.rel_se_mean, 100.0 * res.rel_se_p95, 100.0 * res.frac_se_1pct, bias);
     if (res.partial) {
         fprintf(stderr, "godrays reference: interrupted; %s holds the partial result (godrays:partial = 1)\n", out_path);
