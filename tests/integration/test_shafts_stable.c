@@ -250,6 +250,17 @@ int main(void)
 
     /* The layer's own change (docs "stable_grid"): stable_grid's at most 1/5 of the locked
      * grid's (the issue's criterion, read as the layer's change, not parallax), seed and path. */
+    {
+        /* grid_eye_m given as the camera's own position is the default, bit for bit */
+        gr_scene *sd = load(0, 0.7, -0.4), *se = load_eye(0, 0.7, -0.4, 1, 0.7, -0.4);
+        gr_image *id = gr_image_create(W, H, 3, NULL), *ie = gr_image_create(W, H, 3, NULL);
+        CHECK_OK(gr_shafts_render(r, sd, NULL, id, NULL, &err), err);
+        CHECK_OK(gr_shafts_render(r, se, NULL, ie, NULL, &err), err);
+        CHECK_MSG(memcmp(id->pixels, ie->pixels, (size_t)W * (size_t)H * 3 * sizeof(float)) == 0,
+                  "grid_eye_m = the camera's position changes the image");
+        gr_image_destroy(id), gr_image_destroy(ie);
+        free(sd), free(se);
+    }
     const char *variants[2] = {"shafts.variant=seed", "shafts.variant=path"};
     for (int v = 0; v < 2; v++) {
         variant = variants[v];
