@@ -29,6 +29,7 @@
 #include <string.h>
 
 #include "realtime/shafts.h"
+#include "scene_test.h"
 #include "scene/scene.h"
 #include "tune/truth.h"
 
@@ -47,22 +48,12 @@ static const char *variant = "shafts.variant=seed";
  * (ex, -8, ez) when eye is nonzero (shafts.grid_eye_m), else for the camera. */
 static gr_scene *load_eye(int stable, double dx, double dz, int eye, double ex, double ez)
 {
-    const char *src = getenv("GODRAYS_SOURCE_DIR");
-    char path[4096], pos[128], sw[64], sh[64], ge[128];
-    snprintf(path, sizeof path, "%s/data/scenes/default.json", src ? src : GR_SOURCE_DIR);
-    snprintf(sw, sizeof sw, "camera.width=%d", W);
-    snprintf(sh, sizeof sh, "camera.height=%d", H);
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err;
-    const char *sets[7] = {sw, sh, stable ? "shafts.stable_grid=true" : "shafts.stable_grid=false", pos, variant,
+    char pos[128], ge[128];
+    const char *sets[5] = {stable ? "shafts.stable_grid=true" : "shafts.stable_grid=false", pos, variant,
                            reduced() ? "reference.steps=48" : "reference.steps=128", ge};
     snprintf(pos, sizeof pos, "camera.position_m=[%.17g, -8, %.17g]", dx, dz);
     snprintf(ge, sizeof ge, "shafts.grid_eye_m=[%.17g, -8, %.17g]", ex, ez);
-    if (!s || gr_scene_load_file(path, sets, eye ? 7 : 6, s, &err) != GR_OK) {
-        fprintf(stderr, "cannot load %s: %s\n", path, s ? err.msg : "out of memory");
-        exit(1);
-    }
-    return s;
+    return test_data_scene("default.json", W, H, sets, eye ? 5 : 4);
 }
 
 static gr_scene *load(int stable, double dx, double dz) { return load_eye(stable, dx, dz, 0, 0, 0); }
