@@ -99,6 +99,25 @@ static void flatten_log(char *log)
         if (log[i] == '\n' || log[i] == '\r' || log[i] == '\t') log[i] = ' ';
 }
 
+/* The outcome of compiling a shader (program = 0) or linking a program: on failure the
+ * object is deleted, *obj set to 0, and the driver's log returned on one line. */
+static gr_status gl_outcome(GLuint *obj, int program, const char *name, gr_error *err)
+{
+    GLint ok = 0;
+    if (program) glGetProgramiv(*obj, GL_LINK_STATUS, &ok);
+    else glGetShaderiv(*obj, GL_COMPILE_STATUS, &ok);
+    if (ok) return GR_OK;
+    char log[900];
+    log[0] = '\0';
+    if (program) glGetProgramInfoLog(*obj, (GLsizei)sizeof log, NULL, log);
+    else glGetShaderInfoLog(*obj, (GLsizei)sizeof log, NULL, log);
+    flatten_log(log);
+    if (program) glDeleteProgram(*obj);
+    else glDeleteShader(*obj);
+    *obj = 0;
+    return gr_fail(err, GR_E_GL, "%s: GLSL %s failed: %s", name, program ? "link" : "compile", log[0] ? log : "(no log)");
+}
+
 /* One stage: its files read (from dir or embedded) and compiled as one source, in order;
  * the log names the stage's last file (its own code; the first ones are shared preludes). */
 static gr_status compile_stage(const char *dir, const gr_shader_stage *sg, GLuint *out, int *n_dir, gr_error *err)
@@ -118,17 +137,7 @@ static gr_status compile_stage(const char *dir, const gr_shader_stage *sg, GLuin
     if (st == GR_OK) {
         glShaderSource(sh, k, (const GLchar *const *)src, NULL);
         glCompileShader(sh);
-        GLint ok = 0;
-        glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-        if (!ok) {
-            char log[900];
-            log[0] = '\0';
-            glGetShaderInfoLog(sh, (GLsizei)sizeof log, NULL, log);
-            flatten_log(log);
-            glDeleteShader(sh);
-            sh = 0;
-            st = gr_fail(err, GR_E_GL, "%s: GLSL compile failed: %s", name, log[0] ? log : "(no log)");
-        }
+        st = gl_outcome(&sh, 0, name, err);
     }
     for (int j = 0; j < k; j++) free(src[j]);
     *out = sh;
@@ -152,17 +161,7 @@ gr_status gr_shader_program_stages(const char *dir, const gr_shader_stage *stage
         for (int s = 0; s < n; s++) glAttachShader(prog, sh[s]);
         if (n_tf > 0) glTransformFeedbackVaryings(prog, n_tf, (const GLchar *const *)tf_varyings, GL_INTERLEAVED_ATTRIBS);
         glLinkProgram(prog);
-        GLint ok = 0;
-        glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char log[900];
-            log[0] = '\0';
-            glGetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
-            flatten_log(log);
-            glDeleteProgram(prog);
-            prog = 0;
-            st = gr_fail(err, GR_E_GL, "%s: GLSL link failed: %s", name, log[0] ? log : "(no log)");
-        }
+        st = gl_outcome(&prog, 1, name, err);
     }
     for (int s = 0; s < n; s++)
         if (sh[s]) glDeleteShader(sh[s]);

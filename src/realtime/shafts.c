@@ -307,12 +307,12 @@ gr_status gr_shafts_create_in(gr_gl *gl, const char *shader_dir, gr_shafts **out
     return GR_OK;
 }
 
-/* The shaft pass and the flux pre-pass compile shafts_waves.glsl (the seed's waves and
+/* The shaft pass and the flux pre-pass compile seed_waves.glsl (the seed's waves and
  * surface function) in front of their own file. */
-static const gr_shader_stage shaft_stages[2] = {{GL_VERTEX_SHADER, {"shafts_waves.glsl", "shafts.vert.glsl", NULL}},
+static const gr_shader_stage shaft_stages[2] = {{GL_VERTEX_SHADER, {"seed_waves.glsl", "shafts.vert.glsl", NULL}},
                                                 {GL_FRAGMENT_SHADER, {"shafts.frag.glsl", NULL}}};
 static const gr_shader_stage corner_stages[2] = {{GL_VERTEX_SHADER, {"shafts_final.vert.glsl", NULL}},
-                                                 {GL_FRAGMENT_SHADER, {"shafts_waves.glsl", "shafts_corner.frag.glsl", NULL}}};
+                                                 {GL_FRAGMENT_SHADER, {"seed_waves.glsl", "shafts_corner.frag.glsl", NULL}}};
 
 static gr_status setup_gl(gr_shafts *r, gr_error *err)
 {

@@ -3,7 +3,7 @@
 // Positions are relative to the viewer (camera-relative rendering): the CPU subtracts the
 // viewer in double precision, so float stays exact far from the world origin.
 
-// Compiled after shafts_waves.glsl (#version, the waves' uniforms, surface()).
+// Compiled after seed_waves.glsl (#version, the waves' uniforms, surface()).
 
 layout(location = 0) in vec2 a_cell;    // cell centre, in grid cells, relative to P (flux: lattice point)
 layout(location = 1) in vec2 a_corner;  // corner of the shaft's cross-section, +-0.5 cell

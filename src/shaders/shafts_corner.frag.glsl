@@ -5,7 +5,7 @@
 // transmittance (eq. 5.5.2b) and its refracted sun direction (eq. 5.5.1), evaluated once
 // instead of in every vertex of the lattice.
 
-// Compiled after shafts_waves.glsl (#version, the waves' uniforms, surface()).
+// Compiled after seed_waves.glsl (#version, the waves' uniforms, surface()).
 
 uniform vec3 u_origin;        // P - viewer (m)
 uniform float u_spacing;      // S (m)

@@ -1,6 +1,7 @@
 #version 330 core
-// Shared prelude of the shaft shaders (shafts.vert.glsl, shafts_corner.frag.glsl): the seed's
-// packed Gerstner waves and its surface function, compiled in front of each (shaders.h stages).
+// Shared prelude of the shaders that evaluate seed 000's waves (shafts.vert.glsl,
+// shafts_corner.frag.glsl, radial_blur_light.frag.glsl): the seed's packed Gerstner waves and
+// its surface function, compiled in front of each (shaders.h stages).
 
 #define MAX_WAVE_GROUPS 16
 
