@@ -23,63 +23,6 @@ struct gr_caustics {
 
 /* ---- program builder ---------------------------------------------------------------------- */
 
-static void flatten(char *log)
-{
-    for (char *p = log; *p; p++)
-        if (*p == '\n' || *p == '\r' || *p == '\t') *p = ' ';
-}
-
-gr_status gr_vol_program(const char *dir, const gr_vol_stage *stages, int n, unsigned *program, gr_error *err)
-{
-    GLuint sh[6] = {0};
-    gr_status st = GR_OK;
-    *program = 0;
-    GLuint prog = glCreateProgram();
-    if (!prog) return gr_fail(err, GR_E_GL, "%s: glCreateProgram failed", stages[0].files[0]);
-    for (int s = 0; s < n && s < 6; s++) {
-        char *src[4] = {NULL, NULL, NULL, NULL};
-        int k = 0;
-        for (; k < 4 && stages[s].files[k]; k++)
-            if ((st = gr_shader_source(dir, stages[s].files[k], &src[k], NULL, err)) != GR_OK) break;
-        if (st == GR_OK) {
-            sh[s] = glCreateShader(stages[s].type);
-            glShaderSource(sh[s], k, (const GLchar *const *)src, NULL);
-            glCompileShader(sh[s]);
-            GLint ok = 0;
-            glGetShaderiv(sh[s], GL_COMPILE_STATUS, &ok);
-            if (!ok) {
-                char log[900] = "";
-                glGetShaderInfoLog(sh[s], (GLsizei)sizeof log, NULL, log);
-                flatten(log);
-                st = gr_fail(err, GR_E_GL, "%s: GLSL compile failed: %s", stages[s].files[k - 1], log[0] ? log : "(no log)");
-            } else {
-                glAttachShader(prog, sh[s]);
-            }
-        }
-        for (int j = 0; j < 4; j++) free(src[j]);
-        if (st != GR_OK) break;
-    }
-    if (st == GR_OK) {
-        glLinkProgram(prog);
-        GLint ok = 0;
-        glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char log[900] = "";
-            glGetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
-            flatten(log);
-            st = gr_fail(err, GR_E_GL, "%s: GLSL link failed: %s", stages[0].files[0], log[0] ? log : "(no log)");
-        }
-    }
-    for (int s = 0; s < n && s < 6; s++)
-        if (sh[s]) glDeleteShader(sh[s]);
-    if (st != GR_OK) {
-        glDeleteProgram(prog);
-        return st;
-    }
-    *program = prog;
-    return GR_OK;
-}
-
 /* ---- caustics ------------------------------------------------------------------------------ */
 
 void gr_caustics_depths(int n, double first_m, double last_m, double *out)
@@ -93,10 +36,10 @@ gr_status gr_caustics_create(const char *shader_dir, gr_caustics **out, gr_error
     *out = NULL;
     gr_caustics *c = calloc(1, sizeof *c);
     if (!c) return gr_fail(err, GR_E_NOMEM, "caustics: out of memory");
-    const gr_vol_stage st3[3] = {{GL_VERTEX_SHADER, {"caustics.vert.glsl", NULL, NULL, NULL}},
+    const gr_shader_stage st3[3] = {{GL_VERTEX_SHADER, {"caustics.vert.glsl", NULL, NULL, NULL}},
                                  {GL_GEOMETRY_SHADER, {"caustics.geom.glsl", NULL, NULL, NULL}},
                                  {GL_FRAGMENT_SHADER, {"caustics.frag.glsl", NULL, NULL, NULL}}};
-    gr_status st = gr_vol_program(shader_dir, st3, 3, &c->prog, err);
+    gr_status st = gr_shader_program_stages(shader_dir, st3, 3, NULL, 0, &c->prog, NULL, err);
     if (st != GR_OK) {
         free(c);
         return st;
@@ -367,10 +310,45 @@ double gr_vol_now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-gr_status gr_vol_prepare(const char *name, gr_gl *gl, gr_scenegl *sg, gr_caustics *caus, gr_gl_timer *timer,
-                         const gr_scene *scene, const gr_vol_settings *s, const gr_image *out, gr_vol_prep *p,
-                         gr_error *err)
+gr_status gr_vol_base_init(gr_vol_base *b, gr_gl *gl, const char *dir, int with_caustics, gr_error *err)
 {
+    memset(b, 0, sizeof *b);
+    b->gl = gl;
+    gr_status st = gr_scenegl_create_dir(gl, dir, &b->sg, err);
+    if (st == GR_OK && with_caustics) st = gr_caustics_create(dir, &b->caus, err);
+    if (st != GR_OK) return st;
+    glGenVertexArrays(1, &b->vao);
+    glGenQueries(1, &b->q_samples);
+    gr_gl_timer_init(&b->timer);
+    return GR_OK;
+}
+
+int gr_vol_base_current(const gr_vol_base *b)
+{
+    return b->gl && gr_gl_make_current(b->gl, NULL) == GR_OK;
+}
+
+void gr_vol_base_release(gr_vol_base *b)
+{
+    if (gr_vol_base_current(b)) {
+        if (b->vao) glDeleteVertexArrays(1, &b->vao);
+        if (b->out_fbo) glDeleteFramebuffers(1, &b->out_fbo);
+        if (b->out_tex) glDeleteTextures(1, &b->out_tex);
+        if (b->q_samples) glDeleteQueries(1, &b->q_samples);
+        gr_gl_timer_free(&b->timer);
+    }
+    gr_caustics_destroy(b->caus);
+    gr_scenegl_destroy(b->sg);
+    memset(b, 0, sizeof *b);
+}
+
+gr_status gr_vol_prepare(const char *name, gr_vol_base *b, const gr_scene *scene, const gr_vol_settings *s,
+                         const gr_image *out, gr_vol_prep *p, gr_error *err)
+{
+    gr_gl *gl = b->gl;
+    gr_scenegl *sg = b->sg;
+    gr_caustics *caus = b->caus;
+    gr_gl_timer *timer = &b->timer;
     memset(p, 0, sizeof *p);
     p->t0_ms = gr_vol_now_ms();
     gr_frame *f = &p->frame;
@@ -432,9 +410,10 @@ gr_status gr_vol_prepare(const char *name, gr_gl *gl, gr_scenegl *sg, gr_caustic
     return GR_OK;
 }
 
-gr_status gr_vol_target(unsigned *tex, unsigned *fbo, int *tw, int *th, int w, int h, const char *name,
-                        gr_error *err)
+gr_status gr_vol_target(gr_vol_base *b, int w, int h, const char *name, gr_error *err)
 {
+    unsigned *tex = &b->out_tex, *fbo = &b->out_fbo;
+    int *tw = &b->out_w, *th = &b->out_h;
     if (*tex && *tw == w && *th == h) return GR_OK;
     if (*fbo) glDeleteFramebuffers(1, fbo);
     if (*tex) glDeleteTextures(1, tex);
@@ -458,9 +437,10 @@ gr_status gr_vol_target(unsigned *tex, unsigned *fbo, int *tw, int *th, int w, i
     return gr_gl_check(what, err);
 }
 
-void gr_vol_stats(gr_technique_stats *stats, gr_gl_timer *timer, const char *const *names, int n,
-                  unsigned q_samples, double t0_ms)
+void gr_vol_stats(gr_technique_stats *stats, gr_vol_base *b, const char *const *names, int n, double t0_ms)
 {
+    gr_gl_timer *timer = &b->timer;
+    unsigned q_samples = b->q_samples;
     memset(stats, 0, sizeof *stats);
     double wall_ns = (gr_vol_now_ms() - t0_ms) * 1e6;
     stats->n_passes = n;

@@ -54,12 +54,6 @@ long long gr_caustics_triangles(const gr_caustics *c);
 /* Depths of a stack: n depths geometric between first_m and last_m (n = 1: first_m). */
 void gr_caustics_depths(int n, double first_m, double last_m, double *out);
 
-/* ---- shared program builder ---- */
-typedef struct gr_vol_stage {
-    unsigned type;           /* GL_VERTEX_SHADER, GL_GEOMETRY_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER */
-    const char *files[4];    /* concatenated in order (the first starts with #version); NULL-ended */
-} gr_vol_stage;
-gr_status gr_vol_program(const char *dir, const gr_vol_stage *stages, int n, unsigned *program, gr_error *err);
 
 
 /* ---- what the volume techniques share (volume_common.glsl's uniforms) ---- */
@@ -158,23 +152,41 @@ typedef struct gr_vol_prep {
     double t0_ms;                /* when the render started (for the wall time) */
 } gr_vol_prep;
 
+/* What every volume technique holds: its GL context, scenegl (shadow map, eye depth), the
+ * caustic stack (NULL for a technique without one), the screen VAO, the RGBA32F colour
+ * target with its framebuffer, the samples query and the pass timer. */
+typedef struct gr_vol_base {
+    gr_gl *gl;
+    gr_scenegl *sg;
+    gr_caustics *caus;
+    unsigned vao, out_tex, out_fbo, q_samples;
+    int out_w, out_h;
+    gr_gl_timer timer;
+} gr_vol_base;
+
+/* Creates scenegl (shaders from dir, NULL: the embedded ones), the caustic stack when
+ * with_caustics, the VAO, the query and the timer (gl must be current). On failure what
+ * was made stays in b for gr_vol_base_release. */
+gr_status gr_vol_base_init(gr_vol_base *b, gr_gl *gl, const char *dir, int with_caustics, gr_error *err);
+/* Makes b's context current; 1 when the technique may delete its own GL objects now. */
+int gr_vol_base_current(const gr_vol_base *b);
+/* Deletes what gr_vol_base_init and gr_vol_target made (b may be partly made). */
+void gr_vol_base_release(gr_vol_base *b);
+
 /* The prelude of a volume technique's render (`name` starts its messages): the frame; out
  * must be camera.width x camera.height with R, G, B and the viewer under the water
- * (GR_E_INPUT otherwise); makes gl current; resets timer; the occluders' shadow map (pass
- * GR_VOL_PASS_SHADOW, only with occluders, centred on the eye), the eye depth (pass
- * GR_VOL_PASS_DEPTH), the caustic stack (pass GR_VOL_PASS_CAUSTICS, only if caus is not NULL)
- * from s's caustic fields; p->in filled from s and the scene's scattering. */
-gr_status gr_vol_prepare(const char *name, gr_gl *gl, gr_scenegl *sg, gr_caustics *caus, gr_gl_timer *timer,
-                         const gr_scene *scene, const gr_vol_settings *s, const gr_image *out, gr_vol_prep *p,
-                         gr_error *err);
-/* (Re)allocates an RGBA32F colour target of w x h with its framebuffer when the size changed. */
-gr_status gr_vol_target(unsigned *tex, unsigned *fbo, int *tw, int *th, int w, int h, const char *name,
-                        gr_error *err);
-/* Fills stats: the n passes of timer named by names (a time longer than the render's wall
- * time, llvmpipe's first query, reads -1), the samples of query q_samples (0: -1), the wall
+ * (GR_E_INPUT otherwise); makes b's context current; resets its timer; the occluders' shadow
+ * map (pass GR_VOL_PASS_SHADOW, only with occluders, centred on the eye), the eye depth (pass
+ * GR_VOL_PASS_DEPTH), the caustic stack (pass GR_VOL_PASS_CAUSTICS, only if b->caus is not
+ * NULL) from s's caustic fields; p->in filled from s and the scene's scattering. */
+gr_status gr_vol_prepare(const char *name, gr_vol_base *b, const gr_scene *scene, const gr_vol_settings *s,
+                         const gr_image *out, gr_vol_prep *p, gr_error *err);
+/* (Re)allocates b's RGBA32F colour target of w x h with its framebuffer when the size changed. */
+gr_status gr_vol_target(gr_vol_base *b, int w, int h, const char *name, gr_error *err);
+/* Fills stats: the n passes of b's timer named by names (a time longer than the render's
+ * wall time, llvmpipe's first query, reads -1), the samples of b's query (0: -1), the wall
  * time since t0_ms. */
-void gr_vol_stats(gr_technique_stats *stats, gr_gl_timer *timer, const char *const *names, int n,
-                  unsigned q_samples, double t0_ms);
+void gr_vol_stats(gr_technique_stats *stats, gr_vol_base *b, const char *const *names, int n, double t0_ms);
 /* Monotonic clock (ms). */
 double gr_vol_now_ms(void);
 

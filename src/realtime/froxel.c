@@ -9,6 +9,7 @@
 
 #include "gl/gl.h"
 #include "realtime/caustics.h"
+#include "realtime/shaders.h"
 #include "realtime/frame.h"
 #include "realtime/scenegl.h"
 
@@ -50,17 +51,13 @@ static const gr_technique_level ladder[] = {
 };
 
 typedef struct fx_state {
-    gr_gl *gl;
-    gr_scenegl *sg;
-    gr_caustics *caus;
-    GLuint prog, prog_scatter, prog_integrate, vao, out_tex, out_fbo, vol_tex[2];
-    int out_w, out_h, vol_dims[3];
+    gr_vol_base base;
+    GLuint prog, prog_scatter, prog_integrate, vol_tex[2];
+    int vol_dims[3];
     gr_vol_locs vl, vl_s;
     GLint l_inv, l_fwd, l_bounds, l_eye_depth, l_size, l_tmax, l_nz, l_integrated;
     GLint s_grid, s_bounds, s_inv, s_fwd, s_jitter, s_phase, l_phase;
     GLint i_grid, i_bounds, i_inv, i_fwd, i_sigma;
-    gr_gl_timer timer;
-    GLuint q_samples;
     long long triangles;
     int n_slices;
 } fx_state;
@@ -69,19 +66,13 @@ static void fx_destroy(void *state)
 {
     fx_state *r = state;
     if (!r) return;
-    if (r->gl && gr_gl_make_current(r->gl, NULL) == GR_OK) {
+    if (gr_vol_base_current(&r->base)) {
         if (r->prog) glDeleteProgram(r->prog);
         if (r->prog_scatter) glDeleteProgram(r->prog_scatter);
         if (r->prog_integrate) glDeleteProgram(r->prog_integrate);
-        if (r->vao) glDeleteVertexArrays(1, &r->vao);
-        if (r->out_fbo) glDeleteFramebuffers(1, &r->out_fbo);
-        if (r->out_tex) glDeleteTextures(1, &r->out_tex);
         if (r->vol_tex[0]) glDeleteTextures(2, r->vol_tex);
-        if (r->q_samples) glDeleteQueries(1, &r->q_samples);
-        gr_gl_timer_free(&r->timer);
     }
-    gr_caustics_destroy(r->caus);
-    gr_scenegl_destroy(r->sg);
+    gr_vol_base_release(&r->base);
     free(r);
 }
 
@@ -93,19 +84,17 @@ static gr_status fx_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     const char *dir = opts ? opts->shader_dir : NULL;
     fx_state *r = calloc(1, sizeof *r);
     if (!r) return gr_fail(err, GR_E_NOMEM, "froxel: out of memory");
-    r->gl = gl;
     gr_status st;
-    if ((st = gr_scenegl_create_dir(gl, dir, &r->sg, err)) != GR_OK) goto fail;
-    if ((st = gr_caustics_create(dir, &r->caus, err)) != GR_OK) goto fail;
-    const gr_vol_stage apply[2] = {
+    if ((st = gr_vol_base_init(&r->base, gl, dir, 1, err)) != GR_OK) goto fail;
+    const gr_shader_stage apply[2] = {
         {GL_VERTEX_SHADER, {"volume_screen.vert.glsl", NULL, NULL, NULL}},
         {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "froxel_apply.frag.glsl"}}};
-    const gr_vol_stage scatter[1] = {
+    const gr_shader_stage scatter[1] = {
         {GL_COMPUTE_SHADER, {"volume_version.glsl", "volume_common.glsl", "froxel_scatter.comp.glsl", NULL}}};
-    const gr_vol_stage integrate[1] = {{GL_COMPUTE_SHADER, {"froxel_integrate.comp.glsl", NULL, NULL, NULL}}};
-    if ((st = gr_vol_program(dir, apply, 2, &r->prog, err)) != GR_OK) goto fail;
-    if ((st = gr_vol_program(dir, scatter, 1, &r->prog_scatter, err)) != GR_OK) goto fail;
-    if ((st = gr_vol_program(dir, integrate, 1, &r->prog_integrate, err)) != GR_OK) goto fail;
+    const gr_shader_stage integrate[1] = {{GL_COMPUTE_SHADER, {"froxel_integrate.comp.glsl", NULL, NULL, NULL}}};
+    if ((st = gr_shader_program_stages(dir, apply, 2, NULL, 0, &r->prog, NULL, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, scatter, 1, NULL, 0, &r->prog_scatter, NULL, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, integrate, 1, NULL, 0, &r->prog_integrate, NULL, err)) != GR_OK) goto fail;
     gr_vol_locations(r->prog, &r->vl);
     gr_vol_locations(r->prog_scatter, &r->vl_s);
     r->l_inv = glGetUniformLocation(r->prog, "u_inv_vp_rot");
@@ -128,9 +117,6 @@ static gr_status fx_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     r->i_inv = glGetUniformLocation(r->prog_integrate, "u_inv_vp_rot");
     r->i_fwd = glGetUniformLocation(r->prog_integrate, "u_forward");
     r->i_sigma = glGetUniformLocation(r->prog_integrate, "u_sigma_t");
-    glGenVertexArrays(1, &r->vao);
-    glGenQueries(1, &r->q_samples);
-    gr_gl_timer_init(&r->timer);
     if ((st = gr_gl_check("froxel setup", err)) != GR_OK) goto fail;
     *state = r;
     return GR_OK;
@@ -179,12 +165,12 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     fx_state *r = state;
     const gr_froxel_settings *s = settings;
     gr_vol_prep prep;
-    gr_status st = gr_vol_prepare("froxel", r->gl, r->sg, r->caus, &r->timer, scene, &s->vol, out, &prep, err);
+    gr_status st = gr_vol_prepare("froxel", &r->base, scene, &s->vol, out, &prep, err);
     if (st != GR_OK) return st;
     const gr_frame *f = &prep.frame;
     int W = f->width, H = f->height;
-    if ((st = gr_vol_target(&r->out_tex, &r->out_fbo, &r->out_w, &r->out_h, W, H, "froxel", err)) != GR_OK) return st;
-    r->triangles = gr_caustics_triangles(r->caus);
+    if ((st = gr_vol_target(&r->base, W, H, "froxel", err)) != GR_OK) return st;
+    r->triangles = gr_caustics_triangles(r->base.caus);
     double tmax = prep.t_max;
     double far = gr_vol_far_depth(scene, f, tmax);
     double b[MAX_SLICES + 1];
@@ -200,7 +186,7 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     if ((st = ensure_volume(r, s->grid_x, s->grid_y, nz, err)) != GR_OK) return st;
 
     /* pass: in-scattering per froxel */
-    gr_gl_timer_begin(&r->timer, P_SCATTER);
+    gr_gl_timer_begin(&r->base.timer, P_SCATTER);
     glUseProgram(r->prog_scatter);
     gr_vol_set(&r->vl_s, &prep.in);
     glUniform3i(r->s_grid, s->grid_x, s->grid_y, nz);
@@ -212,10 +198,10 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     glBindImageTexture(0, r->vol_tex[0], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute((GLuint)((s->grid_x + 7) / 8), (GLuint)((s->grid_y + 7) / 8), (GLuint)nz);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    gr_gl_timer_end(&r->timer);
+    gr_gl_timer_end(&r->base.timer);
 
     /* pass: Hillaire's front-to-back integration */
-    gr_gl_timer_begin(&r->timer, P_INTEGRATE);
+    gr_gl_timer_begin(&r->base.timer, P_INTEGRATE);
     glUseProgram(r->prog_integrate);
     glUniform3i(r->i_grid, s->grid_x, s->grid_y, nz);
     glUniform1fv(r->i_bounds, nz + 1, bf);
@@ -226,11 +212,11 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     glBindImageTexture(1, r->vol_tex[1], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute((GLuint)((s->grid_x + 7) / 8), (GLuint)((s->grid_y + 7) / 8), 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-    gr_gl_timer_end(&r->timer);
+    gr_gl_timer_end(&r->base.timer);
 
     /* pass: per pixel, the integrated volume at the ray's end */
-    gr_gl_timer_begin(&r->timer, P_APPLY);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    gr_gl_timer_begin(&r->base.timer, P_APPLY);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out_fbo);
     glViewport(0, 0, W, H);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
@@ -250,19 +236,19 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_3D, r->vol_tex[1]);
     glActiveTexture(GL_TEXTURE0);
-    glBindVertexArray(r->vao);
-    glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
+    glBindVertexArray(r->base.vao);
+    glBeginQuery(GL_SAMPLES_PASSED, r->base.q_samples);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glEndQuery(GL_SAMPLES_PASSED);
-    gr_gl_timer_end(&r->timer);
+    gr_gl_timer_end(&r->base.timer);
     glBindVertexArray(0);
     glUseProgram(0);
     r->n_slices = nz;
-    st = gr_vol_readback(r->out_fbo, W, H, out, "froxel readback", err);
+    st = gr_vol_readback(r->base.out_fbo, W, H, out, "froxel readback", err);
     if (st != GR_OK) return st;
     if (stats) {
         static const char *const names[6] = {"shadow", "eye_depth", "caustics", "scatter", "integrate", "apply"};
-        gr_vol_stats(stats, &r->timer, names, 6, r->q_samples, prep.t0_ms);
+        gr_vol_stats(stats, &r->base, names, 6, prep.t0_ms);
     }
     return gr_image_check_finite(out, "froxel", err);
 }

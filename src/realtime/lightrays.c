@@ -11,6 +11,7 @@
 #include "gl/gl.h"
 #include "realtime/frame.h"
 #include "realtime/scenegl.h"
+#include "realtime/shaders.h"
 
 #define MAX_RAYS 4096
 #define MAX_CELLS 2048
@@ -49,17 +50,14 @@ static const gr_technique_level ladder[] = {
 };
 
 typedef struct lr_state {
-    gr_gl *gl;
-    gr_scenegl *sg;
-    GLuint prog_surf, prog_lines, vao, out_tex, out_fbo;
+    gr_vol_base base;
+    GLuint prog_surf, prog_lines;
     GLuint surf_tex[2], surf_depth, surf_fbo;
-    int out_w, out_h, surf_n;
+    int surf_n;
     gr_vol_locs vl;
     GLint s_cells, s_half, s_win, s_zr, s_c, s_e1, s_e2, s_sun, s_nw, s_wa, s_wamp;
     GLint l_pos, l_nrm, l_rays, l_vp, l_sun, l_ior, l_area, l_footprint, l_pix, l_width, l_max, l_seabed, l_eye_depth,
         l_size, l_tmax, l_fwd, l_h1, l_h2, l_inv, l_kernel;
-    gr_gl_timer timer;
-    GLuint q_samples;
     int n_rays;
     double window_m;
 } lr_state;
@@ -68,19 +66,14 @@ static void lr_destroy(void *state)
 {
     lr_state *r = state;
     if (!r) return;
-    if (r->gl && gr_gl_make_current(r->gl, NULL) == GR_OK) {
+    if (gr_vol_base_current(&r->base)) {
         if (r->prog_surf) glDeleteProgram(r->prog_surf);
         if (r->prog_lines) glDeleteProgram(r->prog_lines);
-        if (r->vao) glDeleteVertexArrays(1, &r->vao);
-        if (r->out_fbo) glDeleteFramebuffers(1, &r->out_fbo);
-        if (r->out_tex) glDeleteTextures(1, &r->out_tex);
         if (r->surf_fbo) glDeleteFramebuffers(1, &r->surf_fbo);
         if (r->surf_tex[0]) glDeleteTextures(2, r->surf_tex);
         if (r->surf_depth) glDeleteTextures(1, &r->surf_depth);
-        if (r->q_samples) glDeleteQueries(1, &r->q_samples);
-        gr_gl_timer_free(&r->timer);
     }
-    gr_scenegl_destroy(r->sg);
+    gr_vol_base_release(&r->base);
     free(r);
 }
 
@@ -92,17 +85,16 @@ static gr_status lr_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     const char *dir = opts ? opts->shader_dir : NULL;
     lr_state *r = calloc(1, sizeof *r);
     if (!r) return gr_fail(err, GR_E_NOMEM, "light_rays: out of memory");
-    r->gl = gl;
     gr_status st;
-    if ((st = gr_scenegl_create_dir(gl, dir, &r->sg, err)) != GR_OK) goto fail;
-    const gr_vol_stage surf[2] = {{GL_VERTEX_SHADER, {"lightrays_surface.vert.glsl", NULL, NULL, NULL}},
+    if ((st = gr_vol_base_init(&r->base, gl, dir, 0, err)) != GR_OK) goto fail;
+    const gr_shader_stage surf[2] = {{GL_VERTEX_SHADER, {"lightrays_surface.vert.glsl", NULL, NULL, NULL}},
                                   {GL_FRAGMENT_SHADER, {"lightrays_surface.frag.glsl", NULL, NULL, NULL}}};
-    const gr_vol_stage lines[3] = {
+    const gr_shader_stage lines[3] = {
         {GL_VERTEX_SHADER, {"lightrays.vert.glsl", NULL, NULL, NULL}},
         {GL_GEOMETRY_SHADER, {"volume_version.glsl", "volume_common.glsl", "lightrays.geom.glsl", NULL}},
         {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "lightrays.frag.glsl"}}};
-    if ((st = gr_vol_program(dir, surf, 2, &r->prog_surf, err)) != GR_OK) goto fail;
-    if ((st = gr_vol_program(dir, lines, 3, &r->prog_lines, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, surf, 2, NULL, 0, &r->prog_surf, NULL, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, lines, 3, NULL, 0, &r->prog_lines, NULL, err)) != GR_OK) goto fail;
     GLuint p = r->prog_surf;
     r->s_cells = glGetUniformLocation(p, "u_cells");
     r->s_half = glGetUniformLocation(p, "u_half");
@@ -137,9 +129,6 @@ static gr_status lr_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     r->l_eye_depth = glGetUniformLocation(p, "u_eye_depth");
     r->l_size = glGetUniformLocation(p, "u_size");
     r->l_tmax = glGetUniformLocation(p, "u_tmax");
-    glGenVertexArrays(1, &r->vao);
-    glGenQueries(1, &r->q_samples);
-    gr_gl_timer_init(&r->timer);
     if ((st = gr_gl_check("light_rays setup", err)) != GR_OK) goto fail;
     *state = r;
     return GR_OK;
@@ -274,11 +263,11 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
     lr_state *r = state;
     const gr_light_rays_settings *s = settings;
     gr_vol_prep prep;
-    gr_status st = gr_vol_prepare("light_rays", r->gl, r->sg, NULL, &r->timer, scene, &s->vol, out, &prep, err);
+    gr_status st = gr_vol_prepare("light_rays", &r->base, scene, &s->vol, out, &prep, err);
     if (st != GR_OK) return st;
     const gr_frame *f = &prep.frame;
     int W = f->width, H = f->height, N = s->rays;
-    if ((st = gr_vol_target(&r->out_tex, &r->out_fbo, &r->out_w, &r->out_h, W, H, "light_rays", err)) != GR_OK)
+    if ((st = gr_vol_target(&r->base, W, H, "light_rays", err)) != GR_OK)
         return st;
     if ((st = ensure_surface(r, N, err)) != GR_OK) return st;
     lr_window win;
@@ -302,7 +291,7 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
         wa[i * 4 + 3] = (float)cst;
         wamp[i] = (float)wv->amplitude_m;
     }
-    gr_gl_timer_begin(&r->timer, P_SURFACE);
+    gr_gl_timer_begin(&r->base.timer, P_SURFACE);
     glBindFramebuffer(GL_FRAMEBUFFER, r->surf_fbo);
     glViewport(0, 0, N, N);
     glClearColor(0, 0, 0, 0);
@@ -325,10 +314,10 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
     glUniform1i(r->s_nw, scene->water.n_waves);
     glUniform4fv(r->s_wa, GR_MAX_WAVES, wa);
     glUniform1fv(r->s_wamp, GR_MAX_WAVES, wamp);
-    glBindVertexArray(r->vao);
+    glBindVertexArray(r->base.vao);
     glDrawArrays(GL_TRIANGLES, 0, cells * cells * 6);
     glDisable(GL_DEPTH_TEST);
-    gr_gl_timer_end(&r->timer);
+    gr_gl_timer_end(&r->base.timer);
 
     /* pass 2: one ribbon per texel into the eye's view, additive */
     double rot[16], inv[16];
@@ -343,8 +332,8 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
         h[0][k] = texel * (win.e1[k] - f->sun_dir[k] * win.e1[1] / f->sun_dir[1]);
         h[1][k] = texel * (win.e2[k] - f->sun_dir[k] * win.e2[1] / f->sun_dir[1]);
     }
-    gr_gl_timer_begin(&r->timer, P_LINES);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    gr_gl_timer_begin(&r->base.timer, P_LINES);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out_fbo);
     glViewport(0, 0, W, H);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
@@ -380,20 +369,20 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
     glActiveTexture(GL_TEXTURE6);
     glBindTexture(GL_TEXTURE_2D, r->surf_tex[1]);
     glActiveTexture(GL_TEXTURE0);
-    glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
+    glBeginQuery(GL_SAMPLES_PASSED, r->base.q_samples);
     glDrawArrays(GL_POINTS, 0, N * N);
     glEndQuery(GL_SAMPLES_PASSED);
     glDisable(GL_BLEND);
-    gr_gl_timer_end(&r->timer);
+    gr_gl_timer_end(&r->base.timer);
     glBindVertexArray(0);
     glUseProgram(0);
     r->n_rays = N;
     r->window_m = 2.0 * win.half_m;
-    st = gr_vol_readback(r->out_fbo, W, H, out, "light_rays readback", err);
+    st = gr_vol_readback(r->base.out_fbo, W, H, out, "light_rays readback", err);
     if (st != GR_OK) return st;
     if (stats) {
         static const char *const names[4] = {"shadow", "eye_depth", "surface", "lines"};
-        gr_vol_stats(stats, &r->timer, names, 4, r->q_samples, prep.t0_ms);
+        gr_vol_stats(stats, &r->base, names, 4, prep.t0_ms);
     }
     return gr_image_check_finite(out, "light_rays", err);
 }

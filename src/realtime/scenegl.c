@@ -218,6 +218,30 @@ static gr_status make_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h
 
 /* ---- shadow map ---------------------------------------------------------------------------- */
 
+/* Light frame: e3 = refr_dir along the beam, e1, e2 across it. */
+static void light_frame(const gr_frame *f, gr_dvec3 *e1, gr_dvec3 *e2, gr_dvec3 *e3)
+{
+    *e3 = gr_d3_norm(gr_d3(f->refr_dir[0], f->refr_dir[1], f->refr_dir[2]));
+    gr_dvec3 a = fabs(e3->x) < 0.9 ? gr_d3(1, 0, 0) : gr_d3(0, 0, 1);
+    *e1 = gr_d3_norm(gr_d3_cross(*e3, a));
+    *e2 = gr_d3_cross(*e3, *e1);
+}
+
+void gr_scenegl_shadow_snap(const gr_frame *f, int size, double half_extent_m, const double center[3],
+                            double out[3])
+{
+    gr_dvec3 e1, e2, e3;
+    light_frame(f, &e1, &e2, &e3);
+    const gr_dvec3 c = gr_d3(center[0], center[1], center[2]);
+    /* the map spans [-h, h] across the beam in `size` texels: texel edges at u_c - h + i texel,
+     * world-fixed when u_c = e1.c is a whole number of texels */
+    const double texel = 2.0 * half_extent_m / (double)size;
+    const double u = gr_d3_dot(e1, c), v = gr_d3_dot(e2, c);
+    const double du = texel * floor(u / texel + 0.5) - u, dv = texel * floor(v / texel + 0.5) - v;
+    const gr_dvec3 o = gr_d3_add(c, gr_d3_add(gr_d3_scale(e1, du), gr_d3_scale(e2, dv)));
+    out[0] = o.x, out[1] = o.y, out[2] = o.z;
+}
+
 gr_status gr_scenegl_shadow_map(gr_scenegl *s, const gr_scene *scene, const gr_frame *f, int size,
                                 const double center[3], double half_extent_m, unsigned *texture,
                                 double light_vp[16], gr_error *err)
@@ -235,11 +259,8 @@ gr_status gr_scenegl_shadow_map(gr_scenegl *s, const gr_scene *scene, const gr_f
             return st;
         s->shadow_size = size;
     }
-    /* Light frame: e3 = refr_dir along the beam, e1, e2 across it (as shafts.c). */
-    gr_dvec3 e3 = gr_d3_norm(gr_d3(f->refr_dir[0], f->refr_dir[1], f->refr_dir[2]));
-    gr_dvec3 a = fabs(e3.x) < 0.9 ? gr_d3(1, 0, 0) : gr_d3(0, 0, 1);
-    gr_dvec3 e1 = gr_d3_norm(gr_d3_cross(e3, a));
-    gr_dvec3 e2 = gr_d3_cross(e3, e1);
+    gr_dvec3 e1, e2, e3;
+    light_frame(f, &e1, &e2, &e3);
     double zmin = 0.0, zmax = 0.0;
     for (size_t i = 0; i < s->mesh_n; i++) {
         const double *p = s->mesh + i * 3;

@@ -40,6 +40,12 @@ void gr_scenegl_destroy(gr_scenegl *s); /* accepts NULL */
 gr_status gr_scenegl_shadow_map(gr_scenegl *s, const gr_scene *scene, const gr_frame *f, int size,
                                 const double center[3], double half_extent_m, unsigned *texture,
                                 double light_vp[16], gr_error *err);
+/* center moved across the beam (in the map's e1, e2) to the nearest multiple of the map's
+ * texel size 2 half_extent_m / size, its component along refr_dir kept: a map centred there
+ * has its texels at the same world places whatever center was (the standard shadow-map
+ * stabilization; docs/realtime-shafts.md "stable_grid"). out may alias center. */
+void gr_scenegl_shadow_snap(const gr_frame *f, int size, double half_extent_m, const double center[3],
+                            double out[3]);
 /* Linear distance (m) from the eye to the first occluder or the seabed along each pixel's
  * view ray, at width x height (R32F; GR_FRAME_FAR_M where nothing is hit). Returns the texture. */
 gr_status gr_scenegl_eye_depth(gr_scenegl *s, const gr_scene *scene, const gr_frame *f, int width, int height,

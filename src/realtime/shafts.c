@@ -85,6 +85,9 @@ static const gr_param shafts_params[] = {
      .doc = "hide shaft surfaces behind the occluders and the seabed as seen from the eye"},
     {.name = "slabs", .type = GR_PT_INT, .offset = SH(slabs), .min = 1, .max = 256, .def = 16, .unit = "",
      .doc = "flux variant: depth slabs per shaft (each with its own cross-section area)"},
+    {.name = "grid_eye_m", .type = GR_PT_RGB, .offset = SH(grid_eye_m), .min = -1e7, .max = 1e7, .flags = FROM,
+     .def = NAN, .unit = "m", .scene_source = "camera.position_m",
+     .doc = "[x, y, z] the shaft grid (P, S) is built for, the view staying the camera's (a debug freeze)"},
 };
 #undef SH
 
@@ -171,6 +174,7 @@ typedef struct frame_setup {
     gr_frame fr;      /* camera matrices, refracted sun (realtime/frame.h) */
     float view_proj[16], inv_view_proj[16]; /* column-major, viewer-relative (rotation only) */
     double shadow_half_m; /* half extent of the shared shadow map around P */
+    double shadow_center[3]; /* P; with stable_grid snapped to whole map texels across the beam */
     float shadow_matrix[16]; /* column-major: viewer-relative -> shadow texture [0,1]^3 */
     float shadow_bias_depth, shadow_dz;  /* bias in depth units; metres per depth unit */
     float hgg[3];
@@ -208,6 +212,8 @@ void gr_shafts_resolve(const gr_scene *scene, const gr_shafts_settings *s, gr_sh
     for (int c = 0; c < 3; c++)
         if (isnan(out->extinction[c])) out->extinction[c] = scene->medium.extinction[c];
     if (isnan(out->g)) out->g = scene->medium.g;
+    for (int c = 0; c < 3; c++)
+        if (isnan(out->grid_eye_m[c])) out->grid_eye_m[c] = scene->camera.position_m[c];
 }
 
 /* ---- GL resources ------------------------------------------------------------------ */
@@ -301,14 +307,20 @@ gr_status gr_shafts_create_in(gr_gl *gl, const char *shader_dir, gr_shafts **out
     return GR_OK;
 }
 
+/* The shaft pass and the flux pre-pass compile seed_waves.glsl (the seed's waves and
+ * surface function) in front of their own file. */
+static const gr_shader_stage shaft_stages[2] = {{GL_VERTEX_SHADER, {"seed_waves.glsl", "shafts.vert.glsl", NULL}},
+                                                {GL_FRAGMENT_SHADER, {"shafts.frag.glsl", NULL}}};
+static const gr_shader_stage corner_stages[2] = {{GL_VERTEX_SHADER, {"shafts_final.vert.glsl", NULL}},
+                                                 {GL_FRAGMENT_SHADER, {"seed_waves.glsl", "shafts_corner.frag.glsl", NULL}}};
+
 static gr_status setup_gl(gr_shafts *r, gr_error *err)
 {
     gr_status st;
     int nd = 0;
     /* the occluders' shadow map and eye depth are scenegl's, shared with every technique */
     if ((st = gr_scenegl_create_dir(r->gl, r->shader_dir, &r->scenegl, err)) != GR_OK) return st;
-    if ((st = gr_shader_program(r->shader_dir, "shafts.vert.glsl", "shafts.frag.glsl", NULL, 0,
-                                &r->prog_shafts, &nd, err)) != GR_OK)
+    if ((st = gr_shader_program_stages(r->shader_dir, shaft_stages, 2, NULL, 0, &r->prog_shafts, &nd, err)) != GR_OK)
         return st;
     r->from_dir += nd;
     if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_final.frag.glsl", NULL, 0,
@@ -316,8 +328,7 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
         return st;
     r->from_dir += nd;
 
-    if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_corner.frag.glsl", NULL, 0,
-                                &r->prog_corner, &nd, err)) != GR_OK)
+    if ((st = gr_shader_program_stages(r->shader_dir, corner_stages, 2, NULL, 0, &r->prog_corner, &nd, err)) != GR_OK)
         return st;
     r->from_dir += nd;
     get_shaft_locs(r->prog_corner, &r->lk);
@@ -702,10 +713,17 @@ static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in
     if (!(depth > 0))
         return gr_fail(err, GR_E_INPUT, "camera.position_m: y = %g is not below the water surface (y = %g); "
                        "the shafts renderer needs an underwater viewer", f->eye.y, h0);
+    /* The grid is built for shafts.grid_eye_m (resolved: the camera's position unless set),
+     * the view stays the camera's: P and S below come from that eye, every position sent to
+     * GL is relative to the camera's (docs "stable_grid": the layer's own change). */
+    const gr_dvec3 ge = gr_d3(s->grid_eye_m[0], s->grid_eye_m[1], s->grid_eye_m[2]);
+    const double grid_depth = h0 - ge.y;
+    if (!(grid_depth > 0))
+        return gr_fail(err, GR_E_INPUT, "shafts.grid_eye_m: y = %g is not below the water surface (y = %g)", ge.y, h0);
     gr_dvec3 I = gr_d3(scene->sun.dir[0], scene->sun.dir[1], scene->sun.dir[2]);
     double ior = scene->medium.ior;
-    f->P = gr_shafts_center(f->eye, I, h0, ior, &f->T);
-    f->S = gr_shafts_spacing(s->K, depth, cam->fov_deg * GR_PI / 180.0, s->N);
+    f->P = gr_shafts_center(ge, I, h0, ior, &f->T);
+    f->S = gr_shafts_spacing(s->K, grid_depth, cam->fov_deg * GR_PI / 180.0, s->N);
     if (!(isfinite(f->P.x) && isfinite(f->P.z) && f->S > 0 && isfinite(f->S)))
         return gr_fail(err, GR_E_INPUT, "sun.elevation_deg: no finite recentering point P for this sun and camera");
     if (w->n_waves > MAX_WAVE_GROUPS * 4)
@@ -793,6 +811,11 @@ static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in
     double half_grid = 0.5 * (double)s->N * f->lvl_S[f->n_levels - 1] * fmax(1.0, s->shaft_width)
                        + (s->stable_grid ? f->lvl_S[f->n_levels - 1] : 0.0);
     f->shadow_half_m = sqrt(2.0) * half_grid + amp_sum + s->shaft_length_m * fmin(1.0, steep + 0.05);
+    /* stable_grid: the map's texels fixed in the world too (its centre snapped to whole texels
+     * across the beam; half_m depends on the depth only), so shadow edges do not shimmer */
+    f->shadow_center[0] = f->P.x, f->shadow_center[1] = f->P.y, f->shadow_center[2] = f->P.z;
+    if (s->stable_grid)
+        gr_scenegl_shadow_snap(&f->fr, s->shadow_map_size, f->shadow_half_m, f->shadow_center, f->shadow_center);
     /* Seed's packed Mie parameters HGg = (1 - g^2, 1 + g^2, 2 g). */
     f->hgg[0] = (float)(1.0 - s->g * s->g);
     f->hgg[1] = (float)(1.0 + s->g * s->g);
@@ -888,8 +911,7 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_SHADOW]);
     unsigned shadow_tex = 0;
     double light_vp[16];
-    const double center[3] = {f->P.x, f->P.y, f->P.z};
-    st = gr_scenegl_shadow_map(r->scenegl, scene, &f->fr, f->s.shadow_map_size, center, f->shadow_half_m,
+    st = gr_scenegl_shadow_map(r->scenegl, scene, &f->fr, f->s.shadow_map_size, f->shadow_center, f->shadow_half_m,
                                &shadow_tex, light_vp, err);
     glEndQuery(GL_TIME_ELAPSED);
     if (st != GR_OK) goto done;
@@ -1096,8 +1118,8 @@ gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
     if (!r->prog_capture) {
         static const char *const varyings[] = {"v_world", "v_intensity"};
-        if ((st = gr_shader_program(r->shader_dir, "shafts.vert.glsl", "shafts.frag.glsl", varyings, 2,
-                                    &r->prog_capture, NULL, err)) != GR_OK)
+        if ((st = gr_shader_program_stages(r->shader_dir, shaft_stages, 2, varyings, 2, &r->prog_capture, NULL, err)) !=
+            GR_OK)
             goto done;
         get_shaft_locs(r->prog_capture, &r->lc);
     }

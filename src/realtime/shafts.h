@@ -47,6 +47,8 @@ typedef struct gr_shafts_settings {
     int stable_grid;              /* P snapped to the grid, S quantized with a cross-fade */
     int depth_test;               /* shafts hidden behind occluders / seabed seen from the eye */
     int slabs;                    /* flux: depth slabs per shaft */
+    double grid_eye_m[3];         /* eye the grid (P, S, stable_grid's levels) is built for, world m;
+                                     default: the camera's position (the view stays the camera's) */
 } gr_shafts_settings;
 
 extern const gr_param_table gr_shafts_param_table;

@@ -8,6 +8,7 @@
 
 #include "gl/gl.h"
 #include "realtime/caustics.h"
+#include "realtime/shaders.h"
 #include "realtime/frame.h"
 #include "realtime/scenegl.h"
 
@@ -41,15 +42,10 @@ static const gr_technique_level ladder[] = {
 };
 
 typedef struct sl_state {
-    gr_gl *gl;
-    gr_scenegl *sg;
-    gr_caustics *caus;
-    GLuint prog, vao, out_tex, out_fbo;
-    int out_w, out_h;
+    gr_vol_base base;
+    GLuint prog;
     gr_vol_locs vl;
     GLint l_inv, l_fwd, l_bounds, l_eye_depth, l_size, l_tmax;
-    gr_gl_timer timer;
-    GLuint q_samples;
     long long triangles;
     int n_slices;
 } sl_state;
@@ -58,16 +54,10 @@ static void sl_destroy(void *state)
 {
     sl_state *r = state;
     if (!r) return;
-    if (r->gl && gr_gl_make_current(r->gl, NULL) == GR_OK) {
+    if (gr_vol_base_current(&r->base)) {
         if (r->prog) glDeleteProgram(r->prog);
-        if (r->vao) glDeleteVertexArrays(1, &r->vao);
-        if (r->out_fbo) glDeleteFramebuffers(1, &r->out_fbo);
-        if (r->out_tex) glDeleteTextures(1, &r->out_tex);
-        if (r->q_samples) glDeleteQueries(1, &r->q_samples);
-        gr_gl_timer_free(&r->timer);
     }
-    gr_caustics_destroy(r->caus);
-    gr_scenegl_destroy(r->sg);
+    gr_vol_base_release(&r->base);
     free(r);
 }
 
@@ -79,14 +69,12 @@ static gr_status sl_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     const char *dir = opts ? opts->shader_dir : NULL;
     sl_state *r = calloc(1, sizeof *r);
     if (!r) return gr_fail(err, GR_E_NOMEM, "slicing: out of memory");
-    r->gl = gl;
     gr_status st;
-    if ((st = gr_scenegl_create_dir(gl, dir, &r->sg, err)) != GR_OK) goto fail;
-    if ((st = gr_caustics_create(dir, &r->caus, err)) != GR_OK) goto fail;
-    const gr_vol_stage stages[2] = {
+    if ((st = gr_vol_base_init(&r->base, gl, dir, 1, err)) != GR_OK) goto fail;
+    const gr_shader_stage stages[2] = {
         {GL_VERTEX_SHADER, {"volume_screen.vert.glsl", NULL, NULL, NULL}},
         {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "slicing.frag.glsl"}}};
-    if ((st = gr_vol_program(dir, stages, 2, &r->prog, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, stages, 2, NULL, 0, &r->prog, NULL, err)) != GR_OK) goto fail;
     gr_vol_locations(r->prog, &r->vl);
     r->l_inv = glGetUniformLocation(r->prog, "u_inv_vp_rot");
     r->l_fwd = glGetUniformLocation(r->prog, "u_forward");
@@ -94,9 +82,6 @@ static gr_status sl_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     r->l_eye_depth = glGetUniformLocation(r->prog, "u_eye_depth");
     r->l_size = glGetUniformLocation(r->prog, "u_size");
     r->l_tmax = glGetUniformLocation(r->prog, "u_tmax");
-    glGenVertexArrays(1, &r->vao);
-    glGenQueries(1, &r->q_samples);
-    gr_gl_timer_init(&r->timer);
     if ((st = gr_gl_check("slicing setup", err)) != GR_OK) goto fail;
     *state = r;
     return GR_OK;
@@ -124,12 +109,12 @@ static gr_status sl_render(void *state, const gr_scene *scene, const void *setti
     sl_state *r = state;
     const gr_slicing_settings *s = settings;
     gr_vol_prep prep;
-    gr_status st = gr_vol_prepare("slicing", r->gl, r->sg, r->caus, &r->timer, scene, &s->vol, out, &prep, err);
+    gr_status st = gr_vol_prepare("slicing", &r->base, scene, &s->vol, out, &prep, err);
     if (st != GR_OK) return st;
     const gr_frame *f = &prep.frame;
     int W = f->width, H = f->height;
-    if ((st = gr_vol_target(&r->out_tex, &r->out_fbo, &r->out_w, &r->out_h, W, H, "slicing", err)) != GR_OK) return st;
-    r->triangles = gr_caustics_triangles(r->caus);
+    if ((st = gr_vol_target(&r->base, W, H, "slicing", err)) != GR_OK) return st;
+    r->triangles = gr_caustics_triangles(r->base.caus);
     double tmax = prep.t_max;
     double far = gr_vol_far_depth(scene, f, tmax);
     double b[MAX_SLICES + 1];
@@ -142,8 +127,8 @@ static gr_status sl_render(void *state, const gr_scene *scene, const void *setti
     float m[16];
     gr_frame_matf(inv, m);
 
-    gr_gl_timer_begin(&r->timer, P_SLICES);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    gr_gl_timer_begin(&r->base.timer, P_SLICES);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out_fbo);
     glViewport(0, 0, W, H);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
@@ -162,20 +147,20 @@ static gr_status sl_render(void *state, const gr_scene *scene, const void *setti
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, prep.depth_tex);
     glActiveTexture(GL_TEXTURE0);
-    glBindVertexArray(r->vao);
-    glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
+    glBindVertexArray(r->base.vao);
+    glBeginQuery(GL_SAMPLES_PASSED, r->base.q_samples);
     glDrawArraysInstanced(GL_TRIANGLES, 0, 3, s->slices);
     glEndQuery(GL_SAMPLES_PASSED);
     glDisable(GL_BLEND);
-    gr_gl_timer_end(&r->timer);
+    gr_gl_timer_end(&r->base.timer);
     glBindVertexArray(0);
     glUseProgram(0);
     r->n_slices = s->slices;
-    st = gr_vol_readback(r->out_fbo, W, H, out, "slicing readback", err);
+    st = gr_vol_readback(r->base.out_fbo, W, H, out, "slicing readback", err);
     if (st != GR_OK) return st;
     if (stats) {
         static const char *const names[4] = {"shadow", "eye_depth", "caustics", "slices"};
-        gr_vol_stats(stats, &r->timer, names, 4, r->q_samples, prep.t0_ms);
+        gr_vol_stats(stats, &r->base, names, 4, prep.t0_ms);
     }
     return gr_image_check_finite(out, "slicing", err);
 }

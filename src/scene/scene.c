@@ -739,6 +739,7 @@ static double scene_source_value(const gr_scene *s, const char *src, int channel
     if (!strcmp(src, "medium.absorption")) return s->medium.absorption[ch];
     if (!strcmp(src, "medium.scattering")) return s->medium.scattering[ch];
     if (!strcmp(src, "medium.ior")) return s->medium.ior;
+    if (!strcmp(src, "camera.position_m")) return s->camera.position_m[ch];
     return NAN;
 }
 

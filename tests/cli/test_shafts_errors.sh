@@ -38,6 +38,8 @@ expect 2 "--frames" "$dir/s.json" -o "$o" --frames 5:1:1
 expect 2 "--shader-dir" "$dir/s.json" -o "$o" --shader-dir "$dir/no_such_dir"
 expect 2 "no scene" -o "$o"
 expect 2 "camera.position_m" "$dir/s.json" -o "$o" --set "camera.position_m=[0, 2, 0]"
+expect 2 "shafts.grid_eye_m" "$dir/s.json" -o "$o" --set "shafts.grid_eye_m=[0, 2, 0]"
+expect 2 "shafts.grid_eye_m[0]" "$dir/s.json" -o "$o" --set "shafts.grid_eye_m=[1e300, -8, 0]"
 # A shader that does not compile: exit 1, the file name and the driver's log on one line.
 mkdir "$dir/shaders"
 printf '#version 330 core\nout vec4 o;\nvoid main() { o = vec4(undeclared_thing, 1.0); }\n' >"$dir/shaders/shafts_final.frag.glsl"
