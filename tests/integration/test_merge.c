@@ -93,11 +93,16 @@ static void same_image(const char *a, const char *b, int expect_probe)
         static const char *const keys[] = {"godrays:image_mean", "godrays:image_p95", "godrays:rel_stderr_mean",
                                            "godrays:rel_stderr_p95", "godrays:frac_pixels_stderr_le_1pct",
                                            "godrays:bias_surface_rel_est", "godrays:spp", "godrays:passes",
-                                           "godrays:preview_exposure"};
+                                           "godrays:preview_exposure", "godrays:steps_mean", "godrays:steps_min",
+                                           "godrays:steps_max"};
         for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++) {
             double va = meta_num(&ma, keys[k]), vb = meta_num(&mb, keys[k]);
             CHECK_MSG(memcmp(&va, &vb, sizeof va) == 0, "%s: %.17g (single) vs %.17g (merged)", keys[k], va, vb);
         }
+        /* adaptive steps (the default): the parts' pilots must agree; under waves the steps vary,
+         * flat water takes the fewest everywhere (docs/reference.md 2.5) */
+        if (expect_probe) CHECK(meta_num(&ma, "godrays:steps_min") < meta_num(&ma, "godrays:steps_max"));
+        else CHECK(meta_num(&ma, "godrays:steps_max") == 8.0);
         double bias = meta_num(&ma, "godrays:bias_surface_rel_est");
         CHECK_MSG(expect_probe ? bias > 0.0 : bias == 0.0, "%s: bias estimate %g (probe expected: %d)", a, bias, expect_probe);
         CHECK(meta_num(&mb, "godrays:merged_parts") == 32.0);
