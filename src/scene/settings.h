@@ -24,6 +24,9 @@ typedef struct gr_reference_settings {
     int sun_disc;                 /* gr_sun_disc_mode: how the sun's disc is averaged */
     int bias_probe;               /* 1: estimate the surface-tessellation bias from a pixel
                                      subsample rendered again at half the surface_res */
+    int refine_factor;            /* surface cells split F x F where camera rays run along the
+                                     beams (1 = off; docs/reference.md 2.2) */
+    double refine_angle_deg;      /* ...those camera rays: within this angle of the refracted sun */
 } gr_reference_settings;
 
 /* reference.sun_disc: the disc average by the analytic convolution of each beam's footprint
