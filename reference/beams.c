@@ -1095,6 +1095,21 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
 
 const gr_beam_stats *gr_beams_stats(const gr_beams *b) { return b ? &b->stats : NULL; }
 RTCScene gr_beams_surface(const gr_beams *b) { return b ? b->surface : NULL; }
+size_t gr_beams_triangle_count(const gr_beams *b) { return b ? b->ntri : 0; }
+
+gr_vec3 gr_beams_vertex(const gr_beams *b, unsigned k)
+{
+    const beam_vertex *v = &b->v[k];
+    return gr_v3(v->pu + b->sx * v->py, v->py, v->pw + b->sz * v->py);
+}
+
+float gr_beams_triangle(const gr_beams *b, size_t t, unsigned idx[3])
+{
+    uint32_t i3[3];
+    tri_vertices(b, (uint32_t)t, i3);
+    for (int c = 0; c < 3; c++) idx[c] = i3[c];
+    return b->tri[t].phi;
+}
 
 void gr_beams_destroy(gr_beams *b)
 {

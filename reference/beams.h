@@ -89,6 +89,12 @@ typedef struct gr_beam_stats {
 gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err);
 void gr_beams_destroy(gr_beams *b); /* accepts NULL */
 const gr_beam_stats *gr_beams_stats(const gr_beams *b);
+/* The tessellation, for tests: the number of triangles; vertex k's displaced local position
+ * (float); triangle t's vertices (wound so that the area vector points down), returning
+ * its flux F_t |I . a| per unit sun irradiance (0: no beam). */
+size_t gr_beams_triangle_count(const gr_beams *b);
+gr_vec3 gr_beams_vertex(const gr_beams *b, unsigned k);
+float gr_beams_triangle(const gr_beams *b, size_t t, unsigned idx[3]);
 /* The displaced surface mesh (NULL unless params.surface_mesh). */
 RTCScene gr_beams_surface(const gr_beams *b);
 
