@@ -47,9 +47,9 @@ static const gr_param reference_params[] = {
      .doc = "sun-disc average: analytic convolution of each beam's footprint, or one sampled direction per pass"},
     {.name = "bias_probe", .type = GR_PT_BOOL, .offset = REF(bias_probe), .min = 0, .max = 1, .def = 1,
      .unit = "", .doc = "estimate the surface-tessellation bias: every 5th pixel re-rendered at surface_res and surface_res/2 (Richardson), about 5 % more time"},
-    {.name = "refine_factor", .type = GR_PT_INT, .offset = REF(refine_factor), .min = 1, .max = 16, .def = 1,
+    {.name = "refine_factor", .type = GR_PT_INT, .offset = REF(refine_factor), .min = 1, .max = 16, .def = 2,
      .unit = "", .doc = "local refinement: surface cells split into F x F where camera rays run along the refracted sun's beams (1 = off)"},
-    {.name = "refine_angle_deg", .type = GR_PT_DOUBLE, .offset = REF(refine_angle_deg), .min = 0, .max = 30, .def = 15,
+    {.name = "refine_angle_deg", .type = GR_PT_DOUBLE, .offset = REF(refine_angle_deg), .min = 0, .max = 30, .def = 8,
      .unit = "deg", .doc = "local refinement: the cells whose beams camera rays within this angle of the refracted sun direction meet"},
 };
 #undef REF
