@@ -823,6 +823,10 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     tp.nu = b->nu;
     tp.nw = b->nw;
     tp.F = p->refine_factor > 1 ? p->refine_factor : 1;
+    if (tp.F > 64) {
+        gr_beams_destroy(b);
+        return gr_fail(err, GR_E_INPUT, "reference.refine_factor: %d, at most 64", p->refine_factor);
+    }
     tp.h = h;
     tp.nv0 = (size_t)(b->nu + 1) * (size_t)(b->nw + 1);
     double rho = tp.F > 1 ? gr_beam_refine_radius(p) : -1.0;
@@ -883,24 +887,18 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     }
     for (size_t t = 0; t < ntri; t++) memset(&b->tri[t], 0, sizeof b->tri[t]);
     {
-        uint32_t vi[3 * (4 * 64 + 4)];
+        /* one cell's triangles: at most 2 F^2 (refined) or 4 F (a fan) */
+        size_t F2 = (size_t)tp.F * (size_t)tp.F;
+        uint32_t *buf = malloc(3 * (2 * F2 + 4 * (size_t)tp.F + 4) * sizeof *buf);
+        if (!buf) tp.oom = 1;
         size_t t = 0;
-        for (int j = 0; j < b->nw; j++)
+        for (int j = 0; j < b->nw && buf; j++)
             for (int i = 0; i < b->nu; i++) {
-                int small = !(ref && ref[(size_t)i + (size_t)j * (size_t)b->nu]);
-                /* a refined cell writes straight into the triangles' slots (2 F^2 of them) */
-                uint32_t *buf = vi;
-                uint32_t *big = NULL;
-                if (!small) {
-                    big = malloc(6 * (size_t)tp.F * (size_t)tp.F * sizeof *big);
-                    if (!big) { tp.oom = 1; break; }
-                    buf = big;
-                }
                 int n = cell_tris(&tp, ref, i, j, buf, lev + t);
                 for (int k = 0; k < n; k++, t++)
                     for (int c = 0; c < 3; c++) b->tri[t].vi[c] = buf[3 * k + c];
-                free(big);
             }
+        free(buf);
     }
     free(ref);
     free(tp.fmap);

@@ -14,7 +14,7 @@
  *    analytic Gerstner tangents (seed eq. 5.5.8): within the O(h^2) of a piecewise-linear
  *    surface, refined or not, and the refined set's region where its own fine cells give
  *    the flux of a uniform tessellation F times finer;
- *  - off (factor 1, or no camera ray near the beams): the regular grid, unchanged. */
+ *  - off (factor 1, or no camera direction within the angle of +-T0): the regular grid. */
 #include "check.h"
 #include "test_ref_util.h"
 
@@ -219,6 +219,29 @@ int main(void)
         printf("%s: %zu triangles (grid %zu), %zu refined + %zu transition cells within %.2f m, flux %.6f vs %.6f\n", what,
                gr_beams_triangle_count(b), grid, st->refined_cells, st->transition_cells, st->refine_radius_m, phi,
                ft * cos_i * area);
+        gr_beams_destroy(b);
+        done(&u);
+    }
+    /* 1b. no camera direction within the angle of +-T0 (looking away from the sun, 10 deg
+     * down: +T0 is 68 deg down, out of the 60 deg frustum): no refinement, the plain grid */
+    {
+        setup u;
+        make(&u, 0, 40, 4);
+        u.s->camera.pitch_deg = -10.0;
+        double f[3] = {cos(-10.0 * GR_PI / 180.0) * sin(210.0 * GR_PI / 180.0), sin(-10.0 * GR_PI / 180.0),
+                       cos(-10.0 * GR_PI / 180.0) * cos(210.0 * GR_PI / 180.0)};
+        double rl = hypot(f[0], f[2]);
+        for (int c = 0; c < 3; c++) u.s->camera.forward[c] = f[c];
+        u.s->camera.right[0] = -f[2] / rl; u.s->camera.right[1] = 0.0; u.s->camera.right[2] = f[0] / rl;
+        const double *r = u.s->camera.right;
+        u.s->camera.up[0] = r[1] * f[2] - r[2] * f[1];
+        u.s->camera.up[1] = r[2] * f[0] - r[0] * f[2];
+        u.s->camera.up[2] = r[0] * f[1] - r[1] * f[0];
+        gr_beams *b = build(&u);
+        const gr_beam_stats *st = gr_beams_stats(b);
+        CHECK_MSG(st->refined_cells == 0 && st->refine_radius_m < 0.0 &&
+                      gr_beams_triangle_count(b) == 2 * (size_t)st->nu * (size_t)st->nw,
+                  "looking away: %zu cells refined, radius %g", st->refined_cells, st->refine_radius_m);
         gr_beams_destroy(b);
         done(&u);
     }
