@@ -626,7 +626,6 @@ int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 
     return out->n;
 }
 
-
 /* ---- local refinement (docs/reference.md 2.2, "Local refinement") ---- */
 
 double gr_beam_refine_radius(const gr_beam_params *p)
