@@ -23,63 +23,6 @@ struct gr_caustics {
 
 /* ---- program builder ---------------------------------------------------------------------- */
 
-static void flatten(char *log)
-{
-    for (char *p = log; *p; p++)
-        if (*p == '\n' || *p == '\r' || *p == '\t') *p = ' ';
-}
-
-gr_status gr_vol_program(const char *dir, const gr_vol_stage *stages, int n, unsigned *program, gr_error *err)
-{
-    GLuint sh[6] = {0};
-    gr_status st = GR_OK;
-    *program = 0;
-    GLuint prog = glCreateProgram();
-    if (!prog) return gr_fail(err, GR_E_GL, "%s: glCreateProgram failed", stages[0].files[0]);
-    for (int s = 0; s < n && s < 6; s++) {
-        char *src[4] = {NULL, NULL, NULL, NULL};
-        int k = 0;
-        for (; k < 4 && stages[s].files[k]; k++)
-            if ((st = gr_shader_source(dir, stages[s].files[k], &src[k], NULL, err)) != GR_OK) break;
-        if (st == GR_OK) {
-            sh[s] = glCreateShader(stages[s].type);
-            glShaderSource(sh[s], k, (const GLchar *const *)src, NULL);
-            glCompileShader(sh[s]);
-            GLint ok = 0;
-            glGetShaderiv(sh[s], GL_COMPILE_STATUS, &ok);
-            if (!ok) {
-                char log[900] = "";
-                glGetShaderInfoLog(sh[s], (GLsizei)sizeof log, NULL, log);
-                flatten(log);
-                st = gr_fail(err, GR_E_GL, "%s: GLSL compile failed: %s", stages[s].files[k - 1], log[0] ? log : "(no log)");
-            } else {
-                glAttachShader(prog, sh[s]);
-            }
-        }
-        for (int j = 0; j < 4; j++) free(src[j]);
-        if (st != GR_OK) break;
-    }
-    if (st == GR_OK) {
-        glLinkProgram(prog);
-        GLint ok = 0;
-        glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char log[900] = "";
-            glGetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
-            flatten(log);
-            st = gr_fail(err, GR_E_GL, "%s: GLSL link failed: %s", stages[0].files[0], log[0] ? log : "(no log)");
-        }
-    }
-    for (int s = 0; s < n && s < 6; s++)
-        if (sh[s]) glDeleteShader(sh[s]);
-    if (st != GR_OK) {
-        glDeleteProgram(prog);
-        return st;
-    }
-    *program = prog;
-    return GR_OK;
-}
-
 /* ---- caustics ------------------------------------------------------------------------------ */
 
 void gr_caustics_depths(int n, double first_m, double last_m, double *out)
@@ -93,10 +36,10 @@ gr_status gr_caustics_create(const char *shader_dir, gr_caustics **out, gr_error
     *out = NULL;
     gr_caustics *c = calloc(1, sizeof *c);
     if (!c) return gr_fail(err, GR_E_NOMEM, "caustics: out of memory");
-    const gr_vol_stage st3[3] = {{GL_VERTEX_SHADER, {"caustics.vert.glsl", NULL, NULL, NULL}},
+    const gr_shader_stage st3[3] = {{GL_VERTEX_SHADER, {"caustics.vert.glsl", NULL, NULL, NULL}},
                                  {GL_GEOMETRY_SHADER, {"caustics.geom.glsl", NULL, NULL, NULL}},
                                  {GL_FRAGMENT_SHADER, {"caustics.frag.glsl", NULL, NULL, NULL}}};
-    gr_status st = gr_vol_program(shader_dir, st3, 3, &c->prog, err);
+    gr_status st = gr_shader_program_stages(shader_dir, st3, 3, NULL, 0, &c->prog, NULL, err);
     if (st != GR_OK) {
         free(c);
         return st;

@@ -54,12 +54,6 @@ long long gr_caustics_triangles(const gr_caustics *c);
 /* Depths of a stack: n depths geometric between first_m and last_m (n = 1: first_m). */
 void gr_caustics_depths(int n, double first_m, double last_m, double *out);
 
-/* ---- shared program builder ---- */
-typedef struct gr_vol_stage {
-    unsigned type;           /* GL_VERTEX_SHADER, GL_GEOMETRY_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER */
-    const char *files[4];    /* concatenated in order (the first starts with #version); NULL-ended */
-} gr_vol_stage;
-gr_status gr_vol_program(const char *dir, const gr_vol_stage *stages, int n, unsigned *program, gr_error *err);
 
 
 /* ---- what the volume techniques share (volume_common.glsl's uniforms) ---- */

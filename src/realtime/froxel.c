@@ -9,6 +9,7 @@
 
 #include "gl/gl.h"
 #include "realtime/caustics.h"
+#include "realtime/shaders.h"
 #include "realtime/frame.h"
 #include "realtime/scenegl.h"
 
@@ -85,15 +86,15 @@ static gr_status fx_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     if (!r) return gr_fail(err, GR_E_NOMEM, "froxel: out of memory");
     gr_status st;
     if ((st = gr_vol_base_init(&r->base, gl, dir, 1, err)) != GR_OK) goto fail;
-    const gr_vol_stage apply[2] = {
+    const gr_shader_stage apply[2] = {
         {GL_VERTEX_SHADER, {"volume_screen.vert.glsl", NULL, NULL, NULL}},
         {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "froxel_apply.frag.glsl"}}};
-    const gr_vol_stage scatter[1] = {
+    const gr_shader_stage scatter[1] = {
         {GL_COMPUTE_SHADER, {"volume_version.glsl", "volume_common.glsl", "froxel_scatter.comp.glsl", NULL}}};
-    const gr_vol_stage integrate[1] = {{GL_COMPUTE_SHADER, {"froxel_integrate.comp.glsl", NULL, NULL, NULL}}};
-    if ((st = gr_vol_program(dir, apply, 2, &r->prog, err)) != GR_OK) goto fail;
-    if ((st = gr_vol_program(dir, scatter, 1, &r->prog_scatter, err)) != GR_OK) goto fail;
-    if ((st = gr_vol_program(dir, integrate, 1, &r->prog_integrate, err)) != GR_OK) goto fail;
+    const gr_shader_stage integrate[1] = {{GL_COMPUTE_SHADER, {"froxel_integrate.comp.glsl", NULL, NULL, NULL}}};
+    if ((st = gr_shader_program_stages(dir, apply, 2, NULL, 0, &r->prog, NULL, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, scatter, 1, NULL, 0, &r->prog_scatter, NULL, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, integrate, 1, NULL, 0, &r->prog_integrate, NULL, err)) != GR_OK) goto fail;
     gr_vol_locations(r->prog, &r->vl);
     gr_vol_locations(r->prog_scatter, &r->vl_s);
     r->l_inv = glGetUniformLocation(r->prog, "u_inv_vp_rot");

@@ -11,6 +11,7 @@
 #include "gl/gl.h"
 #include "realtime/frame.h"
 #include "realtime/scenegl.h"
+#include "realtime/shaders.h"
 
 #define MAX_RAYS 4096
 #define MAX_CELLS 2048
@@ -86,14 +87,14 @@ static gr_status lr_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     if (!r) return gr_fail(err, GR_E_NOMEM, "light_rays: out of memory");
     gr_status st;
     if ((st = gr_vol_base_init(&r->base, gl, dir, 0, err)) != GR_OK) goto fail;
-    const gr_vol_stage surf[2] = {{GL_VERTEX_SHADER, {"lightrays_surface.vert.glsl", NULL, NULL, NULL}},
+    const gr_shader_stage surf[2] = {{GL_VERTEX_SHADER, {"lightrays_surface.vert.glsl", NULL, NULL, NULL}},
                                   {GL_FRAGMENT_SHADER, {"lightrays_surface.frag.glsl", NULL, NULL, NULL}}};
-    const gr_vol_stage lines[3] = {
+    const gr_shader_stage lines[3] = {
         {GL_VERTEX_SHADER, {"lightrays.vert.glsl", NULL, NULL, NULL}},
         {GL_GEOMETRY_SHADER, {"volume_version.glsl", "volume_common.glsl", "lightrays.geom.glsl", NULL}},
         {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "lightrays.frag.glsl"}}};
-    if ((st = gr_vol_program(dir, surf, 2, &r->prog_surf, err)) != GR_OK) goto fail;
-    if ((st = gr_vol_program(dir, lines, 3, &r->prog_lines, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, surf, 2, NULL, 0, &r->prog_surf, NULL, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, lines, 3, NULL, 0, &r->prog_lines, NULL, err)) != GR_OK) goto fail;
     GLuint p = r->prog_surf;
     r->s_cells = glGetUniformLocation(p, "u_cells");
     r->s_half = glGetUniformLocation(p, "u_half");

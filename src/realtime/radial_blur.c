@@ -15,7 +15,7 @@
 #include "realtime/scenegl.h"
 #include "realtime/shaders.h"
 
-#define MAX_WAVE_GROUPS 16 /* u_waves[80] in radial_blur_light.frag.glsl */
+#define MAX_WAVE_GROUPS 16 /* u_waves[MAX_WAVE_GROUPS * 5] in seed_waves.glsl */
 #define MAX_LIGHTS 256
 
 /* Seed 004's listing defaults (GLSL version). */
@@ -265,8 +265,9 @@ static gr_status rb_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
         memcpy(r->shader_dir, dir, n);
     }
     if ((st = gr_scenegl_create_dir(gl, dir, &r->sg, err)) != GR_OK) goto fail;
-    if ((st = gr_shader_program(dir, "radial_blur_screen.vert.glsl", "radial_blur_light.frag.glsl", NULL, 0,
-                                &r->prog_light, NULL, err)) != GR_OK)
+    static const gr_shader_stage light[2] = {{GL_VERTEX_SHADER, {"radial_blur_screen.vert.glsl", NULL}},
+                                             {GL_FRAGMENT_SHADER, {"seed_waves.glsl", "radial_blur_light.frag.glsl", NULL}}};
+    if ((st = gr_shader_program_stages(dir, light, 2, NULL, 0, &r->prog_light, NULL, err)) != GR_OK)
         goto fail;
     if ((st = gr_shader_program(dir, "radial_blur_screen.vert.glsl", "radial_blur.frag.glsl", NULL, 0, &r->prog_blur,
                                 NULL, err)) != GR_OK)

@@ -99,68 +99,80 @@ static void flatten_log(char *log)
         if (log[i] == '\n' || log[i] == '\r' || log[i] == '\t') log[i] = ' ';
 }
 
-static gr_status compile(GLenum type, const char *name, const char *src, GLuint *out, gr_error *err)
+/* The outcome of compiling a shader (program = 0) or linking a program: on failure the
+ * object is deleted, *obj set to 0, and the driver's log returned on one line. */
+static gr_status gl_outcome(GLuint *obj, int program, const char *name, gr_error *err)
 {
-    GLuint sh = glCreateShader(type);
-    if (!sh) return gr_fail(err, GR_E_GL, "%s: glCreateShader failed", name);
-    glShaderSource(sh, 1, &src, NULL);
-    glCompileShader(sh);
     GLint ok = 0;
-    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[900];
-        log[0] = '\0';
-        glGetShaderInfoLog(sh, (GLsizei)sizeof log, NULL, log);
-        flatten_log(log);
-        glDeleteShader(sh);
-        return gr_fail(err, GR_E_GL, "%s: GLSL compile failed: %s", name, log[0] ? log : "(no log)");
+    if (program) glGetProgramiv(*obj, GL_LINK_STATUS, &ok);
+    else glGetShaderiv(*obj, GL_COMPILE_STATUS, &ok);
+    if (ok) return GR_OK;
+    char log[900];
+    log[0] = '\0';
+    if (program) glGetProgramInfoLog(*obj, (GLsizei)sizeof log, NULL, log);
+    else glGetShaderInfoLog(*obj, (GLsizei)sizeof log, NULL, log);
+    flatten_log(log);
+    if (program) glDeleteProgram(*obj);
+    else glDeleteShader(*obj);
+    *obj = 0;
+    return gr_fail(err, GR_E_GL, "%s: GLSL %s failed: %s", name, program ? "link" : "compile", log[0] ? log : "(no log)");
+}
+
+/* One stage: its files read (from dir or embedded) and compiled as one source, in order;
+ * the log names the stage's last file (its own code; the first ones are shared preludes). */
+static gr_status compile_stage(const char *dir, const gr_shader_stage *sg, GLuint *out, int *n_dir, gr_error *err)
+{
+    char *src[GR_SHADER_MAX_FILES] = {NULL};
+    int k = 0, from = 0;
+    gr_status st = GR_OK;
+    *out = 0;
+    for (; k < GR_SHADER_MAX_FILES && sg->files[k]; k++) {
+        if ((st = gr_shader_source(dir, sg->files[k], &src[k], &from, err)) != GR_OK) break;
+        *n_dir += from;
     }
+    const char *name = k > 0 ? sg->files[k - 1] : "(no file)";
+    if (st == GR_OK && k == 0) st = gr_fail(err, GR_E_INPUT, "shader stage with no file");
+    GLuint sh = 0;
+    if (st == GR_OK && !(sh = glCreateShader(sg->type))) st = gr_fail(err, GR_E_GL, "%s: glCreateShader failed", name);
+    if (st == GR_OK) {
+        glShaderSource(sh, k, (const GLchar *const *)src, NULL);
+        glCompileShader(sh);
+        st = gl_outcome(&sh, 0, name, err);
+    }
+    for (int j = 0; j < k; j++) free(src[j]);
     *out = sh;
-    return GR_OK;
+    return st;
+}
+
+gr_status gr_shader_program_stages(const char *dir, const gr_shader_stage *stages, int n,
+                                   const char *const *tf_varyings, int n_tf, unsigned *program,
+                                   int *n_from_dir, gr_error *err)
+{
+    GLuint sh[GR_SHADER_MAX_STAGES] = {0}, prog = 0;
+    int n_dir = 0;
+    gr_status st = GR_OK;
+    *program = 0;
+    if (n < 1 || n > GR_SHADER_MAX_STAGES) return gr_fail(err, GR_E_INPUT, "shader program with %d stages", n);
+    const char *name = stages[n - 1].files[0]; /* the program is named by its last stage */
+    for (int s = 0; s < n && st == GR_OK; s++) st = compile_stage(dir, &stages[s], &sh[s], &n_dir, err);
+    if (n_from_dir) *n_from_dir = n_dir;
+    if (st == GR_OK && !(prog = glCreateProgram())) st = gr_fail(err, GR_E_GL, "%s: glCreateProgram failed", name);
+    if (st == GR_OK) {
+        for (int s = 0; s < n; s++) glAttachShader(prog, sh[s]);
+        if (n_tf > 0) glTransformFeedbackVaryings(prog, n_tf, (const GLchar *const *)tf_varyings, GL_INTERLEAVED_ATTRIBS);
+        glLinkProgram(prog);
+        st = gl_outcome(&prog, 1, name, err);
+    }
+    for (int s = 0; s < n; s++)
+        if (sh[s]) glDeleteShader(sh[s]);
+    if (st == GR_OK) *program = prog;
+    return st;
 }
 
 gr_status gr_shader_program(const char *dir, const char *vert_name, const char *frag_name,
                             const char *const *tf_varyings, int n_tf, unsigned *program,
                             int *n_from_dir, gr_error *err)
 {
-    char *vs_src = NULL, *fs_src = NULL;
-    int vd = 0, fd = 0;
-    GLuint vs = 0, fs = 0, prog = 0;
-    gr_status st;
-    *program = 0;
-    if ((st = gr_shader_source(dir, vert_name, &vs_src, &vd, err)) != GR_OK) goto done;
-    if ((st = gr_shader_source(dir, frag_name, &fs_src, &fd, err)) != GR_OK) goto done;
-    if (n_from_dir) *n_from_dir = vd + fd;
-    if ((st = compile(GL_VERTEX_SHADER, vert_name, vs_src, &vs, err)) != GR_OK) goto done;
-    if ((st = compile(GL_FRAGMENT_SHADER, frag_name, fs_src, &fs, err)) != GR_OK) goto done;
-    prog = glCreateProgram();
-    if (!prog) {
-        st = gr_fail(err, GR_E_GL, "%s + %s: glCreateProgram failed", vert_name, frag_name);
-        goto done;
-    }
-    glAttachShader(prog, vs);
-    glAttachShader(prog, fs);
-    if (n_tf > 0) glTransformFeedbackVaryings(prog, n_tf, (const GLchar *const *)tf_varyings, GL_INTERLEAVED_ATTRIBS);
-    glLinkProgram(prog);
-    GLint ok = 0;
-    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[900];
-        log[0] = '\0';
-        glGetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
-        flatten_log(log);
-        glDeleteProgram(prog);
-        prog = 0;
-        st = gr_fail(err, GR_E_GL, "%s + %s: GLSL link failed: %s", vert_name, frag_name,
-                     log[0] ? log : "(no log)");
-        goto done;
-    }
-    *program = prog;
-    st = GR_OK;
-done:
-    if (vs) glDeleteShader(vs);
-    if (fs) glDeleteShader(fs);
-    free(vs_src);
-    free(fs_src);
-    return st;
+    const gr_shader_stage stages[2] = {{GL_VERTEX_SHADER, {vert_name, NULL}}, {GL_FRAGMENT_SHADER, {frag_name, NULL}}};
+    return gr_shader_program_stages(dir, stages, 2, tf_varyings, n_tf, program, n_from_dir, err);
 }

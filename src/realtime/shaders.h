@@ -16,6 +16,24 @@ gr_status gr_shader_source(const char *dir, const char *name, char **out, int *f
 /* Checks that dir (if not NULL) is a readable directory; the error names --shader-dir. */
 gr_status gr_shader_check_dir(const char *dir, gr_error *err);
 
+/* A program's stage: its files, read as gr_shader_source does and compiled as one source
+ * in this order (the first starts with #version; the others follow, e.g. a shared prelude
+ * then the stage's own file), NULL-ended. */
+#define GR_SHADER_MAX_FILES 4
+#define GR_SHADER_MAX_STAGES 4
+typedef struct gr_shader_stage {
+    unsigned type;                         /* GL_VERTEX_SHADER, GL_GEOMETRY_SHADER, ... */
+    const char *files[GR_SHADER_MAX_FILES];
+} gr_shader_stage;
+
+/* Compiles and links n stages (1 to GR_SHADER_MAX_STAGES); tf_varyings (n_tf, may be 0)
+ * are captured interleaved by transform feedback. Failures return GR_E_GL naming the
+ * stage's last file, with the GLSL log on one line; *program is 0. n_from_dir (may be NULL)
+ * receives how many files came from dir. Needs a current GL context. */
+gr_status gr_shader_program_stages(const char *dir, const gr_shader_stage *stages, int n,
+                                   const char *const *tf_varyings, int n_tf, unsigned *program,
+                                   int *n_from_dir, gr_error *err);
+
 /* Compiles vert_name + frag_name (looked up as gr_shader_source does) and links them.
  * tf_varyings (n_tf of them, may be 0) are captured interleaved by transform feedback.
  * Failures return GR_E_GL with the file name and the GLSL log on one line; *program is 0.

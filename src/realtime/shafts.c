@@ -307,14 +307,20 @@ gr_status gr_shafts_create_in(gr_gl *gl, const char *shader_dir, gr_shafts **out
     return GR_OK;
 }
 
+/* The shaft pass and the flux pre-pass compile seed_waves.glsl (the seed's waves and
+ * surface function) in front of their own file. */
+static const gr_shader_stage shaft_stages[2] = {{GL_VERTEX_SHADER, {"seed_waves.glsl", "shafts.vert.glsl", NULL}},
+                                                {GL_FRAGMENT_SHADER, {"shafts.frag.glsl", NULL}}};
+static const gr_shader_stage corner_stages[2] = {{GL_VERTEX_SHADER, {"shafts_final.vert.glsl", NULL}},
+                                                 {GL_FRAGMENT_SHADER, {"seed_waves.glsl", "shafts_corner.frag.glsl", NULL}}};
+
 static gr_status setup_gl(gr_shafts *r, gr_error *err)
 {
     gr_status st;
     int nd = 0;
     /* the occluders' shadow map and eye depth are scenegl's, shared with every technique */
     if ((st = gr_scenegl_create_dir(r->gl, r->shader_dir, &r->scenegl, err)) != GR_OK) return st;
-    if ((st = gr_shader_program(r->shader_dir, "shafts.vert.glsl", "shafts.frag.glsl", NULL, 0,
-                                &r->prog_shafts, &nd, err)) != GR_OK)
+    if ((st = gr_shader_program_stages(r->shader_dir, shaft_stages, 2, NULL, 0, &r->prog_shafts, &nd, err)) != GR_OK)
         return st;
     r->from_dir += nd;
     if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_final.frag.glsl", NULL, 0,
@@ -322,8 +328,7 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
         return st;
     r->from_dir += nd;
 
-    if ((st = gr_shader_program(r->shader_dir, "shafts_final.vert.glsl", "shafts_corner.frag.glsl", NULL, 0,
-                                &r->prog_corner, &nd, err)) != GR_OK)
+    if ((st = gr_shader_program_stages(r->shader_dir, corner_stages, 2, NULL, 0, &r->prog_corner, &nd, err)) != GR_OK)
         return st;
     r->from_dir += nd;
     get_shaft_locs(r->prog_corner, &r->lk);
@@ -1113,8 +1118,8 @@ gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
     if (!r->prog_capture) {
         static const char *const varyings[] = {"v_world", "v_intensity"};
-        if ((st = gr_shader_program(r->shader_dir, "shafts.vert.glsl", "shafts.frag.glsl", varyings, 2,
-                                    &r->prog_capture, NULL, err)) != GR_OK)
+        if ((st = gr_shader_program_stages(r->shader_dir, shaft_stages, 2, varyings, 2, &r->prog_capture, NULL, err)) !=
+            GR_OK)
             goto done;
         get_shaft_locs(r->prog_capture, &r->lc);
     }

@@ -8,6 +8,7 @@
 
 #include "gl/gl.h"
 #include "realtime/caustics.h"
+#include "realtime/shaders.h"
 #include "realtime/frame.h"
 #include "realtime/scenegl.h"
 
@@ -70,10 +71,10 @@ static gr_status sl_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     if (!r) return gr_fail(err, GR_E_NOMEM, "slicing: out of memory");
     gr_status st;
     if ((st = gr_vol_base_init(&r->base, gl, dir, 1, err)) != GR_OK) goto fail;
-    const gr_vol_stage stages[2] = {
+    const gr_shader_stage stages[2] = {
         {GL_VERTEX_SHADER, {"volume_screen.vert.glsl", NULL, NULL, NULL}},
         {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "slicing.frag.glsl"}}};
-    if ((st = gr_vol_program(dir, stages, 2, &r->prog, err)) != GR_OK) goto fail;
+    if ((st = gr_shader_program_stages(dir, stages, 2, NULL, 0, &r->prog, NULL, err)) != GR_OK) goto fail;
     gr_vol_locations(r->prog, &r->vl);
     r->l_inv = glGetUniformLocation(r->prog, "u_inv_vp_rot");
     r->l_fwd = glGetUniformLocation(r->prog, "u_forward");

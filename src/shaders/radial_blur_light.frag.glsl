@@ -1,4 +1,3 @@
-#version 330 core
 // Radial blur, light pass (docs/radial-blur.md, "Light pass"): the bright region where the
 // refracted sun is seen through the Gerstner surface (seed 000 on NVIDIA's Nalu demo), in
 // units of the flat-water peak:
@@ -12,8 +11,7 @@
 in vec2 v_ndc;
 uniform mat4 u_inv_vp_rot;       // clip -> eye-relative direction
 uniform float u_depth;           // rest height - eye y (m), > 0
-uniform int u_wave_groups;
-uniform vec4 u_waves[80];        // seed packing kx, kz, A/k, A, wt with wt folded to the eye
+// Compiled after seed_waves.glsl (#version, u_waves with wt folded to the eye, surface()).
 uniform float u_ior;
 uniform vec3 u_to_sun;
 uniform float u_a0;              // kernel radius (rad)
@@ -28,25 +26,13 @@ layout(location = 0) out vec4 o_color;
 // Interleaved gradient noise (Jimenez 2014): deterministic per pixel, in [0, 1).
 float ign(vec2 p) { return fract(52.9829189 * fract(dot(p, vec2(0.06711056, 0.00583715)))); }
 
-// Seed 000's CalculateWaterNormal (listing; its y0 is our z) and the surface height
-// sum A cos(phase), both at the eye-relative rest point (x0, z0).
+// Seed 000's CalculateWaterNormal (seed_waves.glsl's surface(); its y0 is our z) and the
+// surface height sum A cos(phase), both at the eye-relative rest point (x0, z0).
 void water(float x0, float z0, out vec3 n, out float eta)
 {
-    vec3 t1 = vec3(1.0, 0.0, 0.0), t2 = vec3(0.0, 0.0, 1.0);
-    eta = 0.0;
-    for (int i = 0, j = 0; i < u_wave_groups; i++, j += 5) {
-        vec4 kx = u_waves[j], ky = u_waves[j + 1], Ainvk = u_waves[j + 2], A = u_waves[j + 3], wt = u_waves[j + 4];
-        vec4 phase = kx * x0 + ky * z0 - wt;
-        vec4 sinp = sin(phase), cosp = cos(phase);
-        t1.x -= dot(Ainvk, kx * cosp * kx);
-        t1.z -= dot(Ainvk, ky * cosp * kx);
-        t1.y += dot(A, (-sinp) * kx);
-        t2.x -= dot(Ainvk, kx * cosp * ky);
-        t2.z -= dot(Ainvk, ky * cosp * ky);
-        t2.y += dot(A, (-sinp) * ky);
-        eta += dot(A, cosp);
-    }
-    n = normalize(cross(t2, t1));
+    vec3 disp;
+    surface(vec2(x0, z0), disp, n);
+    eta = disp.y;
 }
 
 // Exact unpolarized Fresnel reflectance from the side of index n1 (docs/optics.md).

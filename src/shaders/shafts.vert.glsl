@@ -1,10 +1,9 @@
-#version 330 core
 // Seed 000 (Lanza, "Animation and Rendering of Underwater God Rays"), shaft vertex shader,
 // ported from the seed's HLSL VS. Every deviation is listed in docs/realtime-shafts.md.
 // Positions are relative to the viewer (camera-relative rendering): the CPU subtracts the
 // viewer in double precision, so float stays exact far from the world origin.
 
-#define MAX_WAVE_GROUPS 16
+// Compiled after seed_waves.glsl (#version, the waves' uniforms, surface()).
 
 layout(location = 0) in vec2 a_cell;    // cell centre, in grid cells, relative to P (flux: lattice point)
 layout(location = 1) in vec2 a_corner;  // corner of the shaft's cross-section, +-0.5 cell
@@ -21,11 +20,6 @@ uniform float u_eta;          // 1 / ior (seed: 1./1.333)
 uniform float u_r0;           // Schlick R0 (seed: 0.0204)
 uniform mat4 u_view_proj;     // viewer-relative world -> clip
 uniform mat4 u_shadow_matrix; // viewer-relative world -> shadow-map texture space [0,1]^3
-uniform int u_wave_groups;    // number of groups of 4 waves
-// Seed layout per group of 4 waves: kx, ky, A/|k|, A, phase constant. Here "ky" is the
-// z component of the wave vector and the constant is c = w t - phi0 - k.P (mod 2 pi, in
-// double on the CPU), so phase = k.(X0 - P) - c = k.X0 - w t + phi0, eq. 5.5.7.
-uniform vec4 u_waves[MAX_WAVE_GROUPS * 5];
 uniform int u_variant;        // 0 seed, 1 path, 2 flux (docs/realtime-shafts.md "Variants")
 uniform float u_ratio;        // path: irradiance factor cos(theta_i) / cos(theta_t) / width^2 (flat water)
 uniform vec3 u_refr_flat;     // flux: T of the flat surface (cross-sections are taken across it)
@@ -49,41 +43,6 @@ float fast_fresnel(float cos_i, float r0)
     float m = 1.0 - clamp(cos_i, 0.0, 1.0);
     float m2 = m * m;
     return r0 + (1.0 - r0) * (m2 * m2 * m);
-}
-
-// Seed CalculateWaterNormal (eq. 5.5.8), plus the displacement of eq. 5.5.7, at a rest
-// position relative to P.
-void surface(vec2 rest, out vec3 disp, out vec3 normal)
-{
-    vec3 t1 = vec3(1.0, 0.0, 0.0);
-    vec3 t2 = vec3(0.0, 0.0, 1.0);
-    disp = vec3(0.0);
-    for (int i = 0, j = 0; i < u_wave_groups; i++, j += 5) {
-        vec4 kx = u_waves[j];
-        vec4 ky = u_waves[j + 1];
-        vec4 Ainvk = u_waves[j + 2];
-        vec4 A = u_waves[j + 3];
-        vec4 wt = u_waves[j + 4];
-        vec4 phase = kx * rest.x + ky * rest.y - wt;
-        vec4 sinp = sin(phase);
-        vec4 cosp = cos(phase);
-
-        // eq. 5.5.7: X = X0 - sum a K/|K| sin(phase), y = y0 + sum a cos(phase)
-        disp.x -= dot(Ainvk, kx * sinp);
-        disp.z -= dot(Ainvk, ky * sinp);
-        disp.y += dot(A, cosp);
-
-        // Update tangent vector along x0 (eq. 5.5.8, T)
-        t1.x -= dot(Ainvk, kx * cosp * kx);
-        t1.z -= dot(Ainvk, ky * cosp * kx);
-        t1.y += dot(A, (-sinp) * kx);
-
-        // Update tangent vector along z0 (eq. 5.5.8, B)
-        t2.x -= dot(Ainvk, kx * cosp * ky);
-        t2.z -= dot(Ainvk, ky * cosp * ky);
-        t2.y += dot(A, (-sinp) * ky);
-    }
-    normal = normalize(cross(t2, t1));
 }
 
 // Path: length along the refracted direction rd from the surface point p (viewer-relative)

@@ -1,4 +1,3 @@
-#version 330 core
 // Flux variant pre-pass (docs/realtime-shafts.md "flux"): one texel per point of the shaft
 // lattice (M x M): with shaft_width < 1 point 2 i + c is cell i's corner c in {0, 1} (M =
 // 2 (N - 1)); with width 1 the shafts tile the grid and point p is the grid line p (M = N).
@@ -6,7 +5,7 @@
 // transmittance (eq. 5.5.2b) and its refracted sun direction (eq. 5.5.1), evaluated once
 // instead of in every vertex of the lattice.
 
-#define MAX_WAVE_GROUPS 16
+// Compiled after seed_waves.glsl (#version, the waves' uniforms, surface()).
 
 uniform vec3 u_origin;        // P - viewer (m)
 uniform float u_spacing;      // S (m)
@@ -16,8 +15,6 @@ uniform int u_tiled;          // 1: shaft_width 1, lattice = grid lines
 uniform vec3 u_sun_dir;       // I
 uniform float u_eta;          // 1 / ior
 uniform float u_r0;           // Schlick R0
-uniform int u_wave_groups;
-uniform vec4 u_waves[MAX_WAVE_GROUPS * 5]; // as shafts.vert.glsl
 
 layout(location = 0) out vec4 o_pos_tr; // corner position (viewer-relative), transmittance
 layout(location = 1) out vec4 o_refr;   // refracted direction
@@ -33,29 +30,8 @@ void main()
         vec2 corner = vec2((p.x & 1) != 0 ? 0.5 : -0.5, (p.y & 1) != 0 ? 0.5 : -0.5);
         rest = (cell + corner * u_width) * u_spacing;
     }
-    vec3 t1 = vec3(1.0, 0.0, 0.0);
-    vec3 t2 = vec3(0.0, 0.0, 1.0);
-    vec3 disp = vec3(0.0);
-    for (int i = 0, j = 0; i < u_wave_groups; i++, j += 5) {
-        vec4 kx = u_waves[j];
-        vec4 ky = u_waves[j + 1];
-        vec4 Ainvk = u_waves[j + 2];
-        vec4 A = u_waves[j + 3];
-        vec4 wt = u_waves[j + 4];
-        vec4 phase = kx * rest.x + ky * rest.y - wt;
-        vec4 sinp = sin(phase);
-        vec4 cosp = cos(phase);
-        disp.x -= dot(Ainvk, kx * sinp);
-        disp.z -= dot(Ainvk, ky * sinp);
-        disp.y += dot(A, cosp);
-        t1.x -= dot(Ainvk, kx * cosp * kx);
-        t1.z -= dot(Ainvk, ky * cosp * kx);
-        t1.y += dot(A, (-sinp) * kx);
-        t2.x -= dot(Ainvk, kx * cosp * ky);
-        t2.z -= dot(Ainvk, ky * cosp * ky);
-        t2.y += dot(A, (-sinp) * ky);
-    }
-    vec3 n = normalize(cross(t2, t1));
+    vec3 disp, n;
+    surface(rest, disp, n);
     float m = 1.0 - clamp(dot(-u_sun_dir, n), 0.0, 1.0);
     float m2 = m * m;
     float tr = 1.0 - (u_r0 + (1.0 - u_r0) * (m2 * m2 * m));
