@@ -1019,6 +1019,10 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     free(lev);
     if (total > p->max_prims || total >= UINT32_MAX) {
         free(pos); free(drift); free(jv); gr_beams_destroy(b);
+        if (nref)
+            return gr_fail(err, GR_E_NOMEM,
+                           "reference.surface_res: %d with refine_factor %d needs %zu beam primitives, over the budget of %zu",
+                           p->res, tp.F, total, p->max_prims);
         return gr_fail(err, GR_E_NOMEM, "reference.surface_res: %d needs %zu beam primitives, over the budget of %zu",
                        p->res, total, p->max_prims);
     }
