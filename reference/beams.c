@@ -30,17 +30,17 @@ typedef struct beam_tri {
      * vertices, from which the kernel's depth d = ybar - y is measured; kr = rho |M|_F, a
      * bound of the kernel's radius per unit depth */
     float kern[4], ybar, kr;
-    uint32_t v00;            /* first vertex of its cell */
+    uint32_t vi[3];          /* its vertices, wound so that the area vector points down */
     uint32_t first, nslab;   /* its primitives: first, count */
-    uint32_t odd;            /* 1: the cell's second triangle */
-    float pad_[3];
+    float pad_[2];
 } beam_tri;
 _Static_assert(sizeof(beam_tri) == 64, "beam_tri fills one cache line (aligned_alloc needs a multiple of 64)");
 
 struct gr_beams {
     gr_beam_stats stats;
-    int nu, nw;              /* cells */
-    beam_vertex *v;          /* (nu + 1) * (nw + 1) */
+    int nu, nw;              /* cells of the base grid */
+    size_t nv, ntri;         /* vertices (the grid's (nu + 1) (nw + 1) first), triangles */
+    beam_vertex *v;          /* per vertex */
     beam_tri *tri;           /* per triangle */
     int disc;                /* 1: the sun-disc kernel is on */
 
@@ -193,14 +193,14 @@ static void slope_jacobian(gr_dvec3 I, gr_dvec3 n, double eta, gr_dvec3 e1, gr_d
     }
 }
 
-/* Triangle t of cell (i, j): 0 = (v00, v10, v11), 1 = (v00, v11, v01). */
+/* Triangle t's vertices (explicit: the regular grid's cells, refined cells and the
+ * transition fans around them, section 2.2 "Local refinement"). */
 static inline void tri_vertices(const gr_beams *b, uint32_t t, uint32_t idx[3])
 {
     const beam_tri *bt = &b->tri[t];
-    uint32_t row = (uint32_t)b->nu + 1, v00 = bt->v00;
-    idx[0] = v00;
-    idx[1] = bt->odd ? v00 + row + 1 : v00 + 1;
-    idx[2] = bt->odd ? v00 + row : v00 + row + 1;
+    idx[0] = bt->vi[0];
+    idx[1] = bt->vi[1];
+    idx[2] = bt->vi[2];
 }
 
 /* Slab k of triangle t spans [lo, hi); the top slab is open upward and the bottom one
@@ -626,10 +626,146 @@ int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 
     return out->n;
 }
 
+/* ---- local refinement (docs/reference.md 2.2, "Local refinement") ---- */
+
+double gr_beam_refine_radius(const gr_beam_params *p)
+{
+    if (p->refine_factor <= 1 || !(p->refine_angle > 0.0) || !p->camera) return -1.0;
+    const gr_camera *c = p->camera;
+    /* T0 (unit, heading down) from the shear: T0 is parallel to (sx, 1, sz) T0_y */
+    gr_dvec3 T0 = gr_d3_norm(gr_d3(-p->shear_x, -1.0, -p->shear_z));
+    gr_dvec3 f = gr_d3(c->forward[0], c->forward[1], c->forward[2]);
+    gr_dvec3 rt = gr_d3(c->right[0], c->right[1], c->right[2]), up = gr_d3(c->up[0], c->up[1], c->up[2]);
+    double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), ta = tf * (double)c->width / (double)c->height;
+    double ca = cos(p->refine_angle), sa = sin(p->refine_angle);
+    double up_span = fmax(0.0, -(double)p->eye.y), down_span = fmax(0.0, (double)p->eye.y - p->region.y_min);
+    /* a frame around T0 for the cone's rim */
+    gr_dvec3 hlp = fabs(T0.x) < 0.9 ? gr_d3(1, 0, 0) : gr_d3(0, 0, 1);
+    gr_dvec3 e1 = gr_d3_norm(gr_d3_cross(T0, hlp)), e2 = gr_d3_cross(T0, e1);
+    enum { NG = 128, NR = 256 };
+    double best = -1.0;
+    for (int n = 0; n < (NG + 1) * (NG + 1) + 2 * NR + 2; n++) {
+        gr_dvec3 d;
+        if (n < (NG + 1) * (NG + 1)) { /* a grid over the frustum (its border included) */
+            int ix = n % (NG + 1), iy = n / (NG + 1);
+            d = gr_d3_norm(gr_d3_madd(gr_d3_madd(f, rt, (2.0 * ix / NG - 1.0) * ta), up, (1.0 - 2.0 * iy / NG) * tf));
+        } else { /* the cone's axis and rim, +T0 then -T0, where the frustum holds them */
+            int m = n - (NG + 1) * (NG + 1), sg = m < NR + 1 ? 1 : -1, k = m % (NR + 1);
+            gr_dvec3 ax = gr_d3_scale(T0, sg);
+            double ph = 2.0 * GR_PI * k / NR;
+            d = k == NR ? ax : gr_d3_madd(gr_d3_scale(ax, ca), gr_d3_madd(gr_d3_scale(e1, cos(ph)), e2, sin(ph)), sa);
+            double z = gr_d3_dot(d, f);
+            if (!(z > 0.0) || fabs(gr_d3_dot(d, rt)) > ta * z * (1.0 + 1e-9) || fabs(gr_d3_dot(d, up)) > tf * z * (1.0 + 1e-9))
+                continue;
+        }
+        if (fabs(gr_d3_dot(d, T0)) < ca * (1.0 - 1e-12) || fabs(d.y) < 1e-6) continue;
+        /* sheared drift of the ray per metre of height: how fast it crosses beams of drift 0 */
+        double gu = d.x / d.y - p->shear_x, gw = d.z / d.y - p->shear_z;
+        double rr = sqrt(gu * gu + gw * gw) * (d.y > 0.0 ? up_span : down_span);
+        if (rr > best) best = rr;
+    }
+    return best;
+}
+
+/* The surface's topology: the base grid's vertices (i + j (nu + 1)) first, then the extra
+ * vertices of refined and transition cells, by their rest offsets from the patch corner. */
+typedef struct topo {
+    int nu, nw, F;
+    double h;
+    size_t nv0;              /* grid vertices */
+    double *rx;              /* extra vertices: rest offsets (u, w) from the patch corner */
+    size_t nx, capx;
+    int ci0, cj0, mu, mw;    /* window of the fine lattice (in fine units) mapped by fmap */
+    uint32_t *fmap;          /* fine lattice point -> vertex index, UINT32_MAX = none yet */
+    int oom;
+} topo;
+
+static uint32_t topo_extra(topo *T, double ru, double rw)
+{
+    if (T->nx == T->capx) {
+        size_t cap = T->capx ? 2 * T->capx : 1024;
+        double *n = realloc(T->rx, 2 * cap * sizeof *n);
+        if (!n) { T->oom = 1; return 0; }
+        T->rx = n;
+        T->capx = cap;
+    }
+    T->rx[2 * T->nx] = ru;
+    T->rx[2 * T->nx + 1] = rw;
+    return (uint32_t)(T->nv0 + T->nx++);
+}
+
+/* The vertex at fine lattice point (I, J) (cells of h / F): a grid vertex where it is one,
+ * else an extra vertex made once and shared by every cell that touches it. */
+static uint32_t topo_fine(topo *T, int I, int J)
+{
+    int F = T->F;
+    if (I % F == 0 && J % F == 0) return (uint32_t)(I / F + (size_t)(J / F) * (size_t)(T->nu + 1));
+    size_t k = (size_t)(I - T->ci0 * F) + (size_t)(J - T->cj0 * F) * (size_t)T->mu;
+    if (T->fmap[k] == UINT32_MAX) T->fmap[k] = topo_extra(T, (double)I * T->h / F, (double)J * T->h / F);
+    return T->fmap[k];
+}
+
+/* Cell (i, j)'s triangles into vi (3 per triangle, NULL: count only) and their kind into
+ * lev (0 grid, 1 fine, 2 transition fan); returns their number. A refined cell: F x F
+ * sub-cells of two triangles each, wound as the grid's (area vectors down). A cell beside
+ * a refined one: a fan from an added centre vertex over its boundary, whose edges shared
+ * with refined neighbours carry their F - 1 inner fine vertices (no T-junctions). */
+static int cell_tris(topo *T, const uint8_t *ref, int i, int j, uint32_t *vi, uint8_t *lev)
+{
+    int nu = T->nu, nw = T->nw, F = T->F;
+    size_t c = (size_t)i + (size_t)j * (size_t)nu;
+    uint32_t row = (uint32_t)nu + 1, v00 = (uint32_t)(i + (size_t)j * row);
+    if (ref && ref[c]) {
+        if (!vi) return 2 * F * F;
+        int n = 0;
+        for (int sj = 0; sj < F; sj++)
+            for (int si = 0; si < F; si++) {
+                int I = i * F + si, J = j * F + sj;
+                uint32_t a = topo_fine(T, I, J), b = topo_fine(T, I + 1, J), d = topo_fine(T, I + 1, J + 1), e = topo_fine(T, I, J + 1);
+                uint32_t *o = vi + 6 * n;
+                o[0] = a; o[1] = b; o[2] = d;
+                o[3] = a; o[4] = d; o[5] = e;
+                lev[2 * n] = lev[2 * n + 1] = 1;
+                n++;
+            }
+        return 2 * F * F;
+    }
+    /* refined 4-neighbours: below (j - 1), right (i + 1), above (j + 1), left (i - 1) */
+    int nb[4] = {ref && j > 0 && ref[c - (size_t)nu], ref && i + 1 < nu && ref[c + 1], ref && j + 1 < nw && ref[c + (size_t)nu],
+                 ref && i > 0 && ref[c - 1]};
+    if (!nb[0] && !nb[1] && !nb[2] && !nb[3]) {
+        if (vi) {
+            /* the grid's cell: (v00, v10, v11), (v00, v11, v01) */
+            vi[0] = v00; vi[1] = v00 + 1; vi[2] = v00 + row + 1;
+            vi[3] = v00; vi[4] = v00 + row + 1; vi[5] = v00 + row;
+            lev[0] = lev[1] = 0;
+        }
+        return 2;
+    }
+    int nbound = 4;
+    for (int e = 0; e < 4; e++) nbound += nb[e] ? F - 1 : 0;
+    if (!vi) return nbound;
+    /* the boundary counter-clockwise in (u, w) as the grid's triangles wind, from (i, j) */
+    uint32_t poly[4 * 64 + 4];
+    int np = 0, I0 = i * F, J0 = j * F;
+    for (int k = 0; k < F; k++) if (k == 0 || nb[0]) poly[np++] = topo_fine(T, I0 + k, J0);
+    for (int k = 0; k < F; k++) if (k == 0 || nb[1]) poly[np++] = topo_fine(T, I0 + F, J0 + k);
+    for (int k = 0; k < F; k++) if (k == 0 || nb[2]) poly[np++] = topo_fine(T, I0 + F - k, J0 + F);
+    for (int k = 0; k < F; k++) if (k == 0 || nb[3]) poly[np++] = topo_fine(T, I0, J0 + F - k);
+    uint32_t ctr = topo_extra(T, (i + 0.5) * T->h, (j + 0.5) * T->h);
+    for (int k = 0; k < np; k++) {
+        vi[3 * k] = ctr;
+        vi[3 * k + 1] = poly[k];
+        vi[3 * k + 2] = poly[(k + 1) % np];
+        lev[k] = 2;
+    }
+    return np;
+}
+
 static gr_status build_surface_mesh(gr_rtc *rtc, gr_beams *b, const gr_dvec3 *pos, gr_error *err)
 {
     RTCDevice dev = rtc->device;
-    size_t nv = (size_t)(b->nu + 1) * (size_t)(b->nw + 1), nt = 2 * (size_t)b->nu * (size_t)b->nw;
+    size_t nv = b->nv, nt = b->ntri;
     b->surface = rtcNewScene(dev);
     if (!b->surface) return gr_rtc_check(rtc, "reference: surface mesh", err);
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -679,10 +815,101 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->y_min = r->y_min;
     b->sx = (float)p->shear_x;
     b->sz = (float)p->shear_z;
-    size_t nv = (size_t)(b->nu + 1) * (size_t)(b->nw + 1), ntri = 2 * (size_t)b->nu * (size_t)b->nw;
+    double start_u = r->u0 - p->pad_m - p->jitter[0] * h, start_w = r->w0 - p->pad_m - p->jitter[1] * h;
+    /* topology: the grid, with the cells near P_s refined (docs/reference.md 2.2) */
+    topo tp;
+    memset(&tp, 0, sizeof tp);
+    tp.nu = b->nu;
+    tp.nw = b->nw;
+    tp.F = p->refine_factor > 1 ? p->refine_factor : 1;
+    if (tp.F > 64) {
+        gr_beams_destroy(b);
+        return gr_fail(err, GR_E_INPUT, "reference.refine_factor: %d, at most 64", p->refine_factor);
+    }
+    tp.h = h;
+    tp.nv0 = (size_t)(b->nu + 1) * (size_t)(b->nw + 1);
+    double rho = tp.F > 1 ? gr_beam_refine_radius(p) : -1.0;
+    uint8_t *ref = NULL;
+    size_t nref = 0, ntrans = 0;
+    if (rho >= 0.0) {
+        ref = calloc((size_t)b->nu * (size_t)b->nw, 1);
+        if (!ref) {
+            gr_beams_destroy(b);
+            return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the refinement");
+        }
+        /* cells whose rest square comes within rho (plus the waves' horizontal displacement)
+         * of P_s, the camera's sheared position */
+        double A = 0.0;
+        for (int k = 0; k < p->water->n_waves; k++) A += fabs(p->water->waves[k].amplitude_m);
+        double pu = (double)p->eye.x - p->shear_x * p->eye.y - start_u, pw = (double)p->eye.z - p->shear_z * p->eye.y - start_w;
+        double rr = rho + A;
+        int ci0 = b->nu, ci1 = -1, cj0 = b->nw, cj1 = -1;
+        for (int j = 0; j < b->nw; j++)
+            for (int i = 0; i < b->nu; i++) {
+                double du = fmax(fmax(i * h - pu, pu - (i + 1) * h), 0.0), dw = fmax(fmax(j * h - pw, pw - (j + 1) * h), 0.0);
+                if (du * du + dw * dw > rr * rr) continue;
+                ref[(size_t)i + (size_t)j * (size_t)b->nu] = 1;
+                nref++;
+                if (i < ci0) ci0 = i;
+                if (i > ci1) ci1 = i;
+                if (j < cj0) cj0 = j;
+                if (j > cj1) cj1 = j;
+            }
+        if (nref) {
+            tp.ci0 = ci0;
+            tp.cj0 = cj0;
+            tp.mu = (ci1 - ci0 + 1) * tp.F + 1;
+            tp.mw = (cj1 - cj0 + 1) * tp.F + 1;
+            tp.fmap = malloc((size_t)tp.mu * (size_t)tp.mw * sizeof *tp.fmap);
+            if (!tp.fmap) {
+                free(ref); gr_beams_destroy(b);
+                return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the refinement");
+            }
+            memset(tp.fmap, 0xff, (size_t)tp.mu * (size_t)tp.mw * sizeof *tp.fmap);
+        } else {
+            free(ref);
+            ref = NULL;
+        }
+    }
+    size_t ntri = 0;
+    for (int j = 0; j < b->nw; j++)
+        for (int i = 0; i < b->nu; i++) {
+            int n = cell_tris(&tp, ref, i, j, NULL, NULL);
+            ntri += (size_t)n;
+            if (ref && !ref[(size_t)i + (size_t)j * (size_t)b->nu] && n != 2) ntrans++;
+        }
+    b->tri = aligned_alloc(64, ntri * sizeof *b->tri);
+    uint8_t *lev = malloc(ntri);
+    if (!b->tri || !lev || ntri >= UINT32_MAX) {
+        free(ref); free(lev); free(tp.fmap); gr_beams_destroy(b);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu surface triangles (reference.surface_res)", ntri);
+    }
+    for (size_t t = 0; t < ntri; t++) memset(&b->tri[t], 0, sizeof b->tri[t]);
+    {
+        /* one cell's triangles: at most 2 F^2 (refined) or 4 F (a fan) */
+        size_t F2 = (size_t)tp.F * (size_t)tp.F;
+        uint32_t *buf = malloc(3 * (2 * F2 + 4 * (size_t)tp.F + 4) * sizeof *buf);
+        if (!buf) tp.oom = 1;
+        size_t t = 0;
+        for (int j = 0; j < b->nw && buf; j++)
+            for (int i = 0; i < b->nu; i++) {
+                int n = cell_tris(&tp, ref, i, j, buf, lev + t);
+                for (int k = 0; k < n; k++, t++)
+                    for (int c = 0; c < 3; c++) b->tri[t].vi[c] = buf[3 * k + c];
+            }
+        free(buf);
+    }
+    free(ref);
+    free(tp.fmap);
+    b->stats.refine_factor = nref ? tp.F : 1;
+    b->stats.refined_cells = nref;
+    b->stats.transition_cells = ntrans;
+    b->stats.refine_radius_m = rho;
+    size_t nv = tp.nv0 + tp.nx;
+    b->nv = nv;
+    b->ntri = ntri;
     gr_dvec3 *pos = malloc(nv * sizeof *pos);
     b->v = malloc(nv * sizeof *b->v);
-    b->tri = aligned_alloc(64, ntri * sizeof *b->tri);
     float *drift = malloc(ntri * sizeof *drift);
     int disc = p->disc_radius > 0.0;
     float *jv = NULL; /* per vertex: the slope Jacobian J (4 floats) */
@@ -690,21 +917,27 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         jv = malloc(nv * 4 * sizeof *jv);
     }
     b->disc = disc;
-    if (!pos || !b->v || !b->tri || !drift || (disc && !jv)) {
-        free(pos); free(drift); free(jv); gr_beams_destroy(b);
+    if (tp.oom || !pos || !b->v || !drift || (disc && !jv)) {
+        free(pos); free(drift); free(jv); free(lev); free(tp.rx); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu surface vertices (reference.surface_res)", nv);
     }
-    double start_u = r->u0 - p->pad_m - p->jitter[0] * h, start_w = r->w0 - p->pad_m - p->jitter[1] * h;
     gr_dvec3 I = p->sun_dir;
     double eta = 1.0 / p->ior; /* air (n = 1) to water, seed eq. 5.5.1 with eta = n1 / n2 */
-    for (int j = 0; j <= b->nw; j++) {
-        if (p->interrupt && *p->interrupt) { /* Ctrl-C: a cheap read per row of vertices */
-            free(pos); free(drift); free(jv); gr_beams_destroy(b);
+    for (size_t k = 0; k < nv; k++) {
+        if ((k & 4095) == 0 && p->interrupt && *p->interrupt) { /* Ctrl-C: a cheap read per 4096 vertices */
+            free(pos); free(drift); free(jv); free(lev); free(tp.rx); gr_beams_destroy(b);
             return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
         }
-        for (int i = 0; i <= b->nu; i++) {
-            size_t k = (size_t)j * (size_t)(b->nu + 1) + (size_t)i;
-            double x0 = p->origin.x + start_u + i * h, z0 = p->origin.z + start_w + j * h;
+        {
+            double x0, z0;
+            if (k < tp.nv0) {
+                int i = (int)(k % (size_t)(b->nu + 1)), j = (int)(k / (size_t)(b->nu + 1));
+                x0 = p->origin.x + start_u + i * h;
+                z0 = p->origin.z + start_w + j * h;
+            } else {
+                x0 = p->origin.x + start_u + tp.rx[2 * (k - tp.nv0)];
+                z0 = p->origin.z + start_w + tp.rx[2 * (k - tp.nv0) + 1];
+            }
             gr_dvec3 P = gr_gerstner_position(p->water, x0, z0, p->water->time_s);
             gr_dvec3 n;
             gr_gerstner_frame(p->water, x0, z0, p->water->time_s, NULL, NULL, &n);
@@ -735,17 +968,15 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
             v->ity = (float)(1.0 / T.y);
         }
     }
+    free(tp.rx);
     size_t lit = 0;
     for (size_t t = 0; t < ntri; t++) {
         if ((t & 65535) == 0 && p->interrupt && *p->interrupt) { /* Ctrl-C, every 65536 triangles */
-            free(pos); free(drift); free(jv); gr_beams_destroy(b);
+            free(pos); free(drift); free(jv); free(lev); gr_beams_destroy(b);
             return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
         }
         beam_tri *bt = &b->tri[t];
-        memset(bt, 0, sizeof *bt);
-        uint32_t cell = (uint32_t)(t >> 1), idx[3];
-        bt->v00 = cell + cell / (uint32_t)b->nu; /* i + j (nu + 1) */
-        bt->odd = (uint32_t)(t & 1);
+        uint32_t idx[3];
         tri_vertices(b, (uint32_t)t, idx);
         const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
         bt->ytop = fmaxf(v0->py, fmaxf(v1->py, v2->py));
@@ -771,7 +1002,8 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         float d = 0.0f;
         const beam_vertex *vs[3] = {v0, v1, v2};
         for (int c = 0; c < 3; c++) d = fmaxf(d, hypotf(vs[c]->au, vs[c]->aw));
-        drift[t] = d;
+        /* in cells of the grid: a fine triangle's slabs are F times thinner (its box as tight) */
+        drift[t] = lev[t] == 1 ? d * (float)tp.F : d;
         lit++;
     }
     /* slabs: about slab_cells cells of drift each, coarsened uniformly if over the primitive budget */
@@ -784,8 +1016,13 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         if (total <= p->max_prims || total <= lit) break;
         scale *= 1.25 * (double)total / (double)p->max_prims;
     }
+    free(lev);
     if (total > p->max_prims || total >= UINT32_MAX) {
         free(pos); free(drift); free(jv); gr_beams_destroy(b);
+        if (nref)
+            return gr_fail(err, GR_E_NOMEM,
+                           "reference.surface_res: %d with refine_factor %d needs %zu beam primitives, over the budget of %zu",
+                           p->res, tp.F, total, p->max_prims);
         return gr_fail(err, GR_E_NOMEM, "reference.surface_res: %d needs %zu beam primitives, over the budget of %zu",
                        p->res, total, p->max_prims);
     }
@@ -847,6 +1084,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->stats.nw = b->nw;
     b->stats.cell_m = h;
     b->stats.triangles = ntri;
+    b->stats.vertices = nv;
     b->stats.lit_triangles = lit;
     b->stats.prims = np;
     b->stats.bytes = nv * sizeof *b->v + ntri * sizeof *b->tri +
@@ -858,6 +1096,21 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
 
 const gr_beam_stats *gr_beams_stats(const gr_beams *b) { return b ? &b->stats : NULL; }
 RTCScene gr_beams_surface(const gr_beams *b) { return b ? b->surface : NULL; }
+size_t gr_beams_triangle_count(const gr_beams *b) { return b ? b->ntri : 0; }
+
+gr_vec3 gr_beams_vertex(const gr_beams *b, unsigned k)
+{
+    const beam_vertex *v = &b->v[k];
+    return gr_v3(v->pu + b->sx * v->py, v->py, v->pw + b->sz * v->py);
+}
+
+float gr_beams_triangle(const gr_beams *b, size_t t, unsigned idx[3])
+{
+    uint32_t i3[3];
+    tri_vertices(b, (uint32_t)t, i3);
+    for (int c = 0; c < 3; c++) idx[c] = i3[c];
+    return b->tri[t].phi;
+}
 
 void gr_beams_destroy(gr_beams *b)
 {

@@ -53,7 +53,24 @@ typedef struct gr_beam_params {
                                 (0.5) give tighter boxes: fewer candidates per lookup for a
                                 render's march, twice the primitives to build */
     volatile sig_atomic_t *interrupt; /* nonzero (SIGINT/SIGTERM): the build stops, GR_E_INTERRUPTED */
+    /* Local refinement (docs/reference.md 2.2, "Local refinement"): the rest cells whose beams
+     * camera rays run along are split into refine_factor^2 sub-cells (all vertices exact
+     * surface points), with crack-free transition cells around them. Those cells: within
+     * gr_beam_refine_radius of the camera's sheared position (P_s, where the line through
+     * the camera along T0 meets the rest plane). refine_factor <= 1, no camera or
+     * refine_angle <= 0: off (the regular grid, as before). */
+    int refine_factor;
+    double refine_angle;     /* rad: camera rays within this angle of +T0 or -T0 count */
+    const gr_camera *camera; /* its frustum (forward, right, up, fov, aspect) */
+    gr_vec3 eye;             /* the camera's local position */
 } gr_beam_params;
+
+/* The radius (m, horizontal, in sheared coordinates at the rest plane) around P_s of the
+ * surface whose beams camera rays within refine_angle of +-T0 meet: the largest sheared
+ * drift |g| (per metre of height) of such a ray in the frustum times its height span in
+ * the water (up to the rest plane, or down to the region's bottom). 0 when no camera
+ * direction is that close to the beams, or refinement is off. */
+double gr_beam_refine_radius(const gr_beam_params *p);
 
 typedef struct gr_beams gr_beams;
 
@@ -62,12 +79,22 @@ typedef struct gr_beam_stats {
     double cell_m;           /* cell size (m) */
     size_t triangles, lit_triangles, prims;
     size_t bytes;            /* own arrays (Embree's BVH not included) */
+    size_t vertices;         /* surface vertices (grid + refinement) */
+    int refine_factor;       /* the factor used (1 = none) */
+    size_t refined_cells, transition_cells; /* cells split F x F; cells fanned around them */
+    double refine_radius_m;  /* gr_beam_refine_radius */
     double build_s;          /* wall time of the build */
 } gr_beam_stats;
 
 gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err);
 void gr_beams_destroy(gr_beams *b); /* accepts NULL */
 const gr_beam_stats *gr_beams_stats(const gr_beams *b);
+/* The tessellation, for tests: the number of triangles; vertex k's displaced local position
+ * (float); triangle t's vertices (wound so that the area vector points down), returning
+ * its flux F_t |I . a| per unit sun irradiance (0: no beam). */
+size_t gr_beams_triangle_count(const gr_beams *b);
+gr_vec3 gr_beams_vertex(const gr_beams *b, unsigned k);
+float gr_beams_triangle(const gr_beams *b, size_t t, unsigned idx[3]);
 /* The displaced surface mesh (NULL unless params.surface_mesh). */
 RTCScene gr_beams_surface(const gr_beams *b);
 

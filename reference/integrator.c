@@ -381,6 +381,10 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     /* a render's march looks up millions of points per beam set: thinner slabs pay off
      * there (docs/reference.md, "Lookups"); probes keep the cheaper build */
     bp.slab_cells = r->rendering ? 0.5 : 1.0;
+    bp.refine_factor = r->set.refine_factor; /* local refinement (docs/reference.md 2.2) */
+    bp.refine_angle = r->set.refine_angle_deg * GR_PI / 180.0;
+    bp.camera = &r->scene.camera;
+    bp.eye = r->cam;
     if (r->convolve) {
         bp.disc_radius = r->sun_radius;
         bp.disc_e1 = r->e1;
@@ -923,6 +927,11 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
         const gr_beam_stats *bs = &r->main_beams;
         SET(gr_meta_set_double(m, "godrays:surface_cell_m", bs->cell_m));
         SET(gr_meta_set_int(m, "godrays:beam_prims", (long long)bs->prims));
+        if (bs->refine_factor > 1) { /* local refinement (docs/reference.md 2.2) */
+            snprintf(buf, sizeof buf, "factor %d within %.3f m of P_s: %zu cells refined, %zu transition cells, %zu triangles",
+                     bs->refine_factor, bs->refine_radius_m, bs->refined_cells, bs->transition_cells, bs->triangles);
+            SET(gr_meta_set_string(m, "godrays:surface_refine", buf));
+        }
     }
     /* bias next to the noise (docs/reference.md section 4): the surface tessellation is the
      * only discretization bias; measured on this scene by the probe (surface_bias_probe) */

@@ -56,6 +56,10 @@ static const gr_param reference_params[] = {
      .unit = "", .doc = "adaptive steps: the fewest march steps a pixel takes"},
     {.name = "pilot_steps", .type = GR_PT_INT, .offset = REF(pilot_steps), .min = 2, .max = 1 << 16, .def = 32,
      .unit = "", .doc = "adaptive steps: march steps of the pilot ray per pixel that sets the steps"},
+    {.name = "refine_factor", .type = GR_PT_INT, .offset = REF(refine_factor), .min = 1, .max = 16, .def = 2,
+     .unit = "", .doc = "local refinement: surface cells split into F x F where camera rays run along the refracted sun's beams (1 = off)"},
+    {.name = "refine_angle_deg", .type = GR_PT_DOUBLE, .offset = REF(refine_angle_deg), .min = 0, .max = 30, .def = 8,
+     .unit = "deg", .doc = "local refinement: the cells whose beams camera rays within this angle of the refracted sun direction meet"},
 };
 #undef REF
 

@@ -30,6 +30,9 @@ typedef struct gr_reference_settings {
                                      max(pixel, image mean), after the whole render */
     int min_steps;                /* adaptive steps: the fewest a pixel takes */
     int pilot_steps;              /* adaptive steps: march steps of the pilot rays */
+    int refine_factor;            /* surface cells split F x F where camera rays run along the
+                                     beams (1 = off; docs/reference.md 2.2) */
+    double refine_angle_deg;      /* ...those camera rays: within this angle of the refracted sun */
 } gr_reference_settings;
 
 /* reference.sun_disc: the disc average by the analytic convolution of each beam's footprint

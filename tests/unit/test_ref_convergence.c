@@ -20,15 +20,18 @@
 #include <plplot.h>
 #endif
 
-static gr_ref_result render(const char *path, int res, int spp)
+/* refine: the scene's local refinement (docs/reference.md 2.2) as it is (1) or off (0: the
+ * uniform grid, whose O(h^2) rates the study measures) */
+static gr_ref_result render(const char *path, int res, int spp, int refine)
 {
     char r_[64], s_[64];
     snprintf(r_, sizeof r_, "reference.surface_res=%d", res);
     snprintf(s_, sizeof s_, "reference.spp=%d", spp);
-    const char *ov[] = {"camera.width=64", "camera.height=36", "reference.sun_samples=4", "reference.batches=4", r_, s_};
+    const char *ov[] = {"camera.width=64", "camera.height=36", "reference.sun_samples=4", "reference.batches=4", r_, s_,
+                        "reference.refine_factor=1"};
     gr_scene *s = malloc(sizeof *s);
     gr_error err = {GR_OK, ""};
-    if (!s || gr_scene_load_file(path, ov, 6, s, &err) != GR_OK) {
+    if (!s || gr_scene_load_file(path, ov, refine ? 6 : 7, s, &err) != GR_OK) {
         fprintf(stderr, "%s\n", err.msg);
         exit(1);
     }
@@ -59,7 +62,7 @@ int main(void)
     const int resl[] = {32, 64, 128, 256};
     int nres = 4, ref_res = reduced ? 256 : 512;
     if (reduced) nres = 3;
-    gr_ref_result ref = render(path, ref_res, 1);
+    gr_ref_result ref = render(path, ref_res, 1, 0);
     int np = ref.image->width * ref.image->height;
     double mean = 0.0;
     for (int i = 0; i < np; i++) mean += lum(ref.image, i);
@@ -67,7 +70,7 @@ int main(void)
     double err[4], probe[4], bound[4];
     printf("| surface_res | cell (m) | mean abs pixel difference vs %d / image mean | ratio |\n|---|---|---|---|\n", ref_res);
     for (int k = 0; k < nres; k++) {
-        gr_ref_result r = render(path, resl[k], 1);
+        gr_ref_result r = render(path, resl[k], 1, 0);
         double d = 0.0;
         for (int i = 0; i < np; i++) d += fabs(lum(r.image, i) - lum(ref.image, i));
         err[k] = d / np / mean;
@@ -90,12 +93,27 @@ int main(void)
     CHECK_MSG(est > 0.5 * measured && est < 4.0 * measured, "bias probe %g vs measured %g", est, measured);
     CHECK_MSG(err[nres - 2] / err[nres - 1] >= 2.5, "surface_res doubling must cut the bias >= 2.5x, got %.2f",
               err[nres - 2] / err[nres - 1]);
+    /* the local refinement (the scene's defaults) at the finest compared resolution: its
+     * difference to the uniformly finer reference must be well below the uniform grid's
+     * (docs/reference.md 2.2: the bias sits where camera rays run along the beams) */
+    {
+        gr_ref_result r = render(path, resl[nres - 1], 1, 1);
+        double d = 0.0;
+        for (int i = 0; i < np; i++) d += fabs(lum(r.image, i) - lum(ref.image, i));
+        double e_ref = d / np / mean;
+        printf("locally refined (scene defaults) at %d: mean abs pixel difference vs %d / image mean %.3e (uniform %.3e, "
+               "%.2fx); its probe %.3e\n",
+               resl[nres - 1], ref_res, e_ref, err[nres - 1], err[nres - 1] / e_ref, r.bias_surface_rel);
+        CHECK_MSG(e_ref * 2.5 <= err[nres - 1], "the local refinement must cut the difference >= 2.5x: %.3e vs %.3e", e_ref,
+                  err[nres - 1]);
+        gr_ref_result_free(&r);
+    }
 
     /* samples: median relative standard error per pixel */
     double med[2];
     const int spps[2] = {1, 4};
     for (int k = 0; k < 2; k++) {
-        gr_ref_result r = render(path, 128, spps[k]);
+        gr_ref_result r = render(path, 128, spps[k], 0);
         double *rel = malloc(np * sizeof *rel);
         for (int i = 0; i < np; i++) {
             const float *p = r.image->pixels + (size_t)i * r.image->nchannels;
