@@ -1580,6 +1580,13 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         keep->probe_s = r->bias_probe_s;
         keep->beam_cell_m = r->have_main_beams ? r->main_beams.cell_m : 0.0;
         keep->beam_prims = r->have_main_beams ? (long long)r->main_beams.prims : 0;
+        if (r->have_main_beams) {
+            keep->beam_refine_factor = r->main_beams.refine_factor;
+            keep->beam_refine_radius_m = r->main_beams.refine_radius_m;
+            keep->beam_refined_cells = (long long)r->main_beams.refined_cells;
+            keep->beam_transition_cells = (long long)r->main_beams.transition_cells;
+            keep->beam_triangles = (long long)r->main_beams.triangles;
+        }
         keep->beam_build_s = r->beam_build_s;
         keep->march_s = tot.march_s;
         keep->queries = tot.queries;
@@ -1628,6 +1635,11 @@ gr_status gr_ref_assemble(gr_ref_renderer *r, const gr_ref_sums *sums, double wa
     memset(&r->main_beams, 0, sizeof r->main_beams);
     r->main_beams.cell_m = sums->beam_cell_m;
     r->main_beams.prims = (size_t)sums->beam_prims;
+    r->main_beams.refine_factor = sums->beam_refine_factor;
+    r->main_beams.refine_radius_m = sums->beam_refine_radius_m;
+    r->main_beams.refined_cells = (size_t)sums->beam_refined_cells;
+    r->main_beams.transition_cells = (size_t)sums->beam_transition_cells;
+    r->main_beams.triangles = (size_t)sums->beam_triangles;
     r->beam_build_s = sums->beam_build_s;
     r->steps_sum = sums->steps_sum;
     r->steps_pixels = sums->steps_pixels;

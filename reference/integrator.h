@@ -70,6 +70,10 @@ typedef struct gr_ref_sums {
     double probe_s;         /* probe time */
     double beam_cell_m;     /* the main passes' last beam set (0: none) */
     long long beam_prims;
+    /* its local refinement (docs/reference.md 2.2; factor 1: none) */
+    int beam_refine_factor;
+    double beam_refine_radius_m;
+    long long beam_refined_cells, beam_transition_cells, beam_triangles;
     double beam_build_s, march_s;
     long long queries, shadows, overflows;
     /* adaptive steps (docs/reference.md 2.5): the sum of the pixels' march steps over the

@@ -118,6 +118,11 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
         cJSON_AddNumberToObject(h, "probe_s", s->probe_s);
         cJSON_AddNumberToObject(h, "beam_cell_m", s->beam_cell_m);
         cJSON_AddNumberToObject(h, "beam_prims", (double)s->beam_prims);
+        cJSON_AddNumberToObject(h, "beam_refine_factor", s->beam_refine_factor);
+        cJSON_AddNumberToObject(h, "beam_refine_radius_m", s->beam_refine_radius_m);
+        cJSON_AddNumberToObject(h, "beam_refined_cells", (double)s->beam_refined_cells);
+        cJSON_AddNumberToObject(h, "beam_transition_cells", (double)s->beam_transition_cells);
+        cJSON_AddNumberToObject(h, "beam_triangles", (double)s->beam_triangles);
         cJSON_AddNumberToObject(h, "beam_build_s", s->beam_build_s);
         cJSON_AddNumberToObject(h, "march_s", s->march_s);
         cJSON_AddNumberToObject(h, "queries", (double)s->queries);
@@ -413,6 +418,11 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
             if (p->b1 == B && p->row0 == 0) { /* the main passes' last beam set: the last batch's */
                 sums->beam_cell_m = num(p->h, "beam_cell_m", &ok);
                 sums->beam_prims = (long long)num(p->h, "beam_prims", &ok);
+                sums->beam_refine_factor = (int)num(p->h, "beam_refine_factor", &ok);
+                sums->beam_refine_radius_m = num(p->h, "beam_refine_radius_m", &ok);
+                sums->beam_refined_cells = (long long)num(p->h, "beam_refined_cells", &ok);
+                sums->beam_transition_cells = (long long)num(p->h, "beam_transition_cells", &ok);
+                sums->beam_triangles = (long long)num(p->h, "beam_triangles", &ok);
             }
             sums->beam_build_s += num(p->h, "beam_build_s", &ok);
             sums->march_s += num(p->h, "march_s", &ok);

@@ -103,6 +103,12 @@ static void same_image(const char *a, const char *b, int expect_probe)
          * flat water takes the fewest everywhere (docs/reference.md 2.5) */
         if (expect_probe) CHECK(meta_num(&ma, "godrays:steps_min") < meta_num(&ma, "godrays:steps_max"));
         else CHECK(meta_num(&ma, "godrays:steps_max") == 8.0);
+        /* the local refinement's summary (under waves, on by default) travels with the parts */
+        const gr_meta_item *ra = gr_meta_get(&ma, "godrays:surface_refine"), *rb = gr_meta_get(&mb, "godrays:surface_refine");
+        CHECK_MSG((ra != NULL) == (rb != NULL), "godrays:surface_refine: single %s, merged %s", ra ? "set" : "unset",
+                  rb ? "set" : "unset");
+        if (expect_probe) CHECK_MSG(ra != NULL, "godrays:surface_refine missing on %s (the view looks at the sun)", a);
+        if (ra && rb) CHECK_MSG(!strcmp(ra->str, rb->str), "godrays:surface_refine: %s vs %s", ra->str, rb->str);
         double bias = meta_num(&ma, "godrays:bias_surface_rel_est");
         CHECK_MSG(expect_probe ? bias > 0.0 : bias == 0.0, "%s: bias estimate %g (probe expected: %d)", a, bias, expect_probe);
         CHECK(meta_num(&mb, "godrays:merged_parts") == 32.0);
