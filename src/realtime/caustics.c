@@ -36,7 +36,7 @@ gr_status gr_caustics_create(const char *shader_dir, gr_caustics **out, gr_error
     *out = NULL;
     gr_caustics *c = calloc(1, sizeof *c);
     if (!c) return gr_fail(err, GR_E_NOMEM, "caustics: out of memory");
-    const gr_shader_stage st3[3] = {{GL_VERTEX_SHADER, {"caustics.vert.glsl", NULL, NULL, NULL}},
+    const gr_shader_stage st3[3] = {{GL_VERTEX_SHADER, {"volume_version.glsl", "volume_surface.glsl", "caustics.vert.glsl", NULL}},
                                  {GL_GEOMETRY_SHADER, {"caustics.geom.glsl", NULL, NULL, NULL}},
                                  {GL_FRAGMENT_SHADER, {"caustics.frag.glsl", NULL, NULL, NULL}}};
     gr_status st = gr_shader_program_stages(shader_dir, st3, 3, NULL, 0, &c->prog, NULL, err);
@@ -110,20 +110,7 @@ gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_fram
     c->origin[0] = floor(f->eye[0] / L) * L;
     c->origin[1] = floor(f->eye[2] / L) * L;
     float wa[GR_MAX_WAVES * 4], wamp[GR_MAX_WAVES];
-    memset(wa, 0, sizeof wa);
-    memset(wamp, 0, sizeof wamp);
-    for (int i = 0; i < scene->water.n_waves; i++) {
-        double dx = f->waves_a[i][0], dz = f->waves_a[i][1], k = f->waves_a[i][2];
-        const gr_wave *w = &scene->water.waves[i];
-        /* phase = k dir . (origin + x0) - w t + phi0 (seed eq. 5.5.7), the constant in double */
-        double cst = fmod(k * (dx * c->origin[0] + dz * c->origin[1]) - w->omega_rad_s * f->time_s + w->phase_rad,
-                          2.0 * GR_PI);
-        wa[i * 4 + 0] = (float)dx;
-        wa[i * 4 + 1] = (float)dz;
-        wa[i * 4 + 2] = (float)k;
-        wa[i * 4 + 3] = (float)cst;
-        wamp[i] = (float)w->amplitude_m;
-    }
+    gr_vol_waves(scene, f, c->origin[0], c->origin[1], wa, wamp);
     glBindTexture(GL_TEXTURE_2D_ARRAY, c->tex);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_BASE_LEVEL, 0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
@@ -308,6 +295,23 @@ double gr_vol_now_ms(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+void gr_vol_waves(const gr_scene *scene, const gr_frame *f, double ox, double oz, float *wa, float *wamp)
+{
+    memset(wa, 0, GR_MAX_WAVES * 4 * sizeof *wa);
+    memset(wamp, 0, GR_MAX_WAVES * sizeof *wamp);
+    for (int i = 0; i < scene->water.n_waves; i++) {
+        double dx = f->waves_a[i][0], dz = f->waves_a[i][1], k = f->waves_a[i][2];
+        const gr_wave *w = &scene->water.waves[i];
+        /* phase = k dir . (origin + x0) - w t + phi0 (seed eq. 5.5.7), the constant in double */
+        double cst = fmod(k * (dx * ox + dz * oz) - w->omega_rad_s * f->time_s + w->phase_rad, 2.0 * GR_PI);
+        wa[i * 4 + 0] = (float)dx;
+        wa[i * 4 + 1] = (float)dz;
+        wa[i * 4 + 2] = (float)k;
+        wa[i * 4 + 3] = (float)cst;
+        wamp[i] = (float)w->amplitude_m;
+    }
 }
 
 gr_status gr_vol_base_init(gr_vol_base *b, gr_gl *gl, const char *dir, int with_caustics, gr_error *err)

@@ -152,6 +152,11 @@ typedef struct gr_vol_prep {
     double t0_ms;                /* when the render started (for the wall time) */
 } gr_vol_prep;
 
+/* The waves for volume_surface.glsl (u_wa, u_wamp; GR_MAX_WAVES each): per wave (dir.x,
+ * dir.z, k, c) with c = k dir . (ox, oz) - w t + phi0 folded in double, so the shader's phase
+ * is k dir . x0 + c for x0 relative to the world point (ox, oz); unused entries zero. */
+void gr_vol_waves(const gr_scene *scene, const gr_frame *f, double ox, double oz, float *wa, float *wamp);
+
 /* What every volume technique holds: its GL context, scenegl (shadow map, eye depth), the
  * caustic stack (NULL for a technique without one), the screen VAO, the RGBA32F colour
  * target with its framebuffer, the samples query and the pass timer. */

@@ -87,11 +87,11 @@ static gr_status lr_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     if (!r) return gr_fail(err, GR_E_NOMEM, "light_rays: out of memory");
     gr_status st;
     if ((st = gr_vol_base_init(&r->base, gl, dir, 0, err)) != GR_OK) goto fail;
-    const gr_shader_stage surf[2] = {{GL_VERTEX_SHADER, {"lightrays_surface.vert.glsl", NULL, NULL, NULL}},
+    const gr_shader_stage surf[2] = {{GL_VERTEX_SHADER, {"volume_version.glsl", "volume_surface.glsl", "lightrays_surface.vert.glsl", NULL}},
                                   {GL_FRAGMENT_SHADER, {"lightrays_surface.frag.glsl", NULL, NULL, NULL}}};
     const gr_shader_stage lines[3] = {
         {GL_VERTEX_SHADER, {"lightrays.vert.glsl", NULL, NULL, NULL}},
-        {GL_GEOMETRY_SHADER, {"volume_version.glsl", "volume_common.glsl", "lightrays.geom.glsl", NULL}},
+        {GL_GEOMETRY_SHADER, {"volume_version.glsl", "volume_common.glsl", "volume_surface.glsl", "lightrays.geom.glsl"}},
         {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "lightrays.frag.glsl"}}};
     if ((st = gr_shader_program_stages(dir, surf, 2, NULL, 0, &r->prog_surf, NULL, err)) != GR_OK) goto fail;
     if ((st = gr_shader_program_stages(dir, lines, 3, NULL, 0, &r->prog_lines, NULL, err)) != GR_OK) goto fail;
@@ -277,20 +277,7 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
 
     /* pass 1: the surface from the sun */
     float wa[GR_MAX_WAVES * 4], wamp[GR_MAX_WAVES];
-    memset(wa, 0, sizeof wa);
-    memset(wamp, 0, sizeof wamp);
-    for (int i = 0; i < scene->water.n_waves; i++) {
-        const gr_wave *wv = &scene->water.waves[i];
-        double dx = f->waves_a[i][0], dz = f->waves_a[i][1], k = f->waves_a[i][2];
-        /* phase = k dir . (eye + x) - w t + phi0 (seed eq. 5.5.7): the constant in double */
-        double cst = fmod(k * (dx * f->eye[0] + dz * f->eye[2]) - wv->omega_rad_s * f->time_s + wv->phase_rad,
-                          2.0 * GR_PI);
-        wa[i * 4 + 0] = (float)dx;
-        wa[i * 4 + 1] = (float)dz;
-        wa[i * 4 + 2] = (float)k;
-        wa[i * 4 + 3] = (float)cst;
-        wamp[i] = (float)wv->amplitude_m;
-    }
+    gr_vol_waves(scene, f, f->eye[0], f->eye[2], wa, wamp); /* phases relative to the eye */
     gr_gl_timer_begin(&r->base.timer, P_SURFACE);
     glBindFramebuffer(GL_FRAMEBUFFER, r->surf_fbo);
     glViewport(0, 0, N, N);

@@ -39,16 +39,6 @@ flat out float g_ybot;         // prism: y of the line's end (eye-relative)
 
 const int NSEG = 8;
 
-float fresnel_t(float cos_i, float n2)
-{
-    float s2 = (1.0 / n2) * (1.0 / n2) * max(0.0, 1.0 - cos_i * cos_i);
-    if (s2 >= 1.0) return 0.0;
-    float cos_t = sqrt(1.0 - s2);
-    float rs = (cos_i - n2 * cos_t) / (cos_i + n2 * cos_t);
-    float rp = (cos_t - n2 * cos_i) / (cos_t + n2 * cos_i);
-    return 1.0 - 0.5 * (rs * rs + rp * rp);
-}
-
 void emit_ndc(vec2 ndc)
 {
     gl_Position = vec4(ndc, 0.0, 1.0);

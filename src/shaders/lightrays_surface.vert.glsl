@@ -1,4 +1,3 @@
-#version 450 core
 // Light rays (seed 001, Hu et al. 2010), pass 1: the water surface seen from the sun. One
 // vertex of a grid over the light's window (6 per cell), carried along the sun's direction to
 // the rest plane, displaced by seed 000 eq. 5.5.7 with the normal from the analytic tangents
@@ -10,9 +9,7 @@ uniform float u_zr;           // depth half range along the sun (m)
 uniform vec3 u_c;             // window centre on the rest plane (eye-relative)
 uniform vec3 u_e1, u_e2;      // across the sun's direction
 uniform vec3 u_sun_dir;       // direction sunlight travels in air (unit, down)
-uniform int u_n_waves;
-uniform vec4 u_wa[64];        // (dir.x, dir.z, k, c): phase = k dir . x_eye_relative + c
-uniform float u_wamp[64];     // amplitude (m)
+// Compiled after volume_version.glsl and volume_surface.glsl (u_wa: phase = k dir . x_eye_relative + c).
 out vec3 v_p;
 out vec3 v_n;
 
@@ -25,16 +22,8 @@ void main()
     vec3 q = u_c + u_e1 * uv.x + u_e2 * uv.y;
     vec3 x0 = q + u_sun_dir * ((u_c.y - q.y) / u_sun_dir.y); // along the sun to the rest plane
     vec3 p = x0;
-    vec3 tx = vec3(1.0, 0.0, 0.0), tz = vec3(0.0, 0.0, 1.0);
-    for (int i = 0; i < u_n_waves; i++) {
-        vec2 d = u_wa[i].xy;
-        float kk = u_wa[i].z, a = u_wamp[i];
-        float ph = kk * dot(d, x0.xz) + u_wa[i].w;
-        float s = sin(ph), c = cos(ph);
-        p += vec3(-a * d.x * s, a * c, -a * d.y * s);
-        tx += vec3(-a * kk * d.x * d.x * c, -a * kk * d.x * s, -a * kk * d.x * d.y * c);
-        tz += vec3(-a * kk * d.x * d.y * c, -a * kk * d.y * s, -a * kk * d.y * d.y * c);
-    }
+    vec3 tx, tz;
+    vol_waves(x0.xz, p, tx, tz);
     v_p = p;
     v_n = cross(tz, tx);
     vec3 r = p - u_c;
