@@ -48,7 +48,14 @@ struct gr_beams {
     float *box;              /* per primitive: its box, sheared {u, y, w} lower then upper */
     double y_min;
     float sx, sz;            /* shear: T0x / T0y, T0z / T0y */
-    RTCScene bvh, surface;
+    /* the lookup grid (docs/reference.md 2.2, "Lookups"): a uniform grid over the primitives'
+     * boxes in sheared {u, y, w}; cell c lists the primitives whose boxes overlap it,
+     * cell_prim[cell_first[c] .. cell_first[c + 1]), in increasing primitive id */
+    float g0[3], ginv[3];    /* lower corner, 1 / cell size */
+    int gn[3];               /* cells per axis */
+    uint32_t *cell_first;    /* gn[0] gn[1] gn[2] + 1 */
+    uint32_t *cell_prim;
+    RTCScene surface;
 };
 
 static double now_s(void)
@@ -251,16 +258,6 @@ static void prim_box(const gr_beams *b, uint32_t prim, float lo3[3], float hi3[3
     lo3[2] = w0 - ew; hi3[2] = w1 + ew;
 }
 
-static void beam_bounds(const struct RTCBoundsFunctionArguments *args)
-{
-    const gr_beams *b = args->geometryUserPtr;
-    const float *bx = b->box + 6 * (size_t)args->primID;
-    struct RTCBounds *o = args->bounds_o;
-    o->lower_x = bx[0]; o->upper_x = bx[3];
-    o->lower_y = bx[1]; o->upper_y = bx[4];
-    o->lower_z = bx[2]; o->upper_z = bx[5];
-}
-
 typedef struct lookup_state {
     float u, y, w;           /* the point, sheared */
     gr_beam_hits *out;       /* grows as needed */
@@ -388,85 +385,8 @@ static void beam_test(const gr_beams *b, uint32_t prim, lookup_state *s)
                             l0 * v0->tz + l1 * v1->tz + l2 * v2->tz));
 }
 
-typedef struct query_state {
-    const gr_beams *b;
-    lookup_state *s;
-} query_state;
-
-static bool beam_query(struct RTCPointQueryFunctionArguments *args)
-{
-    query_state *q = args->userPtr;
-    beam_test(q->b, args->primID, q->s);
-    return false;
-}
-
-/* ---- all the beams along one camera ray ----
- * One Embree traversal per camera ray (rtcOccluded1 on the sheared ray; the occluded
- * callback never reports a hit, so it sees every primitive whose box the ray may cross)
- * replaces one point query per march point: each collected primitive is binned to the
- * march points that lie inside its box (their t within its interval), and each point then
- * runs the exact test on its bin. The same exact test as gr_beams_lookup on a superset of
- * the same candidates: the same hits, for one BVH traversal per ray. */
-typedef struct ray_prim { float t0, t1; uint32_t prim; int k0; } ray_prim;
-
-struct gr_beam_ray {
-    struct RTCIntersectContext ctx; /* first member: Embree hands it to the callback */
-    const gr_beams *b;
-    float o[3], d[3], tmax;      /* the ray in sheared coordinates */
-    ray_prim *p;                 /* collected primitives and their t intervals */
-    size_t n, cap;
-    uint32_t *stamp;             /* per primitive: the serial of the last ray that took it */
-    size_t nstamp;
-    uint32_t serial;
-    int *first;                  /* per march point: start of its bin (n_points + 1) */
-    int *tab;                    /* first march point of each part of [0, tmax] (2 n_points + 1) */
-    uint32_t *bin;               /* primitive ids, binned by march point */
-    size_t capfirst, capbin;
-    int oom;
-};
-
-static void beam_intersect(const struct RTCIntersectFunctionNArguments *args) { (void)args; }
-
-static void beam_occluded(const struct RTCOccludedFunctionNArguments *args)
-{
-    if (!args->valid[0]) return;
-    gr_beam_ray *r = (gr_beam_ray *)(void *)args->context;
-    uint32_t prim = args->primID;
-    if (r->stamp[prim] == r->serial) return; /* already taken (a primitive split across leaves) */
-    r->stamp[prim] = r->serial;
-    const float *bx = r->b->box + 6 * (size_t)prim;
-    /* slab method: the t interval of the ray inside the box */
-    float t0 = 0.0f, t1 = r->tmax;
-    for (int a = 0; a < 3; a++) {
-        float lo = bx[a], hi = bx[3 + a];
-        if (r->d[a] == 0.0f) {
-            if (r->o[a] < lo || r->o[a] > hi) return;
-            continue;
-        }
-        float inv = 1.0f / r->d[a], ta = (lo - r->o[a]) * inv, tb = (hi - r->o[a]) * inv;
-        if (ta > tb) { float x = ta; ta = tb; tb = x; }
-        t0 = ta > t0 ? ta : t0;
-        t1 = tb < t1 ? tb : t1;
-    }
-    /* widened: float rounding of the interval must not drop a point the box holds */
-    float eps = 1e-5f * (1.0f + r->tmax);
-    t0 -= eps;
-    t1 += eps;
-    if (t0 > t1) return;
-    if (r->n == r->cap) {
-        size_t cap = r->cap ? 2 * r->cap : 256;
-        ray_prim *np = realloc(r->p, cap * sizeof *np);
-        if (!np) { r->oom = 1; return; }
-        r->p = np;
-        r->cap = cap;
-    }
-    r->p[r->n].t0 = t0;
-    r->p[r->n].t1 = t1;
-    r->p[r->n].prim = prim;
-    r->n++;
-}
-
-/* sort by primitive id: the sum over beams then has one order whatever the BVH */
+/* sort by primitive id: the sum over beams then has one order whatever the lookup structure
+ * (the grid's cell lists are already sorted: then a single pass) */
 static int cmp_hit(const void *a, const void *b)
 {
     unsigned x = ((const gr_beam_hit *)a)->prim, y = ((const gr_beam_hit *)b)->prim;
@@ -497,130 +417,36 @@ void gr_beam_hits_free(gr_beam_hits *h)
     h->n = h->cap = 0;
 }
 
+/* The grid cell holding the sheared point (u, y, w), or -1 outside the grid. */
+static inline long grid_cell(const gr_beams *b, float u, float y, float w)
+{
+    float fu = (u - b->g0[0]) * b->ginv[0], fy = (y - b->g0[1]) * b->ginv[1], fw = (w - b->g0[2]) * b->ginv[2];
+    if (!(fu >= 0.0f && fy >= 0.0f && fw >= 0.0f)) return -1; /* also NaN */
+    int iu = (int)fu, iy = (int)fy, iw = (int)fw;
+    if (iu >= b->gn[0] || iy >= b->gn[1] || iw >= b->gn[2]) return -1;
+    return ((long)iw * b->gn[1] + iy) * b->gn[0] + iu;
+}
+
 int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
 {
     out->n = 0;
-    if (!b || !b->bvh) return 0;
+    if (!b || !b->cell_first) return 0;
     lookup_state s;
     s.y = p.y;
     s.u = p.x - b->sx * p.y;
     s.w = p.z - b->sz * p.y;
     s.out = out;
     s.oom = 0;
-    struct RTCPointQuery q;
-    q.x = s.u; q.y = s.y; q.z = s.w; q.time = 0.0f; q.radius = 0.0f;
-    struct RTCPointQueryContext ctx;
-    rtcInitPointQueryContext(&ctx);
-    query_state qs = {b, &s};
-    rtcPointQuery(b->bvh, &q, &ctx, beam_query, &qs);
-    if (s.oom) return -1;
-    sort_hits(out->h, out->n);
-    return out->n;
-}
-
-gr_beam_ray *gr_beam_ray_create(void) { return calloc(1, sizeof(gr_beam_ray)); }
-
-void gr_beam_ray_destroy(gr_beam_ray *r)
-{
-    if (!r) return;
-    free(r->p);
-    free(r->stamp);
-    free(r->first);
-    free(r->tab);
-    free(r->bin);
-    free(r);
-}
-
-int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, const float *t, int npts,
-                         gr_beam_ray *r)
-{
-    r->b = b;
-    r->n = 0;
-    r->oom = 0;
-    if ((size_t)npts + 1 > r->capfirst) {
-        int *nf = realloc(r->first, ((size_t)npts + 1) * sizeof *nf);
-        if (nf) r->first = nf;
-        int *nt = realloc(r->tab, (2 * (size_t)npts + 1) * sizeof *nt);
-        if (nt) r->tab = nt;
-        if (!nf || !nt) return -1;
-        r->capfirst = (size_t)npts + 1;
+    long c = grid_cell(b, s.u, s.y, s.w);
+    if (c < 0) return 0;
+    /* the cell's primitives in increasing id: the hits come out sorted, whatever the grid */
+    for (uint32_t i = b->cell_first[c], e = b->cell_first[c + 1]; i < e; i++) {
+        uint32_t prim = b->cell_prim[i];
+        const float *bx = b->box + 6 * (size_t)prim;
+        /* the box test without branches (most candidates fail it, unpredictably) */
+        int in = (s.u >= bx[0]) & (s.u <= bx[3]) & (s.y >= bx[1]) & (s.y <= bx[4]) & (s.w >= bx[2]) & (s.w <= bx[5]);
+        if (in) beam_test(b, prim, &s);
     }
-    memset(r->first, 0, ((size_t)npts + 1) * sizeof *r->first);
-    if (!b || !b->bvh || !(tmax > 0.0f) || npts < 1) return 0;
-    size_t np = b->stats.prims;
-    if (r->nstamp < np) {
-        uint32_t *ns = realloc(r->stamp, np * sizeof *ns);
-        if (!ns) return -1;
-        memset(ns, 0, np * sizeof *ns);
-        r->stamp = ns;
-        r->nstamp = np;
-        r->serial = 0;
-    }
-    if (++r->serial == 0) { /* wrapped: forget every stamp */
-        memset(r->stamp, 0, r->nstamp * sizeof *r->stamp);
-        r->serial = 1;
-    }
-    r->o[0] = o.x - b->sx * o.y; r->o[1] = o.y; r->o[2] = o.z - b->sz * o.y;
-    r->d[0] = d.x - b->sx * d.y; r->d[1] = d.y; r->d[2] = d.z - b->sz * d.y;
-    r->tmax = tmax;
-    rtcInitIntersectContext(&r->ctx);
-    struct RTCRay ray;
-    memset(&ray, 0, sizeof ray);
-    ray.org_x = r->o[0]; ray.org_y = r->o[1]; ray.org_z = r->o[2];
-    ray.dir_x = r->d[0]; ray.dir_y = r->d[1]; ray.dir_z = r->d[2];
-    ray.tnear = 0.0f;
-    ray.tfar = tmax;
-    ray.mask = ~0u;
-    rtcOccluded1(b->bvh, &r->ctx, &ray);
-    if (r->oom) return -1;
-    /* bin: the march points k with t[k] in [t0, t1] (t ascending), counted then filled.
-     * The first point at or after t0 comes from a table over 2 npts equal parts of [0, tmax]
-     * (its part's first point, then a few steps on). */
-    int nparts = 2 * npts;
-    float scale = (float)nparts / tmax;
-    for (int c = 0, k = 0; c <= nparts; c++) {
-        float tc = (float)c / scale;
-        while (k < npts && t[k] < tc) k++;
-        r->tab[c] = k;
-    }
-    size_t total = 0;
-    for (size_t i = 0; i < r->n; i++) {
-        ray_prim *q = &r->p[i];
-        float c = q->t0 * scale;
-        int k = c <= 0.0f ? 0 : c >= (float)nparts ? r->tab[nparts] : r->tab[(int)c];
-        if (k > 0 && t[k - 1] >= q->t0) k = 0; /* rounding of the part: start over (never seen) */
-        while (k < npts && t[k] < q->t0) k++;
-        q->k0 = k;
-        for (; k < npts && t[k] <= q->t1; k++) { r->first[k + 1]++; total++; }
-    }
-    if (total > r->capbin) {
-        uint32_t *nb = realloc(r->bin, total * sizeof *nb);
-        if (!nb) return -1;
-        r->bin = nb;
-        r->capbin = total;
-    }
-    for (int k = 0; k < npts; k++) r->first[k + 1] += r->first[k];
-    for (size_t i = 0; i < r->n; i++) {
-        const ray_prim *q = &r->p[i];
-        /* first[k] runs ahead as the fill cursor of bin k; restored below */
-        for (int k = q->k0; k < npts && t[k] <= q->t1; k++) r->bin[r->first[k]++] = q->prim;
-    }
-    for (int k = npts; k > 0; k--) r->first[k] = r->first[k - 1];
-    r->first[0] = 0;
-    return 0;
-}
-
-int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 p, gr_beam_hits *out)
-{
-    out->n = 0;
-    if (!b || !b->bvh) return 0;
-    lookup_state s;
-    s.y = p.y;
-    s.u = p.x - b->sx * p.y;
-    s.w = p.z - b->sz * p.y;
-    s.out = out;
-    s.oom = 0;
-    for (int i = r->first[k]; i < r->first[k + 1]; i++) beam_test(b, r->bin[i], &s);
     if (s.oom) return -1;
     sort_hits(out->h, out->n);
     return out->n;
@@ -782,6 +608,95 @@ static gr_status build_surface_mesh(gr_rtc *rtc, gr_beams *b, const gr_dvec3 *po
     rtcReleaseGeometry(g);
     rtcCommitScene(b->surface);
     return gr_rtc_check(rtc, "reference: building the surface mesh", err);
+}
+
+/* The lookup grid over the primitives' boxes (docs/reference.md 2.2, "Lookups"). Cells of
+ * GRID_CELL_BOX times the mean box extent per axis (measured on the default scene: 0.35
+ * against 0.25, 0.5, 1 and 2; a box then spans about 22 cells and a cell lists about 16
+ * boxes), coarsened uniformly while the entries exceed GRID_ENTRIES_PER_PRIM per primitive. Filled in primitive order, so every
+ * cell's list is sorted by primitive id. */
+#define GRID_CELL_BOX 0.35
+#define GRID_ENTRIES_PER_PRIM 32.0
+
+static void grid_range(const gr_beams *b, const float *bx, int lo[3], int hi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        float f0 = (bx[a] - b->g0[a]) * b->ginv[a], f1 = (bx[3 + a] - b->g0[a]) * b->ginv[a];
+        int i0 = f0 > 0.0f ? (int)f0 : 0, i1 = f1 > 0.0f ? (int)f1 : 0;
+        lo[a] = i0 < b->gn[a] ? i0 : b->gn[a] - 1;
+        hi[a] = i1 < b->gn[a] ? i1 : b->gn[a] - 1;
+    }
+}
+
+static gr_status build_grid(gr_beams *b, uint32_t np, gr_error *err)
+{
+    if (np == 0) return GR_OK;
+    double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
+    for (uint32_t k = 0; k < np; k++) {
+        const float *bx = b->box + 6 * (size_t)k;
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], bx[a]);
+            hi[a] = fmax(hi[a], bx[3 + a]);
+            ext[a] += (double)bx[3 + a] - bx[a];
+        }
+    }
+    double cell[3];
+    for (int a = 0; a < 3; a++) {
+        double span = hi[a] - lo[a];
+        cell[a] = GRID_CELL_BOX * ext[a] / np;
+        if (!(cell[a] > span * 1e-6)) cell[a] = span > 0.0 ? span * 1e-6 : 1.0;
+    }
+    size_t entries = 0;
+    for (int attempt = 0; attempt < 64; attempt++) {
+        double ncells = 1.0;
+        for (int a = 0; a < 3; a++) {
+            double n = floor((hi[a] - lo[a]) / cell[a]) + 1.0;
+            if (n > 1e6) { cell[a] = (hi[a] - lo[a]) / 1e6; n = 1e6 + 1.0; }
+            b->gn[a] = (int)n;
+            b->g0[a] = (float)lo[a];
+            b->ginv[a] = (float)(1.0 / cell[a]);
+            ncells *= n;
+        }
+        entries = 0;
+        if (ncells <= GRID_ENTRIES_PER_PRIM * np + 1024.0)
+            for (uint32_t k = 0; k < np; k++) {
+                int l[3], h[3];
+                grid_range(b, b->box + 6 * (size_t)k, l, h);
+                entries += (size_t)(h[0] - l[0] + 1) * (size_t)(h[1] - l[1] + 1) * (size_t)(h[2] - l[2] + 1);
+            }
+        else entries = SIZE_MAX;
+        if (entries <= GRID_ENTRIES_PER_PRIM * np + 1024.0) break;
+        for (int a = 0; a < 3; a++) cell[a] *= 1.25;
+    }
+    size_t ncells = (size_t)b->gn[0] * (size_t)b->gn[1] * (size_t)b->gn[2];
+    if (entries >= UINT32_MAX || ncells >= UINT32_MAX)
+        return gr_fail(err, GR_E_NOMEM, "reference: the beam lookup grid needs %zu entries over %zu cells, too many", entries, ncells);
+    b->cell_first = calloc(ncells + 1, sizeof *b->cell_first);
+    b->cell_prim = malloc((entries ? entries : 1) * sizeof *b->cell_prim);
+    if (!b->cell_first || !b->cell_prim)
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu entries)", entries);
+    const int nu = b->gn[0], ny = b->gn[1];
+    for (uint32_t k = 0; k < np; k++) {
+        int l[3], h[3];
+        grid_range(b, b->box + 6 * (size_t)k, l, h);
+        for (int iw = l[2]; iw <= h[2]; iw++)
+            for (int iy = l[1]; iy <= h[1]; iy++)
+                for (int iu = l[0]; iu <= h[0]; iu++) b->cell_first[((size_t)iw * ny + iy) * nu + iu + 1]++;
+    }
+    for (size_t c = 0; c < ncells; c++) b->cell_first[c + 1] += b->cell_first[c];
+    /* fill cursors: cell_first[c] runs ahead while filling, restored below */
+    for (uint32_t k = 0; k < np; k++) {
+        int l[3], h[3];
+        grid_range(b, b->box + 6 * (size_t)k, l, h);
+        for (int iw = l[2]; iw <= h[2]; iw++)
+            for (int iy = l[1]; iy <= h[1]; iy++)
+                for (int iu = l[0]; iu <= h[0]; iu++) b->cell_prim[b->cell_first[((size_t)iw * ny + iy) * nu + iu]++] = k;
+    }
+    for (size_t c = ncells; c > 0; c--) b->cell_first[c] = b->cell_first[c - 1];
+    b->cell_first[0] = 0;
+    b->stats.grid_entries = entries;
+    b->stats.grid_cells = ncells;
+    return GR_OK;
 }
 
 /* Number of depth slabs for a beam whose corners drift by up to `drift` metres per metre
@@ -1053,27 +968,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     }
     for (uint32_t k = 0; k < np; k++) prim_box(b, k, b->box + 6 * (size_t)k, b->box + 6 * (size_t)k + 3);
 
-    RTCDevice dev = rtc->device;
-    gr_status st = GR_OK;
-    b->bvh = rtcNewScene(dev);
-    if (b->bvh && np > 0) {
-        /* the Morton builder: a quarter faster to build than the SAH one, traversal as fast
-         * for these nearly vertical, regularly spaced slabs (measured) */
-        rtcSetSceneBuildQuality(b->bvh, RTC_BUILD_QUALITY_LOW);
-        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_USER);
-        if (g) {
-            rtcSetGeometryUserPrimitiveCount(g, np);
-            rtcSetGeometryUserData(g, b);
-            rtcSetGeometryBoundsFunction(g, beam_bounds, b);
-            rtcSetGeometryIntersectFunction(g, beam_intersect);
-            rtcSetGeometryOccludedFunction(g, beam_occluded);
-            rtcCommitGeometry(g);
-            rtcAttachGeometry(b->bvh, g);
-            rtcReleaseGeometry(g);
-        }
-    }
-    if (b->bvh) rtcCommitScene(b->bvh);
-    st = gr_rtc_check(rtc, "reference: building the beam BVH", err);
+    gr_status st = build_grid(b, np, err);
     if (st == GR_OK && p->surface_mesh) st = build_surface_mesh(rtc, b, pos, err);
     free(pos);
     if (st != GR_OK) {
@@ -1087,8 +982,8 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->stats.vertices = nv;
     b->stats.lit_triangles = lit;
     b->stats.prims = np;
-    b->stats.bytes = nv * sizeof *b->v + ntri * sizeof *b->tri +
-                     np * (sizeof(uint32_t) + 6 * sizeof(float));
+    b->stats.bytes = nv * sizeof *b->v + ntri * sizeof *b->tri + np * (sizeof(uint32_t) + 6 * sizeof(float)) +
+                     (b->stats.grid_cells + 1 + b->stats.grid_entries) * sizeof(uint32_t);
     b->stats.build_s = now_s() - t_start;
     *out = b;
     return GR_OK;
@@ -1115,11 +1010,12 @@ float gr_beams_triangle(const gr_beams *b, size_t t, unsigned idx[3])
 void gr_beams_destroy(gr_beams *b)
 {
     if (!b) return;
-    if (b->bvh) rtcReleaseScene(b->bvh);
     if (b->surface) rtcReleaseScene(b->surface);
     free(b->v);
     free(b->tri);
     free(b->prim_tri);
     free(b->box);
+    free(b->cell_first);
+    free(b->cell_prim);
     free(b);
 }

@@ -15,9 +15,11 @@
  *   E(p) = flux * area(triangle(y) n (p - K(y))) / (|A(y)| area(K(y))),  K = d J disc,
  * computed exactly (K an ellipse: segment and sector areas in the kernel's own units).
  *
- * Lookups go through an Embree BVH (user geometry): one primitive per beam and depth slab,
- * in coordinates sheared along the mean refracted direction T0 (u = x - T0x/T0y y,
- * w = z - T0z/T0y y), where beams are nearly vertical and slabs keep tight boxes.
+ * Lookups go through a uniform grid over boxes: one primitive per beam and depth slab, in
+ * coordinates sheared along the mean refracted direction T0 (u = x - T0x/T0y y,
+ * w = z - T0z/T0y y), where beams are nearly vertical and slabs keep tight boxes; each
+ * grid cell lists the primitives whose boxes overlap it, in increasing id. (Camera rays,
+ * shadows and the displaced surface stay in Embree: embree_scene.h.)
  * All positions are in the local frame (world - origin), origin.y = the rest height. */
 #ifndef GR_REF_BEAMS_H
 #define GR_REF_BEAMS_H
@@ -78,7 +80,8 @@ typedef struct gr_beam_stats {
     int nu, nw;              /* cells of the rest patch */
     double cell_m;           /* cell size (m) */
     size_t triangles, lit_triangles, prims;
-    size_t bytes;            /* own arrays (Embree's BVH not included) */
+    size_t bytes;            /* own arrays, the lookup grid included */
+    size_t grid_cells, grid_entries; /* the lookup grid: cells, (cell, primitive) entries */
     size_t vertices;         /* surface vertices (grid + refinement) */
     int refine_factor;       /* the factor used (1 = none) */
     size_t refined_cells, transition_cells; /* cells split F x F; cells fanned around them */
@@ -118,21 +121,6 @@ void gr_beam_hits_free(gr_beam_hits *h); /* accepts NULL */
  * whose disc-blurred footprint reaches p, e_h being the disc average) into out->h[0..n-1],
  * sorted by primitive id; returns n, or -1 when out of memory. */
 int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out);
-
-/* The beams along one camera ray, for a march: one BVH traversal per ray instead of one
- * point query per march point, with the same hits as gr_beams_lookup at each point (the
- * same exact test on the primitives whose boxes hold the point). One gr_beam_ray per
- * thread (scratch memory, reused). */
-typedef struct gr_beam_ray gr_beam_ray;
-gr_beam_ray *gr_beam_ray_create(void);      /* NULL when out of memory */
-void gr_beam_ray_destroy(gr_beam_ray *r);   /* accepts NULL */
-/* Collects the primitives whose boxes the local segment o + t d, t in [0, tmax], crosses
- * and bins them to the march points t[0..npts-1] (ascending). Returns 0, or -1 when out of
- * memory. */
-int gr_beams_ray_collect(const gr_beams *b, gr_vec3 o, gr_vec3 d, float tmax, const float *t, int npts,
-                         gr_beam_ray *r);
-/* Every beam through march point k, p = o + t[k] d, like gr_beams_lookup. */
-int gr_beams_ray_lookup(const gr_beams *b, const gr_beam_ray *r, int k, gr_vec3 p, gr_beam_hits *out);
 
 /* The kernel's geometry in its own units (the disc of directions = the unit disc), exposed
  * for tests: the fraction of the unit disc on the side c . n >= -s of a line at signed

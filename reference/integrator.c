@@ -398,12 +398,10 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
 }
 
 /* Sunlight arriving at the local point x: every beam through it under waves, the closed
- * form on flat water (and outside the lit region, where the waves' mean is used). With
- * `ray` (the beams collected along a camera ray), x must be the ray's march point k. The
+ * form on flat water (and outside the lit region, where the waves' mean is used). The
  * lists grow as needed (no beam is ever dropped); returns the number of lights in
  * *lights, or -1 when out of memory. */
-static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray, int k, ref_light **lights,
-                    int *lcap, gr_beam_hits *hits)
+static int light_at(const gr_ref_renderer *r, gr_vec3 x, ref_light **lights, int *lcap, gr_beam_hits *hits)
 {
     if (*lcap < 1) {
         ref_light *nl = realloc(*lights, 64 * sizeof *nl);
@@ -415,7 +413,7 @@ static int light_at(const gr_ref_renderer *r, gr_vec3 x, const gr_beam_ray *ray,
         double u = x.x - r->sx * x.y, w = x.z - r->sz * x.y;
         const gr_beam_region *g = &r->region;
         if (x.y >= g->y_min && u >= g->u0 && u <= g->u1 && w >= g->w0 && w <= g->w1) {
-            int n = ray ? gr_beams_ray_lookup(r->beams, ray, k, x, hits) : gr_beams_lookup(r->beams, x, hits);
+            int n = gr_beams_lookup(r->beams, x, hits);
             if (n < 0) return -1;
             if (n > *lcap) {
                 ref_light *nl = realloc(*lights, (size_t)n * sizeof *nl);
@@ -451,7 +449,7 @@ double gr_ref_irradiance_h(const gr_ref_renderer *r, gr_dvec3 world)
     ref_light *l = NULL;
     int lcap = 0;
     gr_vec3 x = gr_d3_to_f(gr_d3_sub(world, r->origin));
-    int n = light_at(r, x, NULL, 0, &l, &lcap, &hits);
+    int n = light_at(r, x, &l, &lcap, &hits);
     double e = n < 0 ? NAN : 0.0; /* out of memory: NaN, never a silently smaller value */
     for (int i = 0; i < n; i++) e += (double)l[i].eperp * -(double)l[i].T.y;
     free(l);
@@ -527,7 +525,6 @@ typedef struct ref_scratch {
     gr_beam_hits hits;   /* grow as needed */
     ref_light *lights;
     int lcap;
-    gr_beam_ray *ray;
     double *t;     /* march points along the ray (m) */
     float *tf;     /* the same in float, as the points are placed */
 } ref_scratch;
@@ -536,7 +533,6 @@ static void scratch_free(ref_scratch *sc)
 {
     gr_beam_hits_free(&sc->hits);
     free(sc->lights);
-    gr_beam_ray_destroy(sc->ray);
     free(sc->t);
     free(sc->tf);
 }
@@ -546,10 +542,9 @@ static int scratch_alloc(ref_scratch *sc, int steps)
     memset(sc, 0, sizeof *sc);
     sc->lights = malloc(64 * sizeof *sc->lights);
     sc->lcap = 64;
-    sc->ray = gr_beam_ray_create();
     sc->t = malloc((size_t)steps * sizeof *sc->t);
     sc->tf = malloc((size_t)steps * sizeof *sc->tf);
-    if (sc->lights && sc->ray && sc->t && sc->tf) return 0;
+    if (sc->lights && sc->t && sc->tf) return 0;
     scratch_free(sc);
     memset(sc, 0, sizeof *sc);
     return -1;
@@ -600,13 +595,10 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, ref
         sc->t[k] = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
         sc->tf[k] = (float)sc->t[k];
     }
-    /* the beams along this ray, found once and binned to the march points */
-    const gr_beam_ray *ray = NULL;
-    if (!r->flat && gr_beams_ray_collect(r->beams, o, d, D, sc->tf, n, sc->ray) == 0) ray = sc->ray;
     for (int k = 0; k < n; k++) {
         double t = sc->t[k];
         gr_vec3 x = gr_v3_madd(o, d, sc->tf[k]);
-        int m = light_at(r, x, ray, k, &sc->lights, &sc->lcap, &sc->hits);
+        int m = light_at(r, x, &sc->lights, &sc->lcap, &sc->hits);
         if (m < 0) return -1;
         cnt->queries++;
         if (m > cnt->max_hits) cnt->max_hits = m;
