@@ -1,6 +1,7 @@
 #include "reference/beams.h"
 
 #include <float.h>
+#include <pthread.h>
 #include <stdbool.h>
 #include <math.h>
 #include <stdint.h>
@@ -628,7 +629,61 @@ static void grid_range(const gr_beams *b, const float *bx, int lo[3], int hi[3])
     }
 }
 
-static gr_status build_grid(gr_beams *b, uint32_t np, gr_error *err)
+/* Runs fn on n jobs (each `size` bytes apart), job 0 on the calling thread and the others on
+ * their own threads (serially if a thread cannot be started: the same result). */
+#define GRID_MAX_THREADS 64
+static void run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n)
+{
+    pthread_t th[GRID_MAX_THREADS];
+    int started[GRID_MAX_THREADS] = {0};
+    for (int i = 1; i < n; i++) started[i] = pthread_create(&th[i], NULL, fn, (char *)jobs + (size_t)i * size) == 0;
+    fn(jobs);
+    for (int i = 1; i < n; i++) {
+        if (started[i]) pthread_join(th[i], NULL);
+        else fn((char *)jobs + (size_t)i * size);
+    }
+}
+
+typedef struct grid_job {
+    gr_beams *b;
+    uint32_t np;
+    int w0, w1;   /* the w-layers of cells this worker owns */
+    int fill;     /* 0: count the entries per cell; 1: fill them */
+} grid_job;
+
+static void *grid_work(void *arg)
+{
+    grid_job *j = arg;
+    gr_beams *b = j->b;
+    const int nu = b->gn[0], ny = b->gn[1];
+    for (uint32_t k = 0; k < j->np; k++) {
+        int l[3], h[3];
+        grid_range(b, b->box + 6 * (size_t)k, l, h);
+        int w0 = l[2] > j->w0 ? l[2] : j->w0, w1 = h[2] < j->w1 - 1 ? h[2] : j->w1 - 1;
+        for (int iw = w0; iw <= w1; iw++)
+            for (int iy = l[1]; iy <= h[1]; iy++)
+                for (int iu = l[0]; iu <= h[0]; iu++) {
+                    size_t c = ((size_t)iw * ny + iy) * nu + iu;
+                    if (j->fill) b->cell_prim[b->cell_first[c]++] = k;
+                    else b->cell_first[c + 1]++;
+                }
+    }
+    return NULL;
+}
+
+typedef struct box_job {
+    gr_beams *b;
+    uint32_t k0, k1;
+} box_job;
+
+static void *box_work(void *arg)
+{
+    box_job *j = arg;
+    for (uint32_t k = j->k0; k < j->k1; k++) prim_box(j->b, k, j->b->box + 6 * (size_t)k, j->b->box + 6 * (size_t)k + 3);
+    return NULL;
+}
+
+static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err)
 {
     if (np == 0) return GR_OK;
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
@@ -675,23 +730,23 @@ static gr_status build_grid(gr_beams *b, uint32_t np, gr_error *err)
     b->cell_prim = malloc((entries ? entries : 1) * sizeof *b->cell_prim);
     if (!b->cell_first || !b->cell_prim)
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu entries)", entries);
-    const int nu = b->gn[0], ny = b->gn[1];
-    for (uint32_t k = 0; k < np; k++) {
-        int l[3], h[3];
-        grid_range(b, b->box + 6 * (size_t)k, l, h);
-        for (int iw = l[2]; iw <= h[2]; iw++)
-            for (int iy = l[1]; iy <= h[1]; iy++)
-                for (int iu = l[0]; iu <= h[0]; iu++) b->cell_first[((size_t)iw * ny + iy) * nu + iu + 1]++;
+    /* count, prefix sum, fill: each worker owns a range of w-layers of cells and scans every
+     * box, so each cell is filled by one worker in primitive order (deterministic) */
+    grid_job jobs[GRID_MAX_THREADS];
+    int nt = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+    if (nt > b->gn[2]) nt = b->gn[2];
+    for (int i = 0; i < nt; i++) {
+        jobs[i].b = b;
+        jobs[i].np = np;
+        jobs[i].w0 = (int)((long)b->gn[2] * i / nt);
+        jobs[i].w1 = (int)((long)b->gn[2] * (i + 1) / nt);
+        jobs[i].fill = 0;
     }
+    run_jobs(grid_work, jobs, sizeof jobs[0], nt);
     for (size_t c = 0; c < ncells; c++) b->cell_first[c + 1] += b->cell_first[c];
     /* fill cursors: cell_first[c] runs ahead while filling, restored below */
-    for (uint32_t k = 0; k < np; k++) {
-        int l[3], h[3];
-        grid_range(b, b->box + 6 * (size_t)k, l, h);
-        for (int iw = l[2]; iw <= h[2]; iw++)
-            for (int iy = l[1]; iy <= h[1]; iy++)
-                for (int iu = l[0]; iu <= h[0]; iu++) b->cell_prim[b->cell_first[((size_t)iw * ny + iy) * nu + iu]++] = k;
-    }
+    for (int i = 0; i < nt; i++) jobs[i].fill = 1;
+    run_jobs(grid_work, jobs, sizeof jobs[0], nt);
     for (size_t c = ncells; c > 0; c--) b->cell_first[c] = b->cell_first[c - 1];
     b->cell_first[0] = 0;
     b->stats.grid_entries = entries;
@@ -966,9 +1021,18 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         free(pos); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %u beam primitives", np);
     }
-    for (uint32_t k = 0; k < np; k++) prim_box(b, k, b->box + 6 * (size_t)k, b->box + 6 * (size_t)k + 3);
-
-    gr_status st = build_grid(b, np, err);
+    {
+        /* the boxes, in parallel (disjoint outputs) */
+        box_job jobs[GRID_MAX_THREADS];
+        int nt = p->threads < 1 ? 1 : p->threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : p->threads;
+        for (int i = 0; i < nt; i++) {
+            jobs[i].b = b;
+            jobs[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nt);
+            jobs[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nt);
+        }
+        run_jobs(box_work, jobs, sizeof jobs[0], nt);
+    }
+    gr_status st = build_grid(b, np, p->threads, err);
     if (st == GR_OK && p->surface_mesh) st = build_surface_mesh(rtc, b, pos, err);
     free(pos);
     if (st != GR_OK) {

@@ -54,6 +54,8 @@ typedef struct gr_beam_params {
     double slab_cells;       /* drift of a beam per depth slab, in cells; 0 = 1. Thinner slabs
                                 (0.5) give tighter boxes: fewer candidates per lookup for a
                                 render's march, twice the primitives to build */
+    int threads;             /* threads for the boxes and the lookup grid (< 1: one); the
+                                result does not depend on it */
     volatile sig_atomic_t *interrupt; /* nonzero (SIGINT/SIGTERM): the build stops, GR_E_INTERRUPTED */
     /* Local refinement (docs/reference.md 2.2, "Local refinement"): the rest cells whose beams
      * camera rays run along are split into refine_factor^2 sub-cells (all vertices exact

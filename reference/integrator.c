@@ -381,6 +381,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     /* a render's march looks up millions of points per beam set: thinner slabs pay off
      * there (docs/reference.md, "Lookups"); probes keep the cheaper build */
     bp.slab_cells = r->rendering ? 0.5 : 1.0;
+    bp.threads = r->threads;
     bp.refine_factor = r->set.refine_factor; /* local refinement (docs/reference.md 2.2) */
     bp.refine_angle = r->set.refine_angle_deg * GR_PI / 180.0;
     bp.camera = &r->scene.camera;
