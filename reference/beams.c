@@ -441,9 +441,11 @@ int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
     long c = grid_cell(b, s.u, s.y, s.w);
     if (c < 0) return 0;
     /* the cell's primitives in increasing id: the hits come out sorted, whatever the grid */
+    const uint32_t *cp = b->cell_prim;
+    const float *box = b->box; /* locals: the hit list's writes cannot alias them */
     for (uint32_t i = b->cell_first[c], e = b->cell_first[c + 1]; i < e; i++) {
-        uint32_t prim = b->cell_prim[i];
-        const float *bx = b->box + 6 * (size_t)prim;
+        uint32_t prim = cp[i];
+        const float *bx = box + 6 * (size_t)prim;
         /* the box test without branches (most candidates fail it, unpredictably) */
         int in = (s.u >= bx[0]) & (s.u <= bx[3]) & (s.y >= bx[1]) & (s.y <= bx[4]) & (s.w >= bx[2]) & (s.w <= bx[5]);
         if (in) beam_test(b, prim, &s);
