@@ -56,6 +56,11 @@ struct gr_beams {
     int gn[3];               /* cells per axis */
     uint32_t *cell_first;    /* gn[0] gn[1] gn[2] + 1 */
     uint32_t *cell_prim;
+    /* the boxes as the lookups test them: 16-bit units of the grid's span per axis, lower
+     * ends rounded down and upper ends up, one unit wider each side (half the bytes of the
+     * float boxes: fewer cache misses in the candidate loop) */
+    uint16_t *qbox;          /* per primitive: {u, y, w} lower then upper */
+    float q0[3], qinv[3];
     RTCScene surface;
 };
 
@@ -440,14 +445,22 @@ int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
     s.oom = 0;
     long c = grid_cell(b, s.u, s.y, s.w);
     if (c < 0) return 0;
+    /* the point in the boxes' 16-bit units (clamped: a point past the span tests as at its
+     * end, conservatively) */
+    int qp[3];
+    float pc[3] = {s.u, s.y, s.w};
+    for (int a = 0; a < 3; a++) {
+        float q = (pc[a] - b->q0[a]) * b->qinv[a];
+        qp[a] = q <= 0.0f ? 0 : q >= 65535.0f ? 65535 : (int)q;
+    }
     /* the cell's primitives in increasing id: the hits come out sorted, whatever the grid */
     const uint32_t *cp = b->cell_prim;
-    const float *box = b->box; /* locals: the hit list's writes cannot alias them */
+    const uint16_t *qbox = b->qbox; /* locals: the hit list's writes cannot alias them */
     for (uint32_t i = b->cell_first[c], e = b->cell_first[c + 1]; i < e; i++) {
         uint32_t prim = cp[i];
-        const float *bx = box + 6 * (size_t)prim;
+        const uint16_t *bx = qbox + 6 * (size_t)prim;
         /* the box test without branches (most candidates fail it, unpredictably) */
-        int in = (s.u >= bx[0]) & (s.u <= bx[3]) & (s.y >= bx[1]) & (s.y <= bx[4]) & (s.w >= bx[2]) & (s.w <= bx[5]);
+        int in = (qp[0] >= bx[0]) & (qp[0] <= bx[3]) & (qp[1] >= bx[1]) & (qp[1] <= bx[4]) & (qp[2] >= bx[2]) & (qp[2] <= bx[5]);
         if (in) beam_test(b, prim, &s);
     }
     if (s.oom) return -1;
@@ -751,6 +764,28 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     run_jobs(grid_work, jobs, sizeof jobs[0], nt);
     for (size_t c = ncells; c > 0; c--) b->cell_first[c] = b->cell_first[c - 1];
     b->cell_first[0] = 0;
+    /* the 16-bit boxes; the float ones are no longer needed */
+    b->qbox = malloc((size_t)np * 6 * sizeof *b->qbox);
+    if (!b->qbox) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %u beam boxes", np);
+    double qunit[3];
+    for (int a = 0; a < 3; a++) {
+        double span = hi[a] - lo[a];
+        qunit[a] = span > 0.0 ? span / 65535.0 : 1.0;
+        b->q0[a] = (float)lo[a];
+        b->qinv[a] = (float)(1.0 / qunit[a]);
+    }
+    for (uint32_t k = 0; k < np; k++) {
+        const float *bx = b->box + 6 * (size_t)k;
+        uint16_t *q = b->qbox + 6 * (size_t)k;
+        for (int a = 0; a < 3; a++) {
+            double l = floor(((double)bx[a] - (double)b->q0[a]) / qunit[a]) - 1.0;
+            double h = ceil(((double)bx[3 + a] - (double)b->q0[a]) / qunit[a]) + 1.0;
+            q[a] = (uint16_t)(l < 0.0 ? 0.0 : l > 65535.0 ? 65535.0 : l);
+            q[3 + a] = (uint16_t)(h < 0.0 ? 0.0 : h > 65535.0 ? 65535.0 : h);
+        }
+    }
+    free(b->box);
+    b->box = NULL;
     b->stats.grid_entries = entries;
     b->stats.grid_cells = ncells;
     return GR_OK;
@@ -1048,7 +1083,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->stats.vertices = nv;
     b->stats.lit_triangles = lit;
     b->stats.prims = np;
-    b->stats.bytes = nv * sizeof *b->v + ntri * sizeof *b->tri + np * (sizeof(uint32_t) + 6 * sizeof(float)) +
+    b->stats.bytes = nv * sizeof *b->v + ntri * sizeof *b->tri + np * (sizeof(uint32_t) + 6 * sizeof(uint16_t)) +
                      (b->stats.grid_cells + 1 + b->stats.grid_entries) * sizeof(uint32_t);
     b->stats.build_s = now_s() - t_start;
     *out = b;
@@ -1083,5 +1118,6 @@ void gr_beams_destroy(gr_beams *b)
     free(b->box);
     free(b->cell_first);
     free(b->cell_prim);
+    free(b->qbox);
     free(b);
 }
