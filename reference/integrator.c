@@ -46,6 +46,11 @@ enum { STREAM_PASS = 1, STREAM_PILOT = 4, STREAM_PIXEL0 = 16 };
 enum { PILOT_STRIDE = 2, PILOT_RADIUS = 2, PILOT_MEAN_STRIDE = 4 };
 /* the exponent of the step-noise model V(n) = V(n0) (n0 / n)^alpha (docs/reference.md 2.5) */
 #define PILOT_ALPHA 2.0
+/* Steps along the ray (docs/reference.md 2.5, "Steps along the ray"): the march's CDF range
+ * [0, 1) is cut into SEGMENTS equal parts, each with its own number of jittered strata (at
+ * least one), allotted from the pilot's step noise in that part. */
+enum { SEGMENTS = 8 };
+#define ALLOT_FLOOR 0.25
 /* the surface-bias probe's pixel grid and passes (surface_bias_probe) */
 enum { PROBE_STRIDE = 5, PROBE_PASSES = 4 };
 
@@ -100,6 +105,7 @@ struct gr_ref_renderer {
     /* adaptive steps (docs/reference.md 2.5): march steps per image pixel (NULL: r->set.steps
      * everywhere), set by the pilot for the rows [row0, row1); their statistics */
     int *steps_px;
+    uint16_t *alloc_px;       /* per pixel: the strata of each of the SEGMENTS parts (NULL: uniform) */
     int pilot_n0;             /* the pilot's steps (0: no pilot) */
     double steps_sum, steps_pixels, pilot_s;
     int steps_min, steps_max;
@@ -317,6 +323,7 @@ void gr_ref_destroy(gr_ref_renderer *r)
     gr_beams_destroy(r->beams);
     free(r->bias_px);
     free(r->steps_px);
+    free(r->alloc_px);
     gr_ref_geometry_destroy(r->geom);
     gr_rtc_destroy(r->rtc);
     free(r);
@@ -527,6 +534,7 @@ typedef struct ref_scratch {
     ref_light *lights;
     int lcap;
     double *t;     /* march points along the ray (m) */
+    double *w;     /* their weights, with a steps allocation along the ray */
     float *tf;     /* the same in float, as the points are placed */
 } ref_scratch;
 
@@ -535,6 +543,7 @@ static void scratch_free(ref_scratch *sc)
     gr_beam_hits_free(&sc->hits);
     free(sc->lights);
     free(sc->t);
+    free(sc->w);
     free(sc->tf);
 }
 
@@ -544,8 +553,9 @@ static int scratch_alloc(ref_scratch *sc, int steps)
     sc->lights = malloc(64 * sizeof *sc->lights);
     sc->lcap = 64;
     sc->t = malloc((size_t)steps * sizeof *sc->t);
+    sc->w = malloc((size_t)steps * sizeof *sc->w);
     sc->tf = malloc((size_t)steps * sizeof *sc->tf);
-    if (sc->lights && sc->t && sc->tf) return 0;
+    if (sc->lights && sc->t && sc->w && sc->tf) return 0;
     scratch_free(sc);
     memset(sc, 0, sizeof *sc);
     return -1;
@@ -554,8 +564,8 @@ static int scratch_alloc(ref_scratch *sc, int steps)
 /* L (RGB) along the camera ray through the image point (fx, fy) (pixels), marched with n
  * steps (n <= the scratch's). With ck, ck[k] receives the RGB mean of march point k's
  * contribution to L (the step pilot). Returns 0, or -1 when out of memory (a growing hit list). */
-static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, ref_rng *g, double L[3], double *trans,
-                      double *len, ref_counters *cnt, ref_scratch *sc, double *ck)
+static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, const uint16_t *alloc, ref_rng *g, double L[3],
+                      double *trans, double *len, ref_counters *cnt, ref_scratch *sc, double *ck)
 {
     const gr_camera *c = &r->scene.camera;
     double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), aspect = (double)c->width / (double)c->height;
@@ -591,10 +601,25 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, ref
         wbase = (double)D / n;
     }
     double hg_g = r->scene.medium.g;
-    for (int k = 0; k < n; k++) {
-        double u = (k + rng_u(g)) / n;
-        sc->t[k] = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
-        sc->tf[k] = (float)sc->t[k];
+    if (!alloc) {
+        for (int k = 0; k < n; k++) {
+            double u = (k + rng_u(g)) / n;
+            sc->t[k] = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
+            sc->tf[k] = (float)sc->t[k];
+        }
+    } else {
+        /* segment s of the CDF range, [s, s + 1) / SEGMENTS, holds alloc[s] >= 1 jittered
+         * strata; a point there stands for 1 / (SEGMENTS alloc[s]) of the range (the weight
+         * wbase n / (SEGMENTS alloc[s])); n = the sum of alloc (docs/reference.md 2.5) */
+        for (int sg = 0, k = 0; sg < SEGMENTS; sg++) {
+            double ws = wbase * n / ((double)SEGMENTS * alloc[sg]);
+            for (int j = 0; j < alloc[sg]; j++, k++) {
+                double u = (sg + (j + rng_u(g)) / alloc[sg]) / SEGMENTS;
+                sc->t[k] = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
+                sc->tf[k] = (float)sc->t[k];
+                sc->w[k] = ws;
+            }
+        }
     }
     for (int k = 0; k < n; k++) {
         double t = sc->t[k];
@@ -610,7 +635,7 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, ref
                 if (gr_ref_shadowed(r->geom, x, gr_v3_scale(l->T, -1.0f), l->path)) continue;
             }
             double ph = gr_hg_phase(-(double)gr_v3_dot(l->T, d), hg_g);
-            double base = ph * l->eperp * wbase;
+            double base = ph * l->eperp * (alloc ? sc->w[k] : wbase);
             for (int ch = 0; ch < 3; ch++) {
                 /* sun-to-point and point-to-camera extinction, divided by the march density */
                 double ex = r->sig_t[ch] * ((double)l->path + t) - lam * t;
@@ -627,12 +652,12 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, ref
 
 /* One camera sample of pixel (px, py) with n march steps: stratum j of the n_strata camera
  * samples its batch takes in this round, jittered within it. */
-static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, int n, ref_rng *g, double L[3],
-                         double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
+static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, int n, const uint16_t *alloc,
+                         ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
 {
     double jx, jy;
     pixel_stratum(j, n_strata, g, &jx, &jy);
-    return render_ray(r, px + jx, py + jy, n, g, L, trans, len, cnt, sc, NULL);
+    return render_ray(r, px + jx, py + jy, n, alloc, g, L, trans, len, cnt, sc, NULL);
 }
 
 /* Every worker thread: flush denormals, so deep, murky water does not slow down (hard case
@@ -671,6 +696,7 @@ static void *worker(void *arg)
             size_t ai = (size_t)y * acc->W + x;
             double *sum = acc->sum + (ai * acc->B + job->batch) * 3;
             int n = r->steps_px ? r->steps_px[pix] : r->set.steps; /* the pixel's steps (adaptive: the pilot's) */
+            const uint16_t *alloc = r->alloc_px ? r->alloc_px + pix * SEGMENTS : NULL; /* and along its ray */
             for (int s = 0; s < r->spp_pass; s++) {
                 /* Ctrl-C within about a second even at thousands of samples per pixel per pass:
                  * a volatile read every 16 samples (the row then stays unfinished: partial) */
@@ -678,7 +704,7 @@ static void *worker(void *arg)
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
-                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, n, &g, L, &tr, &len,
+                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, n, alloc, &g, L, &tr, &len,
                                   &cnt, &sc) != 0) {
                     oom = 1;
                     break;
@@ -1043,6 +1069,7 @@ typedef struct pilot_job {
     int jb0, jb1;       /* pilot rows needed in full (a part's rows and their neighbours) */
     int n0;             /* the pilot's steps (even) */
     double *pl, *pv;    /* per pilot pixel: L (RGB mean), the step-noise variance estimate V */
+    double *pvs;        /* per pilot pixel and segment: the part of V from the segment's strata */
     atomic_int next_row, rows_done, stop;
     atomic_llong queries, shadow_rays;
 } pilot_job;
@@ -1078,12 +1105,21 @@ static void *pilot_worker(void *arg)
             int bh = H - j * PILOT_STRIDE < PILOT_STRIDE ? H - j * PILOT_STRIDE : PILOT_STRIDE;
             double fx = i * PILOT_STRIDE + bw * rng_u(&g), fy = j * PILOT_STRIDE + bh * rng_u(&g);
             double L[3], tr, len;
-            if (render_ray(r, fx, fy, n0, &g, L, &tr, &len, &cnt, &sc, ck) != 0) { oom = 1; break; }
+            if (render_ray(r, fx, fy, n0, NULL, &g, L, &tr, &len, &cnt, &sc, ck) != 0) { oom = 1; break; }
             /* collapsed strata: the strata 2i and 2i + 1 merged into one holding two samples,
              * whose variance (c_2i - c_2i+1)^2 estimates without bias and that of the stratified
              * pair at most (docs/reference.md 2.5) */
             double v = 0.0;
             for (int k = 0; k + 1 < n0; k += 2) v += (ck[k] - ck[k + 1]) * (ck[k] - ck[k + 1]);
+            /* per segment (where along the ray the noise is): every stratum's squared differences
+             * to both neighbours, halved twice (each difference is counted by two strata, and
+             * the expectation of a difference holds two strata's variances), so that a jump
+             * between merged pairs is seen as well as one inside a pair */
+            double *vs = job->pvs + q * SEGMENTS;
+            for (int k = 0; k < n0; k++) {
+                double dl = k > 0 ? ck[k] - ck[k - 1] : ck[k] - ck[k + 1], dr = k + 1 < n0 ? ck[k] - ck[k + 1] : dl;
+                vs[(size_t)k * SEGMENTS / (size_t)n0] += 0.25 * (dl * dl + dr * dr);
+            }
             job->pl[q] = (L[0] + L[1] + L[2]) / 3.0;
             job->pv[q] = v;
         }
@@ -1096,6 +1132,49 @@ static void *pilot_worker(void *arg)
     scratch_free(&sc);
     free(ck);
     return NULL;
+}
+
+/* Steps along the ray (docs/reference.md 2.5, "Steps along the ray"). Segment s holds m[s]
+ * pilot strata whose step noise was V[s]; with n_s strata its noise is V[s] (m[s] / n_s)^2
+ * (the model, alpha = 2), and the least total sum n_s for sum V[s] (m[s] / n_s)^2 <= T is
+ * n_s = c (V[s] m[s]^2)^(1/3), c = sqrt(sum (V m^2)^(1/3) / T) (Lagrange). Rounded up, at
+ * least one stratum per segment (unbiased), the total clamped to [nmin, nmax]. Returns the
+ * total. */
+static int allot_segments(const double V[SEGMENTS], const int m[SEGMENTS], double T, int nmin, int nmax, double floor_n,
+                          uint16_t n[SEGMENTS])
+{
+    double x[SEGMENTS], sx = 0.0, sc = 0.0;
+    for (int k = 0; k < SEGMENTS; k++) {
+        x[k] = V[k] > 0.0 ? cbrt(V[k] * (double)m[k] * (double)m[k]) : 0.0;
+        sc += x[k];
+    }
+    double c = T > 0.0 ? sqrt(sc / T) : 0.0;
+    int tot = 0;
+    for (int k = 0; k < SEGMENTS; k++) {
+        x[k] *= c;
+        sx += x[k];
+        double v = ceil(fmax(x[k], floor_n * m[k])); /* fmax: NaN gives the floor */
+        n[k] = (uint16_t)(v > 1.0 ? (v < 65535.0 ? v : 65535.0) : 1.0);
+        tot += n[k];
+    }
+    if (tot > nmax) {
+        /* over the cap: the same proportions within it (at least one each) */
+        double f = sx > 0.0 ? (double)(nmax - SEGMENTS) / sx : 0.0; /* the floors sum to at most nmax / 4 */
+        tot = 0;
+        for (int k = 0; k < SEGMENTS; k++) {
+            n[k] = (uint16_t)(1.0 + floor(f * x[k]));
+            tot += n[k];
+        }
+    }
+    while (tot < nmin) {
+        /* under the floor: one more where the strata are scarcest against x */
+        int best = 0;
+        for (int k = 1; k < SEGMENTS; k++)
+            if ((x[k] + 1e-300) / n[k] > (x[best] + 1e-300) / n[best]) best = k;
+        n[best]++;
+        tot++;
+    }
+    return tot;
 }
 
 /* The steps of each pixel of the rows [row0, row1) from the pilot (docs/reference.md 2.5):
@@ -1116,6 +1195,8 @@ static void pilot_steps_map(gr_ref_renderer *r, const pilot_job *job)
     double mean = mn ? msum / (double)mn : 0.0;
     double N = (double)r->passes_per_round * r->spp_pass, tau = r->set.step_error;
     int nmax = r->set.steps, nmin = r->set.min_steps < nmax ? r->set.min_steps : nmax;
+    int m[SEGMENTS] = {0}; /* pilot strata per segment (pairs assigned by their first stratum) */
+    for (int k = 0; k + 1 < job->n0; k += 2) m[(size_t)k * SEGMENTS / (size_t)job->n0] += 2;
     r->steps_sum = r->steps_pixels = 0.0;
     r->steps_min = INT_MAX;
     r->steps_max = 0;
@@ -1132,11 +1213,30 @@ static void pilot_steps_map(gr_ref_renderer *r, const pilot_job *job)
                     nq++;
                 }
             double v = vsum / nq, norm = fmax(lsum / nq, mean);
-            double n = job->n0 * pow(v / (N * tau * tau * norm * norm), 1.0 / PILOT_ALPHA);
             int ni;
-            if (v == 0.0) ni = nmin;
-            else if (!(n < (double)nmax)) ni = nmax; /* also NaN: the most steps */
-            else ni = n > nmin ? (int)ceil(n) : nmin;
+            if (r->alloc_px) {
+                /* the steps along the ray, segment by segment */
+                double V[SEGMENTS] = {0};
+                for (int j = j0 - PILOT_RADIUS; j <= j0 + PILOT_RADIUS; j++)
+                    for (int i = i0 - PILOT_RADIUS; i <= i0 + PILOT_RADIUS; i++) {
+                        if (i < 0 || j < 0 || i >= pw || j >= ph) continue;
+                        const double *vs = job->pvs + ((size_t)j * pw + i) * SEGMENTS;
+                        for (int k = 0; k < SEGMENTS; k++) V[k] += vs[k];
+                    }
+                for (int k = 0; k < SEGMENTS; k++) V[k] /= nq;
+                /* the floor: ALLOT_FLOOR of the uniform allocation's steps per pilot stratum (a part
+                 * the pilot saw as quiet keeps some strata: its noise is at most 1 / ALLOT_FLOOR^2
+                 * times what the uniform march would leave there) */
+                double nu = job->n0 * pow(v / (N * tau * tau * norm * norm), 1.0 / PILOT_ALPHA);
+                nu = v > 0.0 ? (nu < nmax ? nu : nmax) : nmin; /* also NaN: the most */
+                ni = allot_segments(V, m, N * tau * tau * norm * norm, nmin, nmax, ALLOT_FLOOR * nu / job->n0,
+                                    r->alloc_px + ((size_t)py * W + px) * SEGMENTS);
+            } else {
+                double n = job->n0 * pow(v / (N * tau * tau * norm * norm), 1.0 / PILOT_ALPHA);
+                if (v == 0.0) ni = nmin;
+                else if (!(n < (double)nmax)) ni = nmax; /* also NaN: the most steps */
+                else ni = n > nmin ? (int)ceil(n) : nmin;
+            }
             r->steps_px[(size_t)py * W + px] = ni;
             r->steps_sum += ni;
             r->steps_pixels += 1.0;
@@ -1152,6 +1252,8 @@ static gr_status step_pilot(gr_ref_renderer *r, pthread_t *th, gr_progress *prog
     const int W = r->scene.camera.width, H = r->scene.camera.height;
     free(r->steps_px);
     r->steps_px = NULL;
+    free(r->alloc_px);
+    r->alloc_px = NULL;
     r->pilot_n0 = 0;
     r->pilot_s = 0.0;
     r->steps_min = r->steps_max = r->set.steps;
@@ -1174,9 +1276,16 @@ static gr_status step_pilot(gr_ref_renderer *r, pthread_t *th, gr_progress *prog
     size_t nq = (size_t)job.pw * job.ph;
     job.pl = calloc(nq, sizeof *job.pl);
     job.pv = calloc(nq, sizeof *job.pv);
+    job.pvs = calloc(nq * SEGMENTS, sizeof *job.pvs);
     r->steps_px = calloc((size_t)W * H, sizeof *r->steps_px);
-    if (!job.pl || !job.pv || !r->steps_px) {
-        free(job.pl); free(job.pv);
+    /* steps along the ray: when every segment can take a stratum within [min_steps, steps]
+     * and the pilot has one per segment at least */
+    free(r->alloc_px);
+    r->alloc_px = NULL;
+    int allot = r->set.min_steps >= SEGMENTS && job.n0 >= 2 * SEGMENTS;
+    if (allot) r->alloc_px = calloc((size_t)W * H * SEGMENTS, sizeof *r->alloc_px);
+    if (!job.pl || !job.pv || !job.pvs || !r->steps_px || (allot && !r->alloc_px)) {
+        free(job.pl); free(job.pv); free(job.pvs);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the step pilot (%dx%d)", W, H);
     }
     gr_status st = gr_ref_prepare_pass(r, PILOT_PASS, err);
@@ -1216,11 +1325,14 @@ out:
     if (st != GR_OK || !*complete) { /* no steps map: nothing is rendered after this */
         free(r->steps_px);
         r->steps_px = NULL;
+        free(r->alloc_px);
+        r->alloc_px = NULL;
         r->steps_sum = r->steps_pixels = 0.0; /* steps_mean -1: none taken */
         r->steps_min = r->steps_max = 0;
     }
     free(job.pl);
     free(job.pv);
+    free(job.pvs);
     r->pilot_s = mono_s() - t0;
     return st;
 }

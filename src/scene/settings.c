@@ -50,7 +50,7 @@ static const gr_param reference_params[] = {
     {.name = "adaptive_steps", .type = GR_PT_BOOL, .offset = REF(adaptive_steps), .min = 0, .max = 1, .def = 1,
      .unit = "", .doc = "march steps per pixel from a pilot ray (between min_steps and steps) to meet step_error; false: steps everywhere"},
     {.name = "step_error", .type = GR_PT_DOUBLE, .offset = REF(step_error), .min = 0, .max = 1, .flags = LO_X | HI_X,
-     .def = 0.009, .unit = "",
+     .def = 0.010, .unit = "",
      .doc = "adaptive steps: target standard error of the step noise, relative to max(pixel, image mean)"},
     {.name = "min_steps", .type = GR_PT_INT, .offset = REF(min_steps), .min = 1, .max = 1 << 16, .def = 8,
      .unit = "", .doc = "adaptive steps: the fewest march steps a pixel takes"},

@@ -2,7 +2,8 @@
  * ray passing through their shadows. The oracle integrates the closed-form integrand of
  * Oracle 1 numerically (200k midpoints) over [0, D], dropping every point whose sun ray
  * (along -T up to the surface) hits an occluder, with its own slab and sphere tests.
- * Also checks that a scene without occluders traces no shadow rays. */
+ * Also checks that a scene without occluders traces no shadow rays. Fixed 256 steps (not
+ * adaptive, whose target of about 1 % noise is looser than the 0.5 % this oracle checks). */
 #include "check.h"
 #include "test_ref_util.h"
 
@@ -62,7 +63,7 @@ int main(void)
             "{\"water\":{\"waves\":[]},\"sun\":{\"elevation_deg\":%g,\"azimuth_deg\":0,\"angular_diameter_deg\":0},"
             "\"medium\":{\"absorption_per_m\":%g,\"scattering_per_m\":%g,\"g\":%g,\"ior\":%g},"
             "\"camera\":{\"position_m\":[0,%g,0],\"yaw_deg\":90,\"pitch_deg\":0,\"fov_deg\":0.01,\"width\":1,\"height\":1},"
-            "\"reference\":{\"spp\":4,\"steps\":256,\"batches\":4,\"sun_samples\":4}%s}",
+            "\"reference\":{\"spp\":4,\"steps\":256,\"adaptive_steps\":false,\"batches\":4,\"sun_samples\":4}%s}",
             elev, 0.5 * sig, 0.5 * sig, g, n, -z0, occ);
         gr_ref_result res;
         ref_render(s, NULL, &res);
