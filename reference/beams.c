@@ -128,9 +128,8 @@ double gr_beam_disc_triangle(const double v[6])
  * "Fast kernel areas") ----
  * acos by Abramowitz & Stegun 4.4.46: acos(x) = sqrt(1 - x) sum_k a_k x^k on [0, 1], |error|
  * <= 2e-8 rad; acos(-x) = pi - acos(x). */
-static inline double acos_fast(double x)
+static inline double acos_poly(double ax)
 {
-    double ax = fabs(x);
     double p = -0.0012624911;
     p = p * ax + 0.0066700901;
     p = p * ax - 0.0170881256;
@@ -138,8 +137,13 @@ static inline double acos_fast(double x)
     p = p * ax - 0.0501743046;
     p = p * ax + 0.0889789874;
     p = p * ax - 0.2145988016;
-    p = p * ax + 1.5707963050;
-    double r = sqrt(1.0 - ax) * p;
+    return p * ax + 1.5707963050;
+}
+
+static inline double acos_fast(double x)
+{
+    double ax = fabs(x);
+    double r = sqrt(1.0 - ax) * acos_poly(ax);
     return x >= 0.0 ? r : GR_PI - r;
 }
 
@@ -176,11 +180,136 @@ static double disc_wedge_fast(double ax, double ay, double bx, double by)
     return disc_wedge_with(ax, ay, bx, by, atan2_fast);
 }
 
+/* Angle of the arc from q to p (points on the unit circle, up to rounding) turning in the
+ * sense o (+-1), in [0, 2 pi). Both are first put back on the circle (one Newton step for
+ * 1 / |q|, error O((|q| - 1)^2)), since the chord formula below turns a radial error e into
+ * an angle error sqrt(e) near half a turn. The minor arc is acos(q . p), with 1 - q . p =
+ * |p - q|^2 / 2 = w taken from the chord (no cancellation near 0) and 1 + q . p = 2 - w; the
+ * sign of o (q x p) tells minor from major (2 pi - minor). *bad is set where that sign is not
+ * trustworthy: q and p within sqrt(tol2) of each other, the arc near 0 or 2 pi. */
+static inline double arc_angle(double qx, double qy, double px, double py, double o, double tol2, int *bad)
+{
+    double nq = 1.5 - 0.5 * (qx * qx + qy * qy), np = 1.5 - 0.5 * (px * px + py * py);
+    qx *= nq; qy *= nq; px *= np; py *= np;
+    double cr = o * (qx * py - qy * px), dx = px - qx, dy = py - qy;
+    double w = 0.5 * (dx * dx + dy * dy), x = 1.0 - w, ax = fabs(x), u = 1.0 - ax;
+    *bad |= w < tol2;
+    double m = sqrt(u > 0.0 ? u : 0.0) * acos_poly(ax < 1.0 ? ax : 1.0);
+    /* the two choices by sign, without branches (they are hard to predict here): acos(x)
+     * = m or pi - m, the arc = acos or 2 pi - acos; a signed zero only where both agree */
+    double sx = copysign(1.0, x), sc = copysign(1.0, cr);
+    m = 0.5 * GR_PI + sx * (m - 0.5 * GR_PI);
+    return GR_PI + sc * (m - GR_PI);
+}
+
+/* The roots r0 <= r1 of |a + t d|^2 = 1, i.e. A t^2 + 2 B t + C = 0 with C = |a|^2 - 1, in
+ * double, with the discriminant B^2 - A C written as A - (a x b)^2 (Lagrange's identity;
+ * c = a x b = a x d): B^2 and A C cancel to O(ulp(|a|^2 |d|^2)) for far vertices, c is
+ * rounded to O(ulp(|a| |b|)) only. The roots' absolute error, which the clipped points a + t d
+ * inherit, is then a few ulps of |a| + 1, the same as the rounding of those points. Returns
+ * r1 - r0 (2 sqrt(disc) / A). With both ends outside (cross != 0), returns -1 without the
+ * roots where the segment misses the disc: unless its nearest point to the centre, t = -B / A,
+ * lies in (0, 1) and the line's distance is below 1 (disc > 0). */
+static inline double unit_roots(double ax, double ay, double dx, double dy, double c, int cross, double *r0, double *r1)
+{
+    double A = dx * dx + dy * dy, B = ax * dx + ay * dy, disc = A - c * c;
+    if (cross && !(B < 0.0 && A + B > 0.0 && disc > 0.0)) return -1.0;
+    double sq = sqrt(disc > 0.0 ? disc : 0.0), iA = 1.0 / A;
+    *r0 = (-B - sq) * iA;
+    *r1 = (-B + sq) * iA;
+    return 2.0 * sq * iA;
+}
+
+/* The boundary of disc n triangle is made of chords (the parts of the edges inside the disc)
+ * and arcs (the parts of the circle inside the triangle), so (Green) twice its area is
+ * sum_chords p x q + o sum_arcs angle, with o the triangle's orientation. Each edge is
+ * clipped to the disc once (vertex radii shared by the two edges at a vertex); walking the
+ * boundary, the points where it leaves (q) and re-enters (p) the disc alternate, and each
+ * exit is joined to the next entry by an arc: one acos per arc (none when the triangle lies
+ * inside the disc, or no edge meets the circle), against up to six atan2 in the sum of the
+ * three wedges. The vertices are rotated so that one pattern of inside/outside vertices
+ * covers its three rotations. docs/reference.md 2.4, "Fast kernel areas". */
 double gr_beam_disc_triangle_fast(const double v[6])
 {
-    double a = disc_wedge_fast(v[0], v[1], v[2], v[3]) + disc_wedge_fast(v[2], v[3], v[4], v[5]) +
-               disc_wedge_fast(v[4], v[5], v[0], v[1]);
-    return fabs(a) / GR_PI;
+    double r2[3];
+    unsigned in = 0; /* bit i: vertex i lies in the closed disc */
+    for (int i = 0; i < 3; i++) {
+        r2[i] = v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
+        in |= (r2[i] <= 1.0 ? 1u : 0u) << i;
+    }
+    double area2 = (v[2] - v[0]) * (v[5] - v[1]) - (v[3] - v[1]) * (v[4] - v[0]);
+    if (in == 7u) return fabs(area2) * (0.5 / GR_PI); /* the triangle lies inside the disc */
+    if (!(area2 != 0.0)) goto wedges;
+    double o = area2 > 0.0 ? 1.0 : -1.0;
+    /* tol2 = (1e-9 |v|)^2, far above the squared rounding of the points, (1e-16 |v|)^2 */
+    double rmax2 = r2[0] > r2[1] ? (r2[0] > r2[2] ? r2[0] : r2[2]) : (r2[1] > r2[2] ? r2[1] : r2[2]);
+    double tol2 = 1e-18 * (1.0 + rmax2), chord = 0.0, arcs = 0.0;
+    int bad = 0;
+    /* rotation: the lone inside vertex (one in) or the lone outside one (two in) first */
+    double x0 = v[0], y0 = v[1], x1 = v[2], y1 = v[3], x2 = v[4], y2 = v[5];
+    if (in == 2u || in == 5u) { /* vertex 1 first */
+        double tx = x0, ty = y0;
+        x0 = x1; y0 = y1; x1 = x2; y1 = y2; x2 = tx; y2 = ty;
+    } else if (in == 3u || in == 4u) { /* vertex 2 first */
+        double tx = x2, ty = y2;
+        x2 = x1; y2 = y1; x1 = x0; y1 = y0; x0 = tx; y0 = ty;
+    }
+    double c0 = x0 * y1 - y0 * x1, c1 = x1 * y2 - y1 * x2, c2 = x2 * y0 - y2 * x0; /* a x b per edge */
+    double d0x = x1 - x0, d0y = y1 - y0, d1x = x2 - x1, d1y = y2 - y1, d2x = x0 - x2, d2y = y0 - y2;
+    double r0, r1, len;
+    unsigned nin = (in & 1u) + ((in >> 1) & 1u) + (in >> 2);
+    if (nin == 1) {
+        /* 0 in, 1 and 2 out: edge 0 leaves at q0, edge 2 enters at p2, edge 1 may cross */
+        unit_roots(x0, y0, d0x, d0y, c0, 0, &r0, &r1);
+        double t1 = r1 < 1.0 ? r1 : 1.0;
+        double q0x = x0 + t1 * d0x, q0y = y0 + t1 * d0y;
+        unit_roots(x2, y2, d2x, d2y, c2, 0, &r0, &r1);
+        double t0 = r0 > 0.0 ? r0 : 0.0;
+        double p2x = x2 + t0 * d2x, p2y = y2 + t0 * d2y;
+        chord = t1 * c0 + (1.0 - t0) * c2;
+        if ((len = unit_roots(x1, y1, d1x, d1y, c1, 1, &r0, &r1)) >= 0.0) {
+            chord += len * c1;
+            arcs = arc_angle(q0x, q0y, x1 + r0 * d1x, y1 + r0 * d1y, o, tol2, &bad) +
+                   arc_angle(x1 + r1 * d1x, y1 + r1 * d1y, p2x, p2y, o, tol2, &bad);
+        } else {
+            arcs = arc_angle(q0x, q0y, p2x, p2y, o, tol2, &bad);
+        }
+    } else if (nin == 2) {
+        /* 0 out, 1 and 2 in: edge 0 enters at p0, edge 1 inside, edge 2 leaves at q2 */
+        unit_roots(x0, y0, d0x, d0y, c0, 0, &r0, &r1);
+        double t0 = r0 > 0.0 ? r0 : 0.0;
+        double p0x = x0 + t0 * d0x, p0y = y0 + t0 * d0y;
+        unit_roots(x2, y2, d2x, d2y, c2, 0, &r0, &r1);
+        double t1 = r1 < 1.0 ? r1 : 1.0;
+        chord = (1.0 - t0) * c0 + c1 + t1 * c2;
+        arcs = arc_angle(x2 + t1 * d2x, y2 + t1 * d2y, p0x, p0y, o, tol2, &bad);
+    } else {
+        /* all out: each edge crosses the disc or misses it; arcs from each crossing edge's
+         * exit to the next crossing edge's entry */
+        double px[3], py[3], qx[3], qy[3], xs[3] = {x0, x1, x2}, ys[3] = {y0, y1, y2};
+        double dxs[3] = {d0x, d1x, d2x}, dys[3] = {d0y, d1y, d2y}, cs[3] = {c0, c1, c2};
+        int n = 0;
+        for (int i = 0; i < 3; i++) {
+            if (!((len = unit_roots(xs[i], ys[i], dxs[i], dys[i], cs[i], 1, &r0, &r1)) >= 0.0)) continue;
+            chord += len * cs[i];
+            px[n] = xs[i] + r0 * dxs[i]; py[n] = ys[i] + r0 * dys[i];
+            qx[n] = xs[i] + r1 * dxs[i]; qy[n] = ys[i] + r1 * dys[i];
+            n++;
+        }
+        /* no edge meets the circle: the disc lies inside the triangle (the origin on the
+         * inner side of all three edges) or outside it */
+        if (n == 0) return o * c0 > 0.0 && o * c1 > 0.0 && o * c2 > 0.0 ? 1.0 : 0.0;
+        for (int i = 0; i < n; i++) {
+            int m = i + 1 < n ? i + 1 : 0;
+            arcs += arc_angle(qx[i], qy[i], px[m], py[m], o, tol2, &bad);
+        }
+    }
+    if (bad) goto wedges;
+    return fabs(o * chord + arcs) * (0.5 / GR_PI);
+wedges:
+    /* degenerate or ambiguous (measure zero in practice): the sum of the three wedges */
+    return fabs(disc_wedge_fast(v[0], v[1], v[2], v[3]) + disc_wedge_fast(v[2], v[3], v[4], v[5]) +
+                disc_wedge_fast(v[4], v[5], v[0], v[1])) / GR_PI;
 }
 
 float gr_beam_atan2_fast(float y, float x) { return atan2_fast(y, x); }
