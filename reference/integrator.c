@@ -1282,7 +1282,7 @@ static gr_status step_pilot(gr_ref_renderer *r, pthread_t *th, gr_progress *prog
      * and the pilot has one per segment at least */
     free(r->alloc_px);
     r->alloc_px = NULL;
-    int allot = r->set.min_steps >= SEGMENTS && job.n0 >= 2 * SEGMENTS;
+    int allot = r->set.steps_along_ray && r->set.min_steps >= SEGMENTS && job.n0 >= 2 * SEGMENTS;
     if (allot) r->alloc_px = calloc((size_t)W * H * SEGMENTS, sizeof *r->alloc_px);
     if (!job.pl || !job.pv || !job.pvs || !r->steps_px || (allot && !r->alloc_px)) {
         free(job.pl); free(job.pv); free(job.pvs);

@@ -56,6 +56,8 @@ static const gr_param reference_params[] = {
      .unit = "", .doc = "adaptive steps: the fewest march steps a pixel takes"},
     {.name = "pilot_steps", .type = GR_PT_INT, .offset = REF(pilot_steps), .min = 2, .max = 1 << 16, .def = 32,
      .unit = "", .doc = "adaptive steps: march steps of the pilot ray per pixel that sets the steps"},
+    {.name = "steps_along_ray", .type = GR_PT_BOOL, .offset = REF(steps_along_ray), .min = 0, .max = 1, .def = 1,
+     .unit = "", .doc = "adaptive steps: allot a pixel's steps along its ray where the pilot saw the step noise (8 segments, each at least one step and a quarter of its even share); false: evenly"},
     {.name = "refine_factor", .type = GR_PT_INT, .offset = REF(refine_factor), .min = 1, .max = 16, .def = 2,
      .unit = "", .doc = "local refinement: surface cells split into F x F where camera rays run along the refracted sun's beams (1 = off)"},
     {.name = "refine_angle_deg", .type = GR_PT_DOUBLE, .offset = REF(refine_angle_deg), .min = 0, .max = 30, .def = 8,

@@ -30,6 +30,8 @@ typedef struct gr_reference_settings {
                                      max(pixel, image mean), after the whole render */
     int min_steps;                /* adaptive steps: the fewest a pixel takes */
     int pilot_steps;              /* adaptive steps: march steps of the pilot rays */
+    int steps_along_ray;          /* adaptive steps: allotted along each ray by the pilot's noise
+                                     per segment (0: evenly; docs/reference.md 2.5) */
     int refine_factor;            /* surface cells split F x F where camera rays run along the
                                      beams (1 = off; docs/reference.md 2.2) */
     double refine_angle_deg;      /* ...those camera rays: within this angle of the refracted sun */
