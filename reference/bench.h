@@ -10,7 +10,7 @@
 typedef struct gr_ref_bench_result {
     double occluded_occluders_per_s;  /* rtcOccluded1, random rays vs the occluders, 1 thread */
     double occluded_surface_per_s;    /* rtcOccluded1, random rays vs the surface mesh, 1 thread */
-    double point_queries_per_s;       /* beam lookups alone (rtcPointQuery + test), 1 thread */
+    double point_queries_per_s;       /* beam lookups alone (the grid cell, box and containment tests), 1 thread */
     double qps[2];                    /* hot-loop lookups per second, 1 and 2 threads */
     double wall_s[2];                 /* render wall time, 1 and 2 threads */
     double speedup;                   /* wall_s[0] / wall_s[1] */

@@ -192,7 +192,7 @@ static int reference_with(gr_args *args)
         if (st != GR_OK) { rc = gr_cli_report(cmd, &err); goto done; }
         printf("Embree raw rtcOccluded1 (1 thread, random rays): %.3g rays/s vs occluders, %.3g rays/s vs the "
                "surface mesh (%lld triangles)\n", b.occluded_occluders_per_s, b.occluded_surface_per_s, b.surface_triangles);
-        printf("beam lookups alone (rtcPointQuery + containment, 1 thread, %lld primitives): %.3g /s\n", b.beam_prims,
+        printf("beam lookups alone (grid cell + box and containment tests, 1 thread, %lld primitives): %.3g /s\n", b.beam_prims,
                b.point_queries_per_s);
         printf("hot loop (lookups incl. shadow rays and shading): 1 thread %.3g /s (%.2f s), 2 threads %.3g /s (%.2f s)\n",
                b.qps[0], b.wall_s[0], b.qps[1], b.wall_s[1]);
