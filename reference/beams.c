@@ -37,6 +37,13 @@ typedef struct beam_tri {
 } beam_tri;
 _Static_assert(sizeof(beam_tri) == 64, "beam_tri fills one cache line (aligned_alloc needs a multiple of 64)");
 
+/* A primitive as the lookups read it: its box in 16-bit units {u, y, w} lower then upper, and
+ * its triangle (in the same 16 bytes: one load serves the box test and the triangle's address). */
+typedef struct beam_qbox {
+    uint16_t q[6];
+    uint32_t tri;
+} beam_qbox;
+
 struct gr_beams {
     gr_beam_stats stats;
     int nu, nw;              /* cells of the base grid */
@@ -59,7 +66,7 @@ struct gr_beams {
     /* the boxes as the lookups test them: 16-bit units of the grid's span per axis, lower
      * ends rounded down and upper ends up, one unit wider each side (half the bytes of the
      * float boxes: fewer cache misses in the candidate loop) */
-    uint16_t *qbox;          /* per primitive: {u, y, w} lower then upper */
+    beam_qbox *qbox;         /* per primitive */
     float q0[3], qinv[3];
     RTCScene surface;
 };
@@ -401,9 +408,8 @@ typedef struct lookup_state {
 
 /* The exact test of one primitive: is the point in the slab's height interval and in the
  * beam's (disc-blurred) cross-section? Appends the hit to s. */
-static void beam_test(const gr_beams *b, uint32_t prim, lookup_state *s)
+static void beam_test(const gr_beams *b, uint32_t prim, uint32_t t, lookup_state *s)
 {
-    uint32_t t = b->prim_tri[prim];
     const beam_tri *bt = &b->tri[t];
     uint32_t k = prim - bt->first;
     float y = s->y;
@@ -584,13 +590,13 @@ int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
     }
     /* the cell's primitives in increasing id: the hits come out sorted, whatever the grid */
     const uint32_t *cp = b->cell_prim;
-    const uint16_t *qbox = b->qbox; /* locals: the hit list's writes cannot alias them */
+    const beam_qbox *qbox = b->qbox; /* locals: the hit list's writes cannot alias them */
     for (uint32_t i = b->cell_first[c], e = b->cell_first[c + 1]; i < e; i++) {
         uint32_t prim = cp[i];
-        const uint16_t *bx = qbox + 6 * (size_t)prim;
+        const uint16_t *bx = qbox[prim].q;
         /* the box test without branches (most candidates fail it, unpredictably) */
         int in = (qp[0] >= bx[0]) & (qp[0] <= bx[3]) & (qp[1] >= bx[1]) & (qp[1] <= bx[4]) & (qp[2] >= bx[2]) & (qp[2] <= bx[5]);
-        if (in) beam_test(b, prim, &s);
+        if (in) beam_test(b, prim, qbox[prim].tri, &s);
     }
     if (s.oom) return -1;
     sort_hits(out->h, out->n);
@@ -894,7 +900,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     for (size_t c = ncells; c > 0; c--) b->cell_first[c] = b->cell_first[c - 1];
     b->cell_first[0] = 0;
     /* the 16-bit boxes; the float ones are no longer needed */
-    b->qbox = malloc((size_t)np * 6 * sizeof *b->qbox);
+    b->qbox = malloc((size_t)np * sizeof *b->qbox);
     if (!b->qbox) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %u beam boxes", np);
     double qunit[3];
     for (int a = 0; a < 3; a++) {
@@ -905,7 +911,8 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     }
     for (uint32_t k = 0; k < np; k++) {
         const float *bx = b->box + 6 * (size_t)k;
-        uint16_t *q = b->qbox + 6 * (size_t)k;
+        uint16_t *q = b->qbox[k].q;
+        b->qbox[k].tri = b->prim_tri[k];
         for (int a = 0; a < 3; a++) {
             double l = floor(((double)bx[a] - (double)b->q0[a]) / qunit[a]) - 1.0;
             double h = ceil(((double)bx[3 + a] - (double)b->q0[a]) / qunit[a]) + 1.0;
@@ -915,6 +922,8 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     }
     free(b->box);
     b->box = NULL;
+    free(b->prim_tri); /* each primitive's triangle now travels with its box */
+    b->prim_tri = NULL;
     b->stats.grid_entries = entries;
     b->stats.grid_cells = ncells;
     return GR_OK;
@@ -1212,7 +1221,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->stats.vertices = nv;
     b->stats.lit_triangles = lit;
     b->stats.prims = np;
-    b->stats.bytes = nv * sizeof *b->v + ntri * sizeof *b->tri + np * (sizeof(uint32_t) + 6 * sizeof(uint16_t)) +
+    b->stats.bytes = nv * sizeof *b->v + ntri * sizeof *b->tri + np * (sizeof(uint32_t) + sizeof(beam_qbox)) +
                      (b->stats.grid_cells + 1 + b->stats.grid_entries) * sizeof(uint32_t);
     b->stats.build_s = now_s() - t_start;
     *out = b;
