@@ -96,6 +96,13 @@ struct gr_ref_renderer {
     int have_main_beams;
     long long bias_probe_pixels;
     int bias_probe_passes;
+    /* While the main passes 0 .. PROBE_PASSES - 1 run: the probe's level-h accumulator (NULL
+     * otherwise). A probe pixel's level-h value is exactly the main pass's (the same beam set,
+     * steps and random numbers), so it is taken there instead of building the beam set again;
+     * probe_captured has bit p set once pass p was taken (surface_bias_probe) */
+    struct ref_accum *probe_capture;
+    int probe_capture_off;
+    unsigned probe_captured;
     /* per probe pixel (pw x ph, stride PROBE_STRIDE, offset poff), RGB: the signed Richardson
      * estimate of the surface bias (bias.R/G/B channels; NULL when not estimated) */
     float *bias_px;
@@ -713,6 +720,16 @@ static void *worker(void *arg)
                 sum[1] += L[1];
                 sum[2] += L[2];
                 acc->count[ai * acc->B + job->batch]++;
+                const struct ref_accum *pc = r->probe_capture;
+                int po = r->probe_capture_off;
+                if (pc && px >= po && py >= po && (px - po) % PROBE_STRIDE == 0 && (py - po) % PROBE_STRIDE == 0) {
+                    /* a probe pixel: its level-h sum (one thread per pixel: no race) */
+                    size_t qi = (size_t)((py - po) / PROBE_STRIDE) * pc->W + (size_t)((px - po) / PROBE_STRIDE);
+                    pc->sum[qi * 3] += L[0];
+                    pc->sum[qi * 3 + 1] += L[1];
+                    pc->sum[qi * 3 + 2] += L[2];
+                    pc->count[qi]++;
+                }
                 if (acc->aov) {
                     acc->aov[ai * 2] += tr;
                     acc->aov[ai * 2 + 1] += len;
@@ -1400,25 +1417,45 @@ static int probe_row(int row, int stride, int off, int h)
     return y < h ? y : h;
 }
 
-static gr_status surface_bias_probe(gr_ref_renderer *r, gr_ref_sums *keep, pthread_t *th, gr_progress *prog, double frac0, double span,
-                                    ref_march_totals *tot, gr_error *err)
+/* The probe's pixel grid: its offset in the image and its size. */
+static void probe_grid(const gr_ref_renderer *r, int *off, int *pw, int *ph)
+{
+    int W = r->scene.camera.width, H = r->scene.camera.height;
+    *off = W > PROBE_STRIDE / 2 && H > PROBE_STRIDE / 2 ? PROBE_STRIDE / 2 : 0;
+    *pw = (W - *off + PROBE_STRIDE - 1) / PROBE_STRIDE;
+    *ph = (H - *off + PROBE_STRIDE - 1) / PROBE_STRIDE;
+}
+
+static gr_status surface_bias_probe(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *captured, pthread_t *th,
+                                    gr_progress *prog, double frac0, double span, ref_march_totals *tot, gr_error *err)
 {
     enum { NL = 3 }; /* levels h, 2h, 4h */
-    int W = r->scene.camera.width, H = r->scene.camera.height;
-    int off = W > PROBE_STRIDE / 2 && H > PROBE_STRIDE / 2 ? PROBE_STRIDE / 2 : 0;
+    int off, pw, ph;
+    probe_grid(r, &off, &pw, &ph);
     int res = r->set.surface_res, lres[NL];
     for (int k = 0; k < NL; k++) lres[k] = (res >> k) > 2 ? res >> k : 2;
     int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
     ref_accum a[NL];
     memset(a, 0, sizeof a);
     for (int k = 0; k < NL; k++) {
-        a[k].W = (W - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
-        a[k].H = (H - off + PROBE_STRIDE - 1) / PROBE_STRIDE;
+        a[k].W = pw;
+        a[k].H = ph;
         a[k].B = 1; /* the passes summed: the sums a part file carries (src/farm/parts.h) */
     }
     size_t np = (size_t)a[0].W * a[0].H;
     gr_status st = GR_OK;
-    for (int k = 0; k < NL && st == GR_OK; k++) {
+    /* level h taken from the main passes when every probe pass ran there (a part whose batches
+     * miss some of them renders level h here, as the others) */
+    int k0 = 0;
+    unsigned want = (1u << passes) - 1u;
+    if (captured && captured->sum && (r->probe_captured & want) == want) {
+        a[0].sum = captured->sum;
+        a[0].count = captured->count;
+        captured->sum = NULL;
+        captured->count = NULL;
+        k0 = 1;
+    }
+    for (int k = k0; k < NL && st == GR_OK; k++) {
         a[k].sum = calloc(np * 3, sizeof *a[k].sum);
         a[k].count = calloc(np, sizeof *a[k].count);
         if (!a[k].sum || !a[k].count) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
@@ -1427,14 +1464,15 @@ static gr_status surface_bias_probe(gr_ref_renderer *r, gr_ref_sums *keep, pthre
     /* a part probes its own rows' probe pixels */
     int y0 = probe_row(r->opt.row0, PROBE_STRIDE, off, a[0].H), y1 = probe_row(r->opt.row1, PROBE_STRIDE, off, a[0].H);
     for (int p = 0; p < passes && st == GR_OK && complete; p++)
-        for (int k = 0; k < NL && st == GR_OK && complete; k++) {
+        for (int k = k0; k < NL && st == GR_OK && complete; k++) {
             r->set.surface_res = lres[k];
             r->beams_pass = -1; /* another resolution: rebuild */
             st = gr_ref_prepare_pass(r, p, err);
             if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; break; }
             if (st == GR_OK)
                 st = march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, y0, y1, th, prog,
-                                frac0 + span * (NL * p + k) / (NL * (double)passes), span / (NL * (double)passes),
+                                frac0 + span * ((NL - k0) * p + k - k0) / ((NL - k0) * (double)passes),
+                                span / ((NL - k0) * (double)passes),
                                 "surface-bias probe", tot, &complete, err);
         }
     r->set.surface_res = res;
@@ -1634,6 +1672,22 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     int probe = r->set.bias_probe && !r->flat && r->opt.batch0 == 0; /* a part: the one with batch 0 */
     double mainw = probe ? 0.95 : 1.0; /* share of the progress bar for the main passes */
     ref_march_totals tot = {0.0, 0, 0, 0};
+    /* the probe's level h, taken during the main passes 0 .. PROBE_PASSES - 1 */
+    ref_accum cap;
+    memset(&cap, 0, sizeof cap);
+    r->probe_captured = 0;
+    if (probe) {
+        int poff;
+        probe_grid(r, &poff, &cap.W, &cap.H);
+        cap.B = 1;
+        cap.sum = calloc((size_t)cap.W * cap.H * 3, sizeof *cap.sum);
+        cap.count = calloc((size_t)cap.W * cap.H, sizeof *cap.count);
+        r->probe_capture_off = poff;
+        if (!cap.sum || !cap.count) { /* the probe then renders level h itself */
+            free(cap.sum); free(cap.count);
+            cap.sum = NULL; cap.count = NULL;
+        }
+    }
     /* adaptive steps: the pilot sets every pixel's steps before the first pass */
     int pilot_done = 1;
     st = step_pilot(r, th, prog, &pilot_done, err);
@@ -1648,8 +1702,12 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             char note[64];
             snprintf(note, sizeof note, "pass %d/%d%s", pp + 1, P, rounds > 1 ? " (refining)" : "");
             int complete = 0;
+            /* the probe's passes: the first min(P, PROBE_PASSES) (surface_bias_probe) */
+            r->probe_capture = cap.sum && pass < (P < PROBE_PASSES ? P : PROBE_PASSES) ? &cap : NULL;
             st = march_pass(r, &acc, pass, pass % acc.B, 1, 0, r->opt.row0, r->opt.row1, th, prog,
                             mainw * (rounds > 1 ? pp : pass) / P, mainw / P, note, &tot, &complete, err);
+            if (r->probe_capture && st == GR_OK && complete) r->probe_captured |= 1u << pass;
+            r->probe_capture = NULL;
             if (st != GR_OK) break;
             if (!complete) { out->partial = 1; break; }
             out->passes++;
@@ -1667,7 +1725,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     ref_march_totals ptot = {0.0, 0, 0, 0};
     if (st == GR_OK && probe && !out->partial) {
         double tp = mono_s();
-        st = surface_bias_probe(r, keep, th, prog, mainw, 1.0 - mainw, &ptot, err);
+        st = surface_bias_probe(r, keep, &cap, th, prog, mainw, 1.0 - mainw, &ptot, err);
         r->bias_probe_s = mono_s() - tp;
     }
     r->rendering = 0;
@@ -1710,6 +1768,8 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         keep = NULL;
     }
     gr_ref_sums_destroy(keep);
+    free(cap.sum);
+    free(cap.count);
     free(acc.sum);
     free(acc.count);
     free(acc.aov);
