@@ -851,50 +851,54 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         cell[a] = GRID_CELL_BOX * ext[a] / np;
         if (!(cell[a] > span * 1e-6)) cell[a] = span > 0.0 ? span * 1e-6 : 1.0;
     }
-    size_t entries = 0;
-    for (int attempt = 0; attempt < 64; attempt++) {
-        double ncells = 1.0;
+    /* count the entries per cell (each worker owns a range of w-layers of cells and scans
+     * every box), then prefix-sum them; over the budget, coarser cells and count again */
+    grid_job jobs[GRID_MAX_THREADS];
+    int nt = 1;
+    size_t ncells = 0, entries = SIZE_MAX;
+    const double budget = GRID_ENTRIES_PER_PRIM * np + 1024.0;
+    for (int attempt = 0; attempt < 64 && entries == SIZE_MAX; attempt++) {
+        if (attempt > 0)
+            for (int a = 0; a < 3; a++) cell[a] *= 1.25;
+        double nc = 1.0;
         for (int a = 0; a < 3; a++) {
             double n = floor((hi[a] - lo[a]) / cell[a]) + 1.0;
             if (n > 1e6) { cell[a] = (hi[a] - lo[a]) / 1e6; n = 1e6 + 1.0; }
             b->gn[a] = (int)n;
             b->g0[a] = (float)lo[a];
             b->ginv[a] = (float)(1.0 / cell[a]);
-            ncells *= n;
+            nc *= n;
         }
-        entries = 0;
-        if (ncells <= GRID_ENTRIES_PER_PRIM * np + 1024.0)
-            for (uint32_t k = 0; k < np; k++) {
-                int l[3], h[3];
-                grid_range(b, b->box + 6 * (size_t)k, l, h);
-                entries += (size_t)(h[0] - l[0] + 1) * (size_t)(h[1] - l[1] + 1) * (size_t)(h[2] - l[2] + 1);
-            }
-        else entries = SIZE_MAX;
-        if (entries <= GRID_ENTRIES_PER_PRIM * np + 1024.0) break;
-        for (int a = 0; a < 3; a++) cell[a] *= 1.25;
+        if (nc > budget) continue; /* more cells than entries allowed: coarser */
+        ncells = (size_t)b->gn[0] * (size_t)b->gn[1] * (size_t)b->gn[2];
+        free(b->cell_first);
+        b->cell_first = calloc(ncells + 1, sizeof *b->cell_first);
+        if (!b->cell_first)
+            return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu cells)", ncells);
+        nt = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+        if (nt > b->gn[2]) nt = b->gn[2];
+        for (int i = 0; i < nt; i++) {
+            jobs[i].b = b;
+            jobs[i].np = np;
+            jobs[i].w0 = (int)((long)b->gn[2] * i / nt);
+            jobs[i].w1 = (int)((long)b->gn[2] * (i + 1) / nt);
+            jobs[i].fill = 0;
+        }
+        run_jobs(grid_work, jobs, sizeof jobs[0], nt);
+        size_t total = 0; /* in size_t: an attempt far over the budget must not wrap the lists' uint32 */
+        for (size_t c = 0; c < ncells && (double)total <= budget; c++) {
+            total += b->cell_first[c + 1];
+            b->cell_first[c + 1] = (uint32_t)total;
+        }
+        if ((double)total <= budget) entries = total;
     }
-    size_t ncells = (size_t)b->gn[0] * (size_t)b->gn[1] * (size_t)b->gn[2];
-    if (entries >= UINT32_MAX || ncells >= UINT32_MAX)
-        return gr_fail(err, GR_E_NOMEM, "reference: the beam lookup grid needs %zu entries over %zu cells, too many", entries, ncells);
-    b->cell_first = calloc(ncells + 1, sizeof *b->cell_first);
+    if (entries == SIZE_MAX || entries >= UINT32_MAX || ncells >= UINT32_MAX)
+        return gr_fail(err, GR_E_NOMEM, "reference: the beam lookup grid needs more than %.0f entries, too many", budget);
     b->cell_prim = malloc((entries ? entries : 1) * sizeof *b->cell_prim);
-    if (!b->cell_first || !b->cell_prim)
+    if (!b->cell_prim)
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu entries)", entries);
-    /* count, prefix sum, fill: each worker owns a range of w-layers of cells and scans every
-     * box, so each cell is filled by one worker in primitive order (deterministic) */
-    grid_job jobs[GRID_MAX_THREADS];
-    int nt = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
-    if (nt > b->gn[2]) nt = b->gn[2];
-    for (int i = 0; i < nt; i++) {
-        jobs[i].b = b;
-        jobs[i].np = np;
-        jobs[i].w0 = (int)((long)b->gn[2] * i / nt);
-        jobs[i].w1 = (int)((long)b->gn[2] * (i + 1) / nt);
-        jobs[i].fill = 0;
-    }
-    run_jobs(grid_work, jobs, sizeof jobs[0], nt);
-    for (size_t c = 0; c < ncells; c++) b->cell_first[c + 1] += b->cell_first[c];
-    /* fill cursors: cell_first[c] runs ahead while filling, restored below */
+    /* fill, each cell by one worker in primitive order (deterministic): cell_first[c] runs
+     * ahead as the cursor while filling, restored below */
     for (int i = 0; i < nt; i++) jobs[i].fill = 1;
     run_jobs(grid_work, jobs, sizeof jobs[0], nt);
     for (size_t c = ncells; c > 0; c--) b->cell_first[c] = b->cell_first[c - 1];

@@ -704,6 +704,16 @@ static void *worker(void *arg)
             double *sum = acc->sum + (ai * acc->B + job->batch) * 3;
             int n = r->steps_px ? r->steps_px[pix] : r->set.steps; /* the pixel's steps (adaptive: the pilot's) */
             const uint16_t *alloc = r->alloc_px ? r->alloc_px + pix * SEGMENTS : NULL; /* and along its ray */
+            /* a probe pixel during the probe's passes: its level-h sums too (one thread per pixel) */
+            double *psum = NULL;
+            uint32_t *pcnt = NULL;
+            const struct ref_accum *pc = r->probe_capture;
+            int po = r->probe_capture_off;
+            if (pc && px >= po && py >= po && (px - po) % PROBE_STRIDE == 0 && (py - po) % PROBE_STRIDE == 0) {
+                size_t qi = (size_t)((py - po) / PROBE_STRIDE) * pc->W + (size_t)((px - po) / PROBE_STRIDE);
+                psum = pc->sum + qi * 3;
+                pcnt = pc->count + qi;
+            }
             for (int s = 0; s < r->spp_pass; s++) {
                 /* Ctrl-C within about a second even at thousands of samples per pixel per pass:
                  * a volatile read every 16 samples (the row then stays unfinished: partial) */
@@ -720,15 +730,11 @@ static void *worker(void *arg)
                 sum[1] += L[1];
                 sum[2] += L[2];
                 acc->count[ai * acc->B + job->batch]++;
-                const struct ref_accum *pc = r->probe_capture;
-                int po = r->probe_capture_off;
-                if (pc && px >= po && py >= po && (px - po) % PROBE_STRIDE == 0 && (py - po) % PROBE_STRIDE == 0) {
-                    /* a probe pixel: its level-h sum (one thread per pixel: no race) */
-                    size_t qi = (size_t)((py - po) / PROBE_STRIDE) * pc->W + (size_t)((px - po) / PROBE_STRIDE);
-                    pc->sum[qi * 3] += L[0];
-                    pc->sum[qi * 3 + 1] += L[1];
-                    pc->sum[qi * 3 + 2] += L[2];
-                    pc->count[qi]++;
+                if (psum) {
+                    psum[0] += L[0];
+                    psum[1] += L[1];
+                    psum[2] += L[2];
+                    (*pcnt)++;
                 }
                 if (acc->aov) {
                     acc->aov[ai * 2] += tr;
@@ -1230,6 +1236,8 @@ static void pilot_steps_map(gr_ref_renderer *r, const pilot_job *job)
                     nq++;
                 }
             double v = vsum / nq, norm = fmax(lsum / nq, mean);
+            /* the even spread's steps (its floor below, or the pixel's steps without the allotment) */
+            double n = job->n0 * pow(v / (N * tau * tau * norm * norm), 1.0 / PILOT_ALPHA);
             int ni;
             if (r->alloc_px) {
                 /* the steps along the ray, segment by segment */
@@ -1244,12 +1252,10 @@ static void pilot_steps_map(gr_ref_renderer *r, const pilot_job *job)
                 /* the floor: ALLOT_FLOOR of the uniform allocation's steps per pilot stratum (a part
                  * the pilot saw as quiet keeps some strata: its noise is at most 1 / ALLOT_FLOOR^2
                  * times what the uniform march would leave there) */
-                double nu = job->n0 * pow(v / (N * tau * tau * norm * norm), 1.0 / PILOT_ALPHA);
-                nu = v > 0.0 ? (nu < nmax ? nu : nmax) : nmin; /* also NaN: the most */
+                double nu = v > 0.0 ? (n < nmax ? n : nmax) : nmin; /* also NaN: the most */
                 ni = allot_segments(V, m, N * tau * tau * norm * norm, nmin, nmax, ALLOT_FLOOR * nu / job->n0,
                                     r->alloc_px + ((size_t)py * W + px) * SEGMENTS);
             } else {
-                double n = job->n0 * pow(v / (N * tau * tau * norm * norm), 1.0 / PILOT_ALPHA);
                 if (v == 0.0) ni = nmin;
                 else if (!(n < (double)nmax)) ni = nmax; /* also NaN: the most steps */
                 else ni = n > nmin ? (int)ceil(n) : nmin;
@@ -1297,8 +1303,6 @@ static gr_status step_pilot(gr_ref_renderer *r, pthread_t *th, gr_progress *prog
     r->steps_px = calloc((size_t)W * H, sizeof *r->steps_px);
     /* steps along the ray: when every segment can take a stratum within [min_steps, steps]
      * and the pilot has one per segment at least */
-    free(r->alloc_px);
-    r->alloc_px = NULL;
     int allot = r->set.steps_along_ray && r->set.min_steps >= SEGMENTS && job.n0 >= 2 * SEGMENTS;
     if (allot) r->alloc_px = calloc((size_t)W * H * SEGMENTS, sizeof *r->alloc_px);
     if (!job.pl || !job.pv || !job.pvs || !r->steps_px || (allot && !r->alloc_px)) {
