@@ -33,9 +33,14 @@ typedef struct beam_tri {
     float kern[4], ybar, kr;
     uint32_t vi[3];          /* its vertices, wound so that the area vector points down */
     uint32_t first, nslab;   /* its primitives: first, count */
-    float pad_[2];
+    /* the cross-section at height y, d = y - ytop (the lookups' test reads no vertex): vertex
+     * 0 at (c[0] + c[2] d, c[1] + c[3] d), vertices 1 and 2 relative to it at
+     * (c[4] + c[6] d, c[5] + c[7] d) and (c[8] + c[10] d, c[9] + c[11] d), the differences
+     * taken in double (edges a few cm long, positions tens of metres from the origin) */
+    float c[12];
+    float pad_[6];
 } beam_tri;
-_Static_assert(sizeof(beam_tri) == 64, "beam_tri fills one cache line (aligned_alloc needs a multiple of 64)");
+_Static_assert(sizeof(beam_tri) == 128, "beam_tri fills two cache lines (aligned_alloc needs a multiple of 64)");
 
 /* A primitive as the lookups read it: its box in 16-bit units {u, y, w} lower then upper, and
  * its triangle (in the same 16 bytes: one load serves the box test and the triangle's address). */
@@ -416,14 +421,12 @@ static void beam_test(const gr_beams *b, uint32_t prim, uint32_t t, lookup_state
     /* the slab's half-open height interval (top slab open upward, bottom one downward) */
     if (k > 0 && !(y < bt->ytop - (float)k * bt->dy)) return;
     if (k + 1 < bt->nslab && !(y >= bt->ytop - (float)(k + 1) * bt->dy)) return;
-    uint32_t idx[3];
-    tri_vertices(b, t, idx);
-    const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
     /* cross-section vertices at height y, relative to vertex 0 */
-    float d0 = y - v0->py, d1 = y - v1->py, d2 = y - v2->py;
-    float x0 = v0->pu + v0->au * d0, z0 = v0->pw + v0->aw * d0;
-    float e1u = v1->pu + v1->au * d1 - x0, e1w = v1->pw + v1->aw * d1 - z0;
-    float e2u = v2->pu + v2->au * d2 - x0, e2w = v2->pw + v2->aw * d2 - z0;
+    const float *cs = bt->c;
+    float dt = y - bt->ytop;
+    float x0 = cs[0] + cs[2] * dt, z0 = cs[1] + cs[3] * dt;
+    float e1u = cs[4] + cs[6] * dt, e1w = cs[5] + cs[7] * dt;
+    float e2u = cs[8] + cs[10] * dt, e2w = cs[9] + cs[11] * dt;
     float qu = s->u - x0, qw = s->w - z0;
     float det = e1u * e2w - e1w * e2u; /* twice the signed area: negative past a fold */
     /* barycentric coordinates times det (edge functions) of vertices 0, 1, 2 */
@@ -493,6 +496,10 @@ static void beam_test(const gr_beams *b, uint32_t prim, uint32_t t, lookup_state
             e_h = (float)(ex < cap ? ex : cap); /* not fmin: a libm call in this loop */
         }
     }
+    uint32_t idx[3];
+    tri_vertices(b, t, idx);
+    const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
+    float d0 = y - v0->py, d1 = y - v1->py, d2 = y - v2->py;
     /* T and the path length at the nearest point of the cross-section (clamped barycentrics) */
     float l0 = 1.0f / 3.0f, l1 = l0, l2 = l0;
     if (det != 0.0f) {
@@ -568,6 +575,7 @@ static inline long grid_cell(const gr_beams *b, float u, float y, float w)
     return ((long)iw * b->gn[1] + iy) * b->gn[0] + iu;
 }
 
+#define LOOKUP_CHUNK 64
 int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
 {
     out->n = 0;
@@ -591,12 +599,18 @@ int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
     /* the cell's primitives in increasing id: the hits come out sorted, whatever the grid */
     const uint32_t *cp = b->cell_prim;
     const beam_qbox *qbox = b->qbox; /* locals: the hit list's writes cannot alias them */
-    for (uint32_t i = b->cell_first[c], e = b->cell_first[c + 1]; i < e; i++) {
-        uint32_t prim = cp[i];
-        const uint16_t *bx = qbox[prim].q;
-        /* the box test without branches (most candidates fail it, unpredictably) */
-        int in = (qp[0] >= bx[0]) & (qp[0] <= bx[3]) & (qp[1] >= bx[1]) & (qp[1] <= bx[4]) & (qp[2] >= bx[2]) & (qp[2] <= bx[5]);
-        if (in) beam_test(b, prim, qbox[prim].tri, &s);
+    uint32_t pass[LOOKUP_CHUNK];
+    for (uint32_t i0 = b->cell_first[c], e = b->cell_first[c + 1]; i0 < e; i0 += LOOKUP_CHUNK) {
+        uint32_t e1 = e - i0 < LOOKUP_CHUNK ? e : i0 + LOOKUP_CHUNK;
+        int np = 0;
+        for (uint32_t i = i0; i < e1; i++) {
+            const uint16_t *bx = qbox[cp[i]].q;
+            /* the box test without branches (most candidates fail it, unpredictably) */
+            int in = (qp[0] >= bx[0]) & (qp[0] <= bx[3]) & (qp[1] >= bx[1]) & (qp[1] <= bx[4]) & (qp[2] >= bx[2]) & (qp[2] <= bx[5]);
+            pass[np] = cp[i];
+            np += in;
+        }
+        for (int k = 0; k < np; k++) beam_test(b, pass[k], qbox[pass[k]].tri, &s);
     }
     if (s.oom) return -1;
     sort_hits(out->h, out->n);
@@ -1138,6 +1152,17 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         if (!(flux > 0.0)) continue;   /* faces away from the sun: shadowed by its own wave */
         /* F_t averaged over the vertices: O(h^2) like the rest of the tessellation */
         bt->phi = (float)(flux * (v0->ft + v1->ft + v2->ft) / 3.0);
+        const beam_vertex *vs[3] = {v0, v1, v2};
+        /* the cross-section's coefficients for the lookups (beam_tri.c: vertex 0, then vertices 1 and 2 relative to it), in double */
+        double xs[3], zs[3];
+        for (int c = 0; c < 3; c++) {
+            xs[c] = (double)vs[c]->pu + (double)vs[c]->au * ((double)bt->ytop - vs[c]->py);
+            zs[c] = (double)vs[c]->pw + (double)vs[c]->aw * ((double)bt->ytop - vs[c]->py);
+            bt->c[4 * c] = (float)(c ? xs[c] - xs[0] : xs[0]);
+            bt->c[4 * c + 1] = (float)(c ? zs[c] - zs[0] : zs[0]);
+            bt->c[4 * c + 2] = (float)(c ? (double)vs[c]->au - v0->au : v0->au);
+            bt->c[4 * c + 3] = (float)(c ? (double)vs[c]->aw - v0->aw : v0->aw);
+        }
         if (disc) {
             /* the beam's kernel: the disc radius times its vertices' mean Jacobian (first
              * order: the cross-section moves rigidly with the sun direction) */
@@ -1149,7 +1174,6 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
             bt->kr = 1.0001f * sqrtf(M[0] * M[0] + M[1] * M[1] + M[2] * M[2] + M[3] * M[3]);
         }
         float d = 0.0f;
-        const beam_vertex *vs[3] = {v0, v1, v2};
         for (int c = 0; c < 3; c++) d = fmaxf(d, hypotf(vs[c]->au, vs[c]->aw));
         /* in cells of the grid: a fine triangle's slabs are F times thinner (its box as tight) */
         drift[t] = lev[t] == 1 ? d * (float)tp.F : d;

@@ -14,13 +14,13 @@ gr_status gr_cli_render_reference(const gr_scene *scene, const gr_ref_options *o
     o.interrupt = gr_signals_flag(); /* SIGINT and SIGTERM (common/signals, installed by main) */
     /* What the render allocates, estimated before anything is (docs/reliability.md): per
      * pixel the batch sums (3 doubles) and counts (uint32) of every batch, the two AOVs and
-     * the 8-channel float image; per surface cell two beam triangles (64 B + 4 B drift each),
+     * the 8-channel float image; per surface cell two beam triangles (128 B + 4 B drift each),
      * a vertex (24 B position, 40 B beam vertex, 16 B Jacobian) and up to two beam
      * primitives with their lookup grid (box, id, at most 32 grid entries: 160 B each, at most REF's budget of 2^24). */
     const double px = (double)scene->camera.width * (double)scene->camera.height;
     const double B = scene->reference.batches, sr = scene->reference.surface_res;
     const double cells = sr * sr, prims = fmin(2.0 * cells, 16777216.0);
-    const double need = px * (28.0 * B + 16.0 + 32.0) + cells * 216.0 + prims * 160.0;
+    const double need = px * (28.0 * B + 16.0 + 32.0) + cells * 344.0 + prims * 160.0;
     char detail[160];
     snprintf(detail, sizeof detail, "%d x %d pixels x %d batches, surface_res %d", scene->camera.width,
              scene->camera.height, scene->reference.batches, scene->reference.surface_res);
