@@ -607,7 +607,7 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, con
         om = 0.0;
         wbase = (double)D / n;
     }
-    double hg_g = r->scene.medium.g;
+    const gr_hg hg = gr_hg_make(r->scene.medium.g); /* seed eq. 5.5.4 */
     if (!alloc) {
         for (int k = 0; k < n; k++) {
             double u = (k + rng_u(g)) / n;
@@ -641,7 +641,7 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, con
                 cnt->shadow_rays++;
                 if (gr_ref_shadowed(r->geom, x, gr_v3_scale(l->T, -1.0f), l->path)) continue;
             }
-            double ph = gr_hg_phase(-(double)gr_v3_dot(l->T, d), hg_g);
+            double ph = gr_hg_eval(hg, -(double)gr_v3_dot(l->T, d));
             double base = ph * l->eperp * (alloc ? sc->w[k] : wbase);
             for (int ch = 0; ch < 3; ch++) {
                 /* sun-to-point and point-to-camera extinction, divided by the march density */

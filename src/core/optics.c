@@ -99,34 +99,33 @@ double gr_beer(double c, double L)
     return exp(-tau);
 }
 
-double gr_hg_phase_seed(double cos_theta, double g)
+gr_hg gr_hg_make(double g)
 {
     /* Seed eq. 5.5.4 with beta_M = 1. The denominator 1 + g^2 - 2 g cos is rewritten as a
      * sum of non-negative terms so that it keeps full relative precision at the peak:
      *   g >= 0: (1 - g)^2 + 2 g (1 - cos)   (peak at cos = 1)
      *   g <  0: (1 + g)^2 + 2 |g| (1 + cos) (peak at cos = -1). */
-    double c = cos_theta;
-    if (!(c >= -1.0))
-        c = -1.0; /* also maps NaN */
-    if (c > 1.0)
-        c = 1.0;
     if (!(g >= -1.0))
-        g = -1.0;
+        g = -1.0; /* also maps NaN */
     if (g > 1.0)
         g = 1.0;
-    double d;
-    if (g >= 0.0)
-        d = (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c);
-    else
-        d = (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + c);
+    gr_hg h;
+    h.s = g >= 0.0 ? 1.0 : -1.0;
+    h.a = (1.0 - h.s * g) * (1.0 - h.s * g);
+    h.b = 2.0 * h.s * g;
     double num = (1.0 - g) * (1.0 + g);
-    if (!(d > 0.0) || num <= 0.0)
-        return 0.0; /* |g| = 1: a delta function; 0 rather than 0/0 */
-    return num / (d * sqrt(d));
+    /* |g| = 1: a delta function; 0 rather than 0/0. Normalized over the sphere: the integral
+     * of (1 - g^2) / u^(3/2) over solid angle is 4 pi. */
+    h.k = num > 0.0 ? num / (4.0 * GR_PI) : 0.0;
+    return h;
+}
+
+double gr_hg_phase_seed(double cos_theta, double g)
+{
+    return gr_hg_phase(cos_theta, g) * (4.0 * GR_PI);
 }
 
 double gr_hg_phase(double cos_theta, double g)
 {
-    /* Normalized over the sphere: integral of (1-g^2)/u^(3/2) over solid angle is 4 pi. */
-    return gr_hg_phase_seed(cos_theta, g) / (4.0 * GR_PI);
+    return gr_hg_eval(gr_hg_make(g), cos_theta);
 }

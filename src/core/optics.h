@@ -3,6 +3,8 @@
 #ifndef GR_OPTICS_H
 #define GR_OPTICS_H
 
+#include <math.h>
+
 #include "core/vec.h"
 
 #define GR_PI 3.14159265358979323846
@@ -37,5 +39,21 @@ double gr_hg_phase(double cos_theta, double g);
 /* The seed's un-normalized form (eq. 5.5.4 with beta_M = 1), as its second pass uses it:
  * (1 - g^2) / (1 + g^2 - 2 g cos)^(3/2) = 4 pi gr_hg_phase. */
 double gr_hg_phase_seed(double cos_theta, double g);
+/* gr_hg_phase with its constants computed once for a g, for loops that evaluate it per
+ * sample (the ground truth's march): gr_hg_eval(gr_hg_make(g), c) = gr_hg_phase(c, g). */
+typedef struct gr_hg {
+    double a, b;   /* the denominator d = a + b (1 - s c) >= 0 (docs/optics.md) */
+    double s;      /* 1 for g >= 0, -1 for g < 0: the peak's side */
+    double k;      /* (1 - g^2) / (4 pi); 0 for |g| = 1 (a delta function) */
+} gr_hg;
+gr_hg gr_hg_make(double g);
+static inline double gr_hg_eval(gr_hg h, double cos_theta)
+{
+    double c = cos_theta;
+    if (!(c >= -1.0)) c = -1.0; /* also maps NaN */
+    if (c > 1.0) c = 1.0;
+    double d = h.a + h.b * (1.0 - h.s * c);
+    return d > 0.0 ? h.k / (d * sqrt(d)) : 0.0;
+}
 
 #endif
