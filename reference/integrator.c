@@ -1225,15 +1225,20 @@ static void pilot_steps_map(gr_ref_renderer *r, const pilot_job *job)
     r->steps_max = 0;
     for (int py = r->opt.row0; py < r->opt.row1; py++)
         for (int px = 0; px < W; px++) {
-            int i0 = px / PILOT_STRIDE, j0 = py / PILOT_STRIDE, nq = 0;
-            double vsum = 0.0, lsum = 0.0;
-            for (int j = j0 - PILOT_RADIUS; j <= j0 + PILOT_RADIUS; j++)
-                for (int i = i0 - PILOT_RADIUS; i <= i0 + PILOT_RADIUS; i++) {
-                    if (i < 0 || j < 0 || i >= pw || j >= ph) continue;
+            /* the pilot neighbourhood, clamped to the pilot grid: its means of V, L and (with
+             * the allotment) the segments' V */
+            int i0 = px / PILOT_STRIDE, j0 = py / PILOT_STRIDE;
+            int ia = i0 - PILOT_RADIUS > 0 ? i0 - PILOT_RADIUS : 0, ib = i0 + PILOT_RADIUS < pw - 1 ? i0 + PILOT_RADIUS : pw - 1;
+            int ja = j0 - PILOT_RADIUS > 0 ? j0 - PILOT_RADIUS : 0, jb = j0 + PILOT_RADIUS < ph - 1 ? j0 + PILOT_RADIUS : ph - 1;
+            int nq = (ib - ia + 1) * (jb - ja + 1);
+            double vsum = 0.0, lsum = 0.0, V[SEGMENTS] = {0};
+            for (int j = ja; j <= jb; j++)
+                for (int i = ia; i <= ib; i++) {
                     size_t q = (size_t)j * pw + i;
                     vsum += job->pv[q];
                     lsum += job->pl[q];
-                    nq++;
+                    if (r->alloc_px)
+                        for (int k = 0; k < SEGMENTS; k++) V[k] += job->pvs[q * SEGMENTS + (size_t)k];
                 }
             double v = vsum / nq, norm = fmax(lsum / nq, mean);
             /* the even spread's steps (its floor below, or the pixel's steps without the allotment) */
@@ -1241,13 +1246,6 @@ static void pilot_steps_map(gr_ref_renderer *r, const pilot_job *job)
             int ni;
             if (r->alloc_px) {
                 /* the steps along the ray, segment by segment */
-                double V[SEGMENTS] = {0};
-                for (int j = j0 - PILOT_RADIUS; j <= j0 + PILOT_RADIUS; j++)
-                    for (int i = i0 - PILOT_RADIUS; i <= i0 + PILOT_RADIUS; i++) {
-                        if (i < 0 || j < 0 || i >= pw || j >= ph) continue;
-                        const double *vs = job->pvs + ((size_t)j * pw + i) * SEGMENTS;
-                        for (int k = 0; k < SEGMENTS; k++) V[k] += vs[k];
-                    }
                 for (int k = 0; k < SEGMENTS; k++) V[k] /= nq;
                 /* the floor: ALLOT_FLOOR of the uniform allocation's steps per pilot stratum (a part
                  * the pilot saw as quiet keeps some strata: its noise is at most 1 / ALLOT_FLOOR^2
