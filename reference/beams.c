@@ -1047,14 +1047,22 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         free(ref); free(lev); free(tp.fmap); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu surface triangles (reference.surface_res)", ntri);
     }
-    for (size_t t = 0; t < ntri; t++) memset(&b->tri[t], 0, sizeof b->tri[t]);
+    /* Ctrl-C at a fine surface (gigabytes of triangles): a cheap read per 65536 triangles and
+     * per row of cells below */
+    for (size_t t = 0; t < ntri; t++) {
+        if ((t & 65535) == 0 && p->interrupt && *p->interrupt) {
+            free(ref); free(lev); free(tp.fmap); gr_beams_destroy(b);
+            return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
+        }
+        memset(&b->tri[t], 0, sizeof b->tri[t]);
+    }
     {
         /* one cell's triangles: at most 2 F^2 (refined) or 4 F (a fan) */
         size_t F2 = (size_t)tp.F * (size_t)tp.F;
         uint32_t *buf = malloc(3 * (2 * F2 + 4 * (size_t)tp.F + 4) * sizeof *buf);
         if (!buf) tp.oom = 1;
         size_t t = 0;
-        for (int j = 0; j < b->nw && buf; j++)
+        for (int j = 0; j < b->nw && buf && !(p->interrupt && *p->interrupt); j++)
             for (int i = 0; i < b->nu; i++) {
                 int n = cell_tris(&tp, ref, i, j, buf, lev + t);
                 for (int k = 0; k < n; k++, t++)
@@ -1064,6 +1072,10 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     }
     free(ref);
     free(tp.fmap);
+    if (p->interrupt && *p->interrupt) {
+        free(lev); free(tp.rx); gr_beams_destroy(b);
+        return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
+    }
     b->stats.refine_factor = nref ? tp.F : 1;
     b->stats.refined_cells = nref;
     b->stats.transition_cells = ntrans;
