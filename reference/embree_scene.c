@@ -1,5 +1,7 @@
 #include "reference/embree_scene.h"
 
+#include <float.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -228,26 +230,28 @@ int gr_rtc_occluded(RTCScene scene, gr_vec3 o, gr_vec3 d, float tnear, float tfa
     return r.tfar < 0.0f; /* Embree sets tfar = -inf on a hit */
 }
 
-/* Does the segment o + t d, t in [0, tmax] (unit d), touch the padded shape? */
-static int segment_touches(const gr_ref_bound *b, gr_vec3 o, gr_vec3 d, float tmax)
+/* Does the segment o + t d, t in [0, tmax] (unit d), touch the padded shape grown by pad
+ * (a sphere's radius, a box's half extents: the box contains the shape's pad-neighbourhood)? */
+static int segment_touches(const gr_ref_bound *b, gr_vec3 o, gr_vec3 d, float tmax, float pad)
 {
     float v[3] = {b->c[0] - o.x, b->c[1] - o.y, b->c[2] - o.z};
     if (b->sphere) {
         float t = v[0] * d.x + v[1] * d.y + v[2] * d.z;
         t = t < 0.0f ? 0.0f : t > tmax ? tmax : t;
         float q[3] = {v[0] - t * d.x, v[1] - t * d.y, v[2] - t * d.z};
-        return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= b->r * b->r;
+        return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= (b->r + pad) * (b->r + pad);
     }
     /* into the box's frame: ex = (cos, 0, -sin), ey = y, ez = (sin, 0, cos) (add_box) */
     float lo[3] = {-v[0] * b->ca + v[2] * b->sa, -v[1], -v[0] * b->sa - v[2] * b->ca};
     float dl[3] = {d.x * b->ca - d.z * b->sa, d.y, d.x * b->sa + d.z * b->ca};
     float t0 = 0.0f, t1 = tmax;
     for (int k = 0; k < 3; k++) {
+        float h = b->h[k] + pad;
         if (dl[k] == 0.0f) {
-            if (lo[k] < -b->h[k] || lo[k] > b->h[k]) return 0;
+            if (lo[k] < -h || lo[k] > h) return 0;
             continue;
         }
-        float inv = 1.0f / dl[k], ta = (-b->h[k] - lo[k]) * inv, tb = (b->h[k] - lo[k]) * inv;
+        float inv = 1.0f / dl[k], ta = (-h - lo[k]) * inv, tb = (h - lo[k]) * inv;
         if (ta > tb) { float x = ta; ta = tb; tb = x; }
         t0 = ta > t0 ? ta : t0;
         t1 = tb < t1 ? tb : t1;
@@ -260,6 +264,20 @@ int gr_ref_shadowed(const gr_ref_geometry *g, gr_vec3 o, gr_vec3 d, float tfar)
 {
     if (!g->shadow || !(tfar > 0.0f)) return 0;
     int near = 0;
-    for (int i = 0; i < g->n_occluders && !near; i++) near = segment_touches(&g->bound[i], o, d, tfar);
+    for (int i = 0; i < g->n_occluders && !near; i++) near = segment_touches(&g->bound[i], o, d, tfar, 0.0f);
     return near ? gr_rtc_occluded(g->shadow, o, d, 0.0f, tfar) : 0;
+}
+
+int gr_ref_shadow_near(const gr_ref_geometry *g, gr_vec3 o, gr_vec3 d, float tmax, float spread)
+{
+    if (!g->shadow || !(tmax > 0.0f)) return 0;
+    /* a point o - t d' of such a segment lies within t |d' - d| <= spread of o + t d on this
+     * one: if this one misses every shape grown by spread, they all miss the shapes. 1 mm
+     * more against the rounding of the two computations (the shapes' own pad is for
+     * gr_ref_shadowed's); not finite: near */
+    float pad = spread + 1e-3f;
+    if (!(pad < FLT_MAX)) return 1;
+    for (int i = 0; i < g->n_occluders; i++)
+        if (segment_touches(&g->bound[i], o, d, tmax, pad)) return 1;
+    return 0;
 }

@@ -58,5 +58,9 @@ int gr_rtc_occluded(RTCScene scene, gr_vec3 o, gr_vec3 d, float tnear, float tfa
  * occluder's padded shape (tested here in closed form) is not traced; the others go to
  * Embree, whose answer counts. */
 int gr_ref_shadowed(const gr_ref_geometry *g, gr_vec3 o, gr_vec3 d, float tfar);
+/* The prefilter for a bundle of shadow rays from o at once: 0 when no segment o + t d',
+ * t in [0, tmax], with unit d' and |d' - d| tmax <= spread, can touch an occluder's padded
+ * shape (each gr_ref_shadowed of the bundle would then return 0 untraced); else 1. */
+int gr_ref_shadow_near(const gr_ref_geometry *g, gr_vec3 o, gr_vec3 d, float tmax, float spread);
 
 #endif

@@ -635,12 +635,23 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, con
         if (m < 0) return -1;
         cnt->queries++;
         if (m > cnt->max_hits) cnt->max_hits = m;
+        int shadow = r->geom->shadow != NULL && m > 0;
+        if (shadow) {
+            /* the shadow rays' prefilter once for the point's bundle (docs/reference.md 2.3):
+             * every ray lies within path |T - Tp| of the one along Tp */
+            float lmax = 0.0f, dmax = 0.0f;
+            for (int i = 0; i < m; i++) {
+                gr_vec3 dt = gr_v3_sub(sc->lights[i].T, r->Tp);
+                float dl = sqrtf(gr_v3_dot(dt, dt));
+                lmax = sc->lights[i].path > lmax ? sc->lights[i].path : lmax;
+                dmax = dl > dmax ? dl : dmax;
+            }
+            shadow = gr_ref_shadow_near(r->geom, x, gr_v3_scale(r->Tp, -1.0f), lmax, lmax * dmax);
+            cnt->shadow_rays += m;
+        }
         for (int i = 0; i < m; i++) {
             const ref_light *l = &sc->lights[i];
-            if (r->geom->shadow) {
-                cnt->shadow_rays++;
-                if (gr_ref_shadowed(r->geom, x, gr_v3_scale(l->T, -1.0f), l->path)) continue;
-            }
+            if (shadow && gr_ref_shadowed(r->geom, x, gr_v3_scale(l->T, -1.0f), l->path)) continue;
             double ph = gr_hg_eval(hg, -(double)gr_v3_dot(l->T, d));
             double base = ph * l->eperp * (alloc ? sc->w[k] : wbase);
             for (int ch = 0; ch < 3; ch++) {
