@@ -1,13 +1,49 @@
 /* The Embree layer of the ground truth: errors reported by Embree arrive as one-line
  * gr_errors (GR_E_EMBREE, the operation named); ray ends against a box (rotated by yaw) and
  * a sphere match their analytic distances; a scene 1e5 m from the origin gives the same
- * distances (local frame); bad settings are refused with the setting named. */
+ * distances (local frame); the shadow rays' bundle prefilter never clears an occluded bundle;
+ * bad settings are refused with the setting named. */
 #include "check.h"
 #include "test_ref_util.h"
 
 #include <math.h>
 #include <string.h>
+#include "core/rng.h"
 #include "reference/embree_scene.h"
+
+/* The bundle prefilter (gr_ref_shadow_near) against Embree: random points around the two
+ * occluders, random bundles of unit directions within a cone around an axis d; whenever the
+ * prefilter answers 0, no ray of the bundle may be occluded (traced by Embree, the oracle),
+ * and it must answer 0 for some bundles and 1 for bundles that are occluded. */
+static void bundles(const gr_ref_geometry *g)
+{
+    gr_rng rng = gr_rng_make(7, 1, 0);
+    int zero = 0, occluded = 0, missed = 0;
+    for (int k = 0; k < 4000; k++) {
+        gr_vec3 x = gr_v3((float)(-6.0 + 20.0 * gr_rng_double(&rng)), (float)(-16.0 + 12.0 * gr_rng_double(&rng)),
+                          (float)(-6.0 + 22.0 * gr_rng_double(&rng)));
+        double ph = 2.0 * 3.14159265358979 * gr_rng_double(&rng), ct = 2.0 * gr_rng_double(&rng) - 1.0, st = sqrt(1.0 - ct * ct);
+        gr_vec3 d = gr_v3((float)(st * cos(ph)), (float)ct, (float)(st * sin(ph)));
+        float L = (float)(12.0 * gr_rng_double(&rng)), cone = (float)(0.3 * gr_rng_double(&rng));
+        gr_vec3 dirs[8];
+        float lens[8], spread = 0.0f;
+        for (int i = 0; i < 8; i++) {
+            gr_vec3 e = gr_v3((float)(gr_rng_double(&rng) - 0.5), (float)(gr_rng_double(&rng) - 0.5), (float)(gr_rng_double(&rng) - 0.5));
+            dirs[i] = gr_v3_norm(gr_v3_madd(d, e, cone));
+            lens[i] = L * (float)gr_rng_double(&rng);
+            gr_vec3 dd = gr_v3_sub(dirs[i], d);
+            float s = L * sqrtf(gr_v3_dot(dd, dd));
+            spread = s > spread ? s : spread;
+        }
+        int near = gr_ref_shadow_near(g, x, d, L, spread), any = 0;
+        for (int i = 0; i < 8; i++) any |= gr_rtc_occluded(g->shadow, x, dirs[i], 0.0f, lens[i]);
+        zero += !near;
+        occluded += any;
+        missed += !near && any;
+    }
+    CHECK_MSG(missed == 0, "the bundle prefilter answered 0 for %d occluded bundles", missed);
+    CHECK_MSG(zero > 400 && occluded > 50, "a test that can fail: %d bundles cleared, %d occluded", zero, occluded);
+}
 
 static void distances(double off)
 {
@@ -37,6 +73,7 @@ static void distances(double off)
         CHECK(gr_rtc_occluded(g->shadow, gr_v3(0, -10, 0), gr_v3(1, 0, 0), 0.0f, 7.0f) == 1);
         CHECK(gr_rtc_occluded(g->shadow, gr_v3(0, -10, 0), gr_v3(1, 0, 0), 0.0f, 6.0f) == 0);
         CHECK(gr_rtc_occluded(g->shadow, gr_v3(0, -10, 0), gr_v3(0, -1, 0), 0.0f, 100.0f) == 0); /* seabed is no caster */
+        bundles(g);
     }
     gr_ref_geometry_destroy(g);
     gr_rtc_destroy(rtc);
