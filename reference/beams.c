@@ -22,7 +22,7 @@ typedef struct beam_vertex {
     float ft;            /* Fresnel transmittance; < 0 marks an unusable vertex */
 } beam_vertex;
 
-/* Per triangle, packed in one cache line for the lookups. */
+/* Per triangle, packed in two cache lines for the lookups' exact test. */
 typedef struct beam_tri {
     float phi;               /* F_t |I . a| (0 = no beam) */
     float ytop, dy;          /* top of the beam, slab height */
@@ -1165,7 +1165,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         /* F_t averaged over the vertices: O(h^2) like the rest of the tessellation */
         bt->phi = (float)(flux * (v0->ft + v1->ft + v2->ft) / 3.0);
         const beam_vertex *vs[3] = {v0, v1, v2};
-        /* the cross-section's coefficients for the lookups (beam_tri.c: vertex 0, then vertices 1 and 2 relative to it), in double */
+        /* the cross-section's coefficients for the lookups (beam_tri's c), in double */
         double xs[3], zs[3];
         for (int c = 0; c < 3; c++) {
             xs[c] = (double)vs[c]->pu + (double)vs[c]->au * ((double)bt->ytop - vs[c]->py);
