@@ -27,8 +27,10 @@
 /* Bumped when what an entry holds changes, so older entries are rendered again: 2 = bias.R/G/B
  * channels, godrays:stderr_dof, the three-level bias probe, a checksum of the pixels; 3 = the
  * lookups' libm-free disc areas (pixels differ in the last bits); 4 = steps allotted along the
- * ray, the lookup grid, the disc area by one boundary walk (docs/reference.md 2.2, 2.4, 2.5). */
-#define GR_CACHE_FORMAT "godrays-reference-cache-4"
+ * ray, the lookup grid, the disc area by one boundary walk (docs/reference.md 2.2, 2.4, 2.5);
+ * 5 = each triangle's cross-section coefficients and the phase's constants once per g (pixels
+ * differ in the last bits). */
+#define GR_CACHE_FORMAT "godrays-reference-cache-5"
 /* FNV-1a 64 of the pixel bytes (16 hex digits), checked on every read (docs/reliability.md) */
 #define GR_CACHE_META_CHECKSUM "godrays:pixel_fnv1a64"
 
