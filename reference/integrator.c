@@ -608,24 +608,19 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, con
         wbase = (double)D / n;
     }
     const gr_hg hg = gr_hg_make(r->scene.medium.g); /* seed eq. 5.5.4 */
-    if (!alloc) {
-        for (int k = 0; k < n; k++) {
-            double u = (k + rng_u(g)) / n;
+    /* segment sg of the CDF range, [sg, sg + 1) / nseg, holds a >= 1 jittered strata; a point
+     * there stands for 1 / (nseg a) of the range (the weight wbase n / (nseg a)); n = the sum
+     * of alloc (docs/reference.md 2.5). Without an allotment: one segment of n strata, each
+     * of weight wbase */
+    const int nseg = alloc ? SEGMENTS : 1;
+    for (int sg = 0, k = 0; sg < nseg; sg++) {
+        int a = alloc ? alloc[sg] : n;
+        double ws = alloc ? wbase * n / ((double)SEGMENTS * a) : wbase;
+        for (int j = 0; j < a; j++, k++) {
+            double u = (sg + (j + rng_u(g)) / a) / nseg;
             sc->t[k] = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
             sc->tf[k] = (float)sc->t[k];
-        }
-    } else {
-        /* segment s of the CDF range, [s, s + 1) / SEGMENTS, holds alloc[s] >= 1 jittered
-         * strata; a point there stands for 1 / (SEGMENTS alloc[s]) of the range (the weight
-         * wbase n / (SEGMENTS alloc[s])); n = the sum of alloc (docs/reference.md 2.5) */
-        for (int sg = 0, k = 0; sg < SEGMENTS; sg++) {
-            double ws = wbase * n / ((double)SEGMENTS * alloc[sg]);
-            for (int j = 0; j < alloc[sg]; j++, k++) {
-                double u = (sg + (j + rng_u(g)) / alloc[sg]) / SEGMENTS;
-                sc->t[k] = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
-                sc->tf[k] = (float)sc->t[k];
-                sc->w[k] = ws;
-            }
+            sc->w[k] = ws;
         }
     }
     for (int k = 0; k < n; k++) {
@@ -653,7 +648,7 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, con
             const ref_light *l = &sc->lights[i];
             if (shadow && gr_ref_shadowed(r->geom, x, gr_v3_scale(l->T, -1.0f), l->path)) continue;
             double ph = gr_hg_eval(hg, -(double)gr_v3_dot(l->T, d));
-            double base = ph * l->eperp * (alloc ? sc->w[k] : wbase);
+            double base = ph * l->eperp * sc->w[k];
             for (int ch = 0; ch < 3; ch++) {
                 /* sun-to-point and point-to-camera extinction, divided by the march density */
                 double ex = r->sig_t[ch] * ((double)l->path + t) - lam * t;
