@@ -634,14 +634,14 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, con
         if (shadow) {
             /* the shadow rays' prefilter once for the point's bundle (docs/reference.md 2.3):
              * every ray lies within path |T - Tp| of the one along Tp */
-            float lmax = 0.0f, dmax = 0.0f;
+            float lmax = 0.0f, d2max = 0.0f;
             for (int i = 0; i < m; i++) {
                 gr_vec3 dt = gr_v3_sub(sc->lights[i].T, r->Tp);
-                float dl = sqrtf(gr_v3_dot(dt, dt));
+                float d2 = gr_v3_dot(dt, dt);
                 lmax = sc->lights[i].path > lmax ? sc->lights[i].path : lmax;
-                dmax = dl > dmax ? dl : dmax;
+                d2max = d2 > d2max ? d2 : d2max;
             }
-            shadow = gr_ref_shadow_near(r->geom, x, gr_v3_scale(r->Tp, -1.0f), lmax, lmax * dmax);
+            shadow = gr_ref_shadow_near(r->geom, x, gr_v3_scale(r->Tp, -1.0f), lmax, lmax * sqrtf(d2max));
             cnt->shadow_rays += m;
         }
         for (int i = 0; i < m; i++) {
