@@ -51,6 +51,9 @@ enum { PILOT_STRIDE = 2, PILOT_RADIUS = 2, PILOT_MEAN_STRIDE = 4 };
  * least one), allotted from the pilot's step noise in that part. */
 enum { SEGMENTS = 8 };
 #define ALLOT_FLOOR 0.25
+/* the march's unit of work: bands of MARCH_TILE rows, walked in square tiles (worker; the
+ * pilot's of MARCH_TILE / PILOT_STRIDE pilot pixels: the same image area) */
+#define MARCH_TILE 16
 /* the surface-bias probe's pixel grid and passes (surface_bias_probe) */
 enum { PROBE_STRIDE = 5, PROBE_PASSES = 4 };
 
@@ -701,9 +704,15 @@ static void *worker(void *arg)
     }
     for (;;) {
         if (atomic_load(&job->stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
-        int y = atomic_fetch_add(&job->next_row, 1);
-        if (y >= job->y1) break;
-        for (int x = 0; x < acc->W; x++) {
+        /* a band of MARCH_TILE rows, in tiles of MARCH_TILE x MARCH_TILE pixels: neighbouring
+         * rays look up the same beams while they are still in cache (docs/reference.md 2.2,
+         * "Lookups"); the pixels' sums do not depend on the order */
+        int yb = atomic_fetch_add(&job->next_row, MARCH_TILE);
+        if (yb >= job->y1) break;
+        int ye = job->y1 - yb < MARCH_TILE ? job->y1 : yb + MARCH_TILE;
+        for (int xb = 0; xb < acc->W && !oom; xb += MARCH_TILE)
+        for (int y = yb; y < ye && !oom; y++)
+        for (int x = xb; x < acc->W && x < xb + MARCH_TILE && !oom; x++) {
             int px = x * job->stride + job->off, py = y * job->stride + job->off;
             size_t pix = (size_t)py * (size_t)job->img_w + (size_t)px; /* the image pixel: its RNG stream */
             size_t ai = (size_t)y * acc->W + x;
@@ -747,14 +756,13 @@ static void *worker(void *arg)
                     acc->aov[ai * 2 + 1] += len;
                 }
             }
-            if (oom) break;
         }
         if (oom) {
             atomic_store(&job->stop, 2); /* out of memory: the pass fails, nothing is dropped */
             break;
         }
-        if (r->opt.interrupt && *r->opt.interrupt) break; /* the row may be unfinished: not counted */
-        atomic_fetch_add(&job->rows_done, 1);
+        if (r->opt.interrupt && *r->opt.interrupt) break; /* the band may be unfinished: not counted */
+        atomic_fetch_add(&job->rows_done, ye - yb);
     }
     atomic_fetch_add(&job->queries, cnt.queries);
     atomic_fetch_add(&job->shadow_rays, cnt.shadow_rays);
@@ -1122,11 +1130,16 @@ static void *pilot_worker(void *arg)
     }
     for (;;) {
         if (atomic_load(&job->stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
-        int j = atomic_fetch_add(&job->next_row, 1);
-        if (j >= job->ph) break;
-        int full = j >= job->jb0 && j < job->jb1, oom = 0;
-        for (int i = 0; i < job->pw && (full || j % PILOT_MEAN_STRIDE == 0); i++) {
-            if (!full && i % PILOT_MEAN_STRIDE) continue;
+        /* bands of pilot rows in square tiles, as the march's (worker) */
+        const int pt = MARCH_TILE / PILOT_STRIDE;
+        int jb = atomic_fetch_add(&job->next_row, pt), oom = 0;
+        if (jb >= job->ph) break;
+        int je = job->ph - jb < pt ? job->ph : jb + pt;
+        for (int ib = 0; ib < job->pw && !oom; ib += pt)
+        for (int j = jb; j < je && !oom; j++)
+        for (int i = ib; i < job->pw && i < ib + pt && !oom; i++) {
+            int full = j >= job->jb0 && j < job->jb1;
+            if (!full && (j % PILOT_MEAN_STRIDE || i % PILOT_MEAN_STRIDE)) continue;
             size_t q = (size_t)j * job->pw + i;
             ref_rng g = rng_make(r->set.seed, STREAM_PILOT, q);
             /* uniform over the pilot pixel's block of image pixels */
@@ -1154,7 +1167,7 @@ static void *pilot_worker(void *arg)
         }
         if (oom) { atomic_store(&job->stop, 2); break; }
         if (r->opt.interrupt && *r->opt.interrupt) break;
-        atomic_fetch_add(&job->rows_done, 1);
+        atomic_fetch_add(&job->rows_done, je - jb);
     }
     atomic_fetch_add(&job->queries, cnt.queries);
     atomic_fetch_add(&job->shadow_rays, cnt.shadow_rays);
