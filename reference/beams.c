@@ -967,7 +967,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     double ext_u = (r->u1 - r->u0) + 2.0 * p->pad_m, ext_w = (r->w1 - r->w0) + 2.0 * p->pad_m;
     if (!(ext_u > 0.0 && ext_w > 0.0) || p->res < 1)
         return gr_fail(err, GR_E_INPUT, "reference: empty lit region (%g x %g m) or surface_res %d < 1", ext_u, ext_w, p->res);
-    double h = sqrt(ext_u * ext_w) / (double)p->res;
+    double h = p->cell_m > 0.0 ? p->cell_m : sqrt(ext_u * ext_w) / (double)p->res;
     double nu_d = ceil(ext_u / h) + 1.0, nw_d = ceil(ext_w / h) + 1.0;
     if (nu_d * nw_d * 2.0 > 1.0e9)
         return gr_fail(err, GR_E_INPUT, "reference.surface_res: %d gives %.0f x %.0f cells, too many", p->res, nu_d, nw_d);
@@ -979,6 +979,10 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->sx = (float)p->shear_x;
     b->sz = (float)p->shear_z;
     double start_u = r->u0 - p->pad_m - p->jitter[0] * h, start_w = r->w0 - p->pad_m - p->jitter[1] * h;
+    if (p->cell_m > 0.0) { /* another set's grid lines: the last at or before the patch's start */
+        start_u = p->anchor_u + floor((r->u0 - p->pad_m - p->anchor_u) / h) * h;
+        start_w = p->anchor_w + floor((r->w0 - p->pad_m - p->anchor_w) / h) * h;
+    }
     /* topology: the grid, with the cells near P_s refined (docs/reference.md 2.2) */
     topo tp;
     memset(&tp, 0, sizeof tp);
@@ -1257,6 +1261,8 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->stats.nu = b->nu;
     b->stats.nw = b->nw;
     b->stats.cell_m = h;
+    b->stats.grid_u0 = start_u;
+    b->stats.grid_w0 = start_w;
     b->stats.triangles = ntri;
     b->stats.vertices = nv;
     b->stats.lit_triangles = lit;

@@ -67,6 +67,10 @@ typedef struct gr_beam_params {
     double refine_angle;     /* rad: camera rays within this angle of +T0 or -T0 count */
     const gr_camera *camera; /* its frustum (forward, right, up, fov, aspect) */
     gr_vec3 eye;             /* the camera's local position */
+    /* On another set's grid (the camera cone's set, docs/reference.md 2.2): cell_m > 0 gives
+     * the cell size (res and jitter are then unused) and the grid's lines pass through
+     * (anchor_u, anchor_w), that set's gr_beam_stats.grid_u0, grid_w0. 0: from res. */
+    double cell_m, anchor_u, anchor_w;
 } gr_beam_params;
 
 /* The radius (m, horizontal, in sheared coordinates at the rest plane) around P_s of the
@@ -88,6 +92,7 @@ typedef struct gr_beam_stats {
     int refine_factor;       /* the factor used (1 = none) */
     size_t refined_cells, transition_cells; /* cells split F x F; cells fanned around them */
     double refine_radius_m;  /* gr_beam_refine_radius */
+    double grid_u0, grid_w0; /* the rest grid's corner (sheared local, m; the jitter included) */
     double build_s;          /* wall time of the build */
 } gr_beam_stats;
 

@@ -142,6 +142,8 @@ typedef struct gr_ref_info {
     double region[6];       /* sheared u0, u1, w0, w1, y_min (local), pad_m */
     double cell_m;          /* surface cell size of the last beam set (0 before one is built) */
     size_t prims;           /* beam-slab primitives of the last beam set */
+    double cone_cells;      /* estimated surface cells of the camera cone's beam set, its
+                               refined sub-cells included (0: none; docs/reference.md 2.2) */
 } gr_ref_info;
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info);
 /* For the benchmark (reference/bench.c): the displaced surface mesh of the prepared pass

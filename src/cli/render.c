@@ -21,7 +21,7 @@ gr_status gr_cli_render_reference(const gr_scene *scene, const gr_ref_options *o
     const double B = scene->reference.batches, sr = scene->reference.surface_res;
     const double cells = sr * sr, prims = fmin(2.0 * cells, 16777216.0);
     const double need = px * (28.0 * B + 16.0 + 32.0) + cells * 344.0 + prims * 160.0;
-    char detail[160];
+    char detail[200];
     snprintf(detail, sizeof detail, "%d x %d pixels x %d batches, surface_res %d", scene->camera.width,
              scene->camera.height, scene->reference.batches, scene->reference.surface_res);
     gr_status mst = gr_memlimit_check("the ground truth", need, detail, err);
@@ -31,10 +31,21 @@ gr_status gr_cli_render_reference(const gr_scene *scene, const gr_ref_options *o
      * at once (nothing to keep, no temporary file open). */
     gr_status st = gr_ref_create(scene, &o, &r, err);
     if (st != GR_OK) return st;
-    if (passes_per_round) {
-        gr_ref_info info;
-        gr_ref_get_info(r, &info);
-        *passes_per_round = info.passes_per_round;
+    gr_ref_info info;
+    gr_ref_get_info(r, &info);
+    if (passes_per_round) *passes_per_round = info.passes_per_round;
+    if (info.cone_cells > 0.0) {
+        /* the camera cone's beam set beside the plain grid's (docs/reference.md 2.2), known once
+         * the lit region is: its cells at the same bytes per cell and primitive */
+        const double cc = info.cone_cells, need2 = need + cc * 344.0 + fmin(2.0 * cc, 16777216.0) * 160.0;
+        snprintf(detail, sizeof detail, "%d x %d pixels x %d batches, surface_res %d, refine_factor %d (%.0f cells near the camera)",
+                 scene->camera.width, scene->camera.height, scene->reference.batches, scene->reference.surface_res,
+                 scene->reference.refine_factor, cc);
+        mst = gr_memlimit_check("the ground truth", need2, detail, err);
+        if (mst != GR_OK) {
+            gr_ref_destroy(r);
+            return mst;
+        }
     }
     gr_signals_hold_begin(); /* the first signal only sets the flag; the renderer stops at its next check */
     st = gr_ref_render(r, res, err);
