@@ -29,8 +29,9 @@
  * lookups' libm-free disc areas (pixels differ in the last bits); 4 = steps allotted along the
  * ray, the lookup grid, the disc area by one boundary walk (docs/reference.md 2.2, 2.4, 2.5);
  * 5 = each triangle's cross-section coefficients and the phase's constants once per g (pixels
- * differ in the last bits). */
-#define GR_CACHE_FORMAT "godrays-reference-cache-5"
+ * differ in the last bits); 6 = the camera cone (docs/reference.md 2.2): only the rays within
+ * refine_angle of +-T0 look up the refined tessellation. */
+#define GR_CACHE_FORMAT "godrays-reference-cache-6"
 /* FNV-1a 64 of the pixel bytes (16 hex digits), checked on every read (docs/reliability.md) */
 #define GR_CACHE_META_CHECKSUM "godrays:pixel_fnv1a64"
 

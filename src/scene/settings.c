@@ -60,7 +60,7 @@ static const gr_param reference_params[] = {
      .unit = "", .doc = "adaptive steps: allot a pixel's steps along its ray where the pilot saw the step noise (8 segments, each at least one step and a quarter of its even share); false: evenly"},
     {.name = "refine_factor", .type = GR_PT_INT, .offset = REF(refine_factor), .min = 1, .max = 16, .def = 3,
      .unit = "", .doc = "local refinement: the camera rays that run along the refracted sun's beams look up a tessellation with the surface cells they meet split into F x F (1 = off)"},
-    {.name = "refine_angle_deg", .type = GR_PT_DOUBLE, .offset = REF(refine_angle_deg), .min = 0, .max = 30, .def = 15,
+    {.name = "refine_angle_deg", .type = GR_PT_DOUBLE, .offset = REF(refine_angle_deg), .min = 0, .max = 30, .def = 12,
      .unit = "deg", .doc = "local refinement: the camera rays within this angle of the refracted sun direction (either way) look up the refined tessellation; the others the plain grid"},
 };
 #undef REF
