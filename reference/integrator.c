@@ -75,8 +75,8 @@ struct gr_ref_renderer {
      * region such rays reach (cone_box, sheared u0 u1 w0 w1); every other ray looks up
      * `beams`, the plain grid. NULL: no refinement (factor 1, or no camera ray that close) */
     gr_beams *cone;
+    int cone_on;              /* 1: a cone (set by gr_ref_create, the same for every pass) */
     double cone_box[4], cone_cos;
-    double cone_rho;          /* gr_beam_refine_radius (-1: no cone), set by gr_ref_create */
     int beams_pass;
     int flat;
     gr_dvec3 origin;          /* (camera x, rest height, camera z) */
@@ -333,7 +333,15 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
         bp.refine_angle = st->refine_angle_deg * GR_PI / 180.0;
         bp.camera = &s->camera;
         bp.eye = r->cam;
-        r->cone_rho = r->flat ? -1.0 : gr_beam_refine_radius(&bp);
+        double rho = r->flat ? -1.0 : gr_beam_refine_radius(&bp);
+        if (rho >= 0.0) {
+            /* its rays stay within rho of P_s (sheared); the waves' displacement as margin */
+            double R = rho + wave_amplitude_sum(&s->water), pu = r->cam.x - r->sx * r->cam.y, pw = r->cam.z - r->sz * r->cam.y;
+            r->cone_on = 1;
+            r->cone_box[0] = pu - R; r->cone_box[1] = pu + R;
+            r->cone_box[2] = pw - R; r->cone_box[3] = pw + R;
+            r->cone_cos = cos(bp.refine_angle);
+        }
     }
 
     gr_status rc = gr_rtc_create(r->threads, &r->rtc, err);
@@ -430,21 +438,19 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
         bp.disc_e1 = r->e1;
         bp.disc_e2 = r->e2;
     }
-    /* the camera cone (docs/reference.md 2.2): the rays within refine_angle of +-T0 stay
-     * within rho of P_s (sheared); their set covers that disc, refined, on the plain grid's
-     * lines; the plain grid serves every other ray */
-    double rho = r->cone_rho;
+    /* the camera cone (docs/reference.md 2.2): the rays within refine_angle of +-T0 stay in
+     * cone_box; their set covers it, refined, on the plain grid's lines; the plain grid
+     * serves every other ray */
     bp.refine_factor = 1;
     gr_status st = gr_beams_build(r->rtc, &bp, &r->beams, err);
     if (st != GR_OK) return st;
     r->beam_build_s += gr_beams_stats(r->beams)->build_s;
-    if (rho >= 0.0) {
+    if (r->cone_on) {
         const gr_beam_stats *bs = gr_beams_stats(r->beams);
-        double R = rho + wave_amplitude_sum(&r->scene.water), pu = r->cam.x - r->sx * r->cam.y, pw = r->cam.z - r->sz * r->cam.y;
-        bp.region.u0 = pu - R;
-        bp.region.u1 = pu + R;
-        bp.region.w0 = pw - R;
-        bp.region.w1 = pw + R;
+        bp.region.u0 = r->cone_box[0];
+        bp.region.u1 = r->cone_box[1];
+        bp.region.w0 = r->cone_box[2];
+        bp.region.w1 = r->cone_box[3];
         bp.refine_factor = r->set.refine_factor;
         bp.cell_m = bs->cell_m;
         bp.anchor_u = bs->grid_u0;
@@ -456,9 +462,6 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
         st = gr_beams_build(r->rtc, &bp, &r->cone, err);
         if (st != GR_OK) return st;
         r->beam_build_s += gr_beams_stats(r->cone)->build_s;
-        r->cone_box[0] = bp.region.u0; r->cone_box[1] = bp.region.u1;
-        r->cone_box[2] = bp.region.w0; r->cone_box[3] = bp.region.w1;
-        r->cone_cos = cos(bp.refine_angle);
     }
     r->beams_pass = pass;
     return GR_OK;
@@ -547,11 +550,11 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
         info->cell_m = gr_beams_stats(r->beams)->cell_m;
         info->prims = gr_beams_stats(r->beams)->prims;
     }
-    if (!r->flat && r->cone_rho >= 0.0 && r->set.surface_res > 0) {
-        /* the camera cone's set (prepare_pass): a square of half side rho + A + pad on the plain
-         * grid's cells h, those within rho + A + h of P_s split F x F */
+    if (r->cone_on && r->set.surface_res > 0) {
+        /* the camera cone's set (prepare_pass): cone_box (half side R) padded, on the plain
+         * grid's cells h, those within R + h of P_s split F x F */
         double eu = r->region.u1 - r->region.u0 + 2.0 * r->pad, ew = r->region.w1 - r->region.w0 + 2.0 * r->pad;
-        double h = sqrt(eu * ew) / r->set.surface_res, R = r->cone_rho + wave_amplitude_sum(&r->scene.water);
+        double h = sqrt(eu * ew) / r->set.surface_res, R = 0.5 * (r->cone_box[1] - r->cone_box[0]);
         double side = 2.0 * (R + r->pad) / h + 2.0, F = r->set.refine_factor, disc = GR_PI * (R / h + 1.0) * (R / h + 1.0);
         info->cone_cells = side * side + disc * (F * F - 1.0);
     }
@@ -631,6 +634,16 @@ static int scratch_alloc(ref_scratch *sc, int steps)
 /* L (RGB) along the camera ray through the image point (fx, fy) (pixels), marched with n
  * steps (n <= the scratch's). With ck, ck[k] receives the RGB mean of march point k's
  * contribution to L (the step pilot). Returns 0, or -1 when out of memory (a growing hit list). */
+/* Where the camera ray (o, d) ends on the set's displaced surface, before De (occluder,
+ * seabed, cutoff); past the tessellated patch (or on flat water), the rest plane. */
+static float ray_end(const gr_ref_renderer *r, const gr_beams *bs, gr_vec3 o, gr_vec3 d, float De)
+{
+    unsigned hit = RTC_INVALID_GEOMETRY_ID;
+    float D = r->flat ? De : gr_rtc_intersect(gr_beams_surface(bs), o, d, 0.0f, De, &hit, NULL);
+    if (hit == RTC_INVALID_GEOMETRY_ID && d.y > 0.0f && -o.y / d.y < D) D = -o.y / d.y;
+    return D;
+}
+
 static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, const uint16_t *alloc, ref_rng *g, double L[3],
                       double *trans, double *len, ref_counters *cnt, ref_scratch *sc, double *ck)
 {
@@ -640,14 +653,12 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, con
     gr_vec3 d = gr_d3_to_f(dd), o = r->cam;
     L[0] = L[1] = L[2] = 0.0;
     /* where the camera ray ends: occluder or seabed, the water surface, the cutoff */
-    float De = gr_rtc_intersect(r->geom->ends, o, d, 0.0f, (float)r->cutoff_d, NULL, NULL), D = De;
+    float De = gr_rtc_intersect(r->geom->ends, o, d, 0.0f, (float)r->cutoff_d, NULL, NULL), D = -1.0f;
     const gr_beams *bs = r->beams;
-    unsigned hit = RTC_INVALID_GEOMETRY_ID;
     if (r->cone && fabs(dd.x * r->T0.x + dd.y * r->T0.y + dd.z * r->T0.z) >= r->cone_cos) {
         /* within the cone: its refined set, if the whole ray stays where that set is complete
          * (sheared coordinates are linear along the ray: its two ends tell) */
-        D = gr_rtc_intersect(gr_beams_surface(r->cone), o, d, 0.0f, De, &hit, NULL);
-        if (hit == RTC_INVALID_GEOMETRY_ID && d.y > 0.0f && -o.y / d.y < D) D = -o.y / d.y;
+        D = ray_end(r, r->cone, o, d, De);
         /* the part that looks beams up: above the lit region's bottom */
         float De2 = d.y < 0.0f && o.y + d.y * D < (float)r->region.y_min ? ((float)r->region.y_min - o.y) / d.y : D;
         gr_vec3 e = gr_v3_madd(o, d, De2 > 0.0f ? De2 : 0.0f);
@@ -655,19 +666,8 @@ static int render_ray(const gr_ref_renderer *r, double fx, double fy, int n, con
         const double *cb = r->cone_box;
         if (u0 >= cb[0] && u0 <= cb[1] && u1 >= cb[0] && u1 <= cb[1] && w0 >= cb[2] && w0 <= cb[3] && w1 >= cb[2] && w1 <= cb[3])
             bs = r->cone;
-        else {
-            D = De;
-            hit = RTC_INVALID_GEOMETRY_ID;
-        }
     }
-    if (bs == r->beams) {
-        if (!r->flat) D = gr_rtc_intersect(gr_beams_surface(r->beams), o, d, 0.0f, D, &hit, NULL);
-        if (hit == RTC_INVALID_GEOMETRY_ID && d.y > 0.0f) {
-            /* flat water, or beyond the tessellated patch: the rest plane */
-            float tp = -o.y / d.y;
-            if (tp < D) D = tp;
-        }
-    }
+    if (bs == r->beams) D = ray_end(r, r->beams, o, d, De);
     if (!(D > 0.0f)) D = 0.0f;
     *len = D;
     *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
