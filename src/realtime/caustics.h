@@ -8,17 +8,13 @@
  * box-filtered (seed 002's 2x2 supersampling). A texel holds the HORIZONTAL irradiance at that
  * depth per unit E_sun, without extinction (consumers apply exp(-sigma_t depth / mu_t)): on
  * flat water cos(theta_i) F_t. Derivation: docs/volume-techniques.md.
- *
- * Also the volume techniques' shared GLSL program builder (vertex/geometry/fragment or
- * compute stages, each the concatenation of several files, --shader-dir overridable). */
+ * What the volume techniques share around it (settings, the render's prelude): volume.h. */
 #ifndef GR_CAUSTICS_H
 #define GR_CAUSTICS_H
 
 #include "common/status.h"
 #include "image/image.h"
 #include "realtime/frame.h"
-#include "realtime/scenegl.h"
-#include "realtime/technique.h"
 #include "scene/scene.h"
 
 #define GR_CAUSTICS_MAX_DEPTHS 64
@@ -53,146 +49,5 @@ long long gr_caustics_triangles(const gr_caustics *c);
 
 /* Depths of a stack: n depths geometric between first_m and last_m (n = 1: first_m). */
 void gr_caustics_depths(int n, double first_m, double last_m, double *out);
-
-
-
-/* ---- what the volume techniques share (volume_common.glsl's uniforms) ---- */
-typedef struct gr_vol_locs {
-    int caustics, n_depths, cdepth, corigin, patch, refr, rest, shadow, light_vp, use_shadow, sigma_t, sigma_s, g,
-        esun, texel, sun_rw;
-} gr_vol_locs;
-typedef struct gr_vol_inputs {
-    const gr_frame *f;
-    const gr_caustics *caustics;
-    const gr_caustics_params *cp;
-    unsigned shadow_tex;          /* 0: no shadow map */
-    double light_vp[16];          /* world -> shadow clip */
-    double sigma_t[3], sigma_s[3], g, gain[3];
-    int sun_disc;                 /* 1: blur the caustics by the sun's disc (mip level per plane) */
-} gr_vol_inputs;
-void gr_vol_locations(unsigned program, gr_vol_locs *l);
-/* Sets the uniforms of the current program and binds the caustic stack (if in->caustics) to unit 2 and the
- * shadow map to unit 3. */
-void gr_vol_set(const gr_vol_locs *l, const gr_vol_inputs *in);
-/* The farthest view depth (along forward) any pixel's ray needs: rays through a 17 x 17 grid
- * to the surface / seabed, at most t_max (m). */
-double gr_vol_far_depth(const gr_scene *scene, const gr_frame *f, double t_max);
-/* Where the reference stops a camera ray in clear water: min(-ln(cutoff) / min sigma_t, max). */
-double gr_vol_t_max(const gr_scene *scene);
-/* Slab bounds b[0..n] in view depth: b[0] = 0, then linear to far, or geometric from near. */
-void gr_vol_bounds(int n, int exponential, double near_m, double far_m, double *b);
-/* Reads an RGBA32F framebuffer (w x h, bottom row first) into out's R, G, B (top row first). */
-gr_status gr_vol_readback(unsigned fbo, int w, int h, gr_image *out, const char *what, gr_error *err);
-
-/* ---- the prelude every volume technique's render shares ---- */
-
-/* Settings the volume techniques share: a block (member `vol`) of each one's settings struct,
- * described by the GR_VOL_PARAMS_* descriptor lists below (same keys, ranges and docs in every
- * technique's scene section). The caustic fields are unused by a technique without the
- * caustic texture (light rays), which lists only GR_VOL_PARAMS_MEDIUM and _LIGHT. */
-typedef struct gr_vol_settings {
-    int texture_size, grid;      /* caustic texture side, water grid cells per patch side */
-    double patch_m;              /* caustic patch side (m) */
-    int caustic_depths;          /* planes in the caustic stack */
-    double caustic_first_m, caustic_last_m; /* stack depths, geometric between these */
-    double extinction[3];        /* sigma_t on both paths; default: the medium's */
-    double g;                    /* HG asymmetry; default: the medium's */
-    int sun_disc;                /* blur the caustic planes by the sun's disc */
-    double intensity[3];         /* gain on the physical result (1) */
-    int shadow_map_size;
-    double shadow_extent_m;      /* half side of the shadow map's square around the eye */
-} gr_vol_settings;
-
-/* Descriptors of the shared block inside settings struct T (its member `vol`). */
-#define GR_VOL_PARAMS_CAUSTICS(T)                                                                                    \
-    {.name = "texture_size", .type = GR_PT_INT, .offset = offsetof(T, vol.texture_size), .min = 8, .max = 4096,      \
-     .def = 512, .unit = "texels", .doc = "caustic texture side (rendered at twice this, 2x2 box filtered)"},         \
-    {.name = "grid", .type = GR_PT_INT, .offset = offsetof(T, vol.grid), .min = 2, .max = 2048, .def = 256,          \
-     .unit = "cells", .doc = "water grid cells per patch side (beam-traced triangles: 2 grid^2 per depth)"},          \
-    {.name = "patch_m", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.patch_m), .min = 0, .max = 1e4,              \
-     .flags = GR_PF_MIN_EXCL, .def = 24, .unit = "m", .doc = "caustic patch side: the texture repeats with this period"}, \
-    {.name = "caustic_depths", .type = GR_PT_INT, .offset = offsetof(T, vol.caustic_depths), .min = 1,               \
-     .max = GR_CAUSTICS_MAX_DEPTHS, .def = 8, .unit = "", .doc = "planes of the caustic stack"},                      \
-    {.name = "caustic_first_m", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.caustic_first_m), .min = 0,          \
-     .max = 1e4, .flags = GR_PF_MIN_EXCL, .def = 1, .unit = "m", .doc = "shallowest caustic plane below the rest height"}, \
-    {.name = "caustic_last_m", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.caustic_last_m), .min = 0,            \
-     .max = 1e4, .flags = GR_PF_MIN_EXCL, .def = 25, .unit = "m",                                                    \
-     .doc = "deepest caustic plane (geometric spacing between)"}
-#define GR_VOL_PARAMS_MEDIUM(T)                                                                                      \
-    {.name = "extinction", .type = GR_PT_RGB, .offset = offsetof(T, vol.extinction), .min = 0, .max = 1e4,           \
-     .flags = GR_PF_FROM_SCENE, .def = NAN, .unit = "1/m", .scene_source = "medium.extinction",                      \
-     .doc = "sigma_t along the sun's and the view path; default: the medium's", .tune_lo = 0.5, .tune_hi = 2.0},     \
-    {.name = "g", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.g), .min = -1, .max = 1,                           \
-     .flags = GR_PF_MIN_EXCL | GR_PF_MAX_EXCL | GR_PF_FROM_SCENE, .def = NAN, .unit = "", .scene_source = "medium.g", \
-     .doc = "HG asymmetry; default: the medium's", .tune_lo = 0.5, .tune_hi = 0.98}
-#define GR_VOL_PARAMS_SUN_DISC(T)                                                                                    \
-    {.name = "sun_disc", .type = GR_PT_BOOL, .offset = offsetof(T, vol.sun_disc), .min = 0, .max = 1, .def = 1,      \
-     .unit = "", .doc = "blur each caustic plane by the sun's disc (the mip level of its blur diameter)"}
-#define GR_VOL_PARAMS_LIGHT(T)                                                                                       \
-    {.name = "intensity", .type = GR_PT_RGB, .offset = offsetof(T, vol.intensity), .min = 0, .max = 1e9, .def = 1,   \
-     .unit = "", .doc = "gain on the physical radiance (1: no fit)", .tune_lo = 0.2, .tune_hi = 5.0},                \
-    {.name = "shadow_map_size", .type = GR_PT_INT, .offset = offsetof(T, vol.shadow_map_size), .min = 16,            \
-     .max = 8192, .def = 1024, .unit = "texels", .doc = "occluders' shadow map side"},                              \
-    {.name = "shadow_extent_m", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.shadow_extent_m), .min = 0,          \
-     .max = 1e5, .flags = GR_PF_MIN_EXCL, .def = 40, .unit = "m",                                                    \
-     .doc = "half side of the shadow map's square around the eye"}
-
-/* The GL passes of the prelude, in this order in each technique's timer and stats; a
- * technique's own passes follow (GR_VOL_PASS_OWN, or GR_VOL_PASS_CAUSTICS without caustics). */
-enum { GR_VOL_PASS_SHADOW = 0, GR_VOL_PASS_DEPTH = 1, GR_VOL_PASS_CAUSTICS = 2, GR_VOL_PASS_OWN = 3 };
-
-/* What the prelude produced for one render. `in` points into the struct (in.f = &frame,
- * in.cp = &cp): do not copy it. */
-typedef struct gr_vol_prep {
-    gr_frame frame;
-    gr_caustics_params cp;
-    gr_vol_inputs in;            /* caustics NULL when the technique has none */
-    unsigned depth_tex;          /* gr_scenegl_eye_depth at the frame's size */
-    double t_max;                /* gr_vol_t_max */
-    double t0_ms;                /* when the render started (for the wall time) */
-} gr_vol_prep;
-
-/* The waves for volume_surface.glsl (u_wa, u_wamp; GR_MAX_WAVES each): per wave (dir.x,
- * dir.z, k, c) with c = k dir . (ox, oz) - w t + phi0 folded in double, so the shader's phase
- * is k dir . x0 + c for x0 relative to the world point (ox, oz); unused entries zero. */
-void gr_vol_waves(const gr_scene *scene, const gr_frame *f, double ox, double oz, float *wa, float *wamp);
-
-/* What every volume technique holds: its GL context, scenegl (shadow map, eye depth), the
- * caustic stack (NULL for a technique without one), the screen VAO, the RGBA32F colour
- * target with its framebuffer, the samples query and the pass timer. */
-typedef struct gr_vol_base {
-    gr_gl *gl;
-    gr_scenegl *sg;
-    gr_caustics *caus;
-    unsigned vao, out_tex, out_fbo, q_samples;
-    int out_w, out_h;
-    gr_gl_timer timer;
-} gr_vol_base;
-
-/* Creates scenegl (shaders from dir, NULL: the embedded ones), the caustic stack when
- * with_caustics, the VAO, the query and the timer (gl must be current). On failure what
- * was made stays in b for gr_vol_base_release. */
-gr_status gr_vol_base_init(gr_vol_base *b, gr_gl *gl, const char *dir, int with_caustics, gr_error *err);
-/* Makes b's context current; 1 when the technique may delete its own GL objects now. */
-int gr_vol_base_current(const gr_vol_base *b);
-/* Deletes what gr_vol_base_init and gr_vol_target made (b may be partly made). */
-void gr_vol_base_release(gr_vol_base *b);
-
-/* The prelude of a volume technique's render (`name` starts its messages): the frame; out
- * must be camera.width x camera.height with R, G, B and the viewer under the water
- * (GR_E_INPUT otherwise); makes b's context current; resets its timer; the occluders' shadow
- * map (pass GR_VOL_PASS_SHADOW, only with occluders, centred on the eye), the eye depth (pass
- * GR_VOL_PASS_DEPTH), the caustic stack (pass GR_VOL_PASS_CAUSTICS, only if b->caus is not
- * NULL) from s's caustic fields; p->in filled from s and the scene's scattering. */
-gr_status gr_vol_prepare(const char *name, gr_vol_base *b, const gr_scene *scene, const gr_vol_settings *s,
-                         const gr_image *out, gr_vol_prep *p, gr_error *err);
-/* (Re)allocates b's RGBA32F colour target of w x h with its framebuffer when the size changed. */
-gr_status gr_vol_target(gr_vol_base *b, int w, int h, const char *name, gr_error *err);
-/* Fills stats: the n passes of b's timer named by names (a time longer than the render's
- * wall time, llvmpipe's first query, reads -1), the samples of b's query (0: -1), the wall
- * time since t0_ms. */
-void gr_vol_stats(gr_technique_stats *stats, gr_vol_base *b, const char *const *names, int n, double t0_ms);
-/* Monotonic clock (ms). */
-double gr_vol_now_ms(void);
 
 #endif

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "gl/gl.h"
-#include "realtime/caustics.h"
+#include "realtime/volume.h"
 #include "realtime/shaders.h"
 #include "realtime/frame.h"
 #include "realtime/scenegl.h"
@@ -146,15 +146,11 @@ static gr_status ensure_volume(fx_state *r, int x, int y, int z, gr_error *err)
     return gr_gl_check("froxel.grid_x/grid_y/grid_z: froxel volume", err);
 }
 
+/* The table's ranges are checked by technique.c; what it cannot express: */
 static gr_status fx_check(const gr_technique_class *cls, const void *settings, gr_error *err)
 {
     const gr_froxel_settings *s = settings;
-    gr_status st = gr_param_validate(cls->params, settings, 1, err);
-    if (st != GR_OK) return st;
-    if (!(s->vol.caustic_last_m >= s->vol.caustic_first_m))
-        return gr_fail(err, GR_E_INPUT, "froxel.caustic_last_m = %g: must be >= froxel.caustic_first_m (%g)",
-                       s->vol.caustic_last_m, s->vol.caustic_first_m);
-    return GR_OK;
+    return gr_vol_check(cls->name, &s->vol, err);
 }
 
 enum { P_SCATTER = GR_VOL_PASS_OWN, P_INTEGRATE, P_APPLY };
@@ -169,7 +165,6 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     if (st != GR_OK) return st;
     const gr_frame *f = &prep.frame;
     int W = f->width, H = f->height;
-    if ((st = gr_vol_target(&r->base, W, H, "froxel", err)) != GR_OK) return st;
     r->triangles = gr_caustics_triangles(r->base.caus);
     double tmax = prep.t_max;
     double far = gr_vol_far_depth(scene, f, tmax);
@@ -216,7 +211,7 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
 
     /* pass: per pixel, the integrated volume at the ray's end */
     gr_gl_timer_begin(&r->base.timer, P_APPLY);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out.fbo);
     glViewport(0, 0, W, H);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
@@ -244,13 +239,8 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     glBindVertexArray(0);
     glUseProgram(0);
     r->n_slices = nz;
-    st = gr_vol_readback(r->base.out_fbo, W, H, out, "froxel readback", err);
-    if (st != GR_OK) return st;
-    if (stats) {
-        static const char *const names[6] = {"shadow", "eye_depth", "caustics", "scatter", "integrate", "apply"};
-        gr_vol_stats(stats, &r->base, names, 6, prep.t0_ms);
-    }
-    return gr_image_check_finite(out, "froxel", err);
+    static const char *const names[6] = {"shadow", "eye_depth", "caustics", "scatter", "integrate", "apply"};
+    return gr_vol_finish("froxel", &r->base, &prep, out, names, 6, stats, err);
 }
 
 static void fx_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)

@@ -7,7 +7,7 @@
 #ifndef GR_FROXEL_H
 #define GR_FROXEL_H
 
-#include "realtime/caustics.h"
+#include "realtime/volume.h"
 #include "realtime/technique.h"
 
 typedef struct gr_froxel_settings {

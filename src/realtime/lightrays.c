@@ -250,11 +250,6 @@ static void make_window(const gr_scene *scene, const gr_frame *f, const gr_light
     w->zr = 1.5 * w->mesh_m * horiz + 4.0 * (amp + 1.0) / fabs(I[1]);
 }
 
-static gr_status lr_check(const gr_technique_class *cls, const void *settings, gr_error *err)
-{
-    return gr_param_validate(cls->params, settings, 1, err);
-}
-
 enum { P_SURFACE = GR_VOL_PASS_CAUSTICS, P_LINES };
 
 static gr_status lr_render(void *state, const gr_scene *scene, const void *settings, gr_image *out,
@@ -267,8 +262,6 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
     if (st != GR_OK) return st;
     const gr_frame *f = &prep.frame;
     int W = f->width, H = f->height, N = s->rays;
-    if ((st = gr_vol_target(&r->base, W, H, "light_rays", err)) != GR_OK)
-        return st;
     if ((st = ensure_surface(r, N, err)) != GR_OK) return st;
     lr_window win;
     make_window(scene, f, s, prep.t_max, &win);
@@ -320,7 +313,7 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
         h[1][k] = texel * (win.e2[k] - f->sun_dir[k] * win.e2[1] / f->sun_dir[1]);
     }
     gr_gl_timer_begin(&r->base.timer, P_LINES);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out.fbo);
     glViewport(0, 0, W, H);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
@@ -365,13 +358,8 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
     glUseProgram(0);
     r->n_rays = N;
     r->window_m = 2.0 * win.half_m;
-    st = gr_vol_readback(r->base.out_fbo, W, H, out, "light_rays readback", err);
-    if (st != GR_OK) return st;
-    if (stats) {
-        static const char *const names[4] = {"shadow", "eye_depth", "surface", "lines"};
-        gr_vol_stats(stats, &r->base, names, 4, prep.t0_ms);
-    }
-    return gr_image_check_finite(out, "light_rays", err);
+    static const char *const names[4] = {"shadow", "eye_depth", "surface", "lines"};
+    return gr_vol_finish("light_rays", &r->base, &prep, out, names, 4, stats, err);
 }
 
 static void lr_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)
@@ -403,7 +391,6 @@ const gr_technique_class gr_light_rays_class = {
     .ladder = ladder,
     .n_ladder = sizeof ladder / sizeof ladder[0],
     .tune_keys = "extinction,g", /* the attenuation and the phase: line_width only sizes the cover */
-    .check = lr_check,
     .create = lr_create,
     .destroy = lr_destroy,
     .render = lr_render,

@@ -11,7 +11,7 @@
 #ifndef GR_LIGHT_RAYS_H
 #define GR_LIGHT_RAYS_H
 
-#include "realtime/caustics.h"
+#include "realtime/volume.h"
 #include "realtime/technique.h"
 
 typedef enum gr_light_rays_footprint {

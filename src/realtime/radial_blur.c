@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "core/optics.h"
 #include "gl/gl.h"
@@ -14,6 +13,7 @@
 #include "realtime/readback.h"
 #include "realtime/scenegl.h"
 #include "realtime/shaders.h"
+#include "realtime/toolkit.h"
 
 #define MAX_WAVE_GROUPS 16 /* u_waves[MAX_WAVE_GROUPS * 5] in seed_waves.glsl */
 #define MAX_LIGHTS 256
@@ -127,17 +127,7 @@ double gr_radial_blur_kernel_solid_angle(double a0)
     return 2.0 * GR_PI * sum * h / 3.0;
 }
 
-/* ---- class callbacks: check, resolve ------------------------------------------------------ */
-
-static gr_status rb_check(const gr_technique_class *cls, const void *settings, gr_error *err)
-{
-    const gr_radial_blur_settings *s = settings;
-    gr_status st = gr_param_validate(cls->params, settings, 1, err);
-    if (st != GR_OK) return st;
-    if (s->target_format != GR_RB_RGBA16F && s->target_format != GR_RB_RGBA8)
-        return gr_fail(err, GR_E_INPUT, "%s.target_format: invalid choice %d", cls->name, s->target_format);
-    return GR_OK;
-}
+/* ---- scale to the ground truth's units ---------------------------------------------------- */
 
 /* Distance D from the eye to the flat surface along the refracted sun (m); <= 0 above it. */
 static double sun_path_m(const gr_scene *scene, const gr_frame *f)
@@ -165,9 +155,25 @@ static void units_scale(const gr_scene *scene, const gr_frame *f, double light_r
 
 enum { PASS_DEPTH = 0, PASS_LIGHT = 1, PASS_BLUR = 2, PASS_RESOLVE = 3 };
 
-typedef struct rb_state {
+typedef struct rb_state rb_state;
+
+/* What tells the two classes apart: one descriptor per class, its class_data. Both share
+ * the eye depth and light passes; then the variant's screen pass (inside the samples query)
+ * and its optional resolve. */
+typedef struct rb_variant {
+    int quads;      /* radial_blur_local: light selection, one quad per light, an accumulator */
+    int fade;       /* fade the rays out as the refracted sun leaves the screen */
+    gr_status (*screen)(rb_state *r, const gr_radial_blur_settings *s, int w, int h, const double sun_uv[2],
+                        const double scale[3], gr_error *err);
+    void (*resolve)(rb_state *r, const gr_radial_blur_settings *s, int w, int h, const double scale[3]);
+    int n_passes;
+    const char *pass_names[4];
+} rb_variant;
+
+struct rb_state {
     gr_gl *gl;
-    int local;
+    const rb_variant *v;
+    const char *name; /* the class's */
     char *shader_dir;
     gr_scenegl *sg;
     GLuint prog_light, prog_blur, prog_local, prog_resolve;
@@ -180,10 +186,7 @@ typedef struct rb_state {
     } lb, lq;
     GLint loc_acc, loc_rscale, loc_normalize;
     GLuint vao_empty, vao_quads, vbo_quads;
-    GLuint light_tex, light_fbo;
-    int light_w, light_h, light_fmt;
-    GLuint out_tex, out_fbo, acc_tex, acc_fbo; /* acc: radial_blur_local's quads, then resolved */
-    int out_w, out_h, acc_w, acc_h;
+    gr_target light, out, acc; /* acc: radial_blur_local's quads, then resolved */
     GLuint q_samples;
     gr_gl_timer timer;
     gr_readback rb;
@@ -192,14 +195,7 @@ typedef struct rb_state {
     double sun_uv[2], fade;
     int n_lights;
     double light_uv[MAX_LIGHTS][2];
-} rb_state;
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
+};
 
 static void get_blur_locs(GLuint p, GLint *light, GLint *sun_uv, GLint *size, GLint *samples, GLint *density,
                           GLint *decay, GLint *weight, GLint *scale, GLint *dither, GLint *falloff)
@@ -216,13 +212,6 @@ static void get_blur_locs(GLuint p, GLint *light, GLint *sun_uv, GLint *size, GL
     *falloff = glGetUniformLocation(p, "u_falloff");
 }
 
-static void delete_tex_fbo(GLuint *tex, GLuint *fbo)
-{
-    if (*fbo) glDeleteFramebuffers(1, fbo);
-    if (*tex) glDeleteTextures(1, tex);
-    *fbo = *tex = 0;
-}
-
 static void rb_destroy(void *state)
 {
     rb_state *r = state;
@@ -237,9 +226,9 @@ static void rb_destroy(void *state)
     if (r->vbo_quads) glDeleteBuffers(1, &r->vbo_quads);
     if (r->q_samples) glDeleteQueries(1, &r->q_samples);
     if (r->timer.queries[0]) gr_gl_timer_free(&r->timer);
-    delete_tex_fbo(&r->light_tex, &r->light_fbo);
-    delete_tex_fbo(&r->out_tex, &r->out_fbo);
-    delete_tex_fbo(&r->acc_tex, &r->acc_fbo);
+    gr_target_release(&r->light);
+    gr_target_release(&r->out);
+    gr_target_release(&r->acc);
     gr_readback_free(&r->rb);
     free(r->shader_dir);
     free(r);
@@ -255,7 +244,8 @@ static gr_status rb_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     rb_state *r = calloc(1, sizeof *r);
     if (!r) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", cls->name);
     r->gl = gl;
-    r->local = !strcmp(cls->name, "radial_blur_local");
+    r->v = cls->class_data;
+    r->name = cls->name;
     if (dir) {
         size_t n = strlen(dir) + 1;
         if (!(r->shader_dir = malloc(n))) {
@@ -272,7 +262,7 @@ static gr_status rb_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     if ((st = gr_shader_program(dir, "radial_blur_screen.vert.glsl", "radial_blur.frag.glsl", NULL, 0, &r->prog_blur,
                                 NULL, err)) != GR_OK)
         goto fail;
-    if (r->local) {
+    if (r->v->quads) {
         if ((st = gr_shader_program(dir, "radial_blur_local.vert.glsl", "radial_blur_local.frag.glsl", NULL, 0,
                                     &r->prog_local, NULL, err)) != GR_OK)
             goto fail;
@@ -323,58 +313,19 @@ fail:
     return st;
 }
 
-static gr_status make_color_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h, GLint filter, int border,
-                                   const char *what, gr_error *err)
-{
-    delete_tex_fbo(tex, fbo);
-    glGenTextures(1, tex);
-    glBindTexture(GL_TEXTURE_2D, *tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, ifmt, w, h);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
-    /* The light pass reads black outside the screen: taps that leave it add nothing (an
-     * edge clamp would smear the border texels into streaks). */
-    static const float black[4] = {0, 0, 0, 0};
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, border ? GL_CLAMP_TO_BORDER : GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, border ? GL_CLAMP_TO_BORDER : GL_CLAMP_TO_EDGE);
-    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, black);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    glGenFramebuffers(1, fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
-    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (fs != GL_FRAMEBUFFER_COMPLETE)
-        return gr_fail(err, GR_E_GL, "%s (%dx%d): framebuffer incomplete (0x%04x)", what, w, h, (unsigned)fs);
-    return gr_gl_check(what, err);
-}
-
+/* The light pass target: reduced size, the chosen storage (fmt 2, internal: RGBA32F), bilinear,
+ * black outside the screen. */
 static gr_status ensure_light(rb_state *r, int w, int h, int fmt, const char *name, gr_error *err)
 {
-    if (r->light_tex && r->light_w == w && r->light_h == h && r->light_fmt == fmt) return GR_OK;
     char what[96];
     snprintf(what, sizeof what, "%s.target_scale: light pass target", name);
-    r->light_w = 0;
-    gr_status st = make_color_target(&r->light_tex, &r->light_fbo,
-                                     fmt == GR_RB_RGBA8 ? GL_RGBA8 : fmt == GR_RB_RGBA16F ? GL_RGBA16F : GL_RGBA32F, w,
-                                     h, GL_LINEAR, 1, what, err);
-    if (st != GR_OK) return st;
-    r->light_w = w;
-    r->light_h = h;
-    r->light_fmt = fmt;
-    return GR_OK;
+    GLenum ifmt = fmt == GR_RB_RGBA8 ? GL_RGBA8 : fmt == GR_RB_RGBA16F ? GL_RGBA16F : GL_RGBA32F;
+    return gr_target_ensure(&r->light, ifmt, w, h, GR_TARGET_LINEAR | GR_TARGET_BLACK_BORDER, what, err);
 }
 
 static gr_status ensure_out(rb_state *r, int w, int h, gr_error *err)
 {
-    if (r->out_tex && r->out_w == w && r->out_h == h) return GR_OK;
-    r->out_w = 0;
-    gr_status st = make_color_target(&r->out_tex, &r->out_fbo, GL_RGBA32F, w, h, GL_NEAREST, 0,
-                                     "camera.width/height: god-ray layer target", err);
-    if (st != GR_OK) return st;
-    r->out_w = w;
-    r->out_h = h;
-    return GR_OK;
+    return gr_target_ensure(&r->out, GL_RGBA32F, w, h, 0, "camera.width/height: god-ray layer target", err);
 }
 
 static void set_blur_uniforms(GLuint prog, GLint light, GLint size, GLint samples, GLint density, GLint decay,
@@ -390,11 +341,11 @@ static void set_blur_uniforms(GLuint prog, GLint light, GLint size, GLint sample
     glUniform1i(dither, s->dither);
 }
 
-/* Runs the full-screen blur from r->light_tex into r->out_fbo (w x h). */
+/* Runs the full-screen blur from r->light.tex into r->out.fbo (w x h). */
 static void blur_pass(rb_state *r, const gr_radial_blur_settings *s, const double sun_uv[2], const double scale[3],
                       int w, int h)
 {
-    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out.fbo);
     glViewport(0, 0, w, h);
     glDisable(GL_BLEND);
     set_blur_uniforms(r->prog_blur, r->lb.light, r->lb.size, r->lb.samples, r->lb.density, r->lb.decay, r->lb.weight,
@@ -402,17 +353,15 @@ static void blur_pass(rb_state *r, const gr_radial_blur_settings *s, const doubl
     glUniform2f(r->lb.sun_uv, (float)sun_uv[0], (float)sun_uv[1]);
     glUniform3f(r->lb.scale, (float)scale[0], (float)scale[1], (float)scale[2]);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, r->light_tex);
+    glBindTexture(GL_TEXTURE_2D, r->light.tex);
     glBindVertexArray(r->vao_empty);
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-/* Reads r->out_fbo (w x h) into out's R, G, B (top row first). */
+/* Reads r->out.fbo (w x h) into out's R, G, B (top row first). */
 static gr_status read_out(rb_state *r, gr_image *out, const char *what, gr_error *err)
 {
-    gr_status st = gr_readback_fbo(&r->rb, r->out_fbo, out->width, out->height, what, err);
-    if (st == GR_OK) gr_readback_to_rgb(&r->rb, out); /* NaN/Inf: checked by the harness */
-    return st;
+    return gr_readback_rgb(&r->rb, r->out.fbo, out, NULL, what, err); /* NaN/Inf: checked by the harness */
 }
 
 /* ---- light selection (radial_blur_local) -------------------------------------------------- */
@@ -430,13 +379,13 @@ static int cell_cmp(const void *a, const void *b)
  * at most s->lights, each placed at its cell's luminance-weighted centroid (docs, "Lights"). */
 static gr_status select_lights(rb_state *r, const gr_radial_blur_settings *s, gr_error *err)
 {
-    int w = r->light_w, h = r->light_h;
+    int w = r->light.w, h = r->light.h;
     /* cells relative to the frame, so the lights (and their overlap) do not grow in number
      * with the resolution */
     int cp = (int)lround(s->cell_size * h);
     if (cp < 1) cp = 1;
     int cw = (w + cp - 1) / cp, chh = (h + cp - 1) / cp;
-    gr_status st = gr_readback_fbo(&r->rb, r->light_fbo, w, h, "radial_blur_local: light pass", err);
+    gr_status st = gr_readback_fbo(&r->rb, r->light.fbo, w, h, "radial_blur_local: light pass", err);
     if (st != GR_OK) return st;
     cell *cells = malloc((size_t)cw * chh * sizeof *cells);
     double *cx = calloc((size_t)cw * chh * 2, sizeof *cx);
@@ -485,15 +434,95 @@ static gr_status select_lights(rb_state *r, const gr_radial_blur_settings *s, gr
     return gr_gl_check("radial_blur_local: light selection", err);
 }
 
+/* ---- the variants' screen passes -------------------------------------------------------- */
+
+/* radial_blur: one full-screen blur toward the refracted sun. */
+static gr_status stage_blur(rb_state *r, const gr_radial_blur_settings *s, int W, int H, const double sun_uv[2],
+                            const double scale[3], gr_error *err)
+{
+    (void)err;
+    gr_gl_timer_begin(&r->timer, PASS_BLUR);
+    blur_pass(r, s, sun_uv, scale, W, H);
+    gr_gl_timer_end(&r->timer);
+    return GR_OK;
+}
+
+/* radial_blur_local: CPU light selection, then all quads in one draw into the float
+ * accumulator. */
+static gr_status stage_quads(rb_state *r, const gr_radial_blur_settings *s, int W, int H, const double sun_uv[2],
+                             const double scale[3], gr_error *err)
+{
+    (void)sun_uv;
+    (void)scale;
+    gr_status st;
+    if ((st = select_lights(r, s, err)) != GR_OK) return st;
+    float *v = malloc((size_t)(r->n_lights > 0 ? r->n_lights : 1) * 6 * 6 * sizeof *v);
+    if (!v) return gr_fail(err, GR_E_NOMEM, "radial_blur_local: out of memory for the quads");
+    static const float corners[6][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, -1}, {1, 1}, {-1, 1}};
+    float hx = (float)(s->quad_size * (double)H / (double)W), hy = (float)s->quad_size;
+    for (int l = 0; l < r->n_lights; l++)
+        for (int k = 0; k < 6; k++) {
+            float *p = v + ((size_t)l * 6 + (size_t)k) * 6;
+            p[0] = corners[k][0];
+            p[1] = corners[k][1];
+            p[2] = (float)r->light_uv[l][0];
+            p[3] = (float)r->light_uv[l][1];
+            p[4] = hx;
+            p[5] = hy;
+        }
+    glBindBuffer(GL_ARRAY_BUFFER, r->vbo_quads);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)((size_t)r->n_lights * 36 * sizeof *v), r->n_lights ? v : NULL,
+                 GL_STREAM_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    free(v);
+    gr_gl_timer_begin(&r->timer, PASS_BLUR);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->acc.fbo);
+    glViewport(0, 0, W, H);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    set_blur_uniforms(r->prog_local, r->lq.light, r->lq.size, r->lq.samples, r->lq.density, r->lq.decay,
+                      r->lq.weight, r->lq.dither, s, W, H);
+    glUniform1f(r->lq.falloff, (float)s->falloff);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r->light.tex);
+    glBindVertexArray(r->vao_quads);
+    if (r->n_lights > 0) glDrawArrays(GL_TRIANGLES, 0, r->n_lights * 6);
+    glDisable(GL_BLEND);
+    gr_gl_timer_end(&r->timer);
+    return GR_OK;
+}
+
+/* radial_blur_local's resolve: accumulator -> god-ray layer (divide by the summed falloff,
+ * scale). */
+static void stage_resolve(rb_state *r, const gr_radial_blur_settings *s, int W, int H, const double scale[3])
+{
+    gr_gl_timer_begin(&r->timer, PASS_RESOLVE);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out.fbo);
+    glViewport(0, 0, W, H);
+    glUseProgram(r->prog_resolve);
+    glUniform1i(r->loc_acc, 0);
+    glUniform3f(r->loc_rscale, (float)scale[0], (float)scale[1], (float)scale[2]);
+    glUniform1i(r->loc_normalize, s->normalize_overlap);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r->acc.tex);
+    glBindVertexArray(r->vao_empty);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    gr_gl_timer_end(&r->timer);
+}
+
 /* ---- render ---------------------------------------------------------------------------------- */
+
 
 static gr_status rb_render(void *state, const gr_scene *scene, const void *settings, gr_image *out,
                            gr_technique_stats *stats, gr_error *err)
 {
     rb_state *r = state;
     const gr_radial_blur_settings *s = settings;
-    const char *name = r->local ? "radial_blur_local" : "radial_blur";
-    double t0 = now_ms();
+    const char *name = r->name;
+    double t0 = gr_clock_ms();
     gr_status st;
     gr_frame f;
     gr_frame_init(scene, &f);
@@ -516,14 +545,9 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) return st;
     if ((st = ensure_light(r, tw, th, s->target_format, name, err)) != GR_OK) return st;
     if ((st = ensure_out(r, W, H, err)) != GR_OK) return st;
-    if (r->local && !(r->acc_tex && r->acc_w == W && r->acc_h == H)) {
-        r->acc_w = 0;
-        if ((st = make_color_target(&r->acc_tex, &r->acc_fbo, GL_RGBA32F, W, H, GL_NEAREST, 0,
-                                    "camera.width/height: radial_blur_local accumulator", err)) != GR_OK)
-            return st;
-        r->acc_w = W;
-        r->acc_h = H;
-    }
+    if (r->v->quads && (st = gr_target_ensure(&r->acc, GL_RGBA32F, W, H, 0,
+                                              "camera.width/height: radial_blur_local accumulator", err)) != GR_OK)
+        return st;
 
     /* Waves in the seed's packing with wt folded to the eye (phase at eye-relative x0, z0). */
     float waves[MAX_WAVE_GROUPS * 5 * 4];
@@ -547,8 +571,7 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     gr_frame_view_proj_rot(&f, vp_rot);
     if (gr_mat4_inverse(vp_rot, inv_rot) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection");
 
-    r->timer.used = 0;
-    r->timer.n = 0;
+    gr_gl_timer_reset(&r->timer);
     /* Pass 0: occluders' (and the seabed's) distance from the eye at the light target's size. */
     unsigned depth_tex = 0;
     gr_gl_timer_begin(&r->timer, PASS_DEPTH);
@@ -558,7 +581,7 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
 
     /* Pass 1: light pass into the reduced target. */
     gr_gl_timer_begin(&r->timer, PASS_LIGHT);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->light_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->light.fbo);
     glViewport(0, 0, tw, th);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);
@@ -588,7 +611,7 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     /* Output scale: k * intensity * exposure * sample_scale * peak * fade, where peak = n^2 T_flat
      * E / Omega_eff is the flat-water light-pass radiance at the sun (docs, "Units"). */
     double omega = gr_radial_blur_kernel_solid_angle(s->light_radius_deg * GR_PI / 180.0);
-    double fade = r->local ? 1.0 : gr_radial_blur_fade(f.sun_ndc, f.sun_clip_w, s->fade_margin);
+    double fade = r->v->fade ? gr_radial_blur_fade(f.sun_ndc, f.sun_clip_w, s->fade_margin) : 1.0;
     double scale[3], ku[3];
     units_scale(scene, &f, s->light_radius_deg, ku);
     for (int c = 0; c < 3; c++)
@@ -599,93 +622,19 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     r->fade = fade;
 
     glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
-    if (!r->local) {
-        gr_gl_timer_begin(&r->timer, PASS_BLUR);
-        blur_pass(r, s, f.sun_uv, scale, W, H);
-        gr_gl_timer_end(&r->timer);
-    } else {
-        /* CPU light selection, then all quads in one draw into the float accumulator. */
-        if ((st = select_lights(r, s, err)) != GR_OK) {
-            glEndQuery(GL_SAMPLES_PASSED);
-            return st;
-        }
-        float *v = malloc((size_t)(r->n_lights > 0 ? r->n_lights : 1) * 6 * 6 * sizeof *v);
-        if (!v) {
-            glEndQuery(GL_SAMPLES_PASSED);
-            return gr_fail(err, GR_E_NOMEM, "radial_blur_local: out of memory for the quads");
-        }
-        static const float corners[6][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, -1}, {1, 1}, {-1, 1}};
-        float hx = (float)(s->quad_size * (double)H / (double)W), hy = (float)s->quad_size;
-        for (int l = 0; l < r->n_lights; l++)
-            for (int k = 0; k < 6; k++) {
-                float *p = v + ((size_t)l * 6 + (size_t)k) * 6;
-                p[0] = corners[k][0];
-                p[1] = corners[k][1];
-                p[2] = (float)r->light_uv[l][0];
-                p[3] = (float)r->light_uv[l][1];
-                p[4] = hx;
-                p[5] = hy;
-            }
-        glBindBuffer(GL_ARRAY_BUFFER, r->vbo_quads);
-        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)((size_t)r->n_lights * 36 * sizeof *v), r->n_lights ? v : NULL,
-                     GL_STREAM_DRAW);
-        glBindBuffer(GL_ARRAY_BUFFER, 0);
-        free(v);
-        gr_gl_timer_begin(&r->timer, PASS_BLUR);
-        glBindFramebuffer(GL_FRAMEBUFFER, r->acc_fbo);
-        glViewport(0, 0, W, H);
-        glClearColor(0, 0, 0, 0);
-        glClear(GL_COLOR_BUFFER_BIT);
-        glEnable(GL_BLEND);
-        glBlendEquation(GL_FUNC_ADD);
-        glBlendFunc(GL_ONE, GL_ONE);
-        set_blur_uniforms(r->prog_local, r->lq.light, r->lq.size, r->lq.samples, r->lq.density, r->lq.decay,
-                          r->lq.weight, r->lq.dither, s, W, H);
-        glUniform1f(r->lq.falloff, (float)s->falloff);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, r->light_tex);
-        glBindVertexArray(r->vao_quads);
-        if (r->n_lights > 0) glDrawArrays(GL_TRIANGLES, 0, r->n_lights * 6);
-        glDisable(GL_BLEND);
-        gr_gl_timer_end(&r->timer);
-    }
+    st = r->v->screen(r, s, W, H, f.sun_uv, scale, err);
     glEndQuery(GL_SAMPLES_PASSED);
-    if (r->local) {
-        /* Resolve: accumulator -> god-ray layer (divide by the summed falloff, scale). */
-        gr_gl_timer_begin(&r->timer, PASS_RESOLVE);
-        glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
-        glViewport(0, 0, W, H);
-        glUseProgram(r->prog_resolve);
-        glUniform1i(r->loc_acc, 0);
-        glUniform3f(r->loc_rscale, (float)scale[0], (float)scale[1], (float)scale[2]);
-        glUniform1i(r->loc_normalize, s->normalize_overlap);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, r->acc_tex);
-        glBindVertexArray(r->vao_empty);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-        gr_gl_timer_end(&r->timer);
-    }
+    if (st != GR_OK) return st;
+    if (r->v->resolve) r->v->resolve(r, s, W, H, scale);
     st = read_out(r, out, name, err);
     glBindVertexArray(0);
     glUseProgram(0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (st != GR_OK) return st;
     if (stats) {
-        static const char *const names[4] = {"eye_depth", "light", "blur", "resolve"};
-        memset(stats, 0, sizeof *stats);
-        double wall_ns = (now_ms() - t0) * 1e6;
-        stats->n_passes = r->local ? 4 : 3;
-        for (int p = 0; p < stats->n_passes; p++) {
-            snprintf(stats->pass_names[p], sizeof stats->pass_names[p], "%s",
-                     r->local && p == PASS_BLUR ? "quads" : names[p]);
-            long long ns = gr_gl_timer_ns(&r->timer, p);
-            /* a time longer than the whole call is a broken timer (llvmpipe's first query) */
-            stats->gpu_ns[p] = (ns >= 0 && (double)ns <= wall_ns) ? ns : -1;
-        }
-        GLuint64 n = 0;
-        glGetQueryObjectui64v(r->q_samples, GL_QUERY_RESULT, &n);
-        stats->fragments = (long long)n;
-        stats->wall_ms = now_ms() - t0;
+        gr_gl_timer_stats(stats, &r->timer, r->v->pass_names, r->v->n_passes, t0);
+        stats->fragments = gr_gl_query_result(r->q_samples);
+        stats->wall_ms = gr_clock_ms() - t0;
     }
     r->rendered = 1;
     return gr_image_check_finite(out, name, err);
@@ -713,7 +662,7 @@ gr_status gr_radial_blur_blur_image(void *state, const gr_image *light, const do
             for (int c = 0; c < 3; c++) d[c] = src[c];
             d[3] = 1.0f;
         }
-    glBindTexture(GL_TEXTURE_2D, r->light_tex);
+    glBindTexture(GL_TEXTURE_2D, r->light.tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, light->width, light->height, GL_RGBA, GL_FLOAT, px);
     glBindTexture(GL_TEXTURE_2D, 0);
@@ -745,7 +694,7 @@ static gr_status rb_read_target(void *state, gr_image **out, gr_error *err)
     if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "radial blur: no render yet, no light pass to read");
     gr_status st = gr_gl_make_current(r->gl, err);
     if (st != GR_OK) return st;
-    if ((st = gr_readback_fbo(&r->rb, r->light_fbo, r->light_w, r->light_h, "radial blur light pass", err)) != GR_OK)
+    if ((st = gr_readback_fbo(&r->rb, r->light.fbo, r->light.w, r->light.h, "radial blur light pass", err)) != GR_OK)
         return st;
     *out = gr_readback_image(&r->rb);
     return *out ? GR_OK : gr_fail(err, GR_E_NOMEM, "radial blur: out of memory for the light pass image");
@@ -765,9 +714,9 @@ static gr_status rb_metadata(void *state, const gr_scene *scene, const void *set
     snprintf(val, sizeof val, "%.9g %.9g", r->sun_uv[0], r->sun_uv[1]);
     if ((st = gr_meta_set_string(meta, "godrays:radial_blur_sun_uv", val)) != GR_OK) goto fail;
     if ((st = gr_meta_set_double(meta, "godrays:radial_blur_fade", r->fade)) != GR_OK) goto fail;
-    snprintf(val, sizeof val, "%dx%d", r->light_w, r->light_h);
+    snprintf(val, sizeof val, "%dx%d", r->light.w, r->light.h);
     if ((st = gr_meta_set_string(meta, "godrays:radial_blur_target_size", val)) != GR_OK) goto fail;
-    if (r->local && (st = gr_meta_set_int(meta, "godrays:radial_blur_lights", r->n_lights)) != GR_OK) goto fail;
+    if (r->v->quads && (st = gr_meta_set_int(meta, "godrays:radial_blur_lights", r->n_lights)) != GR_OK) goto fail;
     return GR_OK;
 fail:
     return gr_fail(err, st, "radial blur metadata: cannot add an entry (%s)", gr_status_name(st));
@@ -777,10 +726,28 @@ static void rb_summary(void *state, const gr_technique_stats *stats, char *buf, 
 {
     rb_state *r = state;
     (void)stats;
-    int k = snprintf(buf, n, "light target %dx%d, refracted sun at uv (%.3f, %.3f), fade %.3g", r->light_w,
-                     r->light_h, r->sun_uv[0], r->sun_uv[1], r->fade);
-    if (r->local && k > 0 && (size_t)k < n) snprintf(buf + k, n - (size_t)k, ", %d light(s)", r->n_lights);
+    int k = snprintf(buf, n, "light target %dx%d, refracted sun at uv (%.3f, %.3f), fade %.3g", r->light.w,
+                     r->light.h, r->sun_uv[0], r->sun_uv[1], r->fade);
+    if (r->v->quads && k > 0 && (size_t)k < n) snprintf(buf + k, n - (size_t)k, ", %d light(s)", r->n_lights);
 }
+
+static const rb_variant variant_blur = {
+    .quads = 0,
+    .fade = 1,
+    .screen = stage_blur,
+    .resolve = NULL,
+    .n_passes = 3,
+    .pass_names = {"eye_depth", "light", "blur"},
+};
+
+static const rb_variant variant_local = {
+    .quads = 1,
+    .fade = 0,
+    .screen = stage_quads,
+    .resolve = stage_resolve,
+    .n_passes = 4,
+    .pass_names = {"eye_depth", "light", "quads", "resolve"},
+};
 
 const gr_technique_class gr_radial_blur_class = {
     .name = "radial_blur",
@@ -788,8 +755,8 @@ const gr_technique_class gr_radial_blur_class = {
     .params = &gr_radial_blur_param_table,
     .settings_size = sizeof(gr_radial_blur_settings),
     .origin = "built-in",
+    .class_data = &variant_blur,
     .gain_key = "intensity",
-    .check = rb_check,
     .create = rb_create,
     .destroy = rb_destroy,
     .render = rb_render,
@@ -804,8 +771,8 @@ const gr_technique_class gr_radial_blur_local_class = {
     .params = &gr_radial_blur_local_param_table,
     .settings_size = sizeof(gr_radial_blur_settings),
     .origin = "built-in",
+    .class_data = &variant_local,
     .gain_key = "intensity",
-    .check = rb_check,
     .create = rb_create,
     .destroy = rb_destroy,
     .render = rb_render,

@@ -54,6 +54,15 @@ gr_image *gr_readback_image(const gr_readback *rb)
     return img;
 }
 
+gr_status gr_readback_rgb(gr_readback *rb, unsigned fbo, gr_image *out, size_t *bad, const char *what,
+                          gr_error *err)
+{
+    gr_status st = gr_readback_fbo(rb, fbo, out->width, out->height, what, err);
+    size_t n = st == GR_OK ? gr_readback_to_rgb(rb, out) : 0;
+    if (bad) *bad = n;
+    return st;
+}
+
 void gr_readback_free(gr_readback *rb)
 {
     if (!rb) return;

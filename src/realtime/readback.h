@@ -24,6 +24,10 @@ gr_status gr_readback_fbo(gr_readback *rb, unsigned fbo, int w, int h, const cha
 size_t gr_readback_to_rgb(const gr_readback *rb, gr_image *out);
 /* The last read as a new 4-channel image, top row first; NULL if out of memory. */
 gr_image *gr_readback_image(const gr_readback *rb);
+/* gr_readback_fbo of out's size, then gr_readback_to_rgb into out: a technique's final layer.
+ * *bad (may be NULL) receives the count of NaN or infinite values read. */
+gr_status gr_readback_rgb(gr_readback *rb, unsigned fbo, gr_image *out, size_t *bad, const char *what,
+                          gr_error *err);
 void gr_readback_free(gr_readback *rb); /* accepts NULL */
 
 #endif

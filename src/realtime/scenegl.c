@@ -12,6 +12,7 @@
 #include "core/vec.h"
 #include "gl/gl.h"
 #include "realtime/shaders.h"
+#include "realtime/toolkit.h"
 
 #define SPHERE_STACKS 24
 #define SPHERE_SLICES 48
@@ -25,10 +26,7 @@ struct gr_scenegl {
     size_t mesh_n, mesh_cap;
     float *upload;
     size_t upload_cap;
-    GLuint shadow_tex, shadow_fbo;
-    int shadow_size;
-    GLuint depth_tex, depth_fbo;
-    int depth_w, depth_h;
+    gr_target shadow, depth; /* the shadow map (depth), the eye depth (R32F) */
 };
 
 gr_status gr_scenegl_create(gr_gl *gl, gr_scenegl **out, gr_error *err)
@@ -74,13 +72,6 @@ fail:
     return st;
 }
 
-static void delete_tex_fbo(GLuint *tex, GLuint *fbo)
-{
-    if (*fbo) glDeleteFramebuffers(1, fbo);
-    if (*tex) glDeleteTextures(1, tex);
-    *fbo = *tex = 0;
-}
-
 void gr_scenegl_destroy(gr_scenegl *s)
 {
     if (!s) return;
@@ -90,8 +81,8 @@ void gr_scenegl_destroy(gr_scenegl *s)
     if (s->vao_occ) glDeleteVertexArrays(1, &s->vao_occ);
     if (s->vbo_occ) glDeleteBuffers(1, &s->vbo_occ);
     if (s->vao_empty) glDeleteVertexArrays(1, &s->vao_empty);
-    delete_tex_fbo(&s->shadow_tex, &s->shadow_fbo);
-    delete_tex_fbo(&s->depth_tex, &s->depth_fbo);
+    gr_target_release(&s->shadow);
+    gr_target_release(&s->depth);
     free(s->mesh);
     free(s->upload);
     free(s);
@@ -180,42 +171,6 @@ static void upload_mesh(gr_scenegl *s, const double origin[3])
     glBindBuffer(GL_ARRAY_BUFFER, 0);
 }
 
-static gr_status make_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h, int is_depth, const char *what,
-                             gr_error *err)
-{
-    delete_tex_fbo(tex, fbo);
-    glGenTextures(1, tex);
-    glBindTexture(GL_TEXTURE_2D, *tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, ifmt, w, h);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    if (is_depth) {
-        static const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f}; /* outside the map: no caster */
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-        glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);
-    } else {
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    }
-    glBindTexture(GL_TEXTURE_2D, 0);
-    glGenFramebuffers(1, fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
-    if (is_depth) {
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, *tex, 0);
-        glDrawBuffer(GL_NONE);
-        glReadBuffer(GL_NONE);
-    } else {
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
-    }
-    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (fs != GL_FRAMEBUFFER_COMPLETE)
-        return gr_fail(err, GR_E_GL, "%s (%dx%d): framebuffer incomplete (0x%04x)", what, w, h, (unsigned)fs);
-    return gr_gl_check(what, err);
-}
-
 /* ---- shadow map ---------------------------------------------------------------------------- */
 
 /* Light frame: e3 = refr_dir along the beam, e1, e2 across it. */
@@ -252,13 +207,9 @@ gr_status gr_scenegl_shadow_map(gr_scenegl *s, const gr_scene *scene, const gr_f
     if (!(half_extent_m > 0 && isfinite(half_extent_m)))
         return gr_fail(err, GR_E_INPUT, "shadow map half extent %g m: must be finite and > 0", half_extent_m);
     if ((st = build_mesh(s, scene, err)) != GR_OK) return st;
-    if (s->shadow_size != size || !s->shadow_tex) {
-        s->shadow_size = 0;
-        if ((st = make_target(&s->shadow_tex, &s->shadow_fbo, GL_DEPTH_COMPONENT32F, size, size, 1,
-                              "occluder shadow map", err)) != GR_OK)
-            return st;
-        s->shadow_size = size;
-    }
+    if ((st = gr_target_ensure(&s->shadow, GL_DEPTH_COMPONENT32F, size, size, GR_TARGET_DEPTH, "occluder shadow map",
+                               err)) != GR_OK)
+        return st;
     gr_dvec3 e1, e2, e3;
     light_frame(f, &e1, &e2, &e3);
     double zmin = 0.0, zmax = 0.0;
@@ -278,7 +229,7 @@ gr_status gr_scenegl_shadow_map(gr_scenegl *s, const gr_scene *scene, const gr_f
     double tr[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -center[0], -center[1], -center[2], 1};
     gr_mat4_mul(rel, tr, light_vp);
 
-    glBindFramebuffer(GL_FRAMEBUFFER, s->shadow_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, s->shadow.fbo);
     glViewport(0, 0, size, size);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
@@ -301,7 +252,7 @@ gr_status gr_scenegl_shadow_map(gr_scenegl *s, const gr_scene *scene, const gr_f
     glUseProgram(0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if ((st = gr_gl_check("occluder shadow map", err)) != GR_OK) return st;
-    *texture = s->shadow_tex;
+    *texture = s->shadow.tex;
     return GR_OK;
 }
 
@@ -315,19 +266,12 @@ gr_status gr_scenegl_eye_depth(gr_scenegl *s, const gr_scene *scene, const gr_fr
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         return gr_fail(err, GR_E_INPUT, "eye depth target %dx%d: must be in [1, 16384]", width, height);
     if ((st = build_mesh(s, scene, err)) != GR_OK) return st;
-    if (s->depth_w != width || s->depth_h != height || !s->depth_tex) {
-        s->depth_w = 0;
-        if ((st = make_target(&s->depth_tex, &s->depth_fbo, GL_R32F, width, height, 0, "eye depth target", err)) !=
-            GR_OK)
-            return st;
-        s->depth_w = width;
-        s->depth_h = height;
-    }
+    if ((st = gr_target_ensure(&s->depth, GL_R32F, width, height, 0, "eye depth target", err)) != GR_OK) return st;
     double vp_rot[16], inv_rot[16];
     gr_frame_view_proj_rot(f, vp_rot);
     if (gr_mat4_inverse(vp_rot, inv_rot) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection");
     float m[16];
-    glBindFramebuffer(GL_FRAMEBUFFER, s->depth_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, s->depth.fbo);
     glViewport(0, 0, width, height);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
@@ -362,42 +306,6 @@ gr_status gr_scenegl_eye_depth(gr_scenegl *s, const gr_scene *scene, const gr_fr
     glUseProgram(0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if ((st = gr_gl_check("eye depth", err)) != GR_OK) return st;
-    *texture = s->depth_tex;
+    *texture = s->depth.tex;
     return GR_OK;
-}
-
-/* ---- GPU timers ------------------------------------------------------------------------------- */
-
-void gr_gl_timer_init(gr_gl_timer *t)
-{
-    memset(t, 0, sizeof *t);
-    glGenQueries(8, t->queries);
-    t->have_timer = 1; /* GL_TIME_ELAPSED is core since 3.3 */
-}
-
-void gr_gl_timer_begin(gr_gl_timer *t, int pass)
-{
-    if (pass < 0 || pass >= 8 || !t->have_timer) return;
-    glBeginQuery(GL_TIME_ELAPSED, t->queries[pass]);
-    if (pass + 1 > t->n) t->n = pass + 1;
-    t->used |= 1u << pass;
-}
-
-void gr_gl_timer_end(gr_gl_timer *t)
-{
-    if (t->have_timer) glEndQuery(GL_TIME_ELAPSED);
-}
-
-long long gr_gl_timer_ns(gr_gl_timer *t, int pass)
-{
-    if (!t->have_timer || pass < 0 || pass >= t->n || !(t->used & (1u << pass))) return -1;
-    GLuint64 v = 0;
-    glGetQueryObjectui64v(t->queries[pass], GL_QUERY_RESULT, &v);
-    return (long long)v;
-}
-
-void gr_gl_timer_free(gr_gl_timer *t)
-{
-    if (t->queries[0]) glDeleteQueries(8, t->queries);
-    memset(t, 0, sizeof *t);
 }

@@ -1,6 +1,6 @@
 /* GL resources every technique may share within one context: the occluders as a triangle
  * mesh, their shadow map along the refracted sun (orthographic, centred where the camera
- * looks), their depth as seen from the eye, and GPU pass timers. Built once per context
+ * looks) and their depth as seen from the eye (GPU pass timers: realtime/toolkit.h). Built once per context
  * and refreshed per scene; techniques bind the textures, they do not redraw the occluders. */
 #ifndef GR_SCENEGL_H
 #define GR_SCENEGL_H
@@ -50,19 +50,5 @@ void gr_scenegl_shadow_snap(const gr_frame *f, int size, double half_extent_m, c
  * view ray, at width x height (R32F; GR_FRAME_FAR_M where nothing is hit). Returns the texture. */
 gr_status gr_scenegl_eye_depth(gr_scenegl *s, const gr_scene *scene, const gr_frame *f, int width, int height,
                                unsigned *texture, gr_error *err);
-
-/* GPU pass timing: begin/end around a pass; results collected after the frame. */
-typedef struct gr_gl_timer {
-    unsigned queries[8];
-    int n, have_timer;
-    unsigned used;      /* bit p: pass p was timed in this frame */
-} gr_gl_timer;
-void gr_gl_timer_init(gr_gl_timer *t);            /* needs a current context */
-void gr_gl_timer_begin(gr_gl_timer *t, int pass); /* pass < 8 */
-void gr_gl_timer_end(gr_gl_timer *t);
-/* -1 if no timer or the pass was not timed. Waits for the result. On llvmpipe the first query
- * of a context may read ~1e12 ns: callers drop a figure longer than the frame's wall time. */
-long long gr_gl_timer_ns(gr_gl_timer *t, int pass);
-void gr_gl_timer_free(gr_gl_timer *t);
 
 #endif

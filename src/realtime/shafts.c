@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "core/optics.h"
 #include "core/shaftgeom.h"
@@ -15,6 +14,7 @@
 #include "realtime/readback.h"
 #include "realtime/scenegl.h"
 #include "realtime/shaders.h"
+#include "realtime/toolkit.h"
 
 #define MAX_WAVE_GROUPS 16 /* must match shafts.vert.glsl */
 #define GRID_FLOATS 6
@@ -133,20 +133,19 @@ struct gr_shafts {
     GLuint vao_lat, vbo_lat, ibo_lat;
     int lat_N, lat_slabs, lat_tiled, lat_M;
     long long lat_nidx;
-    GLuint prog_flux, flux_tex, flux_fbo;
-    int flux_w, flux_h;
+    GLuint prog_flux;
+    gr_target flux;
     GLint lf_corner_pos, lf_corner_refr, lf_tiled, lf_cells, lf_slabs, lf_length, lf_width, lf_sun_dir, lf_refr_flat,
         lf_sun_radius_w, lf_shadow_matrix, lf_shadow_map, lf_shadow_bias, lf_shadows;
     GLint ls_flux_e, ls_tiled, ls_lattice, ls_cells, ls_slabs, lk_tiled;
 
     GLuint vao_empty;
-    GLuint target_tex, target_fbo;
-    int target_w, target_h, target_fmt;
-    GLuint frame_tex, frame_fbo;
-    int frame_w, frame_h;
+    gr_target target, frame; /* the shafts' reduced target, the god-ray layer */
+    int target_fmt;          /* the format of the last render (TARGET_RGBA32F or a gr_shafts_format) */
 
-    GLuint q_time[GR_SHAFTS_NPASS], q_samples, q_vs, q_fs;
-    int have_timer, have_pipeline_stats;
+    gr_gl_timer timer;       /* passes GR_SHAFTS_PASS_* */
+    GLuint q_samples, q_vs, q_fs;
+    int have_pipeline_stats;
 
     gr_readback rb;
     int rendered;
@@ -180,20 +179,14 @@ typedef struct frame_setup {
     float hgg[3];
 } frame_setup;
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
 /* ---- settings ------------------------------------------------------------------- */
 
-gr_status gr_shafts_check_settings(const gr_shafts_settings *s, gr_error *err)
+/* The class's check (technique.c validated the table's ranges first): structural limits the
+ * table may not express. */
+static gr_status check_structure(const gr_technique_class *cls, const void *settings, gr_error *err)
 {
-    gr_status st = gr_param_validate(&gr_shafts_param_table, s, 1, err);
-    if (st != GR_OK) return st;
-    /* Structural limits the table may not express. */
+    const gr_shafts_settings *s = settings;
+    (void)cls;
     if (s->N < 2) return gr_fail(err, GR_E_INPUT, "shafts.N = %d: must be >= 2 (N grid vertices make (N-1)^2 shafts)", s->N);
     if (s->N > 1024) return gr_fail(err, GR_E_INPUT, "shafts.N = %d: must be <= 1024", s->N);
     if (!(s->K > 0)) return gr_fail(err, GR_E_INPUT, "shafts.K = %g: must be > 0", s->K);
@@ -204,6 +197,11 @@ gr_status gr_shafts_check_settings(const gr_shafts_settings *s, gr_error *err)
     if (s->target_format != GR_TARGET_RGBA8 && s->target_format != GR_TARGET_RGBA16F)
         return gr_fail(err, GR_E_INPUT, "shafts.target_format: invalid choice %d", s->target_format);
     return GR_OK;
+}
+
+gr_status gr_shafts_check_settings(const gr_shafts_settings *s, gr_error *err)
+{
+    return gr_technique_check(&gr_shafts_class, s, err);
 }
 
 void gr_shafts_resolve(const gr_scene *scene, const gr_shafts_settings *s, gr_shafts_settings *out)
@@ -372,10 +370,9 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
     glGenVertexArrays(1, &r->vao_lat);
     glGenBuffers(1, &r->vbo_lat);
     glGenBuffers(1, &r->ibo_lat);
-    glGenQueries(GR_SHAFTS_NPASS, r->q_time);
+    gr_gl_timer_init(&r->timer);
     glGenQueries(1, &r->q_samples);
-    /* Timer queries are core since 3.3; pipeline statistics need GL 4.6 or the ARB extension. */
-    r->have_timer = 1;
+    /* Pipeline statistics need GL 4.6 or the ARB extension. */
     int major = 0, minor = 0;
     gr_gl_context_version(r->gl, &major, &minor);
     r->have_pipeline_stats = (major > 4 || (major == 4 && minor >= 6)) ||
@@ -385,13 +382,6 @@ static gr_status setup_gl(gr_shafts *r, gr_error *err)
         glGenQueries(1, &r->q_fs);
     }
     return gr_gl_check("shafts renderer setup", err);
-}
-
-static void delete_tex_fbo(GLuint *tex, GLuint *fbo)
-{
-    if (*fbo) glDeleteFramebuffers(1, fbo);
-    if (*tex) glDeleteTextures(1, tex);
-    *fbo = *tex = 0;
 }
 
 void gr_shafts_destroy(gr_shafts *r)
@@ -413,13 +403,13 @@ void gr_shafts_destroy(gr_shafts *r)
         if (r->vao_lat) glDeleteVertexArrays(1, &r->vao_lat);
         if (r->vbo_lat) glDeleteBuffers(1, &r->vbo_lat);
         if (r->ibo_lat) glDeleteBuffers(1, &r->ibo_lat);
-        delete_tex_fbo(&r->flux_tex, &r->flux_fbo);
-        if (r->q_time[0]) glDeleteQueries(GR_SHAFTS_NPASS, r->q_time);
+        gr_target_release(&r->flux);
+        gr_gl_timer_free(&r->timer);
         if (r->q_samples) glDeleteQueries(1, &r->q_samples);
         if (r->q_vs) glDeleteQueries(1, &r->q_vs);
         if (r->q_fs) glDeleteQueries(1, &r->q_fs);
-        delete_tex_fbo(&r->target_tex, &r->target_fbo);
-        delete_tex_fbo(&r->frame_tex, &r->frame_fbo);
+        gr_target_release(&r->target);
+        gr_target_release(&r->frame);
         gr_scenegl_destroy(r->scenegl);
         if (r->owns_gl) gr_gl_destroy(r->gl);
     }
@@ -508,43 +498,6 @@ static gr_status ensure_grid(gr_shafts *r, int N, int slabs, gr_error *err)
     r->grid_slabs = slabs;
     r->grid_nshafts = ns;
     return gr_gl_check("shafts.N: uploading the shaft grid", err);
-}
-
-static gr_status make_target(GLuint *tex, GLuint *fbo, GLenum ifmt, int w, int h, int is_depth,
-                             GLint filter, const char *what, gr_error *err)
-{
-    delete_tex_fbo(tex, fbo);
-    glGenTextures(1, tex);
-    glBindTexture(GL_TEXTURE_2D, *tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, ifmt, w, h);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
-    if (is_depth) {
-        /* Outside the map nothing is stored: border depth 1 = no caster = lit. */
-        static const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-        glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);
-    } else {
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    }
-    glBindTexture(GL_TEXTURE_2D, 0);
-    glGenFramebuffers(1, fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
-    if (is_depth) {
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, *tex, 0);
-        glDrawBuffer(GL_NONE);
-        glReadBuffer(GL_NONE);
-    } else {
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
-    }
-    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (fs != GL_FRAMEBUFFER_COMPLETE)
-        return gr_fail(err, GR_E_GL, "%s (%dx%d): framebuffer incomplete (0x%04x)", what, w, h, (unsigned)fs);
-    return gr_gl_check(what, err);
 }
 
 /* The flux pre-pass's two RGBA32F lattice textures, M texels per side. */
@@ -653,35 +606,24 @@ static gr_status ensure_lattice(gr_shafts *r, int N, int slabs, int tiled, gr_er
 
 static gr_status ensure_targets(gr_shafts *r, const frame_setup *f, gr_error *err)
 {
-    gr_status st;
-    if (r->target_w != f->tw || r->target_h != f->th || r->target_fmt != f->fmt || !r->target_tex) {
-        r->target_w = 0;
-        GLenum ifmt = f->fmt == TARGET_RGBA32F ? GL_RGBA32F : f->fmt == GR_TARGET_RGBA16F ? GL_RGBA16F : GL_RGBA8;
-        st = make_target(&r->target_tex, &r->target_fbo, ifmt, f->tw, f->th, 0, GL_LINEAR,
-                         "shafts.target_scale: shaft render target", err);
-        if (st != GR_OK) return st;
-        r->target_w = f->tw;
-        r->target_h = f->th;
-        r->target_fmt = f->fmt;
-    }
-    if (r->frame_w != f->W || r->frame_h != f->H || !r->frame_tex) {
-        r->frame_w = 0;
-        st = make_target(&r->frame_tex, &r->frame_fbo, GL_RGBA32F, f->W, f->H, 0, GL_NEAREST,
-                         "camera.width/height: god-ray layer target", err);
-        if (st != GR_OK) return st;
-        r->frame_w = f->W;
-        r->frame_h = f->H;
-    }
-    return GR_OK;
+    GLenum ifmt = f->fmt == TARGET_RGBA32F ? GL_RGBA32F : f->fmt == GR_TARGET_RGBA16F ? GL_RGBA16F : GL_RGBA8;
+    gr_status st = gr_target_ensure(&r->target, ifmt, f->tw, f->th, GR_TARGET_LINEAR,
+                                    "shafts.target_scale: shaft render target", err);
+    if (st != GR_OK) return st;
+    r->target_fmt = f->fmt;
+    return gr_target_ensure(&r->frame, GL_RGBA32F, f->W, f->H, 0, "camera.width/height: god-ray layer target", err);
 }
 
 /* ---- per-render setup on the CPU ----------------------------------------------------- */
 
-static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in, frame_setup *f, gr_error *err)
+/* checked: the settings passed gr_technique_check already (the class's render); the direct
+ * API (gr_shafts_render, gr_shafts_capture) checks them here, through the same function. */
+static gr_status setup_frame(const gr_scene *scene, const gr_shafts_settings *in, int checked, frame_setup *f,
+                             gr_error *err)
 {
     memset(f, 0, sizeof *f);
     gr_shafts_resolve(scene, in ? in : gr_shafts_scene_settings(scene), &f->s);
-    gr_status st = gr_shafts_check_settings(&f->s, err);
+    gr_status st = checked ? GR_OK : gr_shafts_check_settings(&f->s, err);
     if (st != GR_OK) return st;
     const gr_shafts_settings *s = &f->s;
     for (int c = 0; c < 3; c++) {
@@ -856,21 +798,14 @@ static void set_shaft_uniforms(GLuint prog, const shaft_locs *l, const frame_set
     glUniform1i(l->corner_refr, 3);
 }
 
-static long long query_result(GLuint q)
+static gr_status render_frame(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s, int checked,
+                              gr_image *out, gr_shafts_stats *stats, gr_error *err)
 {
-    GLuint64 v = 0;
-    glGetQueryObjectui64v(q, GL_QUERY_RESULT, &v);
-    return (long long)v;
-}
-
-gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
-                           gr_image *out, gr_shafts_stats *stats, gr_error *err)
-{
-    double t0 = now_ms();
+    double t0 = gr_clock_ms();
     frame_setup *f = malloc(sizeof *f);
     gr_status st;
     if (!f) return gr_fail(err, GR_E_NOMEM, "shafts: out of memory");
-    if ((st = setup_frame(scene, s, f, err)) != GR_OK) goto done;
+    if ((st = setup_frame(scene, s, checked, f, err)) != GR_OK) goto done;
     int ch[3] = {gr_image_channel(out, "R"), gr_image_channel(out, "G"), gr_image_channel(out, "B")};
     if (out->width != f->W || out->height != f->H || ch[0] < 0 || ch[1] < 0 || ch[2] < 0) {
         st = gr_fail(err, GR_E_INPUT, "shafts: output image is %dx%d (needs %dx%d with R, G, B channels)",
@@ -878,6 +813,7 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
         goto done;
     }
     if ((st = gr_gl_make_current(r->gl, err)) != GR_OK) goto done;
+    gr_gl_timer_reset(&r->timer);
     if ((st = ensure_grid(r, f->N, f->slabs, err)) != GR_OK) goto done;
     if ((st = ensure_targets(r, f, err)) != GR_OK) goto done;
     const int tiled = f->s.shaft_width >= 1.0;
@@ -890,14 +826,9 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
         }
         if ((st = ensure_lattice(r, f->N, f->s.slabs, tiled, err)) != GR_OK) goto done;
         if ((st = ensure_corners(r, f->N, r->lat_M, err)) != GR_OK) goto done;
-        if (r->flux_w != C || r->flux_h != C * f->s.slabs || !r->flux_tex) {
-            r->flux_w = 0;
-            if ((st = make_target(&r->flux_tex, &r->flux_fbo, GL_R32F, C, C * f->s.slabs, 0, GL_NEAREST,
-                                  "shafts.slabs: flux irradiance target", err)) != GR_OK)
-                goto done;
-            r->flux_w = C;
-            r->flux_h = C * f->s.slabs;
-        }
+        if ((st = gr_target_ensure(&r->flux, GL_R32F, C, C * f->s.slabs, 0, "shafts.slabs: flux irradiance target",
+                                   err)) != GR_OK)
+            goto done;
     }
     GLuint eye_depth_tex = 0;
     if (f->s.depth_test) {
@@ -908,12 +839,12 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     }
     /* Pass 1: scenegl's shadow map of the occluders from P along T (seed: "from the point of
      * view of the light source P"; docs: D13). */
-    glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_SHADOW]);
+    gr_gl_timer_begin(&r->timer, GR_SHAFTS_PASS_SHADOW);
     unsigned shadow_tex = 0;
     double light_vp[16];
     st = gr_scenegl_shadow_map(r->scenegl, scene, &f->fr, f->s.shadow_map_size, f->shadow_center, f->shadow_half_m,
                                &shadow_tex, light_vp, err);
-    glEndQuery(GL_TIME_ELAPSED);
+    gr_gl_timer_end(&r->timer);
     if (st != GR_OK) goto done;
     {
         /* viewer-relative -> world -> light clip -> [0,1]^3 texture space, in double (GL: origin
@@ -935,13 +866,13 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     /* Pass 2: shafts, additive, no depth test, no culling, into the reduced target. */
     GLsizei n_idx = f->s.variant == GR_SHAFTS_FLUX ? (GLsizei)r->lat_nidx
                                                    : (GLsizei)(f->nshafts * f->slabs * (f->caps ? 36 : 24));
-    glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_SHAFTS]);
+    gr_gl_timer_begin(&r->timer, GR_SHAFTS_PASS_SHAFTS);
     glBeginQuery(GL_SAMPLES_PASSED, r->q_samples);
     if (r->have_pipeline_stats) {
         glBeginQuery(GL_VERTEX_SHADER_INVOCATIONS, r->q_vs);
         glBeginQuery(GL_FRAGMENT_SHADER_INVOCATIONS, r->q_fs);
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->target.fbo);
     glViewport(0, 0, f->tw, f->th);
     glDisable(GL_DITHER); /* dithering would make 8-bit sums depend on the pixel position */
     glClearColor(0, 0, 0, 0);
@@ -980,8 +911,8 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
             glActiveTexture(GL_TEXTURE3);
             glBindTexture(GL_TEXTURE_2D, r->corner_tex[1]);
             glActiveTexture(GL_TEXTURE0);
-            glBindFramebuffer(GL_FRAMEBUFFER, r->flux_fbo);
-            glViewport(0, 0, r->flux_w, r->flux_h);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->flux.fbo);
+            glViewport(0, 0, r->flux.w, r->flux.h);
             glUseProgram(r->prog_flux);
             glUniform1i(r->lf_corner_pos, 2);
             glUniform1i(r->lf_corner_refr, 3);
@@ -999,9 +930,9 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
             glUniform1i(r->lf_shadows, 1);
             glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
             glActiveTexture(GL_TEXTURE4);
-            glBindTexture(GL_TEXTURE_2D, r->flux_tex);
+            glBindTexture(GL_TEXTURE_2D, r->flux.tex);
             glActiveTexture(GL_TEXTURE0);
-            glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+            glBindFramebuffer(GL_FRAMEBUFFER, r->target.fbo);
             glViewport(0, 0, f->tw, f->th);
             glEnable(GL_BLEND);
             set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
@@ -1030,11 +961,11 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
         glEndQuery(GL_VERTEX_SHADER_INVOCATIONS);
     }
     glEndQuery(GL_SAMPLES_PASSED);
-    glEndQuery(GL_TIME_ELAPSED);
+    gr_gl_timer_end(&r->timer);
 
     /* Pass 3: full-screen pass at the frame's resolution into a float target. */
-    glBeginQuery(GL_TIME_ELAPSED, r->q_time[GR_SHAFTS_PASS_FINAL]);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->frame_fbo);
+    gr_gl_timer_begin(&r->timer, GR_SHAFTS_PASS_FINAL);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->frame.fbo);
     glViewport(0, 0, f->W, f->H);
     glClear(GL_COLOR_BUFFER_BIT);
     glUseProgram(r->prog_final);
@@ -1045,28 +976,27 @@ gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_
     glUniform3f(r->loc_refr_sun, (float)f->T.x, (float)f->T.y, (float)f->T.z);
     glUniform3fv(r->loc_intensity, 1, f->final_intensity);
     glUniform1f(r->loc_bias, f->final_bias);
-    glBindTexture(GL_TEXTURE_2D, r->target_tex);
+    glBindTexture(GL_TEXTURE_2D, r->target.tex);
     glBindVertexArray(r->vao_empty);
     glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-    glEndQuery(GL_TIME_ELAPSED);
+    gr_gl_timer_end(&r->timer);
 
     /* Read the layer back (GL rows bottom-up; gr_image top row first). */
-    if ((st = gr_readback_fbo(&r->rb, r->frame_fbo, f->W, f->H, "shafts layer", err)) != GR_OK) goto unbind;
-    gr_readback_to_rgb(&r->rb, out); /* NaN/Inf: gr_image_check_finite below */
+    /* NaN/Inf: gr_image_check_finite below */
+    if ((st = gr_readback_rgb(&r->rb, r->frame.fbo, out, NULL, "shafts layer", err)) != GR_OK) goto unbind;
     if (stats) {
         memset(stats, 0, sizeof *stats);
         /* Every pass ran between t0 and the synchronous readback: a GPU time longer than
          * that wall time is a broken timer (llvmpipe's first query after context creation
          * reads ~1e12 ns) and is reported as unavailable (-1). */
-        double wall_ns = (now_ms() - t0) * 1e6;
+        double wall_ns = (gr_clock_ms() - t0) * 1e6;
         for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
-            long long ns = r->have_timer ? query_result(r->q_time[p]) : -1;
-            stats->gpu_ns[p] = (ns >= 0 && (double)ns <= wall_ns) ? ns : -1;
+            stats->gpu_ns[p] = gr_gl_timer_ns_within(&r->timer, p, wall_ns);
         }
-        stats->fragments = query_result(r->q_samples);
+        stats->fragments = gr_gl_query_result(r->q_samples);
         stats->vertices_submitted = n_idx;
-        stats->vs_invocations = r->have_pipeline_stats ? query_result(r->q_vs) : -1;
-        stats->fs_invocations = r->have_pipeline_stats ? query_result(r->q_fs) : -1;
+        stats->vs_invocations = r->have_pipeline_stats ? gr_gl_query_result(r->q_vs) : -1;
+        stats->fs_invocations = r->have_pipeline_stats ? gr_gl_query_result(r->q_fs) : -1;
         stats->target_width = f->tw;
         stats->target_height = f->th;
         stats->n_shafts = f->nshafts;
@@ -1082,9 +1012,15 @@ unbind:
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
 done:
-    if (stats && st == GR_OK) stats->cpu_ms = now_ms() - t0;
+    if (stats && st == GR_OK) stats->cpu_ms = gr_clock_ms() - t0;
     free(f);
     return st;
+}
+
+gr_status gr_shafts_render(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s,
+                           gr_image *out, gr_shafts_stats *stats, gr_error *err)
+{
+    return render_frame(r, scene, s, 0, out, stats, err);
 }
 
 gr_status gr_shafts_read_target(gr_shafts *r, gr_image **out, gr_error *err)
@@ -1093,7 +1029,7 @@ gr_status gr_shafts_read_target(gr_shafts *r, gr_image **out, gr_error *err)
     if (!r->rendered) return gr_fail(err, GR_E_RUNTIME, "shafts: no render yet, no target to read");
     gr_status st = gr_gl_make_current(r->gl, err);
     if (st != GR_OK) return st;
-    if ((st = gr_readback_fbo(&r->rb, r->target_fbo, r->target_w, r->target_h, "shafts target", err)) != GR_OK)
+    if ((st = gr_readback_fbo(&r->rb, r->target.fbo, r->target.w, r->target.h, "shafts target", err)) != GR_OK)
         return st;
     *out = gr_readback_image(&r->rb);
     return *out ? GR_OK : gr_fail(err, GR_E_NOMEM, "shafts: out of memory for the target image");
@@ -1109,7 +1045,7 @@ gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts
     GLuint tfb = 0;
     float *data = NULL;
     if (!f) return gr_fail(err, GR_E_NOMEM, "shafts: out of memory");
-    if ((st = setup_frame(scene, s, f, err)) != GR_OK) goto done;
+    if ((st = setup_frame(scene, s, 0, f, err)) != GR_OK) goto done;
     if (f->s.variant == GR_SHAFTS_FLUX) {
         /* flux draws the shared lattice (ensure_lattice), not the per-shaft grid captured here */
         st = gr_fail(err, GR_E_INPUT, "shafts.variant = flux: the vertex capture takes the seed and path variants");
@@ -1127,7 +1063,7 @@ gr_status gr_shafts_capture(gr_shafts *r, const gr_scene *scene, const gr_shafts
     if ((st = ensure_targets(r, f, err)) != GR_OK) goto done;
     /* A surfaceless context has no default framebuffer: draw calls need a complete FBO
      * bound even with rasterizer discard on. */
-    glBindFramebuffer(GL_FRAMEBUFFER, r->target_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->target.fbo);
     int nv = r->grid_nshafts * 8;
     size_t bytes = (size_t)nv * 6 * sizeof(float);
     glGenBuffers(1, &tfb);
@@ -1269,11 +1205,6 @@ typedef struct shafts_tech {
     gr_shafts_stats last; /* the renderer's own figures of the last render */
 } shafts_tech;
 
-static gr_status tech_check(const gr_technique_class *cls, const void *settings, gr_error *err)
-{
-    return gr_shafts_check_settings(settings, err);
-}
-
 static void tech_resolve(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out)
 {
     gr_shafts_resolve(scene, in, out);
@@ -1306,7 +1237,7 @@ static gr_status tech_render(void *state, const gr_scene *scene, const void *set
                              gr_technique_stats *stats, gr_error *err)
 {
     shafts_tech *t = state;
-    gr_status st = gr_shafts_render(t->r, scene, settings, out, &t->last, err);
+    gr_status st = render_frame(t->r, scene, settings, 1, out, &t->last, err);
     if (st != GR_OK || !stats) return st;
     stats->n_passes = GR_SHAFTS_NPASS;
     for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
@@ -1386,7 +1317,7 @@ const gr_technique_class gr_shafts_class = {
     .ladder = shafts_ladder,
     .tune_keys = "K,extinction,shaft_width,g", /* spacing, attenuation, gaps, phase: the beams' look */
     .n_ladder = (int)(sizeof shafts_ladder / sizeof shafts_ladder[0]),
-    .check = tech_check,
+    .check = check_structure,
     .resolve = tech_resolve,
     .create = tech_create,
     .destroy = tech_destroy,

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "gl/gl.h"
-#include "realtime/caustics.h"
+#include "realtime/volume.h"
 #include "realtime/shaders.h"
 #include "realtime/frame.h"
 #include "realtime/scenegl.h"
@@ -90,15 +90,11 @@ fail:
     return st;
 }
 
+/* The table's ranges are checked by technique.c; what it cannot express: */
 static gr_status sl_check(const gr_technique_class *cls, const void *settings, gr_error *err)
 {
     const gr_slicing_settings *s = settings;
-    gr_status st = gr_param_validate(cls->params, settings, 1, err);
-    if (st != GR_OK) return st;
-    if (!(s->vol.caustic_last_m >= s->vol.caustic_first_m))
-        return gr_fail(err, GR_E_INPUT, "slicing.caustic_last_m = %g: must be >= slicing.caustic_first_m (%g)",
-                       s->vol.caustic_last_m, s->vol.caustic_first_m);
-    return GR_OK;
+    return gr_vol_check(cls->name, &s->vol, err);
 }
 
 enum { P_SLICES = GR_VOL_PASS_OWN };
@@ -113,7 +109,6 @@ static gr_status sl_render(void *state, const gr_scene *scene, const void *setti
     if (st != GR_OK) return st;
     const gr_frame *f = &prep.frame;
     int W = f->width, H = f->height;
-    if ((st = gr_vol_target(&r->base, W, H, "slicing", err)) != GR_OK) return st;
     r->triangles = gr_caustics_triangles(r->base.caus);
     double tmax = prep.t_max;
     double far = gr_vol_far_depth(scene, f, tmax);
@@ -128,7 +123,7 @@ static gr_status sl_render(void *state, const gr_scene *scene, const void *setti
     gr_frame_matf(inv, m);
 
     gr_gl_timer_begin(&r->base.timer, P_SLICES);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out.fbo);
     glViewport(0, 0, W, H);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
@@ -156,13 +151,8 @@ static gr_status sl_render(void *state, const gr_scene *scene, const void *setti
     glBindVertexArray(0);
     glUseProgram(0);
     r->n_slices = s->slices;
-    st = gr_vol_readback(r->base.out_fbo, W, H, out, "slicing readback", err);
-    if (st != GR_OK) return st;
-    if (stats) {
-        static const char *const names[4] = {"shadow", "eye_depth", "caustics", "slices"};
-        gr_vol_stats(stats, &r->base, names, 4, prep.t0_ms);
-    }
-    return gr_image_check_finite(out, "slicing", err);
+    static const char *const names[4] = {"shadow", "eye_depth", "caustics", "slices"};
+    return gr_vol_finish("slicing", &r->base, &prep, out, names, 4, stats, err);
 }
 
 static void sl_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)

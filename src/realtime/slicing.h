@@ -6,7 +6,7 @@
 #ifndef GR_SLICING_H
 #define GR_SLICING_H
 
-#include "realtime/caustics.h"
+#include "realtime/volume.h"
 #include "realtime/technique.h"
 
 typedef enum gr_vol_distribution { GR_VOL_LINEAR = 0, GR_VOL_EXPONENTIAL = 1 } gr_vol_distribution;

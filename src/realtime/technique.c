@@ -6,7 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+
+#include "realtime/toolkit.h"
 
 /* ---- the built-in techniques: ONE LINE EACH (their header declares the class) -------- */
 #include "realtime/shafts.h"
@@ -280,13 +281,6 @@ const gr_technique_class *gr_technique_class_of(const gr_technique *t) { return 
 
 gr_gl *gr_technique_gl(const gr_technique *t) { return t ? t->gl : NULL; }
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
 gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out,
                               gr_technique_stats *stats, gr_error *err)
 {
@@ -306,9 +300,9 @@ gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void
     int ch[3] = {gr_image_channel(out, "R"), gr_image_channel(out, "G"), gr_image_channel(out, "B")};
     if (ch[0] < 0 || ch[1] < 0 || ch[2] < 0)
         return gr_fail(err, GR_E_RUNTIME, "technique %s: output image lacks channels R, G, B", cls->name);
-    double t0 = now_ms();
+    double t0 = gr_clock_ms();
     if ((st = cls->render(t->state, scene, rs.bytes, out, stats, err)) != GR_OK) return st;
-    if (!(stats->wall_ms >= 0)) stats->wall_ms = now_ms() - t0;
+    if (!(stats->wall_ms >= 0)) stats->wall_ms = gr_clock_ms() - t0;
     /* The harness's guarantee, whatever the technique (a user's shader included): no NaN
      * or Inf reaches an image. */
     const size_t n = (size_t)out->width * (size_t)out->height;

@@ -57,7 +57,7 @@ struct gr_technique_class {
     const gr_param_table *params; /* params->section == name */
     size_t settings_size;      /* <= GR_TECH_SETTINGS_MAX */
     const char *origin;        /* "built-in" or the manifest's path (user techniques) */
-    void *class_data;          /* the class's own data (a user technique's parsed manifest) */
+    const void *class_data;    /* the class's own data (a descriptor; a user technique's parsed manifest) */
     /* A setting (double or RGB) that scales the whole output linearly ("intensity",
      * "exposure"): where `godrays tune` puts the fitted scale in its snippet, and the scale
      * fit is off by default when it is tuned. NULL: none. */
@@ -71,7 +71,10 @@ struct gr_technique_class {
     const char *tune_keys;
 
     /* Checks across settings beyond each one's range (e.g. N >= 2 and a target that fits).
-     * May be NULL. Errors name "NAME.KEY" and the reason (GR_E_INPUT). */
+     * May be NULL. Errors name "NAME.KEY" and the reason (GR_E_INPUT). Called only by
+     * gr_technique_check, after the table's ranges passed: the ONE validation of a class's
+     * settings; a class never re-validates its table, and its render receives settings that
+     * passed both (and gr_technique_render's check of the resolved ones). */
     gr_status (*check)(const gr_technique_class *cls, const void *settings, gr_error *err);
     /* Copies in to out with scene-derived defaults (GR_PF_FROM_SCENE, NaN) resolved from the
      * scene (e.g. extinction from the medium). May be NULL: the generic resolution by each
@@ -135,6 +138,7 @@ const void *gr_technique_scene_settings(const gr_technique_class *cls, const gr_
  * re-validates). NULL for a class registered after the scene was loaded. */
 void *gr_technique_scene_settings_rw(const gr_technique_class *cls, gr_scene *scene);
 void gr_technique_resolve(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out);
+/* The table's ranges (NaN allowed where scene-derived), then the class's check. */
 gr_status gr_technique_check(const gr_technique_class *cls, const void *settings, gr_error *err);
 /* The first (at most max) number or RGB settings of cls that have a tuning box, in table
  * order: the example parameters commands suggest (`--params NAME.A,NAME.B`). Returns how many. */

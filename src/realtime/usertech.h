@@ -21,8 +21,7 @@
 
 #include "common/status.h"
 #include "realtime/technique.h"
-
-#define GR_USERTECH_MANIFEST "manifest.json"
+#include "realtime/usertech_manifest.h" /* GR_USERTECH_MANIFEST */
 
 /* Parses and validates DIR/manifest.json and reads its shader files; *out is a new class
  * (name, description, params, callbacks) owned by the caller: gr_usertech_free. */

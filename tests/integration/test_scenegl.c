@@ -13,6 +13,7 @@
 #include "check.h"
 #include "gl/gl.h"
 #include "realtime/scenegl.h"
+#include "realtime/toolkit.h"
 
 static gr_scene *load(const char *json)
 {

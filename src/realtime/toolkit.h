@@ -1,0 +1,72 @@
+/* The technique toolkit: the GL plumbing every real-time technique (the built-ins and a
+ * user's manifest) needs and used to copy: render targets (a texture with its framebuffer,
+ * remade only when its size or format changes), the wall clock, GPU pass timers and the
+ * stats filled from them. Reading a target back is realtime/readback.h; what the volume
+ * techniques share is realtime/volume.h. Every GL call needs the owning context current. */
+#ifndef GR_TOOLKIT_H
+#define GR_TOOLKIT_H
+
+#include "common/status.h"
+#include "realtime/technique.h"
+
+/* ---- clock ----------------------------------------------------------------------------- */
+
+/* Monotonic wall clock (ms, arbitrary origin): the wall time of a render. */
+double gr_clock_ms(void);
+
+/* ---- render targets -------------------------------------------------------------------- */
+
+/* A 2D texture (one level) and a framebuffer with it attached; zero-initialize. */
+typedef struct gr_target {
+    unsigned tex, fbo;
+    int w, h;          /* 0 x 0 until made */
+    unsigned ifmt;     /* GL internal format it was made with */
+} gr_target;
+
+enum {
+    /* depth attachment (no colour buffer), clamped to a border depth 1 ("no caster" for a
+     * shadow map), compare mode off; else a colour attachment 0 */
+    GR_TARGET_DEPTH = 1,
+    GR_TARGET_LINEAR = 2,       /* GL_LINEAR filtering; else GL_NEAREST */
+    GR_TARGET_BLACK_BORDER = 4, /* colour: reads black outside [0,1]^2; else clamped to the edge */
+};
+
+/* Makes t a w x h target of internal format ifmt with flags, unless it already is one of that
+ * size and format (then nothing happens: the flags of one target must not change). `what`
+ * names the target in errors (GR_E_GL: framebuffer incomplete; a GL error). On failure t is
+ * left empty. Leaves framebuffer 0 and texture 0 bound. */
+gr_status gr_target_ensure(gr_target *t, unsigned ifmt, int w, int h, int flags, const char *what, gr_error *err);
+void gr_target_release(gr_target *t); /* deletes the GL objects; accepts NULL and an empty one */
+
+/* ---- GPU pass timers ------------------------------------------------------------------- */
+
+#define GR_GL_TIMER_PASSES 8
+
+/* GPU pass timing: begin/end around a pass; results collected after the frame. */
+typedef struct gr_gl_timer {
+    unsigned queries[GR_GL_TIMER_PASSES];
+    int n, have_timer;
+    unsigned used;      /* bit p: pass p was timed in this frame */
+} gr_gl_timer;
+void gr_gl_timer_init(gr_gl_timer *t);            /* needs a current context */
+void gr_gl_timer_reset(gr_gl_timer *t);           /* a new frame: no pass timed yet */
+void gr_gl_timer_begin(gr_gl_timer *t, int pass); /* pass < GR_GL_TIMER_PASSES */
+void gr_gl_timer_end(gr_gl_timer *t);
+/* -1 if no timer or the pass was not timed. Waits for the result. On llvmpipe the first query
+ * of a context may read ~1e12 ns: callers drop a figure longer than the frame's wall time
+ * (gr_gl_timer_ns_within). */
+long long gr_gl_timer_ns(gr_gl_timer *t, int pass);
+/* The same, -1 also when longer than wall_ns: every pass ran within the render's wall time,
+ * so a longer figure is a broken timer (llvmpipe's first query after context creation). */
+long long gr_gl_timer_ns_within(gr_gl_timer *t, int pass, double wall_ns);
+void gr_gl_timer_free(gr_gl_timer *t);            /* accepts one never initialized (zeroed) */
+
+/* The result of a query object (GL_SAMPLES_PASSED, ...); waits for it. */
+long long gr_gl_query_result(unsigned query);
+
+/* Fills stats after a render that started at t0_ms (gr_clock_ms): n passes named names[p]
+ * with t's times (gr_gl_timer_ns_within the wall time so far), fragments -1 (the caller sets
+ * it), wall_ms the time since t0_ms. */
+void gr_gl_timer_stats(gr_technique_stats *stats, gr_gl_timer *t, const char *const *names, int n, double t0_ms);
+
+#endif

@@ -1,0 +1,908 @@
+/* A user technique's manifest: parsing and validation (usertech_manifest.h,
+ * docs/techniques.md). */
+#include "realtime/usertech_manifest.h"
+
+#include <cjson/cJSON.h>
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+const char *const gr_ut_type_names[] = {"number", "int", "bool", "rgb", NULL};
+const char *const gr_ut_format_names[] = {"rgba8", "rgba16f", "rgba32f", NULL};
+const char *const gr_ut_blend_names[] = {"none", "additive", "alpha", NULL};
+const char *const gr_ut_prim_names[] = {"triangles", "triangle_strip", "lines", "points", NULL};
+
+/* ---- small helpers ------------------------------------------------------------------------ */
+
+static char *dup_string(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d) memcpy(d, s, n);
+    return d;
+}
+
+void gr_ut_sb_add(gr_ut_strbuf *b, const char *fmt, ...)
+{
+    if (b->failed) return;
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        int n = vsnprintf(b->s ? b->s + b->len : NULL, b->s ? b->cap - b->len : 0, fmt, ap);
+        va_end(ap);
+        if (n < 0) {
+            b->failed = 1;
+            return;
+        }
+        if (b->s && b->len + (size_t)n < b->cap) {
+            b->len += (size_t)n;
+            return;
+        }
+        size_t nc = (b->cap ? b->cap * 2 : 4096);
+        while (nc < b->len + (size_t)n + 1) nc *= 2;
+        char *ns = realloc(b->s, nc);
+        if (!ns) {
+            b->failed = 1;
+            return;
+        }
+        b->s = ns;
+        b->cap = nc;
+    }
+}
+
+typedef struct ut_ctx {
+    gr_error *err;
+    const char *path; /* manifest path, prefixes every message */
+} ut_ctx;
+
+static gr_status vfail(ut_ctx *c, const char *jpath, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static gr_status vfail(ut_ctx *c, const char *jpath, const char *fmt, ...)
+{
+    char msg[700];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    /* one line: a message never carries a newline (file names could) */
+    for (char *q = msg; *q; q++)
+        if (*q == '\n' || *q == '\r') *q = ' ';
+    return gr_fail(c->err, GR_E_INPUT, "%s: %s: %s", c->path, jpath, msg);
+}
+
+/* out = "parent.key" (or "key"), truncated to n - 1 characters */
+static void join(char *out, size_t n, const char *parent, const char *key)
+{
+    size_t k = 0;
+    for (const char *q = parent ? parent : ""; *q && k + 1 < n; q++) out[k++] = *q;
+    if (k > 0 && k + 1 < n) out[k++] = '.';
+    for (const char *q = key; *q && k + 1 < n; q++) out[k++] = *q;
+    out[k] = '\0';
+}
+
+static const char *type_name(const cJSON *v)
+{
+    if (!v) return "nothing";
+    if (cJSON_IsNumber(v)) return "a number";
+    if (cJSON_IsString(v)) return "a string";
+    if (cJSON_IsBool(v)) return "a boolean";
+    if (cJSON_IsNull(v)) return "null";
+    if (cJSON_IsArray(v)) return "an array";
+    if (cJSON_IsObject(v)) return "an object";
+    return "?";
+}
+
+static int in_list(const char *key, const char *const *names)
+{
+    for (int i = 0; names[i]; i++)
+        if (!strcmp(key, names[i])) return i;
+    return -1;
+}
+
+static void list_text(const char *const *names, char *out, size_t n)
+{
+    size_t used = 0;
+    out[0] = '\0';
+    for (int i = 0; names[i]; i++) {
+        int w = snprintf(out + used, n - used, "%s%s", i ? ", " : "", names[i]);
+        if (w < 0 || (size_t)w >= n - used) break;
+        used += (size_t)w;
+    }
+}
+
+/* Object with keys among names (NULL-terminated), each at most once. */
+static gr_status check_object(ut_ctx *c, const cJSON *obj, const char *path, const char *const *names)
+{
+    char p[320], list[400];
+    if (!cJSON_IsObject(obj)) return vfail(c, path[0] ? path : "(top level)", "must be an object, got %s", type_name(obj));
+    for (const cJSON *it = obj->child; it; it = it->next) {
+        const char *k = it->string ? it->string : "";
+        join(p, sizeof p, path, k);
+        if (names && in_list(k, names) < 0) {
+            list_text(names, list, sizeof list);
+            return vfail(c, p, "unknown key (known keys: %s)", list);
+        }
+        for (const cJSON *prev = obj->child; prev != it; prev = prev->next)
+            if (!strcmp(prev->string, k)) return vfail(c, p, "duplicate key");
+    }
+    return GR_OK;
+}
+
+/* [a-z][a-z0-9_]* (lower = 1) or [A-Za-z][A-Za-z0-9_]* (lower = 0), no "__", < max chars. */
+static int is_identifier(const char *s, int lower, size_t max)
+{
+    size_t n = strlen(s);
+    if (n == 0 || n >= max) return 0;
+    if (lower ? !(s[0] >= 'a' && s[0] <= 'z') : !isalpha((unsigned char)s[0])) return 0;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char ch = (unsigned char)s[i];
+        int ok = (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_' || (!lower && ch >= 'A' && ch <= 'Z');
+        if (!ok) return 0;
+        if (ch == '_' && s[i + 1] == '_') return 0;
+    }
+    return 1;
+}
+
+static gr_status get_string(ut_ctx *c, const cJSON *obj, const char *parent, const char *key, int required,
+                            const char **out)
+{
+    char p[320];
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    join(p, sizeof p, parent, key);
+    if (!v) {
+        if (required) return vfail(c, p, "missing (required)");
+        return GR_OK;
+    }
+    if (!cJSON_IsString(v)) return vfail(c, p, "must be a string, got %s", type_name(v));
+    *out = v->valuestring;
+    return GR_OK;
+}
+
+static gr_status get_enum(ut_ctx *c, const cJSON *obj, const char *parent, const char *key,
+                          const char *const *names, int *out)
+{
+    const char *s = NULL;
+    char p[320], list[200];
+    gr_status st = get_string(c, obj, parent, key, 0, &s);
+    if (st || !s) return st;
+    join(p, sizeof p, parent, key);
+    int i = in_list(s, names);
+    if (i < 0) {
+        list_text(names, list, sizeof list);
+        return vfail(c, p, "unknown value '%s', expected one of %s", s, list);
+    }
+    *out = i;
+    return GR_OK;
+}
+
+static gr_status number_at(ut_ctx *c, const cJSON *v, const char *p, double *out)
+{
+    if (!cJSON_IsNumber(v)) return vfail(c, p, "must be a number, got %s", type_name(v));
+    if (!isfinite(v->valuedouble)) return vfail(c, p, "must be a finite number");
+    *out = v->valuedouble;
+    return GR_OK;
+}
+
+static gr_status get_bool(ut_ctx *c, const cJSON *obj, const char *parent, const char *key, int *out)
+{
+    char p[320];
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v) return GR_OK;
+    join(p, sizeof p, parent, key);
+    if (!cJSON_IsBool(v)) return vfail(c, p, "must be true or false, got %s", type_name(v));
+    *out = cJSON_IsTrue(v) ? 1 : 0;
+    return GR_OK;
+}
+
+static int find_setting(const gr_ut_manifest *m, const char *key)
+{
+    for (int i = 0; i < m->n_settings; i++)
+        if (!strcmp(m->settings[i].key, key)) return i;
+    return -1;
+}
+
+static int find_target(const gr_ut_manifest *m, const char *name)
+{
+    for (int i = 0; i < m->n_targets; i++)
+        if (!strcmp(m->targets[i].name, name)) return i;
+    return -1;
+}
+
+/* A number, or the name of a setting of type `want` (GR_UT_NUMBER accepts int settings too)
+ * whose whole range lies within [lo, hi]. */
+static gr_status value_at(ut_ctx *c, const gr_ut_manifest *m, const cJSON *v, const char *p, gr_ut_type want, double lo,
+                          double hi, gr_ut_value *out)
+{
+    if (cJSON_IsString(v)) {
+        int s = find_setting(m, v->valuestring);
+        if (s < 0) return vfail(c, p, "'%s' is not a setting of this technique", v->valuestring);
+        gr_ut_type t = m->settings[s].type;
+        if (!(t == want || (want == GR_UT_NUMBER && t == GR_UT_INT)))
+            return vfail(c, p, "setting '%s' is of type %s, this field needs %s", v->valuestring, gr_ut_type_names[t],
+                         want == GR_UT_INT ? "an int setting" : "a number or int setting");
+        const gr_param *gp = &m->params[s];
+        if (gp->min < lo || gp->max > hi)
+            return vfail(c, p, "setting '%s' has range [%g, %g], this field needs values within [%g, %g]",
+                         v->valuestring, gp->min, gp->max, lo, hi);
+        out->setting = s;
+        out->v = gp->def;
+        return GR_OK;
+    }
+    double d = 0;
+    gr_status st = number_at(c, v, p, &d);
+    if (st) return st;
+    if (want == GR_UT_INT && d != floor(d)) return vfail(c, p, "must be an integer, got %g", d);
+    if (d < lo || d > hi) return vfail(c, p, "must be in [%g, %g], got %g", lo, hi, d);
+    out->setting = -1;
+    out->v = d;
+    return GR_OK;
+}
+
+/* A count: a positive integer, the name of an int setting, or "a*b*..." of those. */
+static gr_status count_at(ut_ctx *c, const gr_ut_manifest *m, const cJSON *v, const char *p, gr_ut_count *out)
+{
+    memset(out, 0, sizeof *out);
+    out->literal = 1;
+    if (cJSON_IsNumber(v)) {
+        double d = v->valuedouble;
+        if (!(d >= 1 && d <= 1e8 && d == floor(d))) return vfail(c, p, "must be an integer in [1, 100000000], got %g", d);
+        out->literal = (long long)d;
+        return GR_OK;
+    }
+    if (!cJSON_IsString(v))
+        return vfail(c, p, "must be an integer, an int setting's name or a product such as \"6*N\", got %s", type_name(v));
+    char buf[128];
+    snprintf(buf, sizeof buf, "%s", v->valuestring);
+    char *save = NULL;
+    int any = 0;
+    for (char *tok = strtok_r(buf, "*", &save); tok; tok = strtok_r(NULL, "*", &save)) {
+        while (*tok == ' ') tok++;
+        char *e = tok + strlen(tok);
+        while (e > tok && e[-1] == ' ') *--e = '\0';
+        any = 1;
+        if (isdigit((unsigned char)tok[0])) {
+            char *end = NULL;
+            long long k = strtoll(tok, &end, 10);
+            if (*end || k < 1 || k > 100000000) return vfail(c, p, "'%s': factor '%s' is not an integer in [1, 100000000]", v->valuestring, tok);
+            out->literal *= k;
+            if (out->literal > 100000000) return vfail(c, p, "'%s': more than 100000000", v->valuestring);
+            continue;
+        }
+        int s = find_setting(m, tok);
+        if (s < 0) return vfail(c, p, "'%s': '%s' is not a setting of this technique", v->valuestring, tok);
+        if (m->settings[s].type != GR_UT_INT) return vfail(c, p, "'%s': setting '%s' must be of type int", v->valuestring, tok);
+        if (m->params[s].min < 0) return vfail(c, p, "'%s': setting '%s' must have min >= 0", v->valuestring, tok);
+        if (out->n_factors == GR_UT_MAX_FACTORS) return vfail(c, p, "'%s': at most %d setting factors", v->valuestring, GR_UT_MAX_FACTORS);
+        out->factor[out->n_factors++] = s;
+    }
+    if (!any) return vfail(c, p, "empty count");
+    return GR_OK;
+}
+
+gr_status gr_ut_read_file(const char *path, char **out, char *why, size_t why_n)
+{
+    FILE *f = fopen(path, "rb");
+    *out = NULL;
+    if (!f) {
+        snprintf(why, why_n, "%s", strerror(errno));
+        return GR_E_IO;
+    }
+    struct stat sb;
+    if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        fclose(f);
+        snprintf(why, why_n, "not a regular file");
+        return GR_E_IO;
+    }
+    size_t cap = (size_t)sb.st_size + 1, len = 0;
+    char *buf = malloc(cap);
+    if (!buf) {
+        fclose(f);
+        snprintf(why, why_n, "out of memory");
+        return GR_E_NOMEM;
+    }
+    len = fread(buf, 1, cap - 1, f);
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        snprintf(why, why_n, "read error");
+        return GR_E_IO;
+    }
+    buf[len] = '\0';
+    if (strlen(buf) != len) {
+        free(buf);
+        snprintf(why, why_n, "contains a NUL byte (not a text file)");
+        return GR_E_IO;
+    }
+    *out = buf;
+    return GR_OK;
+}
+
+/* Reads DIR/file named at JSON path p; a missing or unreadable file is bad input (exit 2). */
+static gr_status shader_file(ut_ctx *c, const gr_ut_manifest *m, const char *file, const char *p, char **src)
+{
+    char full[4096], why[256];
+    if (!file[0]) return vfail(c, p, "empty file name");
+    if (file[0] == '/') snprintf(full, sizeof full, "%s", file);
+    else snprintf(full, sizeof full, "%s/%s", m->dir, file);
+    gr_status st = gr_ut_read_file(full, src, why, sizeof why);
+    if (st == GR_E_NOMEM) return gr_fail(c->err, st, "%s: %s: out of memory", c->path, p);
+    if (st) return vfail(c, p, "cannot read shader %s: %s", full, why);
+    return GR_OK;
+}
+
+/* ---- manifest sections ------------------------------------------------------------------- */
+
+static gr_status parse_settings(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
+{
+    static const char *const keys[] = {"type", "default", "min", "max", "min_exclusive", "max_exclusive",
+                                       "tune", "unit", "doc", NULL};
+    gr_status st = check_object(c, obj, "settings", NULL);
+    if (st) return st;
+    size_t offset = 0;
+    for (const cJSON *it = obj->child; it; it = it->next) {
+        char p[320], q[360];
+        join(p, sizeof p, "settings", it->string);
+        if (m->n_settings == GR_UT_MAX_SETTINGS) return vfail(c, p, "more than %d settings", GR_UT_MAX_SETTINGS);
+        if (!is_identifier(it->string, 0, GR_TECH_NAME_MAX))
+            return vfail(c, p, "a setting's key must be a GLSL-friendly name [A-Za-z][A-Za-z0-9_]* of at most %d characters without '__'",
+                         GR_TECH_NAME_MAX - 1);
+        if ((st = check_object(c, it, p, keys))) return st;
+        int i = m->n_settings;
+        gr_ut_setting *s = &m->settings[i];
+        gr_param *gp = &m->params[i];
+        snprintf(s->key, sizeof s->key, "%s", it->string);
+        int type = -1;
+        if ((st = get_enum(c, it, p, "type", gr_ut_type_names, &type))) return st;
+        if (type < 0) {
+            join(q, sizeof q, p, "type");
+            return vfail(c, q, "missing (required: number, int, bool or rgb)");
+        }
+        s->type = (gr_ut_type)type;
+        size_t size = s->type == GR_UT_RGB ? 3 * sizeof(double) : sizeof(double);
+        s->offset = offset;
+        offset += size;
+        if (offset > GR_TECH_SETTINGS_MAX) return vfail(c, p, "settings take more than %d bytes", GR_TECH_SETTINGS_MAX);
+        gp->name = s->key;
+        gp->offset = s->offset;
+        gp->type = s->type == GR_UT_NUMBER ? GR_PT_DOUBLE : s->type == GR_UT_INT ? GR_PT_INT : s->type == GR_UT_BOOL ? GR_PT_BOOL : GR_PT_RGB;
+        /* range */
+        const cJSON *vmin = cJSON_GetObjectItemCaseSensitive(it, "min");
+        const cJSON *vmax = cJSON_GetObjectItemCaseSensitive(it, "max");
+        if (s->type == GR_UT_BOOL) {
+            if (vmin || vmax) {
+                join(q, sizeof q, p, vmin ? "min" : "max");
+                return vfail(c, q, "a bool setting has no range");
+            }
+            gp->min = 0;
+            gp->max = 1;
+        } else {
+            if (!vmin || !vmax) {
+                join(q, sizeof q, p, !vmin ? "min" : "max");
+                return vfail(c, q, "missing (required: the valid range, also the default tuning box)");
+            }
+            join(q, sizeof q, p, "min");
+            if ((st = number_at(c, vmin, q, &gp->min))) return st;
+            join(q, sizeof q, p, "max");
+            if ((st = number_at(c, vmax, q, &gp->max))) return st;
+            if (!(gp->min < gp->max)) return vfail(c, q, "max (%g) must be greater than min (%g)", gp->max, gp->min);
+            if (s->type == GR_UT_INT && (gp->min != floor(gp->min) || gp->max != floor(gp->max) ||
+                                      fabs(gp->min) > 1e9 || fabs(gp->max) > 1e9))
+                return vfail(c, q, "an int setting's range must be integers within +-1e9");
+            int ex = 0;
+            if ((st = get_bool(c, it, p, "min_exclusive", &ex))) return st;
+            if (ex) gp->flags |= GR_PF_MIN_EXCL;
+            ex = 0;
+            if ((st = get_bool(c, it, p, "max_exclusive", &ex))) return st;
+            if (ex) gp->flags |= GR_PF_MAX_EXCL;
+        }
+        /* default */
+        const cJSON *vdef = cJSON_GetObjectItemCaseSensitive(it, "default");
+        join(q, sizeof q, p, "default");
+        if (!vdef) return vfail(c, q, "missing (required)");
+        if (s->type == GR_UT_BOOL) {
+            if (!cJSON_IsBool(vdef)) return vfail(c, q, "must be true or false, got %s", type_name(vdef));
+            gp->def = cJSON_IsTrue(vdef) ? 1 : 0;
+        } else {
+            if (s->type == GR_UT_RGB && cJSON_IsArray(vdef))
+                return vfail(c, q, "an rgb setting's default is one number (the same for r, g and b)");
+            if ((st = number_at(c, vdef, q, &gp->def))) return st;
+            if (s->type == GR_UT_INT && gp->def != floor(gp->def)) return vfail(c, q, "must be an integer, got %g", gp->def);
+            int below = (gp->flags & GR_PF_MIN_EXCL) ? !(gp->def > gp->min) : !(gp->def >= gp->min);
+            int above = (gp->flags & GR_PF_MAX_EXCL) ? !(gp->def < gp->max) : !(gp->def <= gp->max);
+            if (below || above) {
+                char r[80];
+                return vfail(c, q, "%g is outside the setting's range %s", gp->def, gr_param_range_text(gp, r, sizeof r));
+            }
+        }
+        /* default tuning box */
+        const cJSON *vt = cJSON_GetObjectItemCaseSensitive(it, "tune");
+        if (vt) {
+            join(q, sizeof q, p, "tune");
+            if (s->type != GR_UT_NUMBER && s->type != GR_UT_RGB)
+                return vfail(c, q, "only number and rgb settings are tuned (int settings are swept)");
+            if (!cJSON_IsArray(vt) || cJSON_GetArraySize(vt) != 2) return vfail(c, q, "must be [lo, hi]");
+            double lh[2] = {0, 0};
+            for (int k = 0; k < 2; k++) {
+                char e[380];
+                snprintf(e, sizeof e, "%s[%d]", q, k);
+                if ((st = number_at(c, cJSON_GetArrayItem(vt, k), e, &lh[k]))) return st;
+            }
+            if (!(lh[0] < lh[1])) return vfail(c, q, "lo (%g) must be below hi (%g)", lh[0], lh[1]);
+            if (s->type == GR_UT_NUMBER && (lh[0] < gp->min || lh[1] > gp->max))
+                return vfail(c, q, "[%g, %g] is not within the setting's range [%g, %g]", lh[0], lh[1], gp->min, gp->max);
+            if (s->type == GR_UT_RGB && lh[0] < 0) return vfail(c, q, "an rgb setting is tuned as a scale: lo must be >= 0");
+            gp->tune_lo = lh[0];
+            gp->tune_hi = lh[1];
+        }
+        const char *unit = "", *doc = "";
+        if ((st = get_string(c, it, p, "unit", 0, &unit))) return st;
+        if ((st = get_string(c, it, p, "doc", 0, &doc))) return st;
+        m->param_strings[i][0] = dup_string(unit);
+        m->param_strings[i][1] = dup_string(doc);
+        if (!m->param_strings[i][0] || !m->param_strings[i][1]) return gr_fail(c->err, GR_E_NOMEM, "%s: out of memory", c->path);
+        for (char *z = m->param_strings[i][1]; *z; z++)
+            if (*z == '\n' || *z == '\r') *z = ' ';
+        gp->unit = m->param_strings[i][0];
+        gp->doc = m->param_strings[i][1];
+        m->n_settings++;
+    }
+    m->settings_size = offset ? offset : sizeof(double);
+    return GR_OK;
+}
+
+static gr_status parse_targets(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
+{
+    static const char *const keys[] = {"scale", "size", "format", "filter", NULL};
+    static const char *const filters[] = {"linear", "nearest", NULL};
+    gr_status st = check_object(c, obj, "targets", NULL);
+    if (st) return st;
+    if (!obj->child) return vfail(c, "targets", "must name at least one render target");
+    for (const cJSON *it = obj->child; it; it = it->next) {
+        char p[320], q[360];
+        join(p, sizeof p, "targets", it->string);
+        if (m->n_targets == GR_UT_MAX_TARGETS) return vfail(c, p, "more than %d targets", GR_UT_MAX_TARGETS);
+        if (!is_identifier(it->string, 1, GR_UT_NAME_MAX))
+            return vfail(c, p, "a target's name must be [a-z][a-z0-9_]* of at most %d characters without '__'", GR_UT_NAME_MAX - 1);
+        if (!strcmp(it->string, "shadow_map") || !strcmp(it->string, "eye_depth"))
+            return vfail(c, p, "'%s' is the name of a harness texture", it->string);
+        if ((st = check_object(c, it, p, keys))) return st;
+        gr_ut_target *t = &m->targets[m->n_targets];
+        snprintf(t->name, sizeof t->name, "%s", it->string);
+        const cJSON *vs = cJSON_GetObjectItemCaseSensitive(it, "scale");
+        const cJSON *vz = cJSON_GetObjectItemCaseSensitive(it, "size");
+        t->scale.v = 1;
+        t->scale.setting = -1;
+        if (vs && vz) {
+            join(q, sizeof q, p, "size");
+            return vfail(c, q, "give either scale (relative to the frame) or size (absolute), not both");
+        }
+        if (vs) {
+            join(q, sizeof q, p, "scale");
+            if ((st = value_at(c, m, vs, q, GR_UT_NUMBER, 1.0 / 64.0, 4.0, &t->scale))) return st;
+        } else if (vz) {
+            join(q, sizeof q, p, "size");
+            if (!cJSON_IsArray(vz) || cJSON_GetArraySize(vz) != 2) return vfail(c, q, "must be [width, height] in pixels");
+            double d[2] = {0, 0};
+            for (int k = 0; k < 2; k++) {
+                char e[380];
+                snprintf(e, sizeof e, "%s[%d]", q, k);
+                if ((st = number_at(c, cJSON_GetArrayItem(vz, k), e, &d[k]))) return st;
+                if (!(d[k] >= 1 && d[k] <= GR_UT_MAX_SIZE && d[k] == floor(d[k])))
+                    return vfail(c, e, "must be an integer in [1, %d], got %g", GR_UT_MAX_SIZE, d[k]);
+            }
+            t->absolute = 1;
+            t->width = (int)d[0];
+            t->height = (int)d[1];
+        }
+        int fmt = -1, filt = 0;
+        if ((st = get_enum(c, it, p, "format", gr_ut_format_names, &fmt))) return st;
+        if (fmt < 0) {
+            join(q, sizeof q, p, "format");
+            return vfail(c, q, "missing (required: rgba8, rgba16f or rgba32f)");
+        }
+        t->format = (gr_ut_format)fmt;
+        if ((st = get_enum(c, it, p, "filter", filters, &filt))) return st;
+        t->linear = filt == 0;
+        m->n_targets++;
+    }
+    return GR_OK;
+}
+
+static gr_status parse_pass(ut_ctx *c, gr_ut_manifest *m, const cJSON *it, int idx, const int *written)
+{
+    static const char *const keys[] = {"name", "vertex", "fragment", "draw", "target", "blend", "clear", "inputs", NULL};
+    static const char *const draw_keys[] = {"primitive", "vertices", "instances", NULL};
+    char p[64], q[320], list[400];
+    gr_status st;
+    snprintf(p, sizeof p, "passes[%d]", idx);
+    if ((st = check_object(c, it, p, keys))) return st;
+    gr_ut_pass *ps = &m->passes[idx];
+    const char *s = NULL;
+    if ((st = get_string(c, it, p, "name", 0, &s))) return st;
+    if (s) {
+        join(q, sizeof q, p, "name");
+        if (!is_identifier(s, 1, GR_UT_NAME_MAX))
+            return vfail(c, q, "a pass's name must be [a-z][a-z0-9_]* of at most %d characters", GR_UT_NAME_MAX - 1);
+        for (int k = 0; k < idx; k++)
+            if (!strcmp(m->passes[k].name, s)) return vfail(c, q, "'%s' names passes[%d] already", s, k);
+        snprintf(ps->name, sizeof ps->name, "%s", s);
+    } else {
+        snprintf(ps->name, sizeof ps->name, "pass%d", idx);
+    }
+    /* draw */
+    const cJSON *d = cJSON_GetObjectItemCaseSensitive(it, "draw");
+    join(q, sizeof q, p, "draw");
+    ps->fullscreen = 1;
+    if (d && cJSON_IsString(d)) {
+        if (strcmp(d->valuestring, "fullscreen"))
+            return vfail(c, q, "unknown value '%s', expected \"fullscreen\" or an object {primitive, vertices, instances}",
+                         d->valuestring);
+    } else if (d) {
+        if ((st = check_object(c, d, q, draw_keys))) return st;
+        int prim = -1;
+        if ((st = get_enum(c, d, q, "primitive", gr_ut_prim_names, &prim))) return st;
+        if (prim < 0) {
+            char r[360];
+            join(r, sizeof r, q, "primitive");
+            list_text(gr_ut_prim_names, list, sizeof list);
+            return vfail(c, r, "missing (required: one of %s)", list);
+        }
+        ps->fullscreen = 0;
+        ps->prim = (gr_ut_prim)prim;
+        const cJSON *vv = cJSON_GetObjectItemCaseSensitive(d, "vertices");
+        char r[360];
+        join(r, sizeof r, q, "vertices");
+        if (!vv) return vfail(c, r, "missing (required)");
+        if ((st = count_at(c, m, vv, r, &ps->vertices))) return st;
+        const cJSON *vi = cJSON_GetObjectItemCaseSensitive(d, "instances");
+        join(r, sizeof r, q, "instances");
+        if (vi) {
+            if ((st = count_at(c, m, vi, r, &ps->instances))) return st;
+        } else {
+            ps->instances.literal = 1;
+        }
+    }
+    /* shaders */
+    const char *vf = NULL, *ff = NULL;
+    if ((st = get_string(c, it, p, "vertex", 0, &vf))) return st;
+    if ((st = get_string(c, it, p, "fragment", 1, &ff))) return st;
+    if (!vf && !ps->fullscreen) {
+        join(q, sizeof q, p, "vertex");
+        return vfail(c, q, "missing (required unless draw is \"fullscreen\")");
+    }
+    if (vf) {
+        join(q, sizeof q, p, "vertex");
+        if (!(ps->vertex_file = dup_string(vf))) return gr_fail(c->err, GR_E_NOMEM, "%s: out of memory", c->path);
+        if ((st = shader_file(c, m, vf, q, &ps->vertex_src))) return st;
+    }
+    join(q, sizeof q, p, "fragment");
+    if (!(ps->fragment_file = dup_string(ff))) return gr_fail(c->err, GR_E_NOMEM, "%s: out of memory", c->path);
+    if ((st = shader_file(c, m, ff, q, &ps->fragment_src))) return st;
+    /* target */
+    if ((st = get_string(c, it, p, "target", 1, &s))) return st;
+    join(q, sizeof q, p, "target");
+    ps->target = find_target(m, s);
+    if (ps->target < 0) {
+        const char *names[GR_UT_MAX_TARGETS + 1];
+        for (int k = 0; k < m->n_targets; k++) names[k] = m->targets[k].name;
+        names[m->n_targets] = NULL;
+        list_text(names, list, sizeof list);
+        return vfail(c, q, "unknown target '%s' (targets: %s)", s, list);
+    }
+    int blend = GR_UT_BLEND_NONE;
+    if ((st = get_enum(c, it, p, "blend", gr_ut_blend_names, &blend))) return st;
+    ps->blend = (gr_ut_blend)blend;
+    /* clear */
+    const cJSON *vc = cJSON_GetObjectItemCaseSensitive(it, "clear");
+    join(q, sizeof q, p, "clear");
+    if (vc && !cJSON_IsFalse(vc)) {
+        if (!cJSON_IsArray(vc) || cJSON_GetArraySize(vc) != 4)
+            return vfail(c, q, "must be [r, g, b, a] or false, got %s", type_name(vc));
+        for (int k = 0; k < 4; k++) {
+            char r[360];
+            double x = 0;
+            snprintf(r, sizeof r, "%s[%d]", q, k);
+            if ((st = number_at(c, cJSON_GetArrayItem(vc, k), r, &x))) return st;
+            ps->clear[k] = (float)x;
+        }
+        ps->has_clear = 1;
+    }
+    /* inputs */
+    const cJSON *vin = cJSON_GetObjectItemCaseSensitive(it, "inputs");
+    join(q, sizeof q, p, "inputs");
+    if (vin) {
+        if (!cJSON_IsArray(vin)) return vfail(c, q, "must be an array of names, got %s", type_name(vin));
+        int k = 0;
+        for (const cJSON *e = vin->child; e; e = e->next, k++) {
+            char r[360];
+            snprintf(r, sizeof r, "%s[%d]", q, k);
+            if (k == GR_UT_MAX_INPUTS) return vfail(c, q, "more than %d inputs", GR_UT_MAX_INPUTS);
+            if (!cJSON_IsString(e)) return vfail(c, r, "must be a string, got %s", type_name(e));
+            const char *nm = e->valuestring;
+            int in;
+            if (!strcmp(nm, "shadow_map")) {
+                in = GR_UT_IN_SHADOW_MAP;
+                m->uses_shadow_map = 1;
+            } else if (!strcmp(nm, "eye_depth")) {
+                in = GR_UT_IN_EYE_DEPTH;
+                m->uses_eye_depth = 1;
+            } else {
+                in = find_target(m, nm);
+                if (in < 0) return vfail(c, r, "unknown input '%s' (a target's name, \"shadow_map\" or \"eye_depth\")", nm);
+                if (in == ps->target)
+                    return vfail(c, r, "pass reads its own target '%s' (a feedback loop): render into another target", nm);
+                if (!written[in]) return vfail(c, r, "target '%s' is read before any earlier pass writes it", nm);
+            }
+            for (int j = 0; j < ps->n_inputs; j++)
+                if (ps->inputs[j] == in) return vfail(c, r, "'%s' is listed twice", nm);
+            ps->inputs[ps->n_inputs++] = in;
+        }
+    }
+    return GR_OK;
+}
+
+/* "ladder": [{"settings": {KEY: value, ...}, "quick": bool}, ...] -> "KEY=VALUE,..." levels */
+static gr_status parse_ladder(ut_ctx *c, gr_ut_manifest *m, const cJSON *lad)
+{
+    static const char *const keys[] = {"settings", "quick", NULL};
+    if (!cJSON_IsArray(lad)) return vfail(c, "ladder", "must be an array of levels, got %s", type_name(lad));
+    if (cJSON_GetArraySize(lad) > GR_UT_MAX_LADDER) return vfail(c, "ladder", "more than %d levels", GR_UT_MAX_LADDER);
+    int i = 0;
+    gr_status st;
+    for (const cJSON *lv = lad->child; lv; lv = lv->next, i++) {
+        char p[64], q[320];
+        snprintf(p, sizeof p, "ladder[%d]", i);
+        if ((st = check_object(c, lv, p, keys))) return st;
+        const cJSON *set = cJSON_GetObjectItemCaseSensitive(lv, "settings");
+        join(q, sizeof q, p, "settings");
+        if (!set) return vfail(c, q, "missing (required: {\"KEY\": value, ...})");
+        if ((st = check_object(c, set, q, NULL))) return st;
+        gr_ut_strbuf b = {0};
+        for (const cJSON *e = set->child; e; e = e->next) {
+            char r[360], num[40];
+            join(r, sizeof r, q, e->string);
+            int k = find_setting(m, e->string);
+            if (k < 0) {
+                free(b.s);
+                return vfail(c, r, "'%s' is not a setting of this technique", e->string);
+            }
+            double v = 0;
+            if (m->settings[k].type == GR_UT_BOOL) {
+                if (!cJSON_IsBool(e)) {
+                    free(b.s);
+                    return vfail(c, r, "must be true or false, got %s", type_name(e));
+                }
+                v = cJSON_IsTrue(e);
+            } else if ((st = number_at(c, e, r, &v))) {
+                free(b.s);
+                return st;
+            }
+            gr_error perr;
+            if (gr_param_check(&m->table, &m->params[k], v, 0, &perr) != GR_OK) {
+                free(b.s);
+                const char *why = strstr(perr.msg, ": "); /* drop gr_param_check's "NAME.KEY: " */
+                return vfail(c, r, "%s", why ? why + 2 : perr.msg);
+            }
+            if (m->settings[k].type == GR_UT_BOOL) snprintf(num, sizeof num, "%s", v != 0 ? "true" : "false");
+            else gr_format_double(v, num, sizeof num);
+            gr_ut_sb_add(&b, "%s%s=%s", b.len ? "," : "", e->string, num);
+        }
+        if (b.failed || !b.s) {
+            free(b.s);
+            if (!set->child) return vfail(c, q, "must name at least one setting");
+            return gr_fail(c->err, GR_E_NOMEM, "%s: out of memory", c->path);
+        }
+        m->ladder_text[i] = b.s;
+        m->ladder[i].settings = b.s;
+        int quick = 0;
+        if ((st = get_bool(c, lv, p, "quick", &quick))) return st;
+        m->ladder[i].quick = quick;
+        m->n_ladder = i + 1;
+    }
+    return GR_OK;
+}
+
+static gr_status parse_manifest(ut_ctx *c, gr_ut_manifest *m, const cJSON *root)
+{
+    static const char *const keys[] = {"version", "name", "description", "settings", "gain", "ladder", "shadow_map",
+                                       "targets", "passes", "output", "allow_black", NULL};
+    static const char *const sm_keys[] = {"size", "half_extent_m", NULL};
+    gr_status st = check_object(c, root, "", keys);
+    if (st) return st;
+    const cJSON *ver = cJSON_GetObjectItemCaseSensitive(root, "version");
+    if (!ver) return vfail(c, "version", "missing (required: 1)");
+    if (!cJSON_IsNumber(ver) || ver->valuedouble != 1)
+        return vfail(c, "version", "unsupported manifest version (this harness reads version 1)");
+    const char *s = NULL;
+    if ((st = get_string(c, root, "", "name", 1, &s))) return st;
+    if (!is_identifier(s, 1, GR_TECH_NAME_MAX))
+        return vfail(c, "name", "'%s' is not a technique name: [a-z][a-z0-9_]*, at most %d characters, no '__'", s,
+                     GR_TECH_NAME_MAX - 1);
+    snprintf(m->name, sizeof m->name, "%s", s);
+    s = "";
+    if ((st = get_string(c, root, "", "description", 1, &s))) return st;
+    if (!s[0]) return vfail(c, "description", "must not be empty (one line for `godrays techniques`)");
+    if (strchr(s, '\n')) return vfail(c, "description", "must be one line");
+    if (!(m->description = dup_string(s))) return gr_fail(c->err, GR_E_NOMEM, "%s: out of memory", c->path);
+
+    const cJSON *set = cJSON_GetObjectItemCaseSensitive(root, "settings");
+    m->settings_size = sizeof(double);
+    if (set && (st = parse_settings(c, m, set))) return st;
+    m->table.section = m->name;
+    m->table.params = m->params;
+    m->table.count = (size_t)m->n_settings;
+
+    const cJSON *gain = cJSON_GetObjectItemCaseSensitive(root, "gain");
+    if (gain) {
+        if (!cJSON_IsString(gain)) return vfail(c, "gain", "must be a setting's name, got %s", type_name(gain));
+        int g = find_setting(m, gain->valuestring);
+        if (g < 0) return vfail(c, "gain", "'%s' is not a setting of this technique", gain->valuestring);
+        if (m->settings[g].type != GR_UT_NUMBER && m->settings[g].type != GR_UT_RGB)
+            return vfail(c, "gain", "setting '%s' must be of type number or rgb (a linear scale on the output)",
+                         gain->valuestring);
+        m->cls.gain_key = m->settings[g].key;
+    }
+    const cJSON *lad = cJSON_GetObjectItemCaseSensitive(root, "ladder");
+    if (lad && (st = parse_ladder(c, m, lad))) return st;
+
+    const cJSON *tg = cJSON_GetObjectItemCaseSensitive(root, "targets");
+    if (!tg) return vfail(c, "targets", "missing (required: the render targets, e.g. {\"out\": {\"format\": \"rgba32f\"}})");
+    if ((st = parse_targets(c, m, tg))) return st;
+
+    const cJSON *ps = cJSON_GetObjectItemCaseSensitive(root, "passes");
+    if (!ps) return vfail(c, "passes", "missing (required)");
+    if (!cJSON_IsArray(ps) || cJSON_GetArraySize(ps) < 1) return vfail(c, "passes", "must be a non-empty array of passes");
+    if (cJSON_GetArraySize(ps) > GR_UT_MAX_PASSES) return vfail(c, "passes", "more than %d passes", GR_UT_MAX_PASSES);
+    int written[GR_UT_MAX_TARGETS] = {0};
+    int i = 0;
+    for (const cJSON *it = ps->child; it; it = it->next, i++) {
+        if ((st = parse_pass(c, m, it, i, written))) return st;
+        written[m->passes[i].target] = 1;
+        m->n_passes = i + 1;
+    }
+
+    const cJSON *out = cJSON_GetObjectItemCaseSensitive(root, "output");
+    m->output = m->passes[m->n_passes - 1].target;
+    if (out) {
+        if (!cJSON_IsString(out)) return vfail(c, "output", "must be a target's name, got %s", type_name(out));
+        m->output = find_target(m, out->valuestring);
+        if (m->output < 0) return vfail(c, "output", "unknown target '%s'", out->valuestring);
+        if (!written[m->output]) return vfail(c, "output", "no pass writes target '%s'", out->valuestring);
+    }
+    const gr_ut_target *ot = &m->targets[m->output];
+    if (ot->absolute || ot->scale.setting >= 0 || ot->scale.v != 1.0)
+        return vfail(c, "output", "target '%s' must be frame-sized (\"scale\": 1): the harness reads it back pixel for pixel",
+                     ot->name);
+    if ((st = get_bool(c, root, "", "allow_black", &m->allow_black))) return st;
+
+    m->shadow_size.v = 1024;
+    m->shadow_size.setting = -1;
+    m->shadow_half_extent.v = 40;
+    m->shadow_half_extent.setting = -1;
+    const cJSON *sm = cJSON_GetObjectItemCaseSensitive(root, "shadow_map");
+    if (sm) {
+        if ((st = check_object(c, sm, "shadow_map", sm_keys))) return st;
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(sm, "size");
+        if (v && (st = value_at(c, m, v, "shadow_map.size", GR_UT_INT, 16, 8192, &m->shadow_size))) return st;
+        v = cJSON_GetObjectItemCaseSensitive(sm, "half_extent_m");
+        if (v && (st = value_at(c, m, v, "shadow_map.half_extent_m", GR_UT_NUMBER, 0.01, 1e5, &m->shadow_half_extent)))
+            return st;
+    }
+    return GR_OK;
+}
+
+void gr_ut_manifest_free(gr_ut_manifest *m)
+{
+    if (!m) return;
+    for (int i = 0; i < GR_UT_MAX_PASSES; i++) {
+        free(m->passes[i].vertex_file);
+        free(m->passes[i].fragment_file);
+        free(m->passes[i].vertex_src);
+        free(m->passes[i].fragment_src);
+    }
+    for (int i = 0; i < GR_UT_MAX_SETTINGS; i++) {
+        free(m->param_strings[i][0]);
+        free(m->param_strings[i][1]);
+    }
+    for (int i = 0; i < GR_UT_MAX_LADDER; i++) free(m->ladder_text[i]);
+    free(m->description);
+    free(m->dir);
+    free(m->path);
+    free(m);
+}
+
+static unsigned long long fnv1a(unsigned long long h, const char *s)
+{
+    for (const unsigned char *q = (const unsigned char *)s; *q; q++) {
+        h ^= *q;
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+/* "LABEL:LINE:COL: malformed JSON near '...'" (as the scene loader words it) */
+static gr_status parse_json(const char *text, const char *label, cJSON **out, gr_error *err)
+{
+    const char *end = NULL;
+    *out = cJSON_ParseWithOpts(text, &end, 1);
+    if (*out) return GR_OK;
+    if (!end) end = text;
+    int line = 1, col = 1;
+    for (const char *q = text; q < end && *q; q++) {
+        if (*q == '\n') {
+            line++;
+            col = 1;
+        } else {
+            col++;
+        }
+    }
+    char near[40];
+    size_t k = 0;
+    const char *from = end;
+    while (from > text && from[-1] != '\n' && end - from < 12) from--;
+    while (*from == ' ' || *from == '\t') from++;
+    for (const char *q = from; *q && *q != '\n' && *q != '\r' && k < 32 && q < end + 12; q++) near[k++] = *q;
+    near[k] = '\0';
+    if (!k) return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON at end of input", label, line, col);
+    return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON near '%s'", label, line, col, near);
+}
+
+gr_status gr_ut_manifest_load(const char *dir, gr_ut_manifest **out, gr_error *err)
+{
+    *out = NULL;
+    struct stat sb;
+    if (!dir || !dir[0]) return gr_fail(err, GR_E_USAGE, "--technique-dir: empty folder name");
+    if (stat(dir, &sb) != 0) return gr_fail(err, GR_E_INPUT, "--technique-dir %s: %s", dir, strerror(errno));
+    if (!S_ISDIR(sb.st_mode)) return gr_fail(err, GR_E_INPUT, "--technique-dir %s: not a folder", dir);
+    gr_ut_manifest *m = calloc(1, sizeof *m);
+    if (!m) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", dir);
+    size_t dl = strlen(dir);
+    while (dl > 1 && dir[dl - 1] == '/') dl--;
+    m->dir = malloc(dl + 1);
+    m->path = malloc(dl + sizeof "/" GR_USERTECH_MANIFEST);
+    if (!m->dir || !m->path) {
+        gr_ut_manifest_free(m);
+        return gr_fail(err, GR_E_NOMEM, "%s: out of memory", dir);
+    }
+    memcpy(m->dir, dir, dl);
+    m->dir[dl] = '\0';
+    sprintf(m->path, "%s/%s", m->dir, GR_USERTECH_MANIFEST);
+    char *text = NULL, why[256];
+    gr_status st = gr_ut_read_file(m->path, &text, why, sizeof why);
+    if (st) {
+        st = gr_fail(err, st == GR_E_NOMEM ? GR_E_NOMEM : GR_E_INPUT, "%s: cannot read the manifest: %s", m->path, why);
+        gr_ut_manifest_free(m);
+        return st;
+    }
+    cJSON *root = NULL;
+    st = parse_json(text, m->path, &root, err);
+    if (st == GR_OK) {
+        ut_ctx c = {err, m->path};
+        st = parse_manifest(&c, m, root);
+    }
+    if (st == GR_OK) {
+        /* provenance: which version of the technique rendered an image */
+        unsigned long long h = fnv1a(14695981039346656037ULL, text);
+        for (int i = 0; i < m->n_passes; i++) {
+            if (m->passes[i].vertex_src) h = fnv1a(h, m->passes[i].vertex_src);
+            h = fnv1a(h, m->passes[i].fragment_src);
+        }
+        snprintf(m->source_hash, sizeof m->source_hash, "%016llx", h);
+    }
+    free(text);
+    cJSON_Delete(root);
+    if (st) {
+        gr_ut_manifest_free(m);
+        return st;
+    }
+    m->table.section = m->name;
+    m->table.params = m->params;
+    m->table.count = (size_t)m->n_settings;
+    *out = m;
+    return GR_OK;
+}

@@ -1,0 +1,129 @@
+/* A user technique's manifest (docs/techniques.md): DIR/manifest.json parsed and validated,
+ * every shader file it names read, its settings turned into a gr_param_table. No GL: the
+ * renderer that runs a manifest is realtime/usertech.c.
+ *
+ * Every file of a manifest (the manifest itself and each shader) is opened by ONE function,
+ * gr_ut_read_file, so checks on what a manifest may read belong there. Errors: GR_E_INPUT
+ * with "DIR/manifest.json: JSON.PATH: reason" (one line). */
+#ifndef GR_USERTECH_MANIFEST_H
+#define GR_USERTECH_MANIFEST_H
+
+#include <stddef.h>
+
+#include "common/status.h"
+#include "realtime/technique.h"
+#include "scene/params.h"
+
+#define GR_USERTECH_MANIFEST "manifest.json"
+
+#define GR_UT_MAX_SETTINGS 64
+#define GR_UT_MAX_TARGETS 8
+#define GR_UT_MAX_PASSES 6   /* + the two harness inputs = GR_TECH_MAX_PASSES timed passes */
+#define GR_UT_MAX_INPUTS 8
+#define GR_UT_MAX_FACTORS 4
+#define GR_UT_NAME_MAX 24
+#define GR_UT_MAX_SIZE 16384
+#define GR_UT_MAX_LADDER 16
+
+typedef enum { GR_UT_NUMBER, GR_UT_INT, GR_UT_BOOL, GR_UT_RGB } gr_ut_type;
+extern const char *const gr_ut_type_names[];
+
+typedef enum { GR_UT_FMT_RGBA8, GR_UT_FMT_RGBA16F, GR_UT_FMT_RGBA32F } gr_ut_format;
+extern const char *const gr_ut_format_names[];
+
+typedef enum { GR_UT_BLEND_NONE, GR_UT_BLEND_ADDITIVE, GR_UT_BLEND_ALPHA } gr_ut_blend;
+extern const char *const gr_ut_blend_names[];
+
+typedef enum { GR_UT_PRIM_TRIANGLES, GR_UT_PRIM_TRIANGLE_STRIP, GR_UT_PRIM_LINES, GR_UT_PRIM_POINTS } gr_ut_prim;
+extern const char *const gr_ut_prim_names[];
+
+/* Harness textures a pass may list among its inputs (bound as t_NAME). */
+enum { GR_UT_IN_SHADOW_MAP = -1, GR_UT_IN_EYE_DEPTH = -2 };
+
+typedef struct gr_ut_setting {
+    char key[GR_TECH_NAME_MAX];
+    gr_ut_type type;
+    size_t offset;
+} gr_ut_setting;
+
+/* A number given in the manifest or taken from a setting (setting >= 0). */
+typedef struct gr_ut_value {
+    double v;
+    int setting;
+} gr_ut_value;
+
+/* A count: literal * product of int settings ("6*N*N"). */
+typedef struct gr_ut_count {
+    long long literal;
+    int n_factors;
+    int factor[GR_UT_MAX_FACTORS];
+} gr_ut_count;
+
+typedef struct gr_ut_target {
+    char name[GR_UT_NAME_MAX];
+    int absolute, width, height; /* "size": [w, h] */
+    gr_ut_value scale;              /* "scale": relative to the frame, per axis */
+    gr_ut_format format;
+    int linear;
+} gr_ut_target;
+
+typedef struct gr_ut_pass {
+    char name[GR_UT_NAME_MAX];
+    char *vertex_file, *fragment_file; /* as written in the manifest; vertex NULL = built-in */
+    char *vertex_src, *fragment_src;
+    int fullscreen;
+    gr_ut_prim prim;
+    gr_ut_count vertices, instances;
+    int target;
+    gr_ut_blend blend;
+    int has_clear;
+    float clear[4];
+    int n_inputs;
+    int inputs[GR_UT_MAX_INPUTS]; /* target index, or GR_UT_IN_* */
+} gr_ut_pass;
+
+typedef struct gr_ut_manifest {
+    char name[GR_TECH_NAME_MAX];
+    char *description;
+    char *dir, *path; /* folder, and folder/manifest.json */
+    int n_settings;
+    gr_ut_setting settings[GR_UT_MAX_SETTINGS];
+    gr_param params[GR_UT_MAX_SETTINGS];
+    char *param_strings[GR_UT_MAX_SETTINGS][2]; /* unit, doc (owned) */
+    gr_param_table table;
+    size_t settings_size;
+    int n_targets;
+    gr_ut_target targets[GR_UT_MAX_TARGETS];
+    int n_passes;
+    gr_ut_pass passes[GR_UT_MAX_PASSES];
+    int output;
+    int allow_black;
+    int uses_shadow_map, uses_eye_depth;
+    gr_ut_value shadow_size, shadow_half_extent;
+    char source_hash[17]; /* FNV-1a 64 of the manifest and every shader file, hex */
+    int n_ladder;
+    gr_technique_level ladder[GR_UT_MAX_LADDER];
+    char *ladder_text[GR_UT_MAX_LADDER];
+    gr_technique_class cls; /* the class made from it (usertech.c fills it): lives as long as m */
+} gr_ut_manifest;
+
+/* A growable string (zero-initialize; free .s): gr_ut_sb_add appends printf-style; on no
+ * memory it sets failed and keeps what it had. Ladder texts here, GLSL preludes in usertech.c. */
+typedef struct gr_ut_strbuf {
+    char *s;
+    size_t len, cap;
+    int failed;
+} gr_ut_strbuf;
+void gr_ut_sb_add(gr_ut_strbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Parses and validates DIR/manifest.json and reads its shader files into a new manifest
+ * (source_hash, table set; cls left zero); *out is the caller's: gr_ut_manifest_free. */
+gr_status gr_ut_manifest_load(const char *dir, gr_ut_manifest **out, gr_error *err);
+void gr_ut_manifest_free(gr_ut_manifest *m); /* accepts NULL */
+
+/* Reads the whole text file at path into *out (malloc'd, NUL-terminated): the one place a
+ * manifest's files are opened. GR_E_IO (why: strerror, not a regular file, a NUL byte, a
+ * read error) or GR_E_NOMEM, with the reason in why. */
+gr_status gr_ut_read_file(const char *path, char **out, char *why, size_t why_n);
+
+#endif
