@@ -313,13 +313,7 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
         h[1][k] = texel * (win.e2[k] - f->sun_dir[k] * win.e2[1] / f->sun_dir[1]);
     }
     gr_gl_timer_begin(&r->base.timer, P_LINES);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out.fbo);
-    glViewport(0, 0, W, H);
-    glClearColor(0, 0, 0, 0);
-    glClear(GL_COLOR_BUFFER_BIT);
-    glEnable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFunc(GL_ONE, GL_ONE);
+    gr_target_accumulate(&r->base.out); /* W x H */
     glUseProgram(r->prog_lines);
     gr_vol_set(&r->vl, &prep.in);
     glUniform1i(r->l_pos, 5);

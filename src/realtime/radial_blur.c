@@ -476,13 +476,7 @@ static gr_status stage_quads(rb_state *r, const gr_radial_blur_settings *s, int 
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     free(v);
     gr_gl_timer_begin(&r->timer, PASS_BLUR);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->acc.fbo);
-    glViewport(0, 0, W, H);
-    glClearColor(0, 0, 0, 0);
-    glClear(GL_COLOR_BUFFER_BIT);
-    glEnable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFunc(GL_ONE, GL_ONE);
+    gr_target_accumulate(&r->acc); /* W x H */
     set_blur_uniforms(r->prog_local, r->lq.light, r->lq.size, r->lq.samples, r->lq.density, r->lq.decay,
                       r->lq.weight, r->lq.dither, s, W, H);
     glUniform1f(r->lq.falloff, (float)s->falloff);

@@ -1,7 +1,8 @@
 /* GL resources every technique may share within one context: the occluders as a triangle
  * mesh, their shadow map along the refracted sun (orthographic, centred where the camera
- * looks) and their depth as seen from the eye (GPU pass timers: realtime/toolkit.h). Built once per context
- * and refreshed per scene; techniques bind the textures, they do not redraw the occluders. */
+ * looks) and their depth as seen from the eye. Built once per context and refreshed per
+ * scene; techniques bind the textures, they do not redraw the occluders. (GPU pass timers
+ * and render targets: realtime/toolkit.h.) */
 #ifndef GR_SCENEGL_H
 #define GR_SCENEGL_H
 

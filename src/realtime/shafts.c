@@ -872,14 +872,8 @@ static gr_status render_frame(gr_shafts *r, const gr_scene *scene, const gr_shaf
         glBeginQuery(GL_VERTEX_SHADER_INVOCATIONS, r->q_vs);
         glBeginQuery(GL_FRAGMENT_SHADER_INVOCATIONS, r->q_fs);
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, r->target.fbo);
-    glViewport(0, 0, f->tw, f->th);
     glDisable(GL_DITHER); /* dithering would make 8-bit sums depend on the pixel position */
-    glClearColor(0, 0, 0, 0);
-    glClear(GL_COLOR_BUFFER_BIT);
-    glEnable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFunc(GL_ONE, GL_ONE);
+    gr_target_accumulate(&r->target); /* tw x th */
     set_shaft_uniforms(r->prog_shafts, &r->ls, f, scene);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, eye_depth_tex);

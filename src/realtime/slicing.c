@@ -123,14 +123,8 @@ static gr_status sl_render(void *state, const gr_scene *scene, const void *setti
     gr_frame_matf(inv, m);
 
     gr_gl_timer_begin(&r->base.timer, P_SLICES);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->base.out.fbo);
-    glViewport(0, 0, W, H);
-    glClearColor(0, 0, 0, 0);
-    glClear(GL_COLOR_BUFFER_BIT);
     glDisable(GL_DEPTH_TEST);
-    glEnable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFunc(GL_ONE, GL_ONE);
+    gr_target_accumulate(&r->base.out); /* W x H */
     glUseProgram(r->prog);
     gr_vol_set(&r->vl, &prep.in);
     glUniformMatrix4fv(r->l_inv, 1, GL_FALSE, m);

@@ -74,6 +74,17 @@ gr_status gr_target_ensure(gr_target *t, unsigned ifmt, int w, int h, int flags,
     return GR_OK;
 }
 
+void gr_target_accumulate(const gr_target *t)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    glViewport(0, 0, t->w, t->h);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+}
+
 /* ---- GPU pass timers --------------------------------------------------------------------- */
 
 void gr_gl_timer_init(gr_gl_timer *t)

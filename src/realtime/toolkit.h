@@ -37,6 +37,9 @@ enum {
  * left empty. Leaves framebuffer 0 and texture 0 bound. */
 gr_status gr_target_ensure(gr_target *t, unsigned ifmt, int w, int h, int flags, const char *what, gr_error *err);
 void gr_target_release(gr_target *t); /* deletes the GL objects; accepts NULL and an empty one */
+/* The start of a pass that sums contributions into t: binds t's framebuffer with a viewport
+ * of its size, clears it to zero and enables additive blending (GL_FUNC_ADD, ONE, ONE). */
+void gr_target_accumulate(const gr_target *t);
 
 /* ---- GPU pass timers ------------------------------------------------------------------- */
 

@@ -45,7 +45,7 @@ static inline gr_image *rb_test_render(const gr_technique_class *cls, void *stat
     gr_error err;
     gr_image *img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
     if (!img) exit(1);
-    if (cls->check(cls, s, &err) != GR_OK || cls->render(state, scene, s, img, stats, &err) != GR_OK) {
+    if (gr_technique_check(cls, s, &err) != GR_OK || cls->render(state, scene, s, img, stats, &err) != GR_OK) {
         fprintf(stderr, "%s render failed: %s\n", cls->name, err.msg);
         exit(1);
     }
