@@ -12,6 +12,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "scene/scene.h"
+
 const char *const gr_ut_type_names[] = {"number", "int", "bool", "rgb", NULL};
 const char *const gr_ut_format_names[] = {"rgba8", "rgba16f", "rgba32f", NULL};
 const char *const gr_ut_blend_names[] = {"none", "additive", "alpha", NULL};
@@ -84,18 +86,6 @@ static void join(char *out, size_t n, const char *parent, const char *key)
     out[k] = '\0';
 }
 
-static const char *type_name(const cJSON *v)
-{
-    if (!v) return "nothing";
-    if (cJSON_IsNumber(v)) return "a number";
-    if (cJSON_IsString(v)) return "a string";
-    if (cJSON_IsBool(v)) return "a boolean";
-    if (cJSON_IsNull(v)) return "null";
-    if (cJSON_IsArray(v)) return "an array";
-    if (cJSON_IsObject(v)) return "an object";
-    return "?";
-}
-
 static int in_list(const char *key, const char *const *names)
 {
     for (int i = 0; names[i]; i++)
@@ -118,7 +108,7 @@ static void list_text(const char *const *names, char *out, size_t n)
 static gr_status check_object(ut_ctx *c, const cJSON *obj, const char *path, const char *const *names)
 {
     char p[320], list[400];
-    if (!cJSON_IsObject(obj)) return vfail(c, path[0] ? path : "(top level)", "must be an object, got %s", type_name(obj));
+    if (!cJSON_IsObject(obj)) return vfail(c, path[0] ? path : "(top level)", "must be an object, got %s", gr_json_type_name(obj));
     for (const cJSON *it = obj->child; it; it = it->next) {
         const char *k = it->string ? it->string : "";
         join(p, sizeof p, path, k);
@@ -157,7 +147,7 @@ static gr_status get_string(ut_ctx *c, const cJSON *obj, const char *parent, con
         if (required) return vfail(c, p, "missing (required)");
         return GR_OK;
     }
-    if (!cJSON_IsString(v)) return vfail(c, p, "must be a string, got %s", type_name(v));
+    if (!cJSON_IsString(v)) return vfail(c, p, "must be a string, got %s", gr_json_type_name(v));
     *out = v->valuestring;
     return GR_OK;
 }
@@ -181,7 +171,7 @@ static gr_status get_enum(ut_ctx *c, const cJSON *obj, const char *parent, const
 
 static gr_status number_at(ut_ctx *c, const cJSON *v, const char *p, double *out)
 {
-    if (!cJSON_IsNumber(v)) return vfail(c, p, "must be a number, got %s", type_name(v));
+    if (!cJSON_IsNumber(v)) return vfail(c, p, "must be a number, got %s", gr_json_type_name(v));
     if (!isfinite(v->valuedouble)) return vfail(c, p, "must be a finite number");
     *out = v->valuedouble;
     return GR_OK;
@@ -193,7 +183,7 @@ static gr_status get_bool(ut_ctx *c, const cJSON *obj, const char *parent, const
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v) return GR_OK;
     join(p, sizeof p, parent, key);
-    if (!cJSON_IsBool(v)) return vfail(c, p, "must be true or false, got %s", type_name(v));
+    if (!cJSON_IsBool(v)) return vfail(c, p, "must be true or false, got %s", gr_json_type_name(v));
     *out = cJSON_IsTrue(v) ? 1 : 0;
     return GR_OK;
 }
@@ -254,7 +244,7 @@ static gr_status count_at(ut_ctx *c, const gr_ut_manifest *m, const cJSON *v, co
         return GR_OK;
     }
     if (!cJSON_IsString(v))
-        return vfail(c, p, "must be an integer, an int setting's name or a product such as \"6*N\", got %s", type_name(v));
+        return vfail(c, p, "must be an integer, an int setting's name or a product such as \"6*N\", got %s", gr_json_type_name(v));
     char buf[128];
     snprintf(buf, sizeof buf, "%s", v->valuestring);
     char *save = NULL;
@@ -405,7 +395,7 @@ static gr_status parse_settings(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
         join(q, sizeof q, p, "default");
         if (!vdef) return vfail(c, q, "missing (required)");
         if (s->type == GR_UT_BOOL) {
-            if (!cJSON_IsBool(vdef)) return vfail(c, q, "must be true or false, got %s", type_name(vdef));
+            if (!cJSON_IsBool(vdef)) return vfail(c, q, "must be true or false, got %s", gr_json_type_name(vdef));
             gp->def = cJSON_IsTrue(vdef) ? 1 : 0;
         } else {
             if (s->type == GR_UT_RGB && cJSON_IsArray(vdef))
@@ -602,7 +592,7 @@ static gr_status parse_pass(ut_ctx *c, gr_ut_manifest *m, const cJSON *it, int i
     join(q, sizeof q, p, "clear");
     if (vc && !cJSON_IsFalse(vc)) {
         if (!cJSON_IsArray(vc) || cJSON_GetArraySize(vc) != 4)
-            return vfail(c, q, "must be [r, g, b, a] or false, got %s", type_name(vc));
+            return vfail(c, q, "must be [r, g, b, a] or false, got %s", gr_json_type_name(vc));
         for (int k = 0; k < 4; k++) {
             char r[360];
             double x = 0;
@@ -616,13 +606,13 @@ static gr_status parse_pass(ut_ctx *c, gr_ut_manifest *m, const cJSON *it, int i
     const cJSON *vin = cJSON_GetObjectItemCaseSensitive(it, "inputs");
     join(q, sizeof q, p, "inputs");
     if (vin) {
-        if (!cJSON_IsArray(vin)) return vfail(c, q, "must be an array of names, got %s", type_name(vin));
+        if (!cJSON_IsArray(vin)) return vfail(c, q, "must be an array of names, got %s", gr_json_type_name(vin));
         int k = 0;
         for (const cJSON *e = vin->child; e; e = e->next, k++) {
             char r[360];
             snprintf(r, sizeof r, "%s[%d]", q, k);
             if (k == GR_UT_MAX_INPUTS) return vfail(c, q, "more than %d inputs", GR_UT_MAX_INPUTS);
-            if (!cJSON_IsString(e)) return vfail(c, r, "must be a string, got %s", type_name(e));
+            if (!cJSON_IsString(e)) return vfail(c, r, "must be a string, got %s", gr_json_type_name(e));
             const char *nm = e->valuestring;
             int in;
             if (!strcmp(nm, "shadow_map")) {
@@ -650,7 +640,7 @@ static gr_status parse_pass(ut_ctx *c, gr_ut_manifest *m, const cJSON *it, int i
 static gr_status parse_ladder(ut_ctx *c, gr_ut_manifest *m, const cJSON *lad)
 {
     static const char *const keys[] = {"settings", "quick", NULL};
-    if (!cJSON_IsArray(lad)) return vfail(c, "ladder", "must be an array of levels, got %s", type_name(lad));
+    if (!cJSON_IsArray(lad)) return vfail(c, "ladder", "must be an array of levels, got %s", gr_json_type_name(lad));
     if (cJSON_GetArraySize(lad) > GR_UT_MAX_LADDER) return vfail(c, "ladder", "more than %d levels", GR_UT_MAX_LADDER);
     int i = 0;
     gr_status st;
@@ -675,7 +665,7 @@ static gr_status parse_ladder(ut_ctx *c, gr_ut_manifest *m, const cJSON *lad)
             if (m->settings[k].type == GR_UT_BOOL) {
                 if (!cJSON_IsBool(e)) {
                     free(b.s);
-                    return vfail(c, r, "must be true or false, got %s", type_name(e));
+                    return vfail(c, r, "must be true or false, got %s", gr_json_type_name(e));
                 }
                 v = cJSON_IsTrue(e);
             } else if ((st = number_at(c, e, r, &v))) {
@@ -739,7 +729,7 @@ static gr_status parse_manifest(ut_ctx *c, gr_ut_manifest *m, const cJSON *root)
 
     const cJSON *gain = cJSON_GetObjectItemCaseSensitive(root, "gain");
     if (gain) {
-        if (!cJSON_IsString(gain)) return vfail(c, "gain", "must be a setting's name, got %s", type_name(gain));
+        if (!cJSON_IsString(gain)) return vfail(c, "gain", "must be a setting's name, got %s", gr_json_type_name(gain));
         int g = find_setting(m, gain->valuestring);
         if (g < 0) return vfail(c, "gain", "'%s' is not a setting of this technique", gain->valuestring);
         if (m->settings[g].type != GR_UT_NUMBER && m->settings[g].type != GR_UT_RGB)
@@ -769,7 +759,7 @@ static gr_status parse_manifest(ut_ctx *c, gr_ut_manifest *m, const cJSON *root)
     const cJSON *out = cJSON_GetObjectItemCaseSensitive(root, "output");
     m->output = m->passes[m->n_passes - 1].target;
     if (out) {
-        if (!cJSON_IsString(out)) return vfail(c, "output", "must be a target's name, got %s", type_name(out));
+        if (!cJSON_IsString(out)) return vfail(c, "output", "must be a target's name, got %s", gr_json_type_name(out));
         m->output = find_target(m, out->valuestring);
         if (m->output < 0) return vfail(c, "output", "unknown target '%s'", out->valuestring);
         if (!written[m->output]) return vfail(c, "output", "no pass writes target '%s'", out->valuestring);
@@ -825,33 +815,6 @@ static unsigned long long fnv1a(unsigned long long h, const char *s)
     return h;
 }
 
-/* "LABEL:LINE:COL: malformed JSON near '...'" (as the scene loader words it) */
-static gr_status parse_json(const char *text, const char *label, cJSON **out, gr_error *err)
-{
-    const char *end = NULL;
-    *out = cJSON_ParseWithOpts(text, &end, 1);
-    if (*out) return GR_OK;
-    if (!end) end = text;
-    int line = 1, col = 1;
-    for (const char *q = text; q < end && *q; q++) {
-        if (*q == '\n') {
-            line++;
-            col = 1;
-        } else {
-            col++;
-        }
-    }
-    char near[40];
-    size_t k = 0;
-    const char *from = end;
-    while (from > text && from[-1] != '\n' && end - from < 12) from--;
-    while (*from == ' ' || *from == '\t') from++;
-    for (const char *q = from; *q && *q != '\n' && *q != '\r' && k < 32 && q < end + 12; q++) near[k++] = *q;
-    near[k] = '\0';
-    if (!k) return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON at end of input", label, line, col);
-    return gr_fail(err, GR_E_INPUT, "%s:%d:%d: malformed JSON near '%s'", label, line, col, near);
-}
-
 gr_status gr_ut_manifest_load(const char *dir, gr_ut_manifest **out, gr_error *err)
 {
     *out = NULL;
@@ -880,7 +843,7 @@ gr_status gr_ut_manifest_load(const char *dir, gr_ut_manifest **out, gr_error *e
         return st;
     }
     cJSON *root = NULL;
-    st = parse_json(text, m->path, &root, err);
+    st = gr_json_parse(text, m->path, &root, err);
     if (st == GR_OK) {
         ut_ctx c = {err, m->path};
         st = parse_manifest(&c, m, root);

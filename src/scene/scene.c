@@ -100,8 +100,9 @@ static const char *got_text(const cJSON *v, char *buf, size_t n)
     return buf;
 }
 
-static const char *type_name(const cJSON *v)
+const char *gr_json_type_name(const struct cJSON *v)
 {
+    if (!v) return "nothing";
     if (cJSON_IsNumber(v)) return "a number";
     if (cJSON_IsString(v)) return "a string";
     if (cJSON_IsBool(v)) return "a boolean";
@@ -195,7 +196,7 @@ static gr_status number_value(vctx *c, const cJSON *v, const char *path, double 
 {
     char got[80];
     if (!cJSON_IsNumber(v))
-        return vfail(c, path, "must be a number, got %s %s", type_name(v), got_text(v, got, sizeof got));
+        return vfail(c, path, "must be a number, got %s %s", gr_json_type_name(v), got_text(v, got, sizeof got));
     if (!isfinite(v->valuedouble))
         return vfail(c, path, "must be a finite number, got %s", got_text(v, got, sizeof got));
     *out = v->valuedouble;
@@ -216,7 +217,7 @@ static gr_status get_int(vctx *c, const cJSON *obj, const char *parent, const ch
 {
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     char p[320], got[80];
-    double d;
+    double d = 0; /* set by number_value on success (GCC cannot always see it) */
     if (!v) return GR_OK;
     join(p, sizeof p, parent, key);
     gr_status st = number_value(c, v, p, &d);
@@ -1268,7 +1269,7 @@ static int path_prefix(const char *a, const char *b)
 }
 
 /* Parses text into a tree; fails with "LABEL:LINE:COL: malformed JSON ..." */
-static gr_status parse_text(const char *json, const char *label, cJSON **out, gr_error *err)
+gr_status gr_json_parse(const char *json, const char *label, cJSON **out, gr_error *err)
 {
     const char *end = NULL;
     *out = cJSON_ParseWithOpts(json, &end, 1);
@@ -1316,7 +1317,7 @@ static gr_status load_tree(const char *json, const char *label, const char *cons
                            char *errpath, size_t errpath_n, int *override_failed, gr_error *err)
 {
     cJSON *root;
-    gr_status st = parse_text(json, label, &root, err);
+    gr_status st = gr_json_parse(json, label, &root, err);
     *override_failed = -1;
     errpath[0] = '\0';
     if (st) return st;

@@ -113,6 +113,14 @@ gr_status gr_scene_load_file(const char *path, const char *const *overrides, int
 gr_status gr_scene_load_string(const char *json, const char *label,
                                const char *const *overrides, int n_overrides,
                                gr_scene *out, gr_error *err);
+/* Parses JSON text (a scene, a user technique's manifest) into a cJSON tree (*out, the
+ * caller's: cJSON_Delete); GR_E_INPUT "LABEL:LINE:COL: malformed JSON near '...'" (or at end
+ * of input, or nested deeper than cJSON's limit): the one wording of a JSON syntax error. */
+struct cJSON;
+gr_status gr_json_parse(const char *text, const char *label, struct cJSON **out, gr_error *err);
+/* "a number", "a string", "a boolean", "null", "an array", "an object" for error messages;
+ * "nothing" for NULL (a missing value). */
+const char *gr_json_type_name(const struct cJSON *v);
 /* Normalized JSON (every default filled in, stable key order, 2-space indent).
  * Returns a malloc'd string the caller frees; NULL on allocation failure. */
 char *gr_scene_to_json(const gr_scene *s);

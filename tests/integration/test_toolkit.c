@@ -38,10 +38,8 @@ int main(void)
 {
     gr_error err;
     gr_gl *gl = NULL;
-    if (gr_gl_create(NULL, &gl, &err) != GR_OK) {
-        fprintf(stderr, "GL: %s\n", err.msg);
-        return 1;
-    }
+    CHECK_OK(gr_gl_create(NULL, &gl, &err), err);
+    if (!gl) CHECK_DONE();
     double c0 = gr_clock_ms(), c1 = gr_clock_ms();
     CHECK(c1 >= c0);
 
