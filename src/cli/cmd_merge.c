@@ -60,7 +60,9 @@ static int merge_with(gr_args *args)
     }
     if (!rc && !n) rc = gr_cli_usage_error(cmd, "no part files given");
     if (!rc && !out_path && !cache) rc = gr_cli_usage_error(cmd, "no output given (-o OUT.exr or --cache)");
+    for (int k = 0; k < n && !rc; k++) rc = gr_args_add_input(args, "part", parts[k]); /* never replaced */
     if (!rc && out_path) rc = gr_args_check_output_file(args, "-o", out_path);
+    if (!rc && out_path && preview) rc = gr_args_note_preview(args, "-o", out_path);
     if (rc) {
         free(parts);
         return rc;
