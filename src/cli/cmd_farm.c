@@ -136,6 +136,20 @@ static int status(const char *dir)
     return 0;
 }
 
+/* The files the farm folder gets (farm.h) may not be inputs, such as the scene (common/paths);
+ * out NULL: the default folder, named after the scene, which no input names before it exists. */
+static int check_outputs(gr_args *args, const char *out)
+{
+    static const char *const names[] = {"scene.json", "farm.json", "parts.sh", "merge.sh", "final.sh", "submit.sh"};
+    char p[4200];
+    for (size_t k = 0; out && k < sizeof names / sizeof names[0]; k++) {
+        snprintf(p, sizeof p, "%s/%s", out, names[k]);
+        const int rc = gr_args_note_output(args, "-o", p);
+        if (rc) return rc;
+    }
+    return 0;
+}
+
 static int farm_with(gr_args *args)
 {
     const char *cmd = "farm", *out = NULL, *v = NULL, *status_dir = NULL, *cache = NULL, *binary = NULL;
@@ -193,6 +207,12 @@ static int farm_with(gr_args *args)
     if (rc) return rc;
     if (status_dir) return args->scene_path ? gr_cli_usage_error(cmd, "--status DIR takes no scene") : status(status_dir);
     if ((rc = gr_args_need_scene(args)) != 0) return rc;
+    size_t l = (size_t)snprintf(plan.command, sizeof plan.command, "godrays");
+    for (int k = 0; k < args->argc && l < sizeof plan.command; k++)
+        l += (size_t)snprintf(plan.command + l, sizeof plan.command - l, " %s", args->argv[k]);
+    gr_error err = {GR_OK, ""};
+    if (gr_farm_check(&plan, &err) != GR_OK) return gr_cli_report(cmd, &err); /* before any folder is made */
+    if ((rc = check_outputs(args, out)) != 0) return rc;
     if (strcmp(plan.then, "tune") && strcmp(plan.then, "run") && strcmp(plan.then, "none"))
         return gr_cli_usage_error(cmd, "--then %s: expected tune, run or none", plan.then);
     if (!strcmp(plan.then, "tune") && !strstr(plan.then_args, "--params")) { /* tune needs its parameters */
@@ -218,7 +238,6 @@ static int farm_with(gr_args *args)
     }
     gr_scene *scene = NULL;
     if ((rc = gr_args_load_scene(args, &scene)) != 0) return rc;
-    gr_error err = {GR_OK, ""};
     if (scene->reference.target_error > 0.0) {
         rc = gr_cli_usage_error(cmd, "reference.target_error = %g: parts take the fixed passes of one round; set it to 0 "
                                      "and raise reference.sun_samples or spp instead (docs/farm.md)",
@@ -254,9 +273,6 @@ static int farm_with(gr_args *args)
     }
     buf[bl] = '\0';
     snprintf(plan.binary, sizeof plan.binary, "%s", buf);
-    size_t l = (size_t)snprintf(plan.command, sizeof plan.command, "godrays");
-    for (int k = 0; k < args->argc && l < sizeof plan.command; k++)
-        l += (size_t)snprintf(plan.command + l, sizeof plan.command - l, " %s", args->argv[k]);
     gr_status st = gr_farm_plan_cases(&plan, scene, &err);
     if (st == GR_OK) st = gr_farm_write(&plan, scene, &err);
     if (st == GR_OK) { /* the jobs load the scene copy: it must give the same keys */
