@@ -3,6 +3,7 @@
  * Nelder-Mead with restarts (src/tune/optimize.h). */
 #include "cli/cli.h"
 #include "cli/args.h"
+#include "common/outfile.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -63,7 +64,7 @@ static void usage(FILE *f)
 /* The objective, recording every evaluation into trace.csv. */
 typedef struct traced {
     gr_tune_problem *p;
-    FILE *trace;
+    FILE *trace;        /* trace.f: the temporary file (common/outfile), renamed at the end */
     int n;
     int progress;
 } traced;
@@ -281,7 +282,7 @@ static int tune_with(gr_args *args)
     gr_tune_problem *p = calloc(1, sizeof *p);
     char dirbuf[4096], path[4300];
     char *json = NULL, *snippet = NULL;
-    FILE *trace = NULL;
+    gr_outfile trace = {.slot = -1}; /* a new trace replaces the old one only once complete */
     cJSON *root = NULL;
     const char *outdir = NULL;
     if (!p) {
@@ -307,19 +308,15 @@ static int tune_with(gr_args *args)
     }
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
     snprintf(path, sizeof path, "%s/trace.csv", outdir);
-    trace = fopen(path, "w");
-    if (!trace) {
-        gr_fail(&err, GR_E_IO, "%s: cannot create", path);
-        goto fail;
-    }
-    fprintf(trace, "eval");
-    for (int k = 0; k < n_params; k++) fprintf(trace, ",%s", params[k].key);
-    fprintf(trace, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
+    if (gr_outfile_open_stream(&trace, path, &err) != GR_OK) goto fail;
+    fprintf(trace.f, "eval");
+    for (int k = 0; k < n_params; k++) fprintf(trace.f, ",%s", params[k].key);
+    fprintf(trace.f, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
 
     double before[GR_TUNE_MAX_CASES], after[GR_TUNE_MAX_CASES], sc_b[GR_TUNE_MAX_CASES], sc_a[GR_TUNE_MAX_CASES];
     double fb = 0, fa = 0;
     if (gr_tune_evaluate(p, xb, &fb, before, sc_b, &err) != GR_OK) goto fail;
-    traced t = {.p = p, .trace = trace, .progress = !c.quiet && isatty(2)};
+    traced t = {.p = p, .trace = trace.f, .progress = !c.quiet && isatty(2)};
     gr_opt_options oo;
     gr_tune_search_defaults(&oo, n_params, x0);
     oo.method = method;
@@ -336,8 +333,7 @@ static int tune_with(gr_args *args)
     double t_opt = (double)p->renders, render_s0 = p->render_s, metrics_s0 = p->metrics_s;
     if (gr_opt_minimize(n_params, lo, hi, traced_objective, &t, &oo, &res, &err) != GR_OK) goto fail;
     if (t.progress) fprintf(stderr, "\rgodrays tune: %d evaluations\n", t.n);
-    fclose(trace);
-    trace = NULL;
+    if (gr_outfile_commit(&trace, 0, &err) != GR_OK) goto fail;
     if (gr_tune_evaluate(p, res.x, &fa, after, sc_a, &err) != GR_OK) goto fail;
     double scale_mean = 0.0;
     for (int i = 0; i < s.n_cases; i++) scale_mean += sc_a[i] / s.n_cases;
@@ -499,7 +495,7 @@ static int tune_with(gr_args *args)
 fail:
     rc = gr_cli_report(cmd, &err);
 done:
-    if (trace) fclose(trace);
+    gr_outfile_abort(&trace);
     cJSON_Delete(root);
     free(json);
     free(snippet);
