@@ -16,6 +16,7 @@
 #include "image/oiio.h"
 #include "report/report.h"
 #include "tune/page.h"
+#include "tune/budget.h"
 #include "tune/cliopts.h"
 #include "tune/optimize.h"
 
@@ -67,6 +68,7 @@ typedef struct traced {
     FILE *trace;        /* trace.f: the temporary file (common/outfile), renamed at the end */
     int n;
     int progress;
+    gr_tune_budget *budget; /* the estimate after the first evaluation; NULL: none (-q) */
 } traced;
 
 static gr_status traced_objective(void *user, const double *x, double *f, gr_error *err)
@@ -80,6 +82,8 @@ static gr_status traced_objective(void *user, const double *x, double *f, gr_err
         for (int k = 0; k < t->p->n_params; k++) fprintf(t->trace, ",%.9g", x[k]);
         fprintf(t->trace, ",%.9g\n", *f);
     }
+    char eta[512];
+    if (t->budget && gr_tune_budget_eta(t->budget, t->n, eta, sizeof eta)) fprintf(stderr, "%s\n", eta);
     if (t->progress && t->n % 10 == 0) fprintf(stderr, "\rgodrays tune: %d evaluations", t->n);
     return GR_OK;
 }
@@ -272,6 +276,22 @@ static int tune_with(gr_args *args)
         have_x0[idx] = 1;
     }
     if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    gr_opt_options oo;
+    gr_tune_search_defaults(&oo, n_params, x0);
+    oo.method = method;
+    oo.n_starts = n_starts;
+    oo.screen = screen >= 0 ? screen : (4 * n_starts <= GR_OPT_MAX_STARTS ? 4 * n_starts : GR_OPT_MAX_STARTS);
+    oo.seed = seed;
+    if (max_evals > 0) {
+        oo.max_evals = oo.polish = max_evals;
+        if (oo.screen_evals > max_evals) oo.screen_evals = max_evals; /* a small budget stays small */
+    }
+    if (coarse >= 0) oo.coarse = coarse;
+    if (coarse == 0) oo.polish = 0, oo.screen = 0; /* the fixed-lattice search of before */
+    gr_tune_budget budget; /* the count before the ground truths (tune/budget.h) */
+    if (gr_tune_budget_init(&budget, "godrays tune", "evaluations", gr_tune_budget_search(&oo, n_params),
+                            gr_tune_budget_cases(&c.so), c.yes, &err) != GR_OK)
+        return gr_cli_report(cmd, &err);
     c.so.scene_path = args->scene_path;
     c.so.sets = gr_args_sets(args);
     c.so.n_sets = args->n_sets;
@@ -316,19 +336,11 @@ static int tune_with(gr_args *args)
     double before[GR_TUNE_MAX_CASES], after[GR_TUNE_MAX_CASES], sc_b[GR_TUNE_MAX_CASES], sc_a[GR_TUNE_MAX_CASES];
     double fb = 0, fa = 0;
     if (gr_tune_evaluate(p, xb, &fb, before, sc_b, &err) != GR_OK) goto fail;
-    traced t = {.p = p, .trace = trace.f, .progress = !c.quiet && isatty(2)};
-    gr_opt_options oo;
-    gr_tune_search_defaults(&oo, n_params, x0);
-    oo.method = method;
-    oo.n_starts = n_starts;
-    oo.screen = screen >= 0 ? screen : (4 * n_starts <= GR_OPT_MAX_STARTS ? 4 * n_starts : GR_OPT_MAX_STARTS);
-    oo.seed = seed;
-    if (max_evals > 0) {
-        oo.max_evals = oo.polish = max_evals;
-        if (oo.screen_evals > max_evals) oo.screen_evals = max_evals; /* a small budget stays small */
-    }
-    if (coarse >= 0) oo.coarse = coarse;
-    if (coarse == 0) oo.polish = 0, oo.screen = 0; /* the fixed-lattice search of before */
+    traced t = {.p = p, .trace = trace.f, .progress = !c.quiet && isatty(2), .budget = c.quiet ? NULL : &budget};
+    char plan[512];
+    gr_tune_budget_plan_line(&budget, plan, sizeof plan);
+    if (!c.quiet) fprintf(stderr, "%s (at most)\n", plan);
+    gr_tune_budget_start(&budget);
     gr_opt_result res;
     double t_opt = (double)p->renders, render_s0 = p->render_s, metrics_s0 = p->metrics_s;
     if (gr_opt_minimize(n_params, lo, hi, traced_objective, &t, &oo, &res, &err) != GR_OK) goto fail;
