@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cli/cli.h"
+#include "common/paths.h"
 #include "tune/session.h"
 
 void gr_args_create(gr_args *a, const char *cmd, int argc, char **argv)
@@ -32,6 +33,11 @@ void gr_args_free(gr_args *a)
     }
     free(a->sets);
     free(a->origins);
+    for (int k = 0; k < a->n_outs; k++) {
+        free(a->out_roles[k]);
+        free(a->out_paths[k]);
+    }
+    a->n_outs = 0;
     a->sets = NULL;
     a->origins = NULL;
     a->n_sets = a->cap_sets = 0;
@@ -224,7 +230,41 @@ int gr_args_take_scene(gr_args *a)
     if (v[0] == '-' && v[1] != '\0') return gr_cli_usage_error(a->cmd, "unknown option %s", v);
     if (a->scene_path) return gr_cli_usage_error(a->cmd, "more than one scene given (%s, %s)", a->scene_path, v);
     a->scene_path = v;
+    return gr_args_add_input(a, "the scene", v);
+}
+
+int gr_args_add_input(gr_args *a, const char *role, const char *path)
+{
+    gr_error err;
+    return gr_paths_add_input(role, path, &err) == GR_OK ? 0 : gr_cli_report(a->cmd, &err);
+}
+
+int gr_args_note_output(gr_args *a, const char *role, const char *path)
+{
+    gr_error err;
+    if (gr_paths_check_output(role, path, &err) != GR_OK) return gr_cli_report(a->cmd, &err);
+    for (int k = 0; k < a->n_outs; k++)
+        if (gr_path_same_file(path, a->out_paths[k]))
+            return gr_cli_usage_error(a->cmd, "%s %s: the same file as %s %s: two outputs cannot share a file", role, path,
+                                      a->out_roles[k], a->out_paths[k]);
+    if (a->n_outs == GR_ARGS_MAX_OUTPUTS) return 0; /* more than any command writes beside each other */
+    a->out_roles[a->n_outs] = strdup(role);
+    a->out_paths[a->n_outs] = strdup(path);
+    if (!a->out_roles[a->n_outs] || !a->out_paths[a->n_outs]) {
+        free(a->out_roles[a->n_outs]);
+        free(a->out_paths[a->n_outs]);
+        return out_of_memory(a);
+    }
+    a->n_outs++;
     return 0;
+}
+
+int gr_args_note_preview(gr_args *a, const char *flag, const char *exr)
+{
+    char png[4096], role[4200];
+    gr_args_preview_path(exr, png, sizeof png);
+    snprintf(role, sizeof role, "%s %s's preview", flag, exr);
+    return gr_args_note_output(a, role, png);
 }
 
 int gr_args_need_scene(const gr_args *a)
@@ -298,11 +338,13 @@ static int writable_dir(const char *dir)
     return 0;
 }
 
-int gr_args_check_output_file(const gr_args *a, const char *flag, const char *path)
+int gr_args_check_output_file(gr_args *a, const char *flag, const char *path)
 {
     char dir[4096];
     struct stat sb;
     if (!path[0]) return output_error(a, flag, "''", "cannot write", "", ENOENT);
+    const int rc = gr_args_note_output(a, flag, path);
+    if (rc) return rc;
     if (strlen(path) >= sizeof dir) return output_error(a, flag, path, "cannot write", "", ENAMETOOLONG);
     if (path[strlen(path) - 1] == '/' || (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)))
         return output_error(a, flag, path, "cannot write", "", EISDIR);
@@ -322,6 +364,8 @@ int gr_args_check_output_dir(const gr_args *a, const char *flag, const char *pat
 {
     char buf[4096], self[4096];
     if (!path[0]) return output_error(a, flag, "''", "cannot create", "", ENOENT);
+    gr_error perr;
+    if (gr_paths_check_output(flag, path, &perr) != GR_OK) return gr_cli_report(a->cmd, &perr);
     if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf)
         return output_error(a, flag, path, "cannot create", "", ENAMETOOLONG);
     /* Walk up to the nearest part that exists: the folder itself, or the ancestor in which

@@ -15,6 +15,8 @@
 #include "report/html.h"
 #include "scene/scene.h"
 
+#define GR_ARGS_MAX_OUTPUTS 16 /* files one command writes beside each other (export: 4) */
+
 typedef struct gr_args {
     const char *cmd;            /* the subcommand, for messages ("run") */
     int argc;
@@ -29,6 +31,9 @@ typedef struct gr_args {
     const char *scene_path;     /* the positional SCENE argument (NULL: none yet) */
     const char *tech_dirs[GR_TECH_MAX]; /* --technique-dir values, in order */
     int n_tech_dirs;
+    char *out_roles[GR_ARGS_MAX_OUTPUTS]; /* the outputs checked so far: "--gltf" (owned) */
+    char *out_paths[GR_ARGS_MAX_OUTPUTS]; /* and their paths (owned) */
+    int n_outs;
 } gr_args;
 
 /* Empty overrides, reading argv from argument 1. */
@@ -87,12 +92,25 @@ void gr_args_scene_words(const gr_args *a, gr_strbuf *b);
  * name gets ".png" appended (so frame files OUT.0007 keep distinct previews). */
 void gr_args_preview_path(const char *exr, char *buf, size_t n);
 
+/* Registers an input the command reads (common/paths: no output may replace it), described
+ * as `role path` in messages ("part a.part"); role and path must outlive the command. The
+ * scene argument is registered by gr_args_take_scene ("the scene"). Exit 1: out of memory. */
+int gr_args_add_input(gr_args *a, const char *role, const char *path);
+/* An output the command writes beside the others, e.g. the .bin of a .gltf or an EXR's PNG
+ * preview (role: "--gltf x.gltf's buffer"): refused (exit 2, one line naming both) when it is
+ * the same file as an input or as an output checked before; else remembered. */
+int gr_args_note_output(gr_args *a, const char *role, const char *path);
+/* gr_args_note_output for the PNG preview of the EXR that flag names (gr_args_preview_path). */
+int gr_args_note_preview(gr_args *a, const char *flag, const char *exr);
+
 /* Fails early (exit 2, nothing created) unless a file can be written at path: its folder
- * exists, is a folder and is writable, and path is not a folder. The message names flag
+ * exists, is a folder and is writable, path is not a folder, and it is neither the same file
+ * as an input nor as an output checked before (gr_args_note_output). The message names flag
  * (e.g. "-o", or "default output" when the path was not given), the path and the reason. */
-int gr_args_check_output_file(const gr_args *a, const char *flag, const char *path);
+int gr_args_check_output_file(gr_args *a, const char *flag, const char *path);
 /* The same for a folder the command creates with its missing parents: path is a writable
- * folder, or its nearest existing ancestor is. */
+ * folder, or its nearest existing ancestor is, and it is no input. (A file the command
+ * writes into it that is an input is refused when it is written: common/outfile.) */
 int gr_args_check_output_dir(const gr_args *a, const char *flag, const char *path);
 
 /* The output folder: given (the -o value) or, when NULL, the default out/SCENE_NAME[/sub]

@@ -259,6 +259,10 @@ int cmd_compare(int argc, char **argv)
     if (do_struct == 1 && !have_vp && !scene_path)
         return gr_cli_usage_error(cmd, "--metric structure needs the vanishing point: --vp X,Y or --scene FILE");
     if (do_struct == -1) do_struct = have_vp || scene_path;
+    /* no file written into -o DIR may replace an input (common/paths) */
+    if (gr_args_add_input(&args, "REF", paths[0]) || gr_args_add_input(&args, "TEST", paths[1]) ||
+        (scene_path && gr_args_add_input(&args, "--scene", scene_path)))
+        return 1;
     if (outdir) {
         const int rc = gr_args_check_output_dir(&args, "-o", outdir);
         if (rc) return rc;

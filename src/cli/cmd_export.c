@@ -104,8 +104,14 @@ static int export_with(gr_args *args)
     if ((rc = gr_args_need_scene(args)) != 0) return rc;
     if (!gltf && !constants && !glsl) return gr_cli_usage_error(cmd, "nothing to export: give --gltf, --constants or --glsl");
     if (frames && !gltf) return gr_cli_usage_error(cmd, "--frames %s: only with --gltf", frames);
-    /* every output checked before any work; a .gltf also writes its .bin */
+    /* every output checked before any work (none may be an input or another output); a
+     * .gltf also writes its .bin */
     if (gltf && (rc = gr_args_check_output_file(args, "--gltf", gltf)) != 0) return rc;
+    char bin[4096], bin_role[4200];
+    if (gltf && gr_gltf_bin_path(gltf, bin, sizeof bin)) { /* the buffer beside it is an output too */
+        snprintf(bin_role, sizeof bin_role, "--gltf %s's buffer", gltf);
+        if ((rc = gr_args_note_output(args, bin_role, bin)) != 0) return rc;
+    }
     if (constants && (rc = gr_args_check_output_file(args, "--constants", constants)) != 0) return rc;
     if (glsl && (rc = gr_args_check_output_file(args, "--glsl", glsl)) != 0) return rc;
 

@@ -136,6 +136,67 @@ static int status(const char *dir)
     return 0;
 }
 
+/* The files the farm folder gets (farm.h) may not be inputs, such as the scene (common/paths);
+ * out NULL: the default folder, named after the scene, which no input names before it exists. */
+static int check_outputs(gr_args *args, const char *out)
+{
+    static const char *const names[] = {"scene.json", "farm.json", "parts.sh", "merge.sh", "final.sh", "submit.sh"};
+    char p[4200];
+    for (size_t k = 0; out && k < sizeof names / sizeof names[0]; k++) {
+        snprintf(p, sizeof p, "%s/%s", out, names[k]);
+        const int rc = gr_args_note_output(args, "-o", p);
+        if (rc) return rc;
+    }
+    return 0;
+}
+
+/* The folder, the cache and the binary as absolute paths (the jobs run elsewhere); the folder
+ * and the cache are created. Exit 2 with the message otherwise. */
+static int absolute_paths(gr_farm_plan *plan, const gr_scene *scene, const char *out, const char *cache,
+                          const char *binary)
+{
+    char name[256], buf[PATH_MAX];
+    snprintf(name, sizeof name, "farm-%s", scene->name[0] ? scene->name : "scene");
+    if (!out) out = name;
+    if (make_dirs(out) != 0 || !realpath(out, buf)) {
+        fprintf(stderr, "godrays farm: -o %s: cannot create: %s\n", out, strerror(errno));
+        return 2;
+    }
+    snprintf(plan->dir, sizeof plan->dir, "%s", buf);
+    if (make_dirs(cache) != 0 || !realpath(cache, buf)) {
+        fprintf(stderr, "godrays farm: cache %s: cannot create: %s\n", cache, strerror(errno));
+        return 2;
+    }
+    snprintf(plan->cache, sizeof plan->cache, "%s", buf);
+    ssize_t bl = binary ? (realpath(binary, buf) ? (ssize_t)strlen(buf) : -1) : readlink("/proc/self/exe", buf, sizeof buf - 1);
+    if (bl < 0) {
+        fprintf(stderr, "godrays farm: --binary %s: %s\n", binary ? binary : "(this one)", strerror(errno));
+        return 2;
+    }
+    buf[bl] = '\0';
+    snprintf(plan->binary, sizeof plan->binary, "%s", buf);
+    return 0;
+}
+
+/* tune needs its parameters: without --params in --then-args, the first technique's first
+ * tunable settings (`godrays techniques`) are appended. */
+static int default_tune_params(gr_farm_plan *plan)
+{
+    if (!strcmp(plan->then, "tune") && !strstr(plan->then_args, "--params")) {
+        /* the first technique's first tunable settings (`godrays techniques`) */
+        const gr_technique_class *tc = gr_technique_at(0);
+        const gr_param *ex[2];
+        const int nex = gr_technique_tune_example(tc, ex, 2);
+        if (nex == 0) return gr_cli_usage_error("farm", "--then tune: give --then-args \"--params TECHNIQUE.KEY\"");
+        size_t tl = strlen(plan->then_args);
+        snprintf(plan->then_args + tl, sizeof plan->then_args - tl, "%s--params %s.%s%s%s%s", tl ? " " : "", tc->name,
+                 ex[0]->name, nex > 1 ? "," : "", nex > 1 ? tc->name : "", nex > 1 ? "." : "");
+        tl = strlen(plan->then_args);
+        if (nex > 1) snprintf(plan->then_args + tl, sizeof plan->then_args - tl, "%s", ex[1]->name);
+    }
+    return 0;
+}
+
 static int farm_with(gr_args *args)
 {
     const char *cmd = "farm", *out = NULL, *v = NULL, *status_dir = NULL, *cache = NULL, *binary = NULL;
@@ -193,20 +254,15 @@ static int farm_with(gr_args *args)
     if (rc) return rc;
     if (status_dir) return args->scene_path ? gr_cli_usage_error(cmd, "--status DIR takes no scene") : status(status_dir);
     if ((rc = gr_args_need_scene(args)) != 0) return rc;
+    size_t l = (size_t)snprintf(plan.command, sizeof plan.command, "godrays");
+    for (int k = 0; k < args->argc && l < sizeof plan.command; k++)
+        l += (size_t)snprintf(plan.command + l, sizeof plan.command - l, " %s", args->argv[k]);
+    gr_error err = {GR_OK, ""};
+    if (gr_farm_check(&plan, &err) != GR_OK) return gr_cli_report(cmd, &err); /* before any folder is made */
+    if ((rc = check_outputs(args, out)) != 0) return rc;
     if (strcmp(plan.then, "tune") && strcmp(plan.then, "run") && strcmp(plan.then, "none"))
         return gr_cli_usage_error(cmd, "--then %s: expected tune, run or none", plan.then);
-    if (!strcmp(plan.then, "tune") && !strstr(plan.then_args, "--params")) { /* tune needs its parameters */
-        /* the first technique's first tunable settings (`godrays techniques`) */
-        const gr_technique_class *tc = gr_technique_at(0);
-        const gr_param *ex[2];
-        const int nex = gr_technique_tune_example(tc, ex, 2);
-        if (nex == 0) return gr_cli_usage_error(cmd, "--then tune: give --then-args \"--params TECHNIQUE.KEY\"");
-        size_t tl = strlen(plan.then_args);
-        snprintf(plan.then_args + tl, sizeof plan.then_args - tl, "%s--params %s.%s%s%s%s", tl ? " " : "", tc->name,
-                 ex[0]->name, nex > 1 ? "," : "", nex > 1 ? tc->name : "", nex > 1 ? "." : "");
-        tl = strlen(plan.then_args);
-        if (nex > 1) snprintf(plan.then_args + tl, sizeof plan.then_args - tl, "%s", ex[1]->name);
-    }
+    if ((rc = default_tune_params(&plan)) != 0) return rc;
     if (!cache) cache = getenv("GODRAYS_CACHE");
     char user_cache[4096];
     if (!cache || !cache[0]) { /* the cache run and tune use here; the nodes must see it too */
@@ -218,7 +274,6 @@ static int farm_with(gr_args *args)
     }
     gr_scene *scene = NULL;
     if ((rc = gr_args_load_scene(args, &scene)) != 0) return rc;
-    gr_error err = {GR_OK, ""};
     if (scene->reference.target_error > 0.0) {
         rc = gr_cli_usage_error(cmd, "reference.target_error = %g: parts take the fixed passes of one round; set it to 0 "
                                      "and raise reference.sun_samples or spp instead (docs/farm.md)",
@@ -230,33 +285,7 @@ static int farm_with(gr_args *args)
                                 plan.batch_parts, scene->camera.height, scene->reference.batches);
         goto done;
     }
-    /* absolute paths: the jobs run elsewhere */
-    char name[256], buf[PATH_MAX];
-    snprintf(name, sizeof name, "farm-%s", scene->name[0] ? scene->name : "scene");
-    if (!out) out = name;
-    if (make_dirs(out) != 0 || !realpath(out, buf)) {
-        fprintf(stderr, "godrays farm: -o %s: cannot create: %s\n", out, strerror(errno));
-        rc = 2;
-        goto done;
-    }
-    snprintf(plan.dir, sizeof plan.dir, "%s", buf);
-    if (make_dirs(cache) != 0 || !realpath(cache, buf)) {
-        fprintf(stderr, "godrays farm: cache %s: cannot create: %s\n", cache, strerror(errno));
-        rc = 2;
-        goto done;
-    }
-    snprintf(plan.cache, sizeof plan.cache, "%s", buf);
-    ssize_t bl = binary ? (realpath(binary, buf) ? (ssize_t)strlen(buf) : -1) : readlink("/proc/self/exe", buf, sizeof buf - 1);
-    if (bl < 0) {
-        fprintf(stderr, "godrays farm: --binary %s: %s\n", binary ? binary : "(this one)", strerror(errno));
-        rc = 2;
-        goto done;
-    }
-    buf[bl] = '\0';
-    snprintf(plan.binary, sizeof plan.binary, "%s", buf);
-    size_t l = (size_t)snprintf(plan.command, sizeof plan.command, "godrays");
-    for (int k = 0; k < args->argc && l < sizeof plan.command; k++)
-        l += (size_t)snprintf(plan.command + l, sizeof plan.command - l, " %s", args->argv[k]);
+    if ((rc = absolute_paths(&plan, scene, out, cache, binary)) != 0) goto done;
     gr_status st = gr_farm_plan_cases(&plan, scene, &err);
     if (st == GR_OK) st = gr_farm_write(&plan, scene, &err);
     if (st == GR_OK) { /* the jobs load the scene copy: it must give the same keys */

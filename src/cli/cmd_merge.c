@@ -60,7 +60,9 @@ static int merge_with(gr_args *args)
     }
     if (!rc && !n) rc = gr_cli_usage_error(cmd, "no part files given");
     if (!rc && !out_path && !cache) rc = gr_cli_usage_error(cmd, "no output given (-o OUT.exr or --cache)");
+    for (int k = 0; k < n && !rc; k++) rc = gr_args_add_input(args, "part", parts[k]); /* never replaced */
     if (!rc && out_path) rc = gr_args_check_output_file(args, "-o", out_path);
+    if (!rc && out_path && preview) rc = gr_args_note_preview(args, "-o", out_path);
     if (rc) {
         free(parts);
         return rc;
@@ -92,7 +94,7 @@ static int merge_with(gr_args *args)
     if (st != GR_OK) rc = gr_cli_report(cmd, &err);
     else if (!quiet)
         fprintf(stderr,
-                "godrays merge: %d parts -> %s%s%s (%dx%d, %d spp, parts' wall time %.1f s, merge %.2f s): rel. std. "
+                "godrays merge: %d parts -> %s%s%s (%dx%d, %d spp, parts' wall time %.4g s, merge %.2f s): rel. std. "
                 "error of the mean %.3g%%, of the p95 pixel %.3g%%\n",
                 n, out_path ? out_path : "", out_path && cache ? " and " : "", cache ? cpath : "", res.image->width,
                 res.image->height, res.spp, res.wall_s, merge_s, 100.0 * res.rel_se_mean, 100.0 * res.rel_se_p95);

@@ -15,6 +15,7 @@
 #include "realtime/technique.h"
 #include "report/report.h"
 #include "tune/page.h"
+#include "tune/budget.h"
 #include "tune/pareto.h"
 #include "tune/session.h"
 #include "tune/truth.h"
@@ -51,6 +52,7 @@ static void usage(FILE *f)
             "  --quick            fewer points (q0, q1, the quick levels of each ladder), for tests\n"
             "  --repeat R         renders per setting; time = median (default 5)\n"
             "  --no-cache         render the high-quality ground truth even if cached\n"
+            "  --yes              start more than 20000 technique renders (docs/tuning.md \"Budgets\")\n"
             "  --gl-platform P    auto, surfaceless or device\n"
             "  -q, --quiet        no progress messages\n"
             "  -h, --help         this help\n"
@@ -120,7 +122,7 @@ static int pareto_with(gr_args *args)
     const char *cmd = "pareto", *outopt = NULL;
     const int argc = args->argc;
     char **argv = args->argv;
-    int quiet = 0, quick = 0, use_cache = 1, rc = 0, taken = 0;
+    int quiet = 0, quick = 0, use_cache = 1, rc = 0, taken = 0, yes = 0;
     const char *tech_list = NULL, *tech_flag = "--techniques";
     long repeat = 5;
     gr_gl_platform platform = GR_GL_AUTO;
@@ -141,6 +143,8 @@ static int pareto_with(gr_args *args)
                 rc = gr_cli_usage_error(cmd, "--technique %s: one technique (use --techniques for a list)", tech_list);
         } else if (!strcmp(a, "--no-cache")) {
             use_cache = 0;
+        } else if (!strcmp(a, "--yes")) {
+            yes = 1;
         } else if (!strcmp(a, "--repeat")) {
             const char *v;
             char *end = NULL;
@@ -161,6 +165,13 @@ static int pareto_with(gr_args *args)
         gr_error lerr = {GR_OK, ""};
         if (gr_technique_parse_list(tech_flag, tech_list, techs, GR_TECH_MAX, &n_techs, &lerr) != GR_OK)
             return gr_cli_usage_error(cmd, "%s", lerr.msg);
+    }
+    gr_tune_budget budget; /* the count before the ground truths (tune/budget.h) */
+    {
+        gr_error berr;
+        if (gr_tune_budget_init(&budget, "godrays pareto", "renders", gr_tune_budget_ladders(techs, n_techs, quick, repeat),
+                                1, yes, &berr) != GR_OK)
+            return gr_cli_report(cmd, &berr);
     }
     /* the default size after every override, so that it wins over --set camera.width/height */
     if (!args->have_size && (rc = gr_args_add_set(args, "camera.width=320")) != 0) return rc;
@@ -245,6 +256,10 @@ static int pareto_with(gr_args *args)
         goto fail;
     }
     int gpu_any = 0;
+    char line[512];
+    gr_tune_budget_plan_line(&budget, line, sizeof line);
+    if (!quiet) fprintf(stderr, "%s\n", line);
+    gr_tune_budget_start(&budget);
     for (int k = 0; k < n_techs; k++) {
         const gr_technique_class *cls = techs[k];
         gr_technique_destroy(r);
@@ -267,6 +282,8 @@ static int pareto_with(gr_args *args)
             if (st == GR_OK) st = gr_technique_render(r, scene, s.bytes, img, &stats, &err);
             for (long q = 0; st == GR_OK && q < repeat; q++) {
                 st = gr_technique_render(r, scene, s.bytes, img, &stats, &err);
+                /* once, after the first level's warm-up and first timed render */
+                if (!quiet && gr_tune_budget_eta(&budget, 2, line, sizeof line)) fprintf(stderr, "%s\n", line);
                 times[q] = stats.wall_ms * 1e-3;
                 double g = 0;
                 int ok = stats.n_passes > 0;

@@ -183,6 +183,7 @@ static int reference_with(gr_args *args)
     }
     /* A render takes minutes: an output that cannot be written is refused before it. */
     if (!bench && (rc = gr_args_check_output_file(args, "-o", out_path)) != 0) goto done;
+    if (!bench && preview && (rc = gr_args_note_preview(args, "-o", out_path)) != 0) goto done;
 
     gr_error err = {GR_OK, ""};
     gr_status st;

@@ -194,6 +194,7 @@ static int render_with(gr_args *args)
     if (gr_technique_check(cls, gr_technique_scene_settings(cls, scene), &err) != GR_OK) goto fail;
     /* So are the outputs (frames and previews go beside OUT). */
     if ((rc = gr_args_check_output_file(args, "-o", out_path)) != 0) goto done;
+    if (!have_frames && preview && (rc = gr_args_note_preview(args, "-o", out_path)) != 0) goto done;
     if (target_path && (rc = gr_args_check_output_file(args, "--save-target", target_path)) != 0) goto done;
     double t_base = have_time ? time_s : scene->water.time_s;
 

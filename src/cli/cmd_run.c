@@ -154,7 +154,7 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
     if (res.partial) {
         gr_ref_result_free(&res);
         return gr_fail(err, GR_E_INTERRUPTED, "interrupted while rendering the ground truth: no report written, "
-                       "nothing cached");
+                       "this ground truth not cached");
     }
     ro->img = res.image;
     res.image = NULL;
@@ -381,6 +381,9 @@ static int run_with(gr_args *args)
         if (!quiet) fprintf(stderr, "godrays run: frame %d of %d (t = %g s)\n", i + 1, nf, times[i]);
         if (get_reference(&cases[i], use_cache, quiet, &seq_ref[i], &err) != GR_OK) {
             gr_error_prefix(&err, "frame %d (t = %g s)", i, times[i]);
+            const size_t l = strlen(err.msg); /* the frames before it were cached ("nothing cached" was wrong) */
+            if (err.status == GR_E_INTERRUPTED && ro.cache_on)
+                snprintf(err.msg + l, sizeof err.msg - l, "; the %d frame%s before it cached", i, i > 1 ? "s" : "");
             goto fail;
         }
     }

@@ -13,6 +13,7 @@
 #include "image/oiio.h"
 #include "report/report.h"
 #include "tune/page.h"
+#include "tune/budget.h"
 #include "tune/cliopts.h"
 #include "tune/sweep.h"
 
@@ -41,12 +42,15 @@ static void usage(FILE *f)
 }
 
 typedef struct progress_ctx {
-    int on;
+    int on, quiet;
+    gr_tune_budget budget; /* the estimate after the first grid point (tune/budget.h) */
 } progress_ctx;
 
 static void progress(void *user, int done, int total)
 {
-    const progress_ctx *p = user;
+    progress_ctx *p = user;
+    char eta[512];
+    if (!p->quiet && gr_tune_budget_eta(&p->budget, done, eta, sizeof eta)) fprintf(stderr, "%s%s\n", p->on ? "\r" : "", eta);
     if (!p->on) return;
     if (done == total || done % 8 == 0) {
         fprintf(stderr, "\rgodrays sweep: %d/%d grid points", done, total);
@@ -197,6 +201,11 @@ static int sweep_with(gr_args *args)
                 return gr_cli_usage_error(cmd, "--param %s: %s swept twice", param_specs[j], params[k].key);
     }
     if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    progress_ctx pc = {!c.quiet && isatty(2), c.quiet, {0}}; /* the count before the ground truths */
+    const long long points = (long long)params[0].count * (n_params > 1 ? params[1].count : 1);
+    if (gr_tune_budget_init(&pc.budget, "godrays sweep", "grid points", points, gr_tune_budget_cases(&c.so), c.yes,
+                            &err) != GR_OK)
+        return gr_cli_report(cmd, &err);
     c.so.scene_path = args->scene_path;
     c.so.sets = gr_args_sets(args);
     c.so.n_sets = args->n_sets;
@@ -229,7 +238,10 @@ static int sweep_with(gr_args *args)
     }
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
 
-    progress_ctx pc = {!c.quiet && isatty(2)};
+    char plan[512];
+    gr_tune_budget_plan_line(&pc.budget, plan, sizeof plan);
+    if (!c.quiet) fprintf(stderr, "%s\n", plan);
+    gr_tune_budget_start(&pc.budget);
     if (gr_sweep_run(p, &r, progress, &pc, &err) != GR_OK) goto fail;
     /* the sweep's own accounting, before the extra render of best.png */
     const long long sw_renders = p->renders;

@@ -3,6 +3,7 @@
  * Nelder-Mead with restarts (src/tune/optimize.h). */
 #include "cli/cli.h"
 #include "cli/args.h"
+#include "common/outfile.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -15,6 +16,7 @@
 #include "image/oiio.h"
 #include "report/report.h"
 #include "tune/page.h"
+#include "tune/budget.h"
 #include "tune/cliopts.h"
 #include "tune/optimize.h"
 
@@ -63,9 +65,10 @@ static void usage(FILE *f)
 /* The objective, recording every evaluation into trace.csv. */
 typedef struct traced {
     gr_tune_problem *p;
-    FILE *trace;
+    FILE *trace;        /* trace.f: the temporary file (common/outfile), renamed at the end */
     int n;
     int progress;
+    gr_tune_budget *budget; /* the estimate after the first evaluation; NULL: none (-q) */
 } traced;
 
 static gr_status traced_objective(void *user, const double *x, double *f, gr_error *err)
@@ -79,6 +82,8 @@ static gr_status traced_objective(void *user, const double *x, double *f, gr_err
         for (int k = 0; k < t->p->n_params; k++) fprintf(t->trace, ",%.9g", x[k]);
         fprintf(t->trace, ",%.9g\n", *f);
     }
+    char eta[512];
+    if (t->budget && gr_tune_budget_eta(t->budget, t->n, eta, sizeof eta)) fprintf(stderr, "%s\n", eta);
     if (t->progress && t->n % 10 == 0) fprintf(stderr, "\rgodrays tune: %d evaluations", t->n);
     return GR_OK;
 }
@@ -271,6 +276,22 @@ static int tune_with(gr_args *args)
         have_x0[idx] = 1;
     }
     if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    gr_opt_options oo;
+    gr_tune_search_defaults(&oo, n_params, x0);
+    oo.method = method;
+    oo.n_starts = n_starts;
+    oo.screen = screen >= 0 ? screen : (4 * n_starts <= GR_OPT_MAX_STARTS ? 4 * n_starts : GR_OPT_MAX_STARTS);
+    oo.seed = seed;
+    if (max_evals > 0) {
+        oo.max_evals = oo.polish = max_evals;
+        if (oo.screen_evals > max_evals) oo.screen_evals = max_evals; /* a small budget stays small */
+    }
+    if (coarse >= 0) oo.coarse = coarse;
+    if (coarse == 0) oo.polish = 0, oo.screen = 0; /* the fixed-lattice search of before */
+    gr_tune_budget budget; /* the count before the ground truths (tune/budget.h) */
+    if (gr_tune_budget_init(&budget, "godrays tune", "evaluations", gr_tune_budget_search(&oo, n_params),
+                            gr_tune_budget_cases(&c.so), c.yes, &err) != GR_OK)
+        return gr_cli_report(cmd, &err);
     c.so.scene_path = args->scene_path;
     c.so.sets = gr_args_sets(args);
     c.so.n_sets = args->n_sets;
@@ -281,7 +302,7 @@ static int tune_with(gr_args *args)
     gr_tune_problem *p = calloc(1, sizeof *p);
     char dirbuf[4096], path[4300];
     char *json = NULL, *snippet = NULL;
-    FILE *trace = NULL;
+    gr_outfile trace = {.slot = -1}; /* a new trace replaces the old one only once complete */
     cJSON *root = NULL;
     const char *outdir = NULL;
     if (!p) {
@@ -307,37 +328,24 @@ static int tune_with(gr_args *args)
     }
     if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
     snprintf(path, sizeof path, "%s/trace.csv", outdir);
-    trace = fopen(path, "w");
-    if (!trace) {
-        gr_fail(&err, GR_E_IO, "%s: cannot create", path);
-        goto fail;
-    }
-    fprintf(trace, "eval");
-    for (int k = 0; k < n_params; k++) fprintf(trace, ",%s", params[k].key);
-    fprintf(trace, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
+    if (gr_outfile_open_stream(&trace, path, &err) != GR_OK) goto fail;
+    fprintf(trace.f, "eval");
+    for (int k = 0; k < n_params; k++) fprintf(trace.f, ",%s", params[k].key);
+    fprintf(trace.f, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
 
     double before[GR_TUNE_MAX_CASES], after[GR_TUNE_MAX_CASES], sc_b[GR_TUNE_MAX_CASES], sc_a[GR_TUNE_MAX_CASES];
     double fb = 0, fa = 0;
     if (gr_tune_evaluate(p, xb, &fb, before, sc_b, &err) != GR_OK) goto fail;
-    traced t = {.p = p, .trace = trace, .progress = !c.quiet && isatty(2)};
-    gr_opt_options oo;
-    gr_tune_search_defaults(&oo, n_params, x0);
-    oo.method = method;
-    oo.n_starts = n_starts;
-    oo.screen = screen >= 0 ? screen : (4 * n_starts <= GR_OPT_MAX_STARTS ? 4 * n_starts : GR_OPT_MAX_STARTS);
-    oo.seed = seed;
-    if (max_evals > 0) {
-        oo.max_evals = oo.polish = max_evals;
-        if (oo.screen_evals > max_evals) oo.screen_evals = max_evals; /* a small budget stays small */
-    }
-    if (coarse >= 0) oo.coarse = coarse;
-    if (coarse == 0) oo.polish = 0, oo.screen = 0; /* the fixed-lattice search of before */
+    traced t = {.p = p, .trace = trace.f, .progress = !c.quiet && isatty(2), .budget = c.quiet ? NULL : &budget};
+    char plan[512];
+    gr_tune_budget_plan_line(&budget, plan, sizeof plan);
+    if (!c.quiet) fprintf(stderr, "%s (at most)\n", plan);
+    gr_tune_budget_start(&budget);
     gr_opt_result res;
     double t_opt = (double)p->renders, render_s0 = p->render_s, metrics_s0 = p->metrics_s;
     if (gr_opt_minimize(n_params, lo, hi, traced_objective, &t, &oo, &res, &err) != GR_OK) goto fail;
     if (t.progress) fprintf(stderr, "\rgodrays tune: %d evaluations\n", t.n);
-    fclose(trace);
-    trace = NULL;
+    if (gr_outfile_commit(&trace, 0, &err) != GR_OK) goto fail;
     if (gr_tune_evaluate(p, res.x, &fa, after, sc_a, &err) != GR_OK) goto fail;
     double scale_mean = 0.0;
     for (int i = 0; i < s.n_cases; i++) scale_mean += sc_a[i] / s.n_cases;
@@ -499,7 +507,7 @@ static int tune_with(gr_args *args)
 fail:
     rc = gr_cli_report(cmd, &err);
 done:
-    if (trace) fclose(trace);
+    gr_outfile_abort(&trace);
     cJSON_Delete(root);
     free(json);
     free(snippet);

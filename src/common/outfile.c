@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/paths.h"
 #include "common/signals.h"
 
 static atomic_int g_counter = 0;
@@ -23,42 +24,15 @@ static const char *kind_name(mode_t m)
     return "not a regular file";
 }
 
-/* The file that writing to path replaces: path itself, or the final target of the chain of
- * symlinks it names (a relative target is relative to its link's folder). NULL: no memory. */
-static char *final_target(const char *path)
-{
-    char *cur = strdup(path);
-    for (int hop = 0; cur && hop < 40; hop++) {
-        struct stat sb;
-        if (lstat(cur, &sb) != 0 || !S_ISLNK(sb.st_mode)) return cur;
-        char link[4096];
-        ssize_t n = readlink(cur, link, sizeof link - 1);
-        if (n < 0) return cur;
-        link[n] = '\0';
-        char *next;
-        const char *slash = strrchr(cur, '/');
-        if (link[0] == '/' || !slash) {
-            next = strdup(link);
-        } else {
-            size_t dl = (size_t)(slash - cur) + 1;
-            next = malloc(dl + (size_t)n + 1);
-            if (next) {
-                memcpy(next, cur, dl);
-                memcpy(next + dl, link, (size_t)n + 1);
-            }
-        }
-        free(cur);
-        cur = next;
-    }
-    return cur; /* a loop: the open reports ELOOP */
-}
-
-gr_status gr_outfile_begin(gr_outfile *o, const char *path, gr_error *err)
+static gr_status begin(gr_outfile *o, const char *path, int defer, gr_error *err)
 {
     memset(o, 0, sizeof *o);
     o->slot = -1;
     if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "output: empty file name");
-    char *target = final_target(path);
+    /* an input of the command is never replaced, whatever the output (common/paths) */
+    gr_status pst = gr_paths_check_output(NULL, path, err);
+    if (pst != GR_OK) return pst;
+    char *target = gr_path_final_target(path);
     if (!target) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
     struct stat sb;
     if (stat(target, &sb) == 0 && S_ISDIR(sb.st_mode)) {
@@ -80,14 +54,20 @@ gr_status gr_outfile_begin(gr_outfile *o, const char *path, gr_error *err)
     snprintf(tmp, n, "%s.tmp-%ld-%d", target, (long)getpid(), atomic_fetch_add(&g_counter, 1));
     o->path = target;
     o->tmp = tmp;
-    gr_signals_defer_begin();
+    o->deferred = defer;
+    if (defer) gr_signals_defer_begin();
     o->slot = gr_signals_add_temp(tmp);
     return GR_OK;
 }
 
-gr_status gr_outfile_open(gr_outfile *o, const char *path, gr_error *err)
+gr_status gr_outfile_begin(gr_outfile *o, const char *path, gr_error *err)
 {
-    gr_status st = gr_outfile_begin(o, path, err);
+    return begin(o, path, 1, err);
+}
+
+static gr_status open_with(gr_outfile *o, const char *path, int defer, gr_error *err)
+{
+    gr_status st = begin(o, path, defer, err);
     if (st != GR_OK) return st;
     o->f = fopen(o->tmp, "wb");
     if (!o->f) {
@@ -97,11 +77,21 @@ gr_status gr_outfile_open(gr_outfile *o, const char *path, gr_error *err)
     return st;
 }
 
+gr_status gr_outfile_open(gr_outfile *o, const char *path, gr_error *err)
+{
+    return open_with(o, path, 1, err);
+}
+
+gr_status gr_outfile_open_stream(gr_outfile *o, const char *path, gr_error *err)
+{
+    return open_with(o, path, 0, err);
+}
+
 static void release(gr_outfile *o, int remove_tmp)
 {
     if (o->f) fclose(o->f);
     if (remove_tmp && o->tmp) unlink(o->tmp);
-    const int had = o->tmp != NULL;
+    const int had = o->tmp != NULL && o->deferred;
     gr_signals_remove_temp(o->slot);
     free(o->path);
     free(o->tmp);
@@ -115,9 +105,14 @@ void gr_outfile_abort(gr_outfile *o)
     if (o) release(o, 1);
 }
 
-gr_status gr_outfile_commit(gr_outfile *o, long long min_size, gr_error *err)
+gr_status gr_outfile_finish(gr_outfile *o, long long min_size, gr_error *err)
 {
     if (!o->tmp) return gr_fail(err, GR_E_USAGE, "output: commit without begin");
+    if (o->finished) return GR_OK;
+    if (!o->deferred) { /* from here to the rename a signal waits, as for any output */
+        gr_signals_defer_begin();
+        o->deferred = 1;
+    }
     gr_status st = GR_OK;
     int e = 0;
     if (o->f) {
@@ -146,7 +141,16 @@ gr_status gr_outfile_commit(gr_outfile *o, long long min_size, gr_error *err)
             st = gr_fail(err, GR_E_IO, "%s: cannot write: only %lld of at least %lld bytes reached the disk "
                          "(is it full?)", o->path, (long long)sb.st_size, min_size);
     }
-    if (st == GR_OK && rename(o->tmp, o->path) != 0)
+    if (st != GR_OK) release(o, 1);
+    else o->finished = 1;
+    return st;
+}
+
+gr_status gr_outfile_commit(gr_outfile *o, long long min_size, gr_error *err)
+{
+    gr_status st = gr_outfile_finish(o, min_size, err);
+    if (st != GR_OK) return st;
+    if (rename(o->tmp, o->path) != 0)
         st = gr_fail(err, GR_E_IO, "%s: cannot rename %s into place: %s", o->path, o->tmp, strerror(errno));
     release(o, st != GR_OK);
     return st;

@@ -9,6 +9,7 @@
  *  - every write, the flush, fsync and close are checked, and the file's size is checked
  *    before it is renamed over the target: a full disk gives GR_E_IO and no file, never a
  *    truncated one;
+ *  - an input of the command (common/paths) is never replaced: GR_E_USAGE;
  *  - the temporary name is registered with common/signals so that SIGINT or SIGTERM removes
  *    it, and a signal arriving while a file is written is handled once it is in place. */
 #ifndef GR_OUTFILE_H
@@ -26,6 +27,8 @@ typedef struct gr_outfile {
     char *tmp;   /* the temporary name to write to (owned) */
     FILE *f;     /* open on tmp after gr_outfile_open, else NULL */
     int slot;    /* its entry in the signal-cleanup registry, -1 when none */
+    int deferred; /* signals wait while it is written (all but gr_outfile_open_stream's) */
+    int finished; /* gr_outfile_finish succeeded: only the rename is left */
 } gr_outfile;
 
 /* Checks path (refusing an existing non-regular file, following symlinks), chooses the
@@ -34,6 +37,16 @@ typedef struct gr_outfile {
 gr_status gr_outfile_begin(gr_outfile *o, const char *path, gr_error *err);
 /* gr_outfile_begin, then o->f = fopen(o->tmp, "wb"). */
 gr_status gr_outfile_open(gr_outfile *o, const char *path, gr_error *err);
+/* gr_outfile_open for an output written over a long time (tune's trace.csv, one line per
+ * evaluation): a signal is not held back while it is open but ends the process at once, which
+ * removes the temporary file and leaves the previous file at path as it was; from
+ * gr_outfile_finish or gr_outfile_commit on, a signal waits as for any output. */
+gr_status gr_outfile_open_stream(gr_outfile *o, const char *path, gr_error *err);
+/* The checks of gr_outfile_commit without the rename: closes o->f (ferror, fflush, fsync,
+ * fclose) and checks the size. On failure o->tmp is removed and o released. Lets a caller
+ * write several files and rename them only once all are complete (a .gltf and its .bin);
+ * gr_outfile_commit then only renames. */
+gr_status gr_outfile_finish(gr_outfile *o, long long min_size, gr_error *err);
 /* Closes o->f if open (checking ferror, fflush, fsync, fclose), checks that o->tmp holds at
  * least min_size bytes (a writer that hides a failed write leaves fewer), then renames it over
  * o->path. On any failure o->tmp is removed and the message names o->path. Always releases o. */

@@ -421,7 +421,7 @@ gr_status gr_gltf_parse_frames(const char *text, const char *flag, gr_gltf_optio
     if (v[1] < v[0]) return gr_fail(err, GR_E_USAGE, "%s %s: last time B is before first time A", flag, text);
     double n = floor((v[1] - v[0]) / v[2] * (1.0 + 1e-12) + 1e-9) + 1.0;
     if (!(n <= GR_GLTF_MAX_FRAMES))
-        return gr_fail(err, GR_E_USAGE, "%s %s: %.0f frames, at most %d", flag, text, n, GR_GLTF_MAX_FRAMES);
+        return gr_fail(err, GR_E_USAGE, "%s %s: %.3g frames, at most %d", flag, text, n, GR_GLTF_MAX_FRAMES);
     o->frame_t0 = v[0];
     o->frame_dt = v[2];
     o->n_frames = (int)n;
@@ -442,25 +442,49 @@ int gr_gltf_kind(const char *path)
     return 0;
 }
 
-/* a, then b, then nzero (< 4) zero bytes into path, atomically (common/outfile) */
-static gr_status write_file(const char *path, const void *a, size_t na, const void *b, size_t nb, size_t nzero,
-                            gr_error *err)
+int gr_gltf_bin_path(const char *path, char *buf, size_t n)
+{
+    if (gr_gltf_kind(path) != 1) return 0;
+    const size_t stem = strlen(path) - 5;
+    return snprintf(buf, n, "%.*s.bin", (int)stem, path) < (int)n;
+}
+
+/* a, then b, then nzero (< 4) zero bytes into o's temporary file for path, written and checked
+ * (gr_outfile_finish) but not yet renamed into place; o is released on failure */
+static gr_status write_tmp(gr_outfile *o, const char *path, const void *a, size_t na, const void *b, size_t nb,
+                           size_t nzero, gr_error *err)
 {
     static const unsigned char zero[4] = {0, 0, 0, 0};
-    gr_outfile o;
-    gr_status st = gr_outfile_open(&o, path, err);
+    gr_status st = gr_outfile_open(o, path, err);
     if (st != GR_OK) return st;
-    if (!o.f) {
-        gr_outfile_abort(&o);
-        return gr_fail(err, GR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-    }
-    if ((na && fwrite(a, 1, na, o.f) != na) || (nb && fwrite(b, 1, nb, o.f) != nb) ||
-        (nzero && fwrite(zero, 1, nzero, o.f) != nzero)) {
+    if ((na && fwrite(a, 1, na, o->f) != na) || (nb && fwrite(b, 1, nb, o->f) != nb) ||
+        (nzero && fwrite(zero, 1, nzero, o->f) != nzero)) {
         int e = errno;
-        gr_outfile_abort(&o);
+        gr_outfile_abort(o);
         return gr_fail(err, GR_E_IO, "%s: write failed: %s", path, strerror(e));
     }
-    return gr_outfile_commit(&o, (long long)(na + nb + nzero), err);
+    return gr_outfile_finish(o, (long long)(na + nb + nzero), err);
+}
+
+/* The .bin and the .gltf that names it, as a pair: both are written and checked under their
+ * temporary names first, then the .bin is renamed into place and the .gltf last. A signal
+ * waits until both are in place (common/outfile), so an interrupted export leaves the old pair
+ * or the new one, never a new .bin beside an old .gltf. */
+static gr_status write_pair(const char *binpath, const void *bin, size_t nbin, const char *path, const char *json,
+                            size_t njson, gr_error *err)
+{
+    gr_outfile ob, og;
+    gr_status st = write_tmp(&ob, binpath, bin, nbin, NULL, 0, 0, err);
+    if (st != GR_OK) return st;
+    if ((st = write_tmp(&og, path, json, njson, NULL, 0, 0, err)) != GR_OK) {
+        gr_outfile_abort(&ob);
+        return st;
+    }
+    if ((st = gr_outfile_commit(&ob, (long long)nbin, err)) != GR_OK) {
+        gr_outfile_abort(&og); /* the old pair stays */
+        return st;
+    }
+    return gr_outfile_commit(&og, (long long)njson, err);
 }
 
 static void put_u32(unsigned char *p, uint32_t v)
@@ -718,13 +742,13 @@ gr_status gr_gltf_write(const gr_scene *s, const gr_gltf_options *opt, const cha
     size_t plen = strlen(path);
     binpath = malloc(plen + 8);
     if (!binpath) goto nomem;
+    binpath[0] = '\0';
     size_t binlen = c.n;
     cJSON *buf = cJSON_CreateObject();
     cJSON_AddNumberToObject(buf, "byteLength", (double)binlen);
     const char *uri_name = NULL;
     if (kind == 1) {
-        memcpy(binpath, path, plen - 5);
-        strcpy(binpath + plen - 5, ".bin");
+        gr_gltf_bin_path(path, binpath, plen + 8);
         const char *slash = strrchr(binpath, '/');
         uri_name = slash ? slash + 1 : binpath;
         char *uri = uri_encode(uri_name);
@@ -737,9 +761,7 @@ gr_status gr_gltf_write(const gr_scene *s, const gr_gltf_options *opt, const cha
     if (!json) goto nomem;
     size_t jlen = strlen(json);
     if (kind == 1) {
-        /* the .bin first: a .gltf never names a buffer that is not there */
-        if ((st = write_file(binpath, c.bin, binlen, NULL, 0, 0, err)) != GR_OK) goto done;
-        st = write_file(path, json, jlen, NULL, 0, 0, err);
+        st = write_pair(binpath, c.bin, binlen, path, json, jlen, err);
     } else {
         /* GLB (glTF 2.0 spec, "Binary glTF Layout"): 12-byte header, JSON chunk padded with
          * spaces, BIN chunk padded with zeros, both to 4 bytes */
@@ -761,7 +783,9 @@ gr_status gr_gltf_write(const gr_scene *s, const gr_gltf_options *opt, const cha
         memset(head + 20 + jlen, ' ', jpad - jlen);
         put_u32(head + 20 + jpad, (uint32_t)bpad);
         put_u32(head + 24 + jpad, 0x004E4942u); /* "BIN\0" */
-        st = write_file(path, head, 28u + jpad, c.bin, binlen, bpad - binlen, err);
+        gr_outfile out;
+        st = write_tmp(&out, path, head, 28u + jpad, c.bin, binlen, bpad - binlen, err);
+        if (st == GR_OK) st = gr_outfile_commit(&out, (long long)total, err);
         free(head);
     }
     goto done;

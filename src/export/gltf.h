@@ -7,6 +7,8 @@
 #ifndef GR_EXPORT_GLTF_H
 #define GR_EXPORT_GLTF_H
 
+#include <stddef.h>
+
 #include "scene/scene.h"
 
 #define GR_GLTF_MAX_FRAMES 1000
@@ -27,8 +29,14 @@ gr_status gr_gltf_parse_frames(const char *text, const char *flag, gr_gltf_optio
 /* 1 if path ends in .gltf, 2 if in .glb (any case), 0 otherwise. */
 int gr_gltf_kind(const char *path);
 
+/* The buffer a .gltf at path names, written beside it: PATH-without-extension.bin into buf.
+ * 1 when path is a .gltf (and buf large enough), 0 otherwise (a .glb holds its buffer). */
+int gr_gltf_bin_path(const char *path, char *buf, size_t n);
+
 /* Writes the scene to path (.gltf: also PATH-without-extension.bin beside it; .glb: one file).
- * Files are written under temporary names and renamed: nothing half-written stays behind.
+ * Files are written under temporary names and renamed: nothing half-written stays behind;
+ * the .bin and the .gltf are renamed only once both are complete, the .gltf last (an
+ * interrupted export leaves the old pair or the new one).
  * GR_E_USAGE for an unknown extension or bad options, GR_E_IO when a file cannot be written,
  * GR_E_NOMEM. */
 gr_status gr_gltf_write(const gr_scene *s, const gr_gltf_options *o, const char *path, gr_error *err);

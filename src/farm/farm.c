@@ -10,6 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "common/outfile.h"
 #include "report/cache.h"
 #include "tune/objective.h"
 #include "tune/session.h"
@@ -132,28 +133,91 @@ static void sq(FILE *f, const char *s)
     fputc('\'', f);
 }
 
-typedef struct wfile { FILE *f; char path[8400], tmp[8500]; } wfile;
+/* s double-quoted for a #SBATCH line, which sbatch splits into words itself (no shell): inside
+ * quotes a space or '#' is part of the value, and '"' and '\\' are escaped with a backslash */
+static void dq(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"' || *s == '\\') fputc('\\', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+/* The words of s (split at spaces and tabs), each single-quoted: --then-args "A B" becomes the
+ * arguments 'A' 'B', and nothing in them ($(...), `...`, ;, globs) reaches the shell as code. */
+static void sq_words(FILE *f, const char *s)
+{
+    char w[1024];
+    while (*s) {
+        size_t n = strcspn(s, " \t");
+        if (n > 0 && n < sizeof w) {
+            memcpy(w, s, n);
+            w[n] = '\0';
+            fputc(' ', f);
+            sq(f, w);
+        }
+        s += n;
+        s += strspn(s, " \t");
+    }
+}
+
+/* A value that goes into a script: a control character (a line break ends a #SBATCH line or a
+ * comment and starts a command) is refused. */
+static gr_status no_control(const char *what, const char *v, gr_error *err)
+{
+    for (const unsigned char *c = (const unsigned char *)v; *c; c++)
+        if (*c < 0x20 || *c == 0x7f)
+            return gr_fail(err, GR_E_USAGE, "%s '%s': control character 0x%02x: refusing to write it into a job script",
+                           what, v, *c);
+    return GR_OK;
+}
+
+/* A value that goes into a case's arguments, which the scripts split into words unquoted:
+ * only what numbers are written with. */
+static gr_status plain_word(const char *what, const char *v, gr_error *err)
+{
+    for (const char *c = v; *c; c++)
+        if (!strchr("0123456789+-.,:eEinfatyINFATY", *c))
+            return gr_fail(err, GR_E_USAGE, "%s '%s': unexpected character '%c' (numbers only)", what, v, *c);
+    return GR_OK;
+}
+
+gr_status gr_farm_check(const gr_farm_plan *plan, gr_error *err)
+{
+    const struct { const char *what, *v; } vals[] = {
+        {"-o", plan->dir},           {"--cache", plan->cache},    {"--binary", plan->binary},
+        {"--partition", plan->partition}, {"--time", plan->time_limit}, {"--frames", plan->frames},
+        {"--then", plan->then},      {"--then-args", plan->then_args}, {"the command line", plan->command},
+    };
+    gr_status st = GR_OK;
+    for (size_t k = 0; st == GR_OK && k < sizeof vals / sizeof vals[0]; k++) st = no_control(vals[k].what, vals[k].v, err);
+    if (st == GR_OK) st = plain_word("--frames", plan->frames, err);
+    for (int v = 0; st == GR_OK && v < plan->n_views; v++) st = plain_word("--view", plan->views[v], err);
+    return st;
+}
+
+typedef struct wfile { gr_outfile o; FILE *f; } wfile;
 
 static gr_status wopen(wfile *w, const gr_farm_plan *plan, const char *name, gr_error *err)
 {
-    snprintf(w->path, sizeof w->path, "%s/%s", plan->dir, name);
-    snprintf(w->tmp, sizeof w->tmp, "%s.tmp-%ld", w->path, (long)getpid());
-    w->f = fopen(w->tmp, "w");
-    if (!w->f) return gr_fail(err, GR_E_IO, "%s: cannot write: %s", w->path, strerror(errno));
-    return GR_OK;
+    char path[8400];
+    snprintf(path, sizeof path, "%s/%s", plan->dir, name);
+    gr_status st = gr_outfile_open(&w->o, path, err); /* atomic, never over an input: common/outfile */
+    w->f = w->o.f;
+    return st;
 }
 
 static gr_status wclose(wfile *w, int exec, gr_error *err)
 {
-    int ok = !ferror(w->f);
-    ok = (fclose(w->f) == 0) && ok;
-    if (ok && exec) ok = chmod(w->tmp, 0755) == 0;
-    if (ok) ok = rename(w->tmp, w->path) == 0;
-    if (!ok) {
-        remove(w->tmp);
-        return gr_fail(err, GR_E_IO, "%s: write failed: %s", w->path, strerror(errno));
+    if (exec && chmod(w->o.tmp, 0755) != 0) {
+        const int e = errno;
+        gr_status st = gr_fail(err, GR_E_IO, "%s: cannot make it executable: %s", w->o.path, strerror(e));
+        gr_outfile_abort(&w->o);
+        return st;
     }
-    return GR_OK;
+    return gr_outfile_commit(&w->o, 0, err);
 }
 
 static void header(FILE *f, const gr_farm_plan *plan, const char *what)
@@ -168,10 +232,24 @@ static void header(FILE *f, const gr_farm_plan *plan, const char *what)
 
 static void sbatch_common(FILE *f, const gr_farm_plan *plan, const char *name, const char *log)
 {
-    fprintf(f, "#SBATCH --job-name=%s\n#SBATCH --output=%s/logs/%s.out\n#SBATCH --error=%s/logs/%s.err\n", name, plan->dir,
-            log, plan->dir, log);
-    if (plan->partition[0]) fprintf(f, "#SBATCH --partition=%s\n", plan->partition);
-    if (plan->time_limit[0]) fprintf(f, "#SBATCH --time=%s\n", plan->time_limit);
+    char p[8400];
+    fprintf(f, "#SBATCH --job-name=%s\n#SBATCH --output=", name);
+    snprintf(p, sizeof p, "%s/logs/%s.out", plan->dir, log);
+    dq(f, p);
+    fputs("\n#SBATCH --error=", f);
+    snprintf(p, sizeof p, "%s/logs/%s.err", plan->dir, log);
+    dq(f, p);
+    fputc('\n', f);
+    if (plan->partition[0]) {
+        fputs("#SBATCH --partition=", f);
+        dq(f, plan->partition);
+        fputc('\n', f);
+    }
+    if (plan->time_limit[0]) {
+        fputs("#SBATCH --time=", f);
+        dq(f, plan->time_limit);
+        fputc('\n', f);
+    }
 }
 
 static void vars(FILE *f, const gr_farm_plan *plan)
@@ -195,6 +273,8 @@ static void vars(FILE *f, const gr_farm_plan *plan)
 
 gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_error *err)
 {
+    gr_status cst = gr_farm_check(plan, err);
+    if (cst != GR_OK) return cst;
     char p[8400];
     snprintf(p, sizeof p, "%s/logs", plan->dir);
     if (mkdir(plan->dir, 0755) != 0 && errno != EEXIST)
@@ -311,15 +391,27 @@ gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_erro
     fputc('\n', f);
     if (!strcmp(plan->then, "tune")) {
         fputs("\"$GODRAYS\" tune \"$SCENE\"", f);
-        if (plan->frames[0]) fprintf(f, " --frames %s --fps %.17g", plan->frames, plan->fps);
-        for (int v = 0; v < plan->n_views; v++) fprintf(f, " --view %s", plan->views[v]);
-        fprintf(f, " --quiet -o \"$FARM/tune\" %s\n", plan->then_args);
+        if (plan->frames[0]) {
+            fputs(" --frames ", f);
+            sq(f, plan->frames);
+            fprintf(f, " --fps %.17g", plan->fps);
+        }
+        for (int v = 0; v < plan->n_views; v++) {
+            fputs(" --view ", f);
+            sq(f, plan->views[v]);
+        }
+        fputs(" --quiet -o \"$FARM/tune\"", f);
+        sq_words(f, plan->then_args);
+        fputc('\n', f);
     } else if (!strcmp(plan->then, "run")) {
         fputs("# run takes the scene's own view; each frame's water time as tune computes it\nfail=0\n", f);
         for (int c = 0; c < plan->n_cases; c++)
-            if (plan->cases[c].view == 0)
-                fprintf(f, "\"$GODRAYS\" run \"$SCENE\" --set water.time_s=%.17g --quiet -o \"$FARM/run/case-%d\" %s || fail=1\n",
-                        plan->cases[c].time_s, c, plan->then_args);
+            if (plan->cases[c].view == 0) {
+                fprintf(f, "\"$GODRAYS\" run \"$SCENE\" --set water.time_s=%.17g --quiet -o \"$FARM/run/case-%d\"",
+                        plan->cases[c].time_s, c);
+                sq_words(f, plan->then_args);
+                fputs(" || fail=1\n", f);
+            }
         fputs("exit $fail\n", f);
     } else {
         fputs("echo \"nothing to do (farm --then none)\"\n", f);

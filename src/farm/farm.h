@@ -63,8 +63,16 @@ void gr_farm_part_path(const gr_farm_plan *plan, int c, int i, int j, char *buf,
 /* Array indices of the parts still to render ("0-3,8,10-11"; "" if none) into buf. */
 void gr_farm_todo(const gr_farm_plan *plan, char *buf, size_t n);
 
+/* GR_E_USAGE naming the option when a value that goes into the scripts cannot be written there
+ * safely: a control character in any of them (a line break would start a command), or in
+ * --frames and --view anything but what numbers are written with (they become unquoted words
+ * of a case's arguments). Every value is quoted in the scripts: single quotes for bash, double
+ * quotes on #SBATCH lines (which sbatch splits itself); --then-args is split at blanks into
+ * words, each quoted. */
+gr_status gr_farm_check(const gr_farm_plan *plan, gr_error *err);
+
 /* Writes the farm folder (scene.json, parts.sh, merge.sh, final.sh, submit.sh, farm.json,
- * logs/). GR_E_IO naming the file. */
+ * logs/), after gr_farm_check; each file atomically (common/outfile). GR_E_IO naming the file. */
 gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_error *err);
 
 /* Reads farm.json of a farm folder back into plan (cases with keys and args; the cache

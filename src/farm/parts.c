@@ -296,7 +296,7 @@ static gr_status part_read(const char *path, part *p, gr_error *err)
     if (p->probe) expect += (size_t)p->plevels * (size_t)(p->py1 - p->py0) * p->pw * (3 * sizeof(double) + sizeof(uint32_t));
     if ((double)expect != pn || total - hn != expect) {
         part_free(p);
-        return gr_fail(err, GR_E_INPUT, "%s: payload is %zu bytes, the header says %.0f (expected %zu): truncated or damaged",
+        return gr_fail(err, GR_E_INPUT, "%s: payload is %zu bytes, the header says %.15g (expected %zu): truncated or damaged",
                        path, total - hn, pn, expect);
     }
     p->pay_n = expect;
@@ -482,7 +482,7 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
             const char *host = pv ? str(pv, "host") : NULL, *date = pv ? str(pv, "date") : NULL;
             char mk[48], line[1024];
             snprintf(mk, sizeof mk, "godrays:part.%d", i);
-            snprintf(line, sizeof line, "%s: rows [%d, %d) batches [%d, %d) host %s pid %.0f date %s wall_s %.3f threads %.0f",
+            snprintf(line, sizeof line, "%s: rows [%d, %d) batches [%d, %d) host %s pid %.15g date %s wall_s %.6g threads %.15g",
                      ps[i].path, ps[i].row0, ps[i].row1, ps[i].b0, ps[i].b1, host ? host : "?",
                      pv ? num(pv, "pid", &ok) : 0.0, date ? date : "?", pv ? num(pv, "wall_s", &ok) : 0.0,
                      pv ? num(pv, "threads", &ok) : 0.0);

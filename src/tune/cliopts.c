@@ -33,6 +33,8 @@ const char gr_tune_cli_help[] =
     "                       repeatable; the scene's own view is always included)\n"
     "  --no-cache           render the ground truths even if cached, and do not store them\n"
     "  --gl-platform P      auto, surfaceless or device\n"
+    "  --yes                start more than 20000 technique renders (without it such a run is\n"
+    "                       refused before the ground truths; docs/tuning.md \"Budgets\")\n"
     "  -q, --quiet          no progress messages\n";
 
 void gr_tune_cli_init(gr_tune_cli *c)
@@ -59,6 +61,10 @@ int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *
     const char *a = argv[*i];
     if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
         c->quiet = 1;
+        return 1;
+    }
+    if (!strcmp(a, "--yes")) {
+        c->yes = 1;
         return 1;
     }
     if (!strcmp(a, "--normalize")) {

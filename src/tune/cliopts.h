@@ -17,6 +17,7 @@ typedef struct gr_tune_cli {
     int fit;                      /* -1: auto (on unless the gain_key setting is a parameter) */
     int normalize;                /* --normalize */
     int quiet;
+    int yes;                      /* --yes: more renders than GR_TUNE_BUDGET_RENDERS (tune/budget.h) */
     double fps;
     const char *frames_spec;      /* parsed in gr_tune_cli_finish (needs --fps) */
     const char *times_spec;
