@@ -15,9 +15,9 @@
 #include "realtime/technique.h"
 #include "report/report.h"
 #include "tune/page.h"
+#include "reference/truth.h"
 #include "tune/pareto.h"
 #include "tune/session.h"
-#include "tune/truth.h"
 
 #define MAX_POINTS 256
 
@@ -199,7 +199,11 @@ static int pareto_with(gr_args *args)
     if (!quiet) fprintf(stderr, "godrays pareto: high-quality ground truth (%d x %d)...\n", work->camera.width,
                         work->camera.height);
     gr_truth_info ti;
-    if (gr_truth_get(work, use_cache, !quiet, &truth, &ti, &err) != GR_OK) goto fail;
+    gr_truth_options to;
+    gr_truth_options_default(&to);
+    to.use_cache = use_cache;
+    to.ref.progress = !quiet;
+    if (gr_truth_image(work, &to, &truth, &ti, &err) != GR_OK) goto fail;
     if (!quiet && ti.cached) fprintf(stderr, "godrays pareto:   from the cache %s\n", ti.path);
 
     gr_metrics_options mo = {0};
@@ -215,8 +219,11 @@ static int pareto_with(gr_args *args)
         if (gr_scene_refresh(work, &err) != GR_OK) goto fail;
         if (!quiet) fprintf(stderr, "godrays pareto: ground truth %s...\n", lv.name);
         gr_image *ri = NULL;
-        double secs = 0;
-        if (gr_truth_render(work, !quiet, &ri, &secs, &err) != GR_OK) goto fail;
+        gr_truth_options lo = to;
+        lo.use_cache = 0; /* each level is timed: rendered, never cached */
+        gr_truth_info li;
+        if (gr_truth_image(work, &lo, &ri, &li, &err) != GR_OK) goto fail;
+        const double secs = li.seconds;
         /* no stderr exclusion: the HQ image is the reference, its own noise is tiny */
         gr_metrics_options ro = mo;
         ro.stderr_bound = INFINITY;

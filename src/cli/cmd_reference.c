@@ -2,9 +2,7 @@
  * PNG preview beside it. Quality flags become "reference.*" overrides of the scene, so they
  * are range-checked by the same tables as the file. */
 #include "cli/cli.h"
-#include "common/memlimit.h"
 #include "cli/args.h"
-#include "cli/render.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +13,7 @@
 #include "image/oiio.h"
 #include "reference/bench.h"
 #include "reference/integrator.h"
+#include "reference/truth.h"
 #include "scene/scene.h"
 #include "tune/objective.h"
 #include "tune/session.h"
@@ -65,19 +64,6 @@ static void usage(FILE *f)
             "                         (parts take the fixed passes: no --target-error, no --aov)\n"
             "\n"
             "Ctrl-C stops the render and writes what is done, marked godrays:partial = 1 (exit 1).\n");
-}
-
-/* --max-memory SIZE (common/memlimit). */
-static int take_max_memory(gr_args *args)
-{
-    const char *v = NULL;
-    int rc = gr_args_value(args, &v);
-    if (rc) return rc;
-    gr_error err;
-    double bytes;
-    if (gr_memlimit_parse("--max-memory", v, &bytes, &err) != GR_OK) return gr_cli_usage_error(args->cmd, "%s", err.msg);
-    gr_memlimit_set(bytes);
-    return 0;
 }
 
 /* --target-error stops refining at the round cap (gr_ref_result.max_rounds) whether or not the
@@ -149,7 +135,7 @@ static int reference_with(gr_args *args)
             if (!rc && gr_tune_parse_view(a, v, &view, &verr) != GR_OK) rc = gr_cli_report(cmd, &verr);
             have_view = 1;
         } else if (!strcmp(a, "--technique-dir")) rc = gr_args_take_technique_dir(args);
-        else if (!strcmp(a, "--max-memory")) rc = take_max_memory(args);
+        else if (!strcmp(a, "--max-memory")) rc = gr_args_take_max_memory(args);
         else rc = gr_args_take_scene(args);
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
@@ -200,8 +186,11 @@ static int reference_with(gr_args *args)
                b.identical ? "yes" : "NO", 100.0 * b.frac_se_1pct);
         goto done;
     }
-    gr_ref_options opt;
-    gr_ref_options_default(&opt);
+    gr_truth_options to;
+    gr_truth_options_default(&to);
+    to.use_cache = 0;     /* the user asked for this render: written, not looked up */
+    to.keep_partial = 1;  /* Ctrl-C writes what is done (godrays:partial = 1) */
+    gr_ref_options opt = to.ref;
     opt.progress = !quiet;
     opt.aovs = aov;
     if (part) {
@@ -214,8 +203,10 @@ static int reference_with(gr_args *args)
         gr_part_rows(bp_m ? bp_j : 0, bp_m ? bp_m : 1, scene->reference.batches, &opt.batch0, &opt.batch1);
     }
     gr_ref_result res;
-    int per_round = 0;
-    st = gr_cli_render_reference(scene, &opt, &res, &per_round, &err);
+    gr_truth_info ti;
+    to.ref = opt;
+    st = gr_truth_get(scene, &to, &res, &ti, &err);
+    const int per_round = ti.passes_per_round;
     if (st != GR_OK) { rc = gr_cli_report(cmd, &err); goto done; }
     if (part) {
         if (res.partial) {

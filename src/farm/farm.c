@@ -10,7 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "report/cache.h"
+#include "reference/cache.h"
 #include "tune/objective.h"
 #include "tune/session.h"
 

@@ -16,7 +16,7 @@
 #include "check.h"
 #include "realtime/technique.h"
 #include "image/exr.h"
-#include "report/cache.h"
+#include "reference/cache.h"
 #include "scene/scene.h"
 
 static const char *BASE =
