@@ -28,24 +28,7 @@ ck "no cache entry from a refused render" sh -c '! ls cache/reference-*.exr >/de
 # ---- b: a signal during the ground truth ---------------------------------------------------
 # 8 x 8 pixels at 65536 samples per pixel per pass: a render of minutes
 slow="--size 8x8 --set reference.spp=65536 --set reference.bias_probe=false"
-# wait_for TEXT FILE SECONDS
-wait_for() {
-    n=0
-    until grep -q "$1" "$2" 2>/dev/null; do
-        n=$((n + 1))
-        [ "$n" -gt $(($3 * 20)) ] && return 1
-        sleep 0.05
-    done
-}
-# wait_gone PID SECONDS
-wait_gone() {
-    n=0
-    while kill -0 "$1" 2>/dev/null; do
-        n=$((n + 1))
-        [ "$n" -gt $(($2 * 20)) ] && return 1
-        sleep 0.05
-    done
-}
+. "$(dirname "$0")/wait.sh" # wait_gone, wait_for
 signal_case() { # NAME SIGNAL ARGS...: NAME's message before its ground truth, then the signal
     name=$1 sig=$2
     shift 2
