@@ -51,6 +51,8 @@ static void usage(FILE *f)
             "  --quick            fewer points (q0, q1, the quick levels of each ladder), for tests\n"
             "  --repeat R         renders per setting; time = median (default 5)\n"
             "  --no-cache         render the high-quality ground truth even if cached\n"
+            "  --max-memory SIZE  refuse (exit 2) a ground truth estimated to need more (e.g. 8G;\n"
+            "                     default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  --gl-platform P    auto, surfaceless or device\n"
             "  -q, --quiet        no progress messages\n"
             "  -h, --help         this help\n"

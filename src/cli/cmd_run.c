@@ -59,6 +59,8 @@ static void usage(FILE *f)
             "  --fps F              frames per second of --frames (default 30)\n"
             "  --no-cache           render the ground truth even if a cached one exists, and do not\n"
             "                       store it\n"
+            "  --max-memory SIZE    refuse (exit 2) a ground truth estimated to need more (e.g. 8G;\n"
+            "                       default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  -q, --quiet          no progress bar or step messages (the summary table is printed)\n"
             "  -h, --help           this help\n"
             "\n"
