@@ -1,5 +1,6 @@
 /* Shared argument handling of the godrays commands (args.h). */
 #include "cli/args.h"
+#include "common/memlimit.h"
 #include "common/outfile.h"
 
 #include <errno.h>
@@ -186,7 +187,20 @@ int gr_args_take_common(gr_args *a, const char **dir, gr_gl_platform *platform, 
     if (!strcmp(f, "--size")) return gr_args_take_size(a);
     if (platform && !strcmp(f, "--gl-platform")) return gr_args_take_gl_platform(a, platform);
     if (!strcmp(f, "--technique-dir")) return gr_args_take_technique_dir(a);
+    if (!strcmp(f, "--max-memory")) return gr_args_take_max_memory(a);
     *taken = 0;
+    return 0;
+}
+
+int gr_args_take_max_memory(gr_args *a)
+{
+    const char *v = NULL;
+    int rc = gr_args_value(a, &v);
+    if (rc) return rc;
+    gr_error err = {GR_OK, ""};
+    double bytes;
+    if (gr_memlimit_parse("--max-memory", v, &bytes, &err) != GR_OK) return gr_cli_usage_error(a->cmd, "%s", err.msg);
+    gr_memlimit_set(bytes);
     return 0;
 }
 

@@ -15,7 +15,7 @@
 #include <unistd.h>
 
 #include "farm/farm.h"
-#include "report/cache.h"
+#include "reference/cache.h"
 #include "realtime/technique.h"
 
 static void usage(FILE *f)

@@ -6,6 +6,7 @@
 #include "gl/gl.h"
 #include "gl/glctx.h"
 #include "image/oiio.h"
+#include "reference/cache.h"
 
 #include <cjson/cJSON.h>
 #include <embree3/rtcore.h>
@@ -102,6 +103,8 @@ static void usage(FILE *f)
 static void print_text_libs(const info *in)
 {
     printf("godrays          %s\n", GR_VERSION);
+    /* the build digest of the ground truth's sources, part of every cache key (reference/cache.h) */
+    printf("truth digest     %s\n", gr_cache_digest());
     if (in->embree_error)
         printf("Embree           unavailable: %s\n", in->embree_error);
     else
@@ -137,6 +140,7 @@ static int print_json(const info *in, const gr_gl *gl, const gr_error *glerr)
 {
     cJSON *root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "godrays", GR_VERSION);
+    cJSON_AddStringToObject(root, "truth_digest", gr_cache_digest());
     cJSON *emb = cJSON_AddObjectToObject(root, "embree");
     if (in->embree_error) {
         cJSON_AddNullToObject(emb, "version");

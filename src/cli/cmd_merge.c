@@ -11,7 +11,7 @@
 #include "farm/parts.h"
 #include "image/exr.h"
 #include "image/oiio.h"
-#include "report/cache.h"
+#include "reference/truth.h"
 
 static void usage(FILE *f)
 {
@@ -72,8 +72,7 @@ static int merge_with(gr_args *args)
     gr_scene *scene = malloc(sizeof *scene);
     gr_ref_result res;
     memset(&res, 0, sizeof res);
-    char key[64] = "";
-    gr_status st = scene ? gr_parts_merge(parts, n, scene, &res, key, sizeof key, &err)
+    gr_status st = scene ? gr_parts_merge(parts, n, scene, &res, NULL, 0, &err)
                          : gr_fail(&err, GR_E_NOMEM, "out of memory");
     double merge_s = now_s() - t0;
     if (st == GR_OK) gr_meta_set_double(&res.meta, "godrays:merge_s", merge_s);
@@ -84,19 +83,15 @@ static int merge_with(gr_args *args)
         const int rgb[3] = {0, 1, 2};
         st = gr_oiio_write_preview(pp, res.image, rgb, res.preview_exposure, &err);
     }
-    char cpath[4200] = "";
-    if (st == GR_OK && cache) {
-        char dir[4096];
-        st = gr_cache_dir(dir, sizeof dir, &err);
-        if (st == GR_OK) st = gr_cache_store(dir, key, res.image, &res.meta, &err);
-        if (st == GR_OK) gr_cache_path(dir, key, cpath, sizeof cpath, &err);
-    }
+    gr_truth_info ti;
+    memset(&ti, 0, sizeof ti);
+    if (st == GR_OK && cache) st = gr_truth_store(scene, res.image, &res.meta, &ti, &err);
     if (st != GR_OK) rc = gr_cli_report(cmd, &err);
     else if (!quiet)
         fprintf(stderr,
                 "godrays merge: %d parts -> %s%s%s (%dx%d, %d spp, parts' wall time %.4g s, merge %.2f s): rel. std. "
                 "error of the mean %.3g%%, of the p95 pixel %.3g%%\n",
-                n, out_path ? out_path : "", out_path && cache ? " and " : "", cache ? cpath : "", res.image->width,
+                n, out_path ? out_path : "", out_path && cache ? " and " : "", cache ? ti.path : "", res.image->width,
                 res.image->height, res.spp, res.wall_s, merge_s, 100.0 * res.rel_se_mean, 100.0 * res.rel_se_p95);
     gr_ref_result_free(&res);
     free(scene);

@@ -16,9 +16,9 @@
 #include "report/report.h"
 #include "tune/page.h"
 #include "tune/budget.h"
+#include "reference/truth.h"
 #include "tune/pareto.h"
 #include "tune/session.h"
-#include "tune/truth.h"
 
 #define MAX_POINTS 256
 
@@ -53,6 +53,8 @@ static void usage(FILE *f)
             "  --repeat R         renders per setting; time = median (default 5)\n"
             "  --no-cache         render the high-quality ground truth even if cached\n"
             "  --yes              start more than 20000 technique renders (docs/tuning.md \"Budgets\")\n"
+            "  --max-memory SIZE  refuse (exit 2) a ground truth estimated to need more (e.g. 8G;\n"
+            "                     default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  --gl-platform P    auto, surfaceless or device\n"
             "  -q, --quiet        no progress messages\n"
             "  -h, --help         this help\n"
@@ -116,239 +118,237 @@ static void set_level(gr_scene *s, const ref_level *l)
     s->reference.spp = l->spp;
 }
 
-/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
-static int pareto_with(gr_args *args)
+/* What the command line asks for. */
+typedef struct pareto_opts {
+    const char *outopt, *tech_list, *tech_flag;
+    int quiet, quick, use_cache, help, yes;
+    gr_tune_budget budget; /* the count before the ground truths, the estimate after a render (tune/budget.h) */
+    long repeat;
+    gr_gl_platform platform;
+    const gr_technique_class *techs[GR_TECH_MAX];
+    int n_techs;
+} pareto_opts;
+
+/* The argument loop and the technique list; returns the exit code (o->help: help printed). */
+static int parse_args(gr_args *args, pareto_opts *o)
 {
-    const char *cmd = "pareto", *outopt = NULL;
-    const int argc = args->argc;
-    char **argv = args->argv;
-    int quiet = 0, quick = 0, use_cache = 1, rc = 0, taken = 0, yes = 0;
-    const char *tech_list = NULL, *tech_flag = "--techniques";
-    long repeat = 5;
-    gr_gl_platform platform = GR_GL_AUTO;
+    const char *cmd = "pareto";
+    int rc = 0, taken = 0;
+    o->use_cache = 1;
+    o->repeat = 5;
+    o->tech_flag = "--techniques";
+    o->platform = GR_GL_AUTO;
     args->size_example = "320x180";
-    for (; args->i < argc && !rc; args->i++) {
-        const char *a = argv[args->i];
+    for (; args->i < args->argc && !rc; args->i++) {
+        const char *a = args->argv[args->i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
+            o->help = 1;
             return 0;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-            quiet = 1;
+            o->quiet = 1;
         } else if (!strcmp(a, "--quick")) {
-            quick = 1;
+            o->quick = 1;
         } else if (!strcmp(a, "--techniques") || !strcmp(a, "--technique")) {
-            tech_flag = a;
-            if ((rc = gr_args_value(args, &tech_list)) != 0) break;
-            if (!strcmp(a, "--technique") && strchr(tech_list, ','))
-                rc = gr_cli_usage_error(cmd, "--technique %s: one technique (use --techniques for a list)", tech_list);
+            o->tech_flag = a;
+            if ((rc = gr_args_value(args, &o->tech_list)) != 0) break;
+            if (!strcmp(a, "--technique") && strchr(o->tech_list, ','))
+                rc = gr_cli_usage_error(cmd, "--technique %s: one technique (use --techniques for a list)", o->tech_list);
         } else if (!strcmp(a, "--no-cache")) {
-            use_cache = 0;
+            o->use_cache = 0;
         } else if (!strcmp(a, "--yes")) {
-            yes = 1;
+            o->yes = 1;
         } else if (!strcmp(a, "--repeat")) {
             const char *v;
             char *end = NULL;
             if ((rc = gr_args_value(args, &v)) != 0) break;
             errno = 0;
-            repeat = strtol(v, &end, 10);
-            if (errno || end == v || *end || repeat < 1 || repeat > 1000)
+            o->repeat = strtol(v, &end, 10);
+            if (errno || end == v || *end || o->repeat < 1 || o->repeat > 1000)
                 rc = gr_cli_usage_error(cmd, "--repeat %s: expected an integer in [1, 1000]", v);
-        } else if ((rc = gr_args_take_common(args, &outopt, &platform, &taken)) == 0 && !taken) {
+        } else if ((rc = gr_args_take_common(args, &o->outopt, &o->platform, &taken)) == 0 && !taken) {
             rc = gr_args_take_scene(args);
         }
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
     if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
-    const gr_technique_class *techs[GR_TECH_MAX];
-    int n_techs = 0;
-    {
-        gr_error lerr = {GR_OK, ""};
-        if (gr_technique_parse_list(tech_flag, tech_list, techs, GR_TECH_MAX, &n_techs, &lerr) != GR_OK)
-            return gr_cli_usage_error(cmd, "%s", lerr.msg);
-    }
-    gr_tune_budget budget; /* the count before the ground truths (tune/budget.h) */
-    {
-        gr_error berr;
-        if (gr_tune_budget_init(&budget, "godrays pareto", "renders", gr_tune_budget_ladders(techs, n_techs, quick, repeat),
-                                1, yes, &berr) != GR_OK)
-            return gr_cli_report(cmd, &berr);
-    }
+    gr_error lerr = {GR_OK, ""};
+    if (gr_technique_parse_list(o->tech_flag, o->tech_list, o->techs, GR_TECH_MAX, &o->n_techs, &lerr) != GR_OK)
+        return gr_cli_usage_error(cmd, "%s", lerr.msg);
+    if (gr_tune_budget_init(&o->budget, "godrays pareto", "renders",
+                            gr_tune_budget_ladders(o->techs, o->n_techs, o->quick, o->repeat), 1, o->yes, &lerr) != GR_OK)
+        return gr_cli_report(cmd, &lerr);
     /* the default size after every override, so that it wins over --set camera.width/height */
     if (!args->have_size && (rc = gr_args_add_set(args, "camera.width=320")) != 0) return rc;
     if (!args->have_size && (rc = gr_args_add_set(args, "camera.height=180")) != 0) return rc;
+    return 0;
+}
 
-    gr_error err = {GR_OK, ""};
-    gr_scene *scene = NULL, *work = malloc(sizeof *work);
-    gr_image *truth = NULL, *img = NULL;
-    gr_gl *gl = NULL;
-    gr_technique *r = NULL;
-    gr_pareto_point *pts = calloc(MAX_POINTS, sizeof *pts);
-    int n = 0;
-    char dirbuf[4096], path[4300];
-    const char *outdir = NULL;
-    if (!work || !pts) {
-        gr_fail(&err, GR_E_NOMEM, "out of memory");
-        goto fail;
-    }
-    if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
-    for (int k = 0; k < n_techs; k++)
-        if (gr_technique_check(techs[k], gr_technique_scene_settings(techs[k], scene), &err) != GR_OK) goto fail;
-    /* The ground truths take minutes: a folder that cannot be made is refused before them. */
-    if ((rc = gr_args_output_dir(args, scene, outopt, "pareto", dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
-    gr_gl_options glo;
-    memset(&glo, 0, sizeof glo);
-    glo.platform = platform;
-    if (gr_gl_create(&glo, &gl, &err) != GR_OK) goto fail;
-
+/* The high-quality ground truth (*truth, cached), then the ground truth's own ladder: each
+ * level timed (never cached) and scored against it; points appended to pts[*n]. */
+static gr_status reference_points(const pareto_opts *o, const gr_scene *scene, gr_scene *work, gr_image **truth,
+                                  gr_truth_info *ti, gr_pareto_point *pts, int *n, gr_error *err)
+{
     /* the high-quality ground truth, with its own seed so that no ladder level shares its
      * random numbers (a shared seed would make the lower levels look better than they are) */
     memcpy(work, scene, sizeof *work);
     const ref_level hq = make_level(&scene->reference, N_LEVELS);
     set_level(work, &hq);
     work->reference.seed = scene->reference.seed + 7919;
-    if (gr_scene_refresh(work, &err) != GR_OK) goto fail;
-    if (!quiet) fprintf(stderr, "godrays pareto: high-quality ground truth (%d x %d)...\n", work->camera.width,
-                        work->camera.height);
-    gr_truth_info ti;
-    if (gr_truth_get(work, use_cache, !quiet, &truth, &ti, &err) != GR_OK) goto fail;
-    if (!quiet && ti.cached) fprintf(stderr, "godrays pareto:   from the cache %s\n", ti.path);
-
-    gr_metrics_options mo = {0};
-    mo.skip_ssim = 1;
-    mo.skip_blur = 1;
-    gr_metrics m;
-    /* ground truth ladder */
-    int n_levels = quick ? 2 : N_LEVELS;
+    gr_status st = gr_scene_refresh(work, err);
+    if (st != GR_OK) return st;
+    if (!o->quiet)
+        fprintf(stderr, "godrays pareto: high-quality ground truth (%d x %d)...\n", work->camera.width, work->camera.height);
+    gr_truth_options to;
+    gr_truth_options_default(&to);
+    to.use_cache = o->use_cache;
+    to.ref.progress = !o->quiet;
+    if ((st = gr_truth_image(work, &to, truth, ti, err)) != GR_OK) return st;
+    if (!o->quiet && ti->cached) fprintf(stderr, "godrays pareto:   from the cache %s\n", ti->path);
+    to.use_cache = 0; /* each level is timed: rendered, never cached */
+    const int n_levels = o->quick ? 2 : N_LEVELS;
     for (int l = 0; l < n_levels; l++) {
         memcpy(work, scene, sizeof *work);
         const ref_level lv = make_level(&scene->reference, l);
         set_level(work, &lv);
-        if (gr_scene_refresh(work, &err) != GR_OK) goto fail;
-        if (!quiet) fprintf(stderr, "godrays pareto: ground truth %s...\n", lv.name);
+        if ((st = gr_scene_refresh(work, err)) != GR_OK) return st;
+        if (!o->quiet) fprintf(stderr, "godrays pareto: ground truth %s...\n", lv.name);
         gr_image *ri = NULL;
-        double secs = 0;
-        if (gr_truth_render(work, !quiet, &ri, &secs, &err) != GR_OK) goto fail;
+        gr_truth_info li;
+        if ((st = gr_truth_image(work, &to, &ri, &li, err)) != GR_OK) return st;
         /* no stderr exclusion: the HQ image is the reference, its own noise is tiny */
-        gr_metrics_options ro = mo;
+        gr_metrics_options ro = {0};
+        ro.skip_ssim = 1;
+        ro.skip_blur = 1;
         ro.stderr_bound = INFINITY;
-        gr_status st = gr_metrics_compute(truth, ri, &ro, &m, &err);
+        gr_metrics m;
+        st = gr_metrics_compute(*truth, ri, &ro, &m, err);
         gr_image_destroy(ri);
-        if (st != GR_OK) goto fail;
-        gr_pareto_point *p = &pts[n++];
+        if (st != GR_OK) return st;
+        gr_pareto_point *p = &pts[(*n)++];
         p->family = GR_PARETO_REFERENCE;
         snprintf(p->family_name, sizeof p->family_name, "reference");
         snprintf(p->label, sizeof p->label, "%s", lv.name);
         snprintf(p->settings, sizeof p->settings, "sun_samples=%d;batches=%d;steps=%d;surface_res=%d;spp=%d",
                  lv.sun_samples, lv.batches, lv.steps, lv.surface_res, lv.spp);
-        p->time_s = secs;
+        p->time_s = li.seconds;
         p->gpu_s = -1;
-        p->cost_s = secs;
+        p->cost_s = li.seconds;
         p->error = rel_rmse(&m.raw);
     }
+    return GR_OK;
+}
 
-    /* each technique over the settings of its ladder, which trade speed for quality */
-    img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
-    double *times = malloc((size_t)repeat * sizeof *times), *gpus = malloc((size_t)repeat * sizeof *gpus);
-    if (!img || !times || !gpus) {
-        free(times);
-        free(gpus);
-        gr_fail(&err, GR_E_NOMEM, "out of memory");
-        goto fail;
+/* One setting of a technique's ladder: a warm-up render (buffers rebuilt for new sizes,
+ * shader JIT), then o->repeat timed renders (median wall and GPU time) and the error after
+ * the best scale fit against truth. times, gpus: o->repeat scratch values each. */
+static gr_status ladder_point(pareto_opts *o, const gr_technique_class *cls, gr_technique *r,
+                              const gr_scene *scene, const char *lvs, const gr_image *truth, gr_image *img,
+                              double *times, double *gpus, gr_pareto_point *p, gr_error *err)
+{
+    gr_section_store s;
+    memcpy(s.bytes, gr_technique_scene_settings(cls, scene), cls->settings_size);
+    gr_technique_stats stats;
+    gr_status st = gr_technique_apply_text(cls, s.bytes, lvs, err);
+    if (st == GR_OK) st = gr_technique_render(r, scene, s.bytes, img, &stats, err);
+    for (long q = 0; st == GR_OK && q < o->repeat; q++) {
+        st = gr_technique_render(r, scene, s.bytes, img, &stats, err);
+        /* once, after the first level's warm-up and first timed render */
+        char line[512];
+        if (!o->quiet && gr_tune_budget_eta(&o->budget, 2, line, sizeof line)) fprintf(stderr, "%s\n", line);
+        times[q] = stats.wall_ms * 1e-3;
+        double g = 0;
+        int ok = stats.n_passes > 0;
+        for (int pp = 0; pp < stats.n_passes; pp++) {
+            if (stats.gpu_ns[pp] < 0) ok = 0;
+            else g += (double)stats.gpu_ns[pp] * 1e-9;
+        }
+        gpus[q] = ok ? g : -1;
     }
-    int gpu_any = 0;
+    gr_metrics m;
+    if (st == GR_OK) {
+        gr_metrics_options fo = {0};
+        fo.skip_ssim = 1;
+        fo.skip_blur = 1;
+        fo.fit_scale = 1;
+        fo.stderr_bound = INFINITY;
+        st = gr_metrics_compute(truth, img, &fo, &m, err);
+    }
+    if (st != GR_OK) return st;
+    qsort(times, (size_t)o->repeat, sizeof *times, cmp_double);
+    qsort(gpus, (size_t)o->repeat, sizeof *gpus, cmp_double);
+    snprintf(p->family_name, sizeof p->family_name, "%s", cls->name);
+    snprintf(p->label, sizeof p->label, "%s %s", cls->name, lvs[0] ? lvs : "(scene's settings)");
+    for (char *c = p->label; *c; c++)
+        if (*c == ',') *c = ' ';
+    snprintf(p->settings, sizeof p->settings, "%s", lvs);
+    for (char *c = p->settings; *c; c++)
+        if (*c == ',') *c = ';';
+    p->time_s = times[o->repeat / 2];
+    p->gpu_s = gpus[o->repeat / 2];
+    p->error = rel_rmse(&m.fit);
+    return GR_OK;
+}
+
+/* Each technique over the settings of its ladder, which trade speed for quality; points
+ * appended to pts[*n]; *gpu_any = 1 when some GL pass timer worked. */
+static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *gl, const gr_image *truth,
+                                  gr_pareto_point *pts, int *n, int *gpu_any, gr_error *err)
+{
+    gr_image *img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
+    double *times = malloc((size_t)o->repeat * sizeof *times), *gpus = malloc((size_t)o->repeat * sizeof *gpus);
+    gr_technique *r = NULL;
+    gr_status st = img && times && gpus ? GR_OK : gr_fail(err, GR_E_NOMEM, "out of memory");
     char line[512];
-    gr_tune_budget_plan_line(&budget, line, sizeof line);
-    if (!quiet) fprintf(stderr, "%s\n", line);
-    gr_tune_budget_start(&budget);
-    for (int k = 0; k < n_techs; k++) {
-        const gr_technique_class *cls = techs[k];
+    gr_tune_budget_plan_line(&o->budget, line, sizeof line);
+    if (!o->quiet) fprintf(stderr, "%s\n", line);
+    gr_tune_budget_start(&o->budget);
+    for (int k = 0; k < o->n_techs && st == GR_OK; k++) {
+        const gr_technique_class *cls = o->techs[k];
         gr_technique_destroy(r);
         r = NULL;
-        if (gr_technique_create(cls, gl, NULL, &r, &err) != GR_OK) {
-            free(times);
-            free(gpus);
-            goto fail;
-        }
+        if ((st = gr_technique_create(cls, gl, NULL, &r, err)) != GR_OK) break;
         const int n_lv = cls->n_ladder > 0 ? cls->n_ladder : 1;
-        for (int l = 0; l < n_lv; l++) {
+        for (int l = 0; l < n_lv && st == GR_OK; l++) {
             const char *lvs = cls->n_ladder > 0 ? cls->ladder[l].settings : "";
-            if (quick && cls->n_ladder > 0 && !cls->ladder[l].quick) continue;
-            if (n >= MAX_POINTS) break;
-            gr_section_store s;
-            memcpy(s.bytes, gr_technique_scene_settings(cls, scene), cls->settings_size);
-            gr_technique_stats stats;
-            /* warm-up render: buffers rebuilt for new sizes, shader JIT */
-            gr_status st = gr_technique_apply_text(cls, s.bytes, lvs, &err);
-            if (st == GR_OK) st = gr_technique_render(r, scene, s.bytes, img, &stats, &err);
-            for (long q = 0; st == GR_OK && q < repeat; q++) {
-                st = gr_technique_render(r, scene, s.bytes, img, &stats, &err);
-                /* once, after the first level's warm-up and first timed render */
-                if (!quiet && gr_tune_budget_eta(&budget, 2, line, sizeof line)) fprintf(stderr, "%s\n", line);
-                times[q] = stats.wall_ms * 1e-3;
-                double g = 0;
-                int ok = stats.n_passes > 0;
-                for (int pp = 0; pp < stats.n_passes; pp++) {
-                    if (stats.gpu_ns[pp] < 0) ok = 0;
-                    else g += (double)stats.gpu_ns[pp] * 1e-9;
-                }
-                gpus[q] = ok ? g : -1;
-            }
-            if (st == GR_OK) {
-                gr_metrics_options fo = mo;
-                fo.fit_scale = 1;
-                fo.stderr_bound = INFINITY;
-                st = gr_metrics_compute(truth, img, &fo, &m, &err);
-            }
-            if (st != GR_OK) {
-                free(times);
-                free(gpus);
-                goto fail;
-            }
-            qsort(times, (size_t)repeat, sizeof *times, cmp_double);
-            qsort(gpus, (size_t)repeat, sizeof *gpus, cmp_double);
-            gr_pareto_point *p = &pts[n++];
+            if (o->quick && cls->n_ladder > 0 && !cls->ladder[l].quick) continue;
+            if (*n >= MAX_POINTS) break;
+            gr_pareto_point *p = &pts[*n];
+            if ((st = ladder_point(o, cls, r, scene, lvs, truth, img, times, gpus, p, err)) != GR_OK) break;
+            (*n)++;
             p->family = 1 + k;
-            snprintf(p->family_name, sizeof p->family_name, "%s", cls->name);
-            snprintf(p->label, sizeof p->label, "%s %s", cls->name, lvs[0] ? lvs : "(scene's settings)");
-            for (char *c = p->label; *c; c++)
-                if (*c == ',') *c = ' ';
-            snprintf(p->settings, sizeof p->settings, "%s", lvs);
-            for (char *c = p->settings; *c; c++)
-                if (*c == ',') *c = ';';
-            p->time_s = times[repeat / 2];
-            p->gpu_s = gpus[repeat / 2];
-            if (p->gpu_s >= 0) gpu_any = 1;
-            p->error = rel_rmse(&m.fit);
-            if (!quiet) fprintf(stderr, "godrays pareto: %s: %.2f ms, error %.4g\n", p->label, 1e3 * p->time_s, p->error);
+            if (p->gpu_s >= 0) *gpu_any = 1;
+            if (!o->quiet) fprintf(stderr, "godrays pareto: %s: %.2f ms, error %.4g\n", p->label, 1e3 * p->time_s, p->error);
         }
     }
+    gr_technique_destroy(r);
     free(times);
     free(gpus);
-    const char *glr = gr_gl_renderer(gl);
-    int is_llvmpipe = glr && strstr(glr, "llvmpipe") != NULL;
-    /* What the techniques cost: on a hardware GPU the GL pass timers (a render's wall time there
-     * is mostly this harness's synchronous float readback: docs/benchmarks.md); on llvmpipe
-     * the wall time (its timers see a deferred rasterizer). */
-    int by_gpu = !is_llvmpipe && gpu_any;
-    for (int i = 0; i < n; i++)
-        if (pts[i].family != GR_PARETO_REFERENCE) pts[i].cost_s = by_gpu && pts[i].gpu_s >= 0 ? pts[i].gpu_s : pts[i].time_s;
-    gr_pareto_mark_fronts(pts, n);
+    gr_image_destroy(img);
+    return st;
+}
 
-    char tlabel[128], title[256];
+/* pareto.csv, pareto.png, the summary (printed) and index.html. */
+static gr_status write_outputs(const gr_scene *scene, const gr_truth_info *ti, const char *glr, int is_llvmpipe,
+                               int by_gpu, int gpu_any, const gr_pareto_point *pts, int n, const char *outdir,
+                               gr_error *err)
+{
+    char tlabel[128], title[256], path[4300];
     snprintf(tlabel, sizeof tlabel, "%s", is_llvmpipe ? "llvmpipe wall time" : by_gpu ? "GPU time of the GL passes" : "GPU frame wall time");
     snprintf(title, sizeof title, "speed vs error, scene '%s' %dx%d (real time on %s)", scene->name, scene->camera.width,
              scene->camera.height, is_llvmpipe ? "llvmpipe, no GPU" : glr);
-    if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
+    gr_status st = gr_report_make_dir(outdir, err);
+    if (st != GR_OK) return st;
     snprintf(path, sizeof path, "%s/pareto.csv", outdir);
-    if (gr_pareto_write_csv(path, pts, n, &err) != GR_OK) goto fail;
+    if ((st = gr_pareto_write_csv(path, pts, n, err)) != GR_OK) return st;
     int drawn = 0;
     snprintf(path, sizeof path, "%s/pareto.png", outdir);
-    if (gr_pareto_write_plot(path, pts, n, title, tlabel, &drawn, &err) != GR_OK) goto fail;
+    if ((st = gr_pareto_write_plot(path, pts, n, title, tlabel, &drawn, err)) != GR_OK) return st;
 
     gr_strbuf sum;
     gr_sb_init(&sum);
     gr_sb_printf(&sum, "scene '%s' (%d x %d); high-quality ground truth %.1f s (%s); real time on %s\n", scene->name,
-           scene->camera.width, scene->camera.height, ti.seconds, ti.cached ? "from the cache" : "rendered", glr);
+           scene->camera.width, scene->camera.height, ti->seconds, ti->cached ? "from the cache" : "rendered", glr);
     gr_sb_printf(&sum, "%-16s %-50s %12s %12s %12s %6s\n", "family", "setting", "time ms", "GL timers ms", "rel. RMSE Y", "front");
     for (int i = 0; i < n; i++) {
         char g[32];
@@ -361,25 +361,70 @@ static int pareto_with(gr_args *args)
            is_llvmpipe ? "llvmpipe (CPU) wall times" : by_gpu ? "the GPU time of their GL passes" : "wall times on the GPU");
     gr_sb_printf(&sum, "written: %s/pareto.csv%s\n", outdir, drawn ? ", pareto.png" : " (no plot: charts need PLplot)");
     fputs(gr_sb_str(&sum), stdout);
-    {
-        gr_strbuf pg;
-        gr_sb_init(&pg);
-        gr_tune_page_begin(&pg, outdir, "godrays pareto: %s", scene->name);
-        if (drawn) gr_tune_page_figure(&pg, "pareto.png", title);
-        gr_status pst = gr_tune_page_write(&pg, gr_sb_str(&sum), "pareto.csv", outdir, &err);
-        gr_sb_free(&sum);
-        if (pst != GR_OK) goto fail;
+    gr_strbuf pg;
+    gr_sb_init(&pg);
+    gr_tune_page_begin(&pg, outdir, "godrays pareto: %s", scene->name);
+    if (drawn) gr_tune_page_figure(&pg, "pareto.png", title);
+    st = gr_tune_page_write(&pg, gr_sb_str(&sum), "pareto.csv", outdir, err);
+    gr_sb_free(&sum);
+    return st;
+}
+
+/* Everything after the command line. */
+static gr_status pareto_scene(pareto_opts *o, const gr_scene *scene, const char *outdir, gr_error *err)
+{
+    gr_scene *work = malloc(sizeof *work);
+    gr_pareto_point *pts = calloc(MAX_POINTS, sizeof *pts);
+    gr_image *truth = NULL;
+    gr_gl *gl = NULL;
+    gr_truth_info ti;
+    int n = 0, gpu_any = 0;
+    gr_gl_options glo;
+    memset(&glo, 0, sizeof glo);
+    glo.platform = o->platform;
+    gr_status st = work && pts ? GR_OK : gr_fail(err, GR_E_NOMEM, "out of memory");
+    if (st == GR_OK) st = gr_gl_create(&glo, &gl, err); /* before the slow ground truths */
+    if (st == GR_OK) st = reference_points(o, scene, work, &truth, &ti, pts, &n, err);
+    if (st == GR_OK) st = technique_points(o, scene, gl, truth, pts, &n, &gpu_any, err);
+    if (st == GR_OK) {
+        const char *glr = gr_gl_renderer(gl);
+        int is_llvmpipe = glr && strstr(glr, "llvmpipe") != NULL;
+        /* What the techniques cost: on a hardware GPU the GL pass timers (a render's wall time
+         * there is mostly this harness's synchronous float readback: docs/benchmarks.md); on
+         * llvmpipe the wall time (its timers see a deferred rasterizer). */
+        int by_gpu = !is_llvmpipe && gpu_any;
+        for (int i = 0; i < n; i++)
+            if (pts[i].family != GR_PARETO_REFERENCE)
+                pts[i].cost_s = by_gpu && pts[i].gpu_s >= 0 ? pts[i].gpu_s : pts[i].time_s;
+        gr_pareto_mark_fronts(pts, n);
+        st = write_outputs(scene, &ti, glr, is_llvmpipe, by_gpu, gpu_any, pts, n, outdir, err);
     }
-    goto done;
-fail:
-    rc = gr_cli_report(cmd, &err);
-done:
-    gr_image_destroy(img);
     gr_image_destroy(truth);
-    gr_technique_destroy(r);
     gr_gl_destroy(gl);
     free(pts);
     free(work);
+    return st;
+}
+
+/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
+static int pareto_with(gr_args *args)
+{
+    const char *cmd = "pareto";
+    pareto_opts o;
+    memset(&o, 0, sizeof o);
+    int rc = parse_args(args, &o);
+    if (rc || o.help) return rc;
+    gr_error err = {GR_OK, ""};
+    gr_scene *scene = NULL;
+    char dirbuf[4096];
+    const char *outdir = NULL;
+    if ((rc = gr_args_load_scene(args, &scene)) != 0) return rc;
+    for (int k = 0; k < o.n_techs && !rc; k++)
+        if (gr_technique_check(o.techs[k], gr_technique_scene_settings(o.techs[k], scene), &err) != GR_OK)
+            rc = gr_cli_report(cmd, &err);
+    /* The ground truths take minutes: a folder that cannot be made is refused before them. */
+    if (!rc) rc = gr_args_output_dir(args, scene, o.outopt, "pareto", dirbuf, sizeof dirbuf, &outdir);
+    if (!rc && pareto_scene(&o, scene, outdir, &err) != GR_OK) rc = gr_cli_report(cmd, &err);
     free(scene);
     return rc;
 }

@@ -2,9 +2,7 @@
  * PNG preview beside it. Quality flags become "reference.*" overrides of the scene, so they
  * are range-checked by the same tables as the file. */
 #include "cli/cli.h"
-#include "common/memlimit.h"
 #include "cli/args.h"
-#include "cli/render.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +13,7 @@
 #include "image/oiio.h"
 #include "reference/bench.h"
 #include "reference/integrator.h"
+#include "reference/truth.h"
 #include "scene/scene.h"
 #include "tune/objective.h"
 #include "tune/session.h"
@@ -67,19 +66,6 @@ static void usage(FILE *f)
             "Ctrl-C stops the render and writes what is done, marked godrays:partial = 1 (exit 1).\n");
 }
 
-/* --max-memory SIZE (common/memlimit). */
-static int take_max_memory(gr_args *args)
-{
-    const char *v = NULL;
-    int rc = gr_args_value(args, &v);
-    if (rc) return rc;
-    gr_error err;
-    double bytes;
-    if (gr_memlimit_parse("--max-memory", v, &bytes, &err) != GR_OK) return gr_cli_usage_error(args->cmd, "%s", err.msg);
-    gr_memlimit_set(bytes);
-    return 0;
-}
-
 /* --target-error stops refining at the round cap (gr_ref_result.max_rounds) whether or not the
  * target was met: say so, even with --quiet, since the image is less accurate than asked. */
 static void warn_target(const gr_scene *scene, int passes_per_round, const gr_ref_result *res)
@@ -100,6 +86,90 @@ static int parse_part(const char *flag, const char *v, int *i, int *n)
     char extra;
     if (sscanf(v, "%d/%d%c", i, n, &extra) != 2 || *n < 1 || *i < 0 || *i >= *n)
         return gr_cli_usage_error("reference", "%s %s: expected I/N with 0 <= I < N", flag, v);
+    return 0;
+}
+
+/* --bench: the figures of reference/bench.h; an exit code. */
+static int print_bench(const gr_scene *scene)
+{
+    gr_error err = {GR_OK, ""};
+    gr_ref_bench_result b;
+    if (gr_ref_bench(scene, &b, &err) != GR_OK) return gr_cli_report("reference", &err);
+    printf("Embree raw rtcOccluded1 (1 thread, random rays): %.3g rays/s vs occluders, %.3g rays/s vs the "
+           "surface mesh (%lld triangles)\n", b.occluded_occluders_per_s, b.occluded_surface_per_s, b.surface_triangles);
+    printf("beam lookups alone (grid cell + box and containment tests, 1 thread, %lld primitives): %.3g /s\n", b.beam_prims,
+           b.point_queries_per_s);
+    printf("hot loop (lookups incl. shadow rays and shading): 1 thread %.3g /s (%.2f s), 2 threads %.3g /s (%.2f s)\n",
+           b.qps[0], b.wall_s[0], b.qps[1], b.wall_s[1]);
+    printf("speed-up 1 -> 2 threads: %.2fx; identical bytes: %s; pixels within 1%%: %.1f%%\n", b.speedup,
+           b.identical ? "yes" : "NO", 100.0 * b.frac_se_1pct);
+    return 0;
+}
+
+/* A part file (--tile, --batch-part: src/farm/parts.h); an exit code. */
+static int write_part(const gr_args *args, const gr_scene *scene, const gr_ref_options *opt, const gr_ref_result *res,
+                      const char *out_path, int quiet)
+{
+    if (res->partial) {
+        fprintf(stderr, "godrays reference: interrupted; no part written (%s)\n", out_path);
+        return 1;
+    }
+    char command[2048] = "godrays";
+    for (int k = 0; k < args->argc; k++) {
+        size_t l = strlen(command);
+        snprintf(command + l, sizeof command - l, " %s", args->argv[k]);
+    }
+    gr_error err = {GR_OK, ""};
+    if (gr_part_write(out_path, scene, opt, res, command, &err) != GR_OK) return gr_cli_report("reference", &err);
+    if (!quiet)
+        fprintf(stderr, "godrays reference: wrote part %s (rows [%d, %d) of %d, batches [%d, %d) of %d, %d passes, %.1f s)\n",
+                out_path, opt->row0, opt->row1, scene->camera.height, opt->batch0, opt->batch1, scene->reference.batches,
+                res->passes, res->wall_s);
+    return 0;
+}
+
+/* The EXR, its preview and the summary line; an exit code (1 for a partial render). */
+static int write_image(const gr_scene *scene, const gr_ref_result *res, const char *out_path, int preview, int quiet,
+                       int per_round)
+{
+    gr_error err = {GR_OK, ""};
+    gr_status st = gr_exr_write(out_path, res->image, &res->meta, &err);
+    if (st == GR_OK && preview) {
+        char pp[4096];
+        gr_args_preview_path(out_path, pp, sizeof pp);
+        const int rgb[3] = {0, 1, 2};
+        st = gr_oiio_write_preview(pp, res->image, rgb, res->preview_exposure, &err);
+    }
+    if (st != GR_OK) return gr_cli_report("reference", &err);
+    char bias[224];
+    /* the measured-order figure beside the order-2 estimate: where the coarser levels are not
+     * yet asymptotic (the camera cone, docs/reference.md 2.2) it is the one a finer render confirms */
+    const gr_meta_item *mo = gr_meta_get(&res->meta, "godrays:bias_surface_rel_measured_order");
+    if (res->bias_surface_rel >= 0.0 && res->bias_block_p95 >= 0.0 && mo && mo->num >= 0.0)
+        snprintf(bias, sizeof bias,
+                 "~%.2g%% of the mean (%.2g%% with the measured order), 95th-percentile 10x10 block %.2g%% "
+                 "(godrays:bias_surface_rel_est, _measured_order, bias_block_p95_rel)",
+                 100.0 * res->bias_surface_rel, 100.0 * mo->num, 100.0 * res->bias_block_p95);
+    else if (res->bias_surface_rel >= 0.0 && res->bias_block_p95 >= 0.0)
+        snprintf(bias, sizeof bias, "~%.2g%% of the mean, 95th-percentile 10x10 block %.2g%% (godrays:bias_surface_rel_est, bias_block_p95_rel)",
+                 100.0 * res->bias_surface_rel, 100.0 * res->bias_block_p95);
+    else if (res->bias_surface_rel >= 0.0)
+        snprintf(bias, sizeof bias, "~%.2g%% of the mean (godrays:bias_surface_rel_est)", 100.0 * res->bias_surface_rel);
+    else
+        snprintf(bias, sizeof bias, "not estimated");
+    if (!quiet)
+        fprintf(stderr,
+                "godrays reference: wrote %s (%dx%d, %d spp, %.1f march steps per ray on average, %.1f s%s): rel. std. "
+                "error of the mean %.3g%%, "
+                "of the p95 pixel %.3g%%, %.1f%% of pixels within 1%%; surface bias %s\n",
+                out_path, res->image->width, res->image->height, res->spp, res->steps_mean > 0.0 ? res->steps_mean : 0.0,
+                res->wall_s, res->partial ? ", PARTIAL" : "",
+                100.0 * res->rel_se_mean, 100.0 * res->rel_se_p95, 100.0 * res->frac_se_1pct, bias);
+    if (res->partial) {
+        fprintf(stderr, "godrays reference: interrupted; %s holds the partial result (godrays:partial = 1)\n", out_path);
+        return 1;
+    }
+    warn_target(scene, per_round, res);
     return 0;
 }
 
@@ -149,7 +219,7 @@ static int reference_with(gr_args *args)
             if (!rc && gr_tune_parse_view(a, v, &view, &verr) != GR_OK) rc = gr_cli_report(cmd, &verr);
             have_view = 1;
         } else if (!strcmp(a, "--technique-dir")) rc = gr_args_take_technique_dir(args);
-        else if (!strcmp(a, "--max-memory")) rc = take_max_memory(args);
+        else if (!strcmp(a, "--max-memory")) rc = gr_args_take_max_memory(args);
         else rc = gr_args_take_scene(args);
     }
     if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
@@ -186,102 +256,34 @@ static int reference_with(gr_args *args)
     if (!bench && preview && (rc = gr_args_note_preview(args, "-o", out_path)) != 0) goto done;
 
     gr_error err = {GR_OK, ""};
-    gr_status st;
     if (bench) {
-        gr_ref_bench_result b;
-        st = gr_ref_bench(scene, &b, &err);
-        if (st != GR_OK) { rc = gr_cli_report(cmd, &err); goto done; }
-        printf("Embree raw rtcOccluded1 (1 thread, random rays): %.3g rays/s vs occluders, %.3g rays/s vs the "
-               "surface mesh (%lld triangles)\n", b.occluded_occluders_per_s, b.occluded_surface_per_s, b.surface_triangles);
-        printf("beam lookups alone (grid cell + box and containment tests, 1 thread, %lld primitives): %.3g /s\n", b.beam_prims,
-               b.point_queries_per_s);
-        printf("hot loop (lookups incl. shadow rays and shading): 1 thread %.3g /s (%.2f s), 2 threads %.3g /s (%.2f s)\n",
-               b.qps[0], b.wall_s[0], b.qps[1], b.wall_s[1]);
-        printf("speed-up 1 -> 2 threads: %.2fx; identical bytes: %s; pixels within 1%%: %.1f%%\n", b.speedup,
-               b.identical ? "yes" : "NO", 100.0 * b.frac_se_1pct);
+        rc = print_bench(scene);
         goto done;
     }
-    gr_ref_options opt;
-    gr_ref_options_default(&opt);
-    opt.progress = !quiet;
-    opt.aovs = aov;
+    gr_truth_options to;
+    gr_truth_options_default(&to);
+    to.use_cache = 0;     /* the user asked for this render: written, not looked up */
+    to.keep_partial = 1;  /* Ctrl-C writes what is done (godrays:partial = 1) */
+    gr_ref_options *opt = &to.ref;
+    opt->progress = !quiet;
+    opt->aovs = aov;
     if (part) {
-        opt.keep_sums = 1;
+        opt->keep_sums = 1;
         if (tile_n > scene->camera.height) {
             rc = gr_cli_usage_error(cmd, "--tile %d/%d: more tiles than the %d rows", tile_i, tile_n, scene->camera.height);
             goto done;
         }
-        gr_part_rows(tile_n ? tile_i : 0, tile_n ? tile_n : 1, scene->camera.height, &opt.row0, &opt.row1);
-        gr_part_rows(bp_m ? bp_j : 0, bp_m ? bp_m : 1, scene->reference.batches, &opt.batch0, &opt.batch1);
+        gr_part_rows(tile_n ? tile_i : 0, tile_n ? tile_n : 1, scene->camera.height, &opt->row0, &opt->row1);
+        gr_part_rows(bp_m ? bp_j : 0, bp_m ? bp_m : 1, scene->reference.batches, &opt->batch0, &opt->batch1);
     }
     gr_ref_result res;
-    int per_round = 0;
-    st = gr_cli_render_reference(scene, &opt, &res, &per_round, &err);
-    if (st != GR_OK) { rc = gr_cli_report(cmd, &err); goto done; }
-    if (part) {
-        if (res.partial) {
-            fprintf(stderr, "godrays reference: interrupted; no part written (%s)\n", out_path);
-            gr_ref_result_free(&res);
-            rc = 1;
-            goto done;
-        }
-        char command[2048] = "godrays";
-        for (int k = 0; k < argc; k++) {
-            size_t l = strlen(command);
-            snprintf(command + l, sizeof command - l, " %s", argv[k]);
-        }
-        st = gr_part_write(out_path, scene, &opt, &res, command, &err);
-        if (st == GR_OK && !quiet)
-            fprintf(stderr, "godrays reference: wrote part %s (rows [%d, %d) of %d, batches [%d, %d) of %d, %d passes, %.1f s)\n",
-                    out_path, opt.row0, opt.row1, scene->camera.height, opt.batch0, opt.batch1, scene->reference.batches,
-                    res.passes, res.wall_s);
-        rc = st == GR_OK ? 0 : gr_cli_report(cmd, &err);
-        gr_ref_result_free(&res);
-        goto done;
-    }
-    st = gr_exr_write(out_path, res.image, &res.meta, &err);
-    if (st == GR_OK && preview) {
-        char pp[4096];
-        gr_args_preview_path(out_path, pp, sizeof pp);
-        const int rgb[3] = {0, 1, 2};
-        st = gr_oiio_write_preview(pp, res.image, rgb, res.preview_exposure, &err);
-    }
-    if (st != GR_OK) {
+    gr_truth_info ti;
+    if (gr_truth_get(scene, &to, &res, &ti, &err) != GR_OK) {
         rc = gr_cli_report(cmd, &err);
-        gr_ref_result_free(&res);
         goto done;
     }
-    char bias[224];
-    /* the measured-order figure beside the order-2 estimate: where the coarser levels are not
-     * yet asymptotic (the camera cone, docs/reference.md 2.2) it is the one a finer render confirms */
-    const gr_meta_item *mo = gr_meta_get(&res.meta, "godrays:bias_surface_rel_measured_order");
-    if (res.bias_surface_rel >= 0.0 && res.bias_block_p95 >= 0.0 && mo && mo->num >= 0.0)
-        snprintf(bias, sizeof bias,
-                 "~%.2g%% of the mean (%.2g%% with the measured order), 95th-percentile 10x10 block %.2g%% "
-                 "(godrays:bias_surface_rel_est, _measured_order, bias_block_p95_rel)",
-                 100.0 * res.bias_surface_rel, 100.0 * mo->num, 100.0 * res.bias_block_p95);
-    else if (res.bias_surface_rel >= 0.0 && res.bias_block_p95 >= 0.0)
-        snprintf(bias, sizeof bias, "~%.2g%% of the mean, 95th-percentile 10x10 block %.2g%% (godrays:bias_surface_rel_est, bias_block_p95_rel)",
-                 100.0 * res.bias_surface_rel, 100.0 * res.bias_block_p95);
-    else if (res.bias_surface_rel >= 0.0)
-        snprintf(bias, sizeof bias, "~%.2g%% of the mean (godrays:bias_surface_rel_est)", 100.0 * res.bias_surface_rel);
-    else
-        snprintf(bias, sizeof bias, "not estimated");
-    if (!quiet)
-        fprintf(stderr,
-                "godrays reference: wrote %s (%dx%d, %d spp, %.1f march steps per ray on average, %.1f s%s): rel. std. "
-                "error of the mean %.3g%%, "
-                "of the p95 pixel %.3g%%, %.1f%% of pixels within 1%%; surface bias %s\n",
-                out_path, res.image->width, res.image->height, res.spp, res.steps_mean > 0.0 ? res.steps_mean : 0.0, res.wall_s,
-                res.partial ? ", PARTIAL" : "",
-                100.0 * res.rel_se_mean, 100.0 * res.rel_se_p95, 100.0 * res.frac_se_1pct, bias);
-    if (res.partial) {
-        fprintf(stderr, "godrays reference: interrupted; %s holds the partial result (godrays:partial = 1)\n", out_path);
-        rc = 1;
-    } else {
-        warn_target(scene, per_round, &res);
-        rc = 0;
-    }
+    if (part) rc = write_part(args, scene, opt, &res, out_path, quiet);
+    else rc = write_image(scene, &res, out_path, preview, quiet, ti.passes_per_round);
     gr_ref_result_free(&res);
 done:
     free(scene);

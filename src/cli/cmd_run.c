@@ -4,7 +4,6 @@
  * the report folder with its leaderboard (src/report/report.h) and prints a short table. */
 #include "cli/cli.h"
 #include "cli/args.h"
-#include "cli/render.h"
 
 #include <errno.h>
 #include <math.h>
@@ -17,8 +16,7 @@
 #include "compare/structure.h"
 #include "image/exr.h"
 #include "realtime/technique.h"
-#include "reference/integrator.h"
-#include "report/cache.h"
+#include "reference/truth.h"
 #include "report/profile.h"
 #include "report/report.h"
 #include "report/sequence.h"
@@ -61,6 +59,8 @@ static void usage(FILE *f)
             "  --fps F              frames per second of --frames (default 30)\n"
             "  --no-cache           render the ground truth even if a cached one exists, and do not\n"
             "                       store it\n"
+            "  --max-memory SIZE    refuse (exit 2) a ground truth estimated to need more (e.g. 8G;\n"
+            "                       default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  -q, --quiet          no progress bar or step messages (the summary table is printed)\n"
             "  -h, --help           this help\n"
             "\n"
@@ -114,63 +114,44 @@ typedef struct ref_out {
     char note[1400];       /* why an entry was ignored, or why caching is off */
 } ref_out;
 
-/* The ground truth: from the cache when a valid entry exists, else rendered (and stored). */
-static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, ref_out *ro, gr_error *err)
+/* Before a ground truth is rendered (gr_truth_options.before_render): why the cache was not
+ * used, then what comes. */
+static void say_render(void *user, const gr_scene *scene, const gr_truth_info *info)
 {
-    char dir[4096], key[GR_CACHE_KEY_LEN + 1];
-    gr_status st;
-    if (use_cache) {
-        gr_error cerr = {GR_OK, ""};
-        if (gr_cache_dir(dir, sizeof dir, &cerr) != GR_OK) {
-            snprintf(ro->note, sizeof ro->note, "cache off: %.1000s", cerr.msg);
-            fprintf(stderr, "godrays run: warning: %s\n", ro->note); /* warnings even with -q */
-        } else {
-            if ((st = gr_cache_key(scene, key, err)) != GR_OK) return st;
-            if ((st = gr_cache_path(dir, key, ro->cache_path, sizeof ro->cache_path, err)) != GR_OK) return st;
-            ro->cache_on = 1;
-            char why[1400];
-            st = gr_cache_load(dir, key, scene->camera.width, scene->camera.height, &ro->img, &ro->meta, &ro->cached,
-                               why, sizeof why, err);
-            if (st != GR_OK) return st;
-            if (ro->cached) {
-                if (!quiet) fprintf(stderr, "godrays run: ground truth from the cache: %s\n", ro->cache_path);
-                return GR_OK;
-            }
-            if (strstr(why, "ignored")) {
-                snprintf(ro->note, sizeof ro->note, "%s", why);
-                fprintf(stderr, "godrays run: warning: cache entry %s\n", why); /* even with -q */
-            }
-        }
-    }
+    const int quiet = *(const int *)user;
+    if (info->note[0]) fprintf(stderr, "godrays run: warning: %s\n", info->note); /* warnings even with -q */
     if (!quiet)
         fprintf(stderr, "godrays run: rendering the ground truth (%d x %d; %s)...\n", scene->camera.width,
-                scene->camera.height, ro->cache_on ? "cached for later runs" : "not cached");
-    gr_ref_options opt;
-    gr_ref_options_default(&opt);
-    opt.progress = !quiet;
+                scene->camera.height, info->cache_on ? "cached for later runs" : "not cached");
+}
+
+/* The ground truth through the provider (reference/truth.h): from the cache when a valid
+ * entry exists, else rendered (Ctrl-C, --max-memory) and stored. */
+static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, ref_out *ro, gr_error *err)
+{
+    gr_truth_options to;
+    gr_truth_options_default(&to);
+    to.use_cache = use_cache;
+    to.ref.progress = !quiet;
+    to.before_render = say_render;
+    to.user = &quiet;
     gr_ref_result res;
-    st = gr_cli_render_reference(scene, &opt, &res, NULL, err);
+    gr_truth_info ti;
+    gr_status st = gr_truth_get(scene, &to, &res, &ti, err);
+    if (st == GR_E_INTERRUPTED) gr_error_prefix(err, "no report written");
     if (st != GR_OK) return st;
-    if (res.partial) {
-        gr_ref_result_free(&res);
-        return gr_fail(err, GR_E_INTERRUPTED, "interrupted while rendering the ground truth: no report written, "
-                       "this ground truth not cached");
-    }
     ro->img = res.image;
     res.image = NULL;
     gr_meta_free(&ro->meta);
     ro->meta = res.meta; /* hand the items over */
     gr_meta_init(&res.meta);
     gr_ref_result_free(&res);
-    if (ro->cache_on) {
-        gr_error serr = {GR_OK, ""};
-        if (gr_cache_store(dir, key, ro->img, &ro->meta, &serr) != GR_OK) {
-            /* A cache that cannot be written costs time later, not correctness now. */
-            snprintf(ro->note, sizeof ro->note, "not cached: %.1200s", serr.msg);
-            fprintf(stderr, "godrays run: warning: %s\n", ro->note); /* warnings even with -q */
-            ro->cache_on = 0;
-        }
-    }
+    ro->cached = ti.cached;
+    ro->cache_on = ti.cache_on;
+    snprintf(ro->cache_path, sizeof ro->cache_path, "%s", ti.path);
+    snprintf(ro->note, sizeof ro->note, "%s", ti.note);
+    if (ti.cached && !quiet) fprintf(stderr, "godrays run: ground truth from the cache: %s\n", ti.path);
+    if (!strncmp(ti.note, "not cached", 10)) fprintf(stderr, "godrays run: warning: %s\n", ti.note); /* even with -q */
     return GR_OK;
 }
 
@@ -227,282 +208,362 @@ static void print_summary(const char *dir, const gr_scene *scene, const gr_repor
                 "(camera inside an occluder, no scattering, or no light reaching the view?)\n");
 }
 
-/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
-static int run_with(gr_args *args)
+/* What the command line asks for. */
+typedef struct run_opts {
+    const char *outdir, *tech_list, *frames_spec, *times_spec, *fps_spec;
+    int quiet, use_cache, help;
+    const gr_technique_class *cls[GR_REPORT_MAX_TECHNIQUES];
+    int nt;                         /* techniques */
+    double fps, times[GR_SEQUENCE_MAX_FRAMES];
+    long frame_no[GR_SEQUENCE_MAX_FRAMES];
+    int n_times;                    /* 0: one frame, no sequence */
+    int nf;                         /* frames (1 without a sequence) */
+} run_opts;
+
+/* What a run makes; run_free frees it. */
+typedef struct run_state {
+    gr_scene *scene;
+    gr_scene *cases;                /* a sequence: one scene per frame (NULL otherwise) */
+    const gr_scene *scene0;         /* the frame index.html compares */
+    gr_image *test[GR_REPORT_MAX_TECHNIQUES];
+    gr_metadata smeta[GR_REPORT_MAX_TECHNIQUES];
+    gr_image **seq_test;            /* seq_test[k * nf + i], i >= 1 (frame 0: test[k]) */
+    ref_out ro;                     /* frame 0's ground truth */
+    ref_out *seq_ref;               /* frames >= 1 */
+    gr_metrics *mets;
+    float *angles;
+    gr_report_technique ts[GR_REPORT_MAX_TECHNIQUES];
+    char exr_names[GR_REPORT_MAX_TECHNIQUES][48];
+    char *seq_json;
+    gr_sequence_result sres;
+    gr_strbuf cmdline, words;
+    double t_ref, t_refs, t_cmp;    /* frame 0's ground truth, every frame's, the comparison (s) */
+} run_state;
+
+/* The argument loop; returns the exit code (o->help: the help was printed). */
+static int parse_args(gr_args *args, run_opts *o)
 {
-    const int argc = args->argc;
-    char **argv = args->argv;
-    const char *cmd = "run";
-    const char *outdir = NULL, *tech_list = NULL;
-    const char *frames_spec = NULL, *times_spec = NULL, *fps_spec = NULL;
-    int quiet = 0, use_cache = 1, rc = 0, taken = 0;
-    for (; args->i < argc && !rc; args->i++) {
-        const char *a = argv[args->i];
+    int rc = 0, taken = 0;
+    for (; args->i < args->argc && !rc; args->i++) {
+        const char *a = args->argv[args->i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
+            o->help = 1;
             return 0;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-            quiet = 1;
+            o->quiet = 1;
         } else if (!strcmp(a, "--no-cache")) {
-            use_cache = 0;
+            o->use_cache = 0;
         } else if (!strcmp(a, "--techniques")) {
-            rc = gr_args_value(args, &tech_list);
+            rc = gr_args_value(args, &o->tech_list);
         } else if (!strcmp(a, "--frames")) {
-            rc = gr_args_value(args, &frames_spec);
+            rc = gr_args_value(args, &o->frames_spec);
         } else if (!strcmp(a, "--times")) {
-            rc = gr_args_value(args, &times_spec);
+            rc = gr_args_value(args, &o->times_spec);
         } else if (!strcmp(a, "--fps")) {
-            rc = gr_args_value(args, &fps_spec);
-        } else if ((rc = gr_args_take_common(args, &outdir, NULL, &taken)) == 0 && !taken) {
+            rc = gr_args_value(args, &o->fps_spec);
+        } else if ((rc = gr_args_take_common(args, &o->outdir, NULL, &taken)) == 0 && !taken) {
             rc = gr_args_take_scene(args);
         }
     }
-    if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
-    /* user techniques before the scene, whose sections they add */
-    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
-    const gr_technique_class *cls[GR_REPORT_MAX_TECHNIQUES];
-    int nt = 0;
+    return rc;
+}
+
+/* --techniques and a sequence's --frames/--times/--fps (report/sequence.h); an exit code. */
+static int parse_choices(run_opts *o)
+{
+    const char *cmd = "run";
     gr_error err = {GR_OK, ""};
-    if (gr_technique_parse_list("--techniques", tech_list, cls, GR_REPORT_MAX_TECHNIQUES, &nt, &err) != GR_OK)
+    if (gr_technique_parse_list("--techniques", o->tech_list, o->cls, GR_REPORT_MAX_TECHNIQUES, &o->nt, &err) != GR_OK)
         return gr_cli_usage_error(cmd, "%s", err.msg);
-    if (nt == 0) return gr_cli_usage_error(cmd, "no real-time technique to compare");
-    /* a sequence: --frames or --times (report/sequence.h) */
-    double fps = 30.0, times[GR_SEQUENCE_MAX_FRAMES];
-    long frame_no[GR_SEQUENCE_MAX_FRAMES];
-    int n_times = 0;
-    if (frames_spec && times_spec) return gr_cli_usage_error(cmd, "--frames and --times: give one of them");
-    if (fps_spec) {
+    if (o->nt == 0) return gr_cli_usage_error(cmd, "no real-time technique to compare");
+    if (o->frames_spec && o->times_spec) return gr_cli_usage_error(cmd, "--frames and --times: give one of them");
+    o->fps = 30.0;
+    if (o->fps_spec) {
         char *end = NULL;
-        fps = strtod(fps_spec, &end);
-        if (end == fps_spec || *end || !isfinite(fps) || !(fps > 0))
-            return gr_cli_usage_error(cmd, "--fps %s: expected a number > 0", fps_spec);
+        o->fps = strtod(o->fps_spec, &end);
+        if (end == o->fps_spec || *end || !isfinite(o->fps) || !(o->fps > 0))
+            return gr_cli_usage_error(cmd, "--fps %s: expected a number > 0", o->fps_spec);
     }
-    if (frames_spec &&
-        gr_tune_parse_frames("--frames", frames_spec, fps, times, GR_SEQUENCE_MAX_FRAMES, &n_times, &err) != GR_OK)
+    if (o->frames_spec && gr_tune_parse_frames("--frames", o->frames_spec, o->fps, o->times, GR_SEQUENCE_MAX_FRAMES,
+                                               &o->n_times, &err) != GR_OK)
         return gr_cli_usage_error(cmd, "%s", err.msg);
-    if (times_spec && gr_tune_parse_times("--times", times_spec, times, GR_SEQUENCE_MAX_FRAMES, &n_times, &err) != GR_OK)
+    if (o->times_spec &&
+        gr_tune_parse_times("--times", o->times_spec, o->times, GR_SEQUENCE_MAX_FRAMES, &o->n_times, &err) != GR_OK)
         return gr_cli_usage_error(cmd, "%s", err.msg);
-    if ((frames_spec || times_spec) && n_times < 2)
-        return gr_cli_usage_error(cmd, "%s %s: one frame; a sequence needs two or more", frames_spec ? "--frames" : "--times",
-                                  frames_spec ? frames_spec : times_spec);
-    for (int i = 0; i < n_times; i++) frame_no[i] = lround(times[i] * fps);
-    const int nf = n_times > 0 ? n_times : 1;
+    if ((o->frames_spec || o->times_spec) && o->n_times < 2)
+        return gr_cli_usage_error(cmd, "%s %s: one frame; a sequence needs two or more",
+                                  o->frames_spec ? "--frames" : "--times", o->frames_spec ? o->frames_spec : o->times_spec);
+    for (int i = 0; i < o->n_times; i++) o->frame_no[i] = lround(o->times[i] * o->fps);
+    o->nf = o->n_times > 0 ? o->n_times : 1;
+    return 0;
+}
 
-    gr_scene *scene = NULL, *cases = NULL;
-    float *angles = NULL;
-    gr_image **seq_test = NULL; /* seq_test[k * nf + i], i >= 1 (frame 0: test[k]) */
-    ref_out *seq_ref = NULL;    /* frames >= 1 (frame 0: ro) */
-    char *seq_json = NULL;
-    gr_sequence_result sres;
-    memset(&sres, 0, sizeof sres);
+/* A sequence: each frame's scene, the water at its time (--frames: from the scene's time). */
+static gr_status make_cases(run_opts *o, run_state *rs, gr_error *err)
+{
+    const int nf = o->nf;
+    rs->cases = calloc((size_t)nf, sizeof *rs->cases);
+    rs->seq_test = calloc((size_t)(nf * o->nt), sizeof *rs->seq_test);
+    rs->seq_ref = calloc((size_t)nf, sizeof *rs->seq_ref);
+    if (!rs->cases || !rs->seq_test || !rs->seq_ref) return gr_fail(err, GR_E_NOMEM, "out of memory");
+    for (int i = 0; i < nf; i++) {
+        gr_meta_init(&rs->seq_ref[i].meta);
+        const double tw = o->times[i] + (o->frames_spec ? rs->scene->water.time_s : 0.0);
+        if (gr_tune_make_case(rs->scene, tw, NULL, &rs->cases[i], err) != GR_OK)
+            return gr_error_prefix(err, "%s: frame %d", o->frames_spec ? "--frames" : "--times", i);
+        o->times[i] = tw;
+    }
+    return GR_OK;
+}
+
+/* The real-time side: it takes seconds, and a GL failure should not cost the user a
+ * two-minute ground truth first. One context, one instance per technique. */
+static gr_status render_techniques(const run_opts *o, run_state *rs, gr_error *err)
+{
+    const int nf = o->nf;
     gr_gl *gl = NULL;
-    gr_image *test[GR_REPORT_MAX_TECHNIQUES] = {NULL};
-    gr_metadata smeta[GR_REPORT_MAX_TECHNIQUES];
-    gr_metrics *mets = calloc((size_t)nt, sizeof *mets);
-    gr_report_technique ts[GR_REPORT_MAX_TECHNIQUES];
-    char exr_names[GR_REPORT_MAX_TECHNIQUES][48];
-    memset(ts, 0, sizeof ts);
-    for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) gr_meta_init(&smeta[k]);
-    ref_out ro;
-    memset(&ro, 0, sizeof ro);
-    gr_meta_init(&ro.meta);
-    gr_strbuf cmdline, words;
-    gr_sb_init(&cmdline);
-    gr_sb_init(&words);
-    char dirbuf[4096], path[4300];
-    if (!mets) {
-        gr_fail(&err, GR_E_NOMEM, "out of memory");
-        goto fail;
-    }
-    if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
-    if (n_times > 0) { /* each frame's scene: the water at its time (--frames: from the scene's time) */
-        cases = calloc((size_t)nf, sizeof *cases);
-        seq_test = calloc((size_t)(nf * nt), sizeof *seq_test);
-        seq_ref = calloc((size_t)nf, sizeof *seq_ref);
-        if (!cases || !seq_test || !seq_ref) {
-            gr_fail(&err, GR_E_NOMEM, "out of memory");
-            goto fail;
-        }
-        for (int i = 0; i < nf; i++) {
-            gr_meta_init(&seq_ref[i].meta);
-            const double tw = times[i] + (frames_spec ? scene->water.time_s : 0.0);
-            if (gr_tune_make_case(scene, tw, NULL, &cases[i], &err) != GR_OK) {
-                gr_error_prefix(&err, "%s: frame %d", frames_spec ? "--frames" : "--times", i);
-                goto fail;
-            }
-            times[i] = tw;
-        }
-    }
-    const gr_scene *scene0 = cases ? &cases[0] : scene; /* the frame index.html compares */
-    /* Bad settings are bad input (exit 2) before any slow or GL work. */
-    for (int k = 0; k < nt; k++)
-        if (gr_technique_check(cls[k], gr_technique_scene_settings(cls[k], scene), &err) != GR_OK) goto fail;
-    /* The ground truth takes minutes: a folder that cannot be made is refused before it. */
-    if ((rc = gr_args_output_dir(args, scene, outdir, NULL, dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
-    command_line(argc, argv, &cmdline);
-    gr_args_scene_words(args, &words);
-    if (gr_sb_status(&cmdline, "the command line", &err) != GR_OK || gr_sb_status(&words, "the command line", &err) != GR_OK)
-        goto fail;
-
-    /* The real-time side first: it takes seconds, and a GL failure should not cost the user
-     * a two-minute ground truth first. One context, one instance per technique. */
-    if (gr_gl_create(NULL, &gl, &err) != GR_OK) goto fail;
-    for (int k = 0; k < nt; k++) {
-        if (!quiet) fprintf(stderr, "godrays run: rendering %s...\n", cls[k]->name);
+    gr_status st = gr_gl_create(NULL, &gl, err);
+    for (int k = 0; k < o->nt && st == GR_OK; k++) {
+        const gr_technique_class *cls = o->cls[k];
+        if (!o->quiet) fprintf(stderr, "godrays run: rendering %s...\n", cls->name);
         double t = now_s();
-        if (render_technique(cls[k], gl, scene0, &test[k], &smeta[k], &err) != GR_OK) goto fail;
-        ts[k].seconds = now_s() - t;
-        ts[k].name = cls[k]->name;
-        ts[k].description = cls[k]->description;
-        ts[k].test = test[k];
-        ts[k].meta = &smeta[k];
-        snprintf(exr_names[k], sizeof exr_names[k], "%s.exr", cls[k]->name);
-        ts[k].exr = exr_names[k];
-        for (int i = 1; i < nf; i++) {
+        if ((st = render_technique(cls, gl, rs->scene0, &rs->test[k], &rs->smeta[k], err)) != GR_OK) break;
+        gr_report_technique *ts = &rs->ts[k];
+        ts->seconds = now_s() - t;
+        ts->name = cls->name;
+        ts->description = cls->description;
+        ts->test = rs->test[k];
+        ts->meta = &rs->smeta[k];
+        snprintf(rs->exr_names[k], sizeof rs->exr_names[k], "%s.exr", cls->name);
+        ts->exr = rs->exr_names[k];
+        for (int i = 1; i < nf && st == GR_OK; i++) {
             gr_metadata scratch;
             gr_meta_init(&scratch);
-            gr_status rst = render_technique(cls[k], gl, &cases[i], &seq_test[k * nf + i], &scratch, &err);
+            st = render_technique(cls, gl, &rs->cases[i], &rs->seq_test[k * nf + i], &scratch, err);
             gr_meta_free(&scratch);
-            if (rst != GR_OK) {
-                gr_error_prefix(&err, "frame %d (t = %g s)", i, times[i]);
-                goto fail;
-            }
+            if (st != GR_OK) gr_error_prefix(err, "frame %d (t = %g s)", i, o->times[i]);
         }
-        if (nf > 1) seq_test[k * nf] = test[k];
+        if (nf > 1) rs->seq_test[k * nf] = rs->test[k];
     }
     gr_gl_destroy(gl);
-    gl = NULL;
+    return st;
+}
 
+/* Every frame's ground truth (reference/truth.h). */
+static gr_status get_references(const run_opts *o, run_state *rs, gr_error *err)
+{
+    const int nf = o->nf;
     double t = now_s();
-    if (nf > 1 && !quiet) fprintf(stderr, "godrays run: frame 1 of %d (t = %g s)\n", nf, times[0]);
-    if (get_reference(scene0, use_cache, quiet, &ro, &err) != GR_OK) goto fail;
-    const double t_ref = now_s() - t;
+    if (nf > 1 && !o->quiet) fprintf(stderr, "godrays run: frame 1 of %d (t = %g s)\n", nf, o->times[0]);
+    gr_status st = get_reference(rs->scene0, o->use_cache, o->quiet, &rs->ro, err);
+    if (st != GR_OK) return st;
+    rs->t_ref = now_s() - t;
     for (int i = 1; i < nf; i++) {
-        if (!quiet) fprintf(stderr, "godrays run: frame %d of %d (t = %g s)\n", i + 1, nf, times[i]);
-        if (get_reference(&cases[i], use_cache, quiet, &seq_ref[i], &err) != GR_OK) {
-            gr_error_prefix(&err, "frame %d (t = %g s)", i, times[i]);
-            const size_t l = strlen(err.msg); /* the frames before it were cached ("nothing cached" was wrong) */
-            if (err.status == GR_E_INTERRUPTED && ro.cache_on)
-                snprintf(err.msg + l, sizeof err.msg - l, "; the %d frame%s before it cached", i, i > 1 ? "s" : "");
-            goto fail;
+        if (!o->quiet) fprintf(stderr, "godrays run: frame %d of %d (t = %g s)\n", i + 1, nf, o->times[i]);
+        if ((st = get_reference(&rs->cases[i], o->use_cache, o->quiet, &rs->seq_ref[i], err)) != GR_OK) {
+            gr_error_prefix(err, "frame %d (t = %g s)", i, o->times[i]);
+            const size_t l = strlen(err->msg); /* the frames before it were cached ("nothing cached" was wrong) */
+            if (st == GR_E_INTERRUPTED && rs->ro.cache_on)
+                snprintf(err->msg + l, sizeof err->msg - l, "; the %d frame%s before it cached", i, i > 1 ? "s" : "");
+            return st;
         }
     }
-    const double t_refs = now_s() - t;
+    rs->t_refs = now_s() - t;
+    return GR_OK;
+}
 
-    if (!quiet) fprintf(stderr, "godrays run: comparing...\n");
-    t = now_s();
-    const gr_meta_item *dof = gr_meta_get(&ro.meta, "godrays:stderr_dof"); /* Student t for significance */
+/* Each technique's metrics against frame 0's ground truth (compare/metrics.h): raw and after
+ * the best scale fit, reference-stderr aware. */
+static gr_status compute_metrics(const run_opts *o, run_state *rs, gr_error *err)
+{
+    const gr_scene *scene = rs->scene;
+    const gr_meta_item *dof = gr_meta_get(&rs->ro.meta, "godrays:stderr_dof"); /* Student t for significance */
     /* beam structure around the refracted sun's vanishing point, de-glowed by the angle to
      * the sun (docs/metrics.md), in every technique's metric sets; skipped when the beams have
      * no finite vanishing point (parallel to the image plane) */
     gr_structure_options so = {.radial_bin = scene->camera.fov_deg / scene->camera.height};
     int with_structure = 0;
-    {
-        gr_error e2 = {GR_OK, ""};
-        angles = malloc((size_t)scene->camera.width * (size_t)scene->camera.height * sizeof(float));
-        if (!angles) {
-            gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
-            goto fail;
-        }
-        if (gr_structure_scene_vp(scene, scene->camera.width, scene->camera.height, &so.vp_x, &so.vp_y, &e2) == GR_OK) {
-            double dir[3];
-            gr_profile_sun_view_dir(scene, dir);
-            gr_profile_angles(&scene->camera, dir, angles);
-            so.radial = angles;
-            with_structure = 1;
-        }
+    gr_error e2 = {GR_OK, ""};
+    rs->angles = malloc((size_t)scene->camera.width * (size_t)scene->camera.height * sizeof(float));
+    if (!rs->angles) return gr_fail(err, GR_E_NOMEM, "out of memory for the structure metrics");
+    if (gr_structure_scene_vp(scene, scene->camera.width, scene->camera.height, &so.vp_x, &so.vp_y, &e2) == GR_OK) {
+        double dir[3];
+        gr_profile_sun_view_dir(scene, dir);
+        gr_profile_angles(&scene->camera, dir, rs->angles);
+        so.radial = rs->angles;
+        with_structure = 1;
     }
-    for (int k = 0; k < nt; k++) {
+    for (int k = 0; k < o->nt; k++) {
         gr_metrics_options mopt = {0};
         mopt.fit_scale = 1; /* a technique's intensity is an arbitrary factor (seed 000) */
         if (with_structure) mopt.structure = &so;
         if (dof && dof->type != GR_META_STRING && dof->num >= 1.0) mopt.stderr_dof = (int)dof->num;
-        if (gr_metrics_compute(ro.img, test[k], &mopt, &mets[k], &err) != GR_OK) goto fail;
-        ts[k].metrics = &mets[k];
+        gr_status st = gr_metrics_compute(rs->ro.img, rs->test[k], &mopt, &rs->mets[k], err);
+        if (st != GR_OK) return st;
+        rs->ts[k].metrics = &rs->mets[k];
     }
-    const double t_cmp = now_s() - t;
+    return GR_OK;
+}
 
-    /* The report links the EXRs; they are written first so that a finished index.html never
-     * points at a missing file. */
-    if (!quiet) fprintf(stderr, "godrays run: writing the report...\n");
-    if (nf > 1) {
-        if (!quiet) fprintf(stderr, "godrays run: the sequence (%d frames)...\n", nf);
-        const gr_scene *fs[GR_SEQUENCE_MAX_FRAMES];
-        const gr_image *frefs[GR_SEQUENCE_MAX_FRAMES];
-        const char *names[GR_REPORT_MAX_TECHNIQUES];
-        for (int i = 0; i < nf; i++) {
-            fs[i] = &cases[i];
-            frefs[i] = i ? seq_ref[i].img : ro.img;
-        }
-        for (int k = 0; k < nt; k++) names[k] = cls[k]->name;
-        gr_sequence_input sin = {.n_frames = nf, .times = times, .frame_numbers = frames_spec ? frame_no : NULL,
-                                 .scenes = fs, .refs = frefs, .n_techniques = nt, .names = names,
-                                 .tests = (const gr_image *const *)seq_test, .up_href = "../index.html",
-                                 .command_line = gr_sb_str(&cmdline)};
-        if (snprintf(path, sizeof path, "%s/sequence", outdir) >= (int)sizeof path - 48) {
-            gr_fail(&err, GR_E_USAGE, "%s: output directory name too long", outdir);
-            goto fail;
-        }
-        if (gr_sequence_write(path, &sin, &seq_json, &sres, &err) != GR_OK) goto fail;
+/* OUTDIR/sequence (report/sequence.h). */
+static gr_status write_sequence(const run_opts *o, run_state *rs, const char *outdir, gr_error *err)
+{
+    const int nf = o->nf;
+    if (!o->quiet) fprintf(stderr, "godrays run: the sequence (%d frames)...\n", nf);
+    const gr_scene *fs[GR_SEQUENCE_MAX_FRAMES];
+    const gr_image *frefs[GR_SEQUENCE_MAX_FRAMES];
+    const char *names[GR_REPORT_MAX_TECHNIQUES];
+    for (int i = 0; i < nf; i++) {
+        fs[i] = &rs->cases[i];
+        frefs[i] = i ? rs->seq_ref[i].img : rs->ro.img;
     }
-    gr_report_input in = {.scene = scene0, .ref = ro.img, .ref_meta = &ro.meta, .n_techniques = nt, .techniques = ts,
-                          .command_line = gr_sb_str(&cmdline), .scene_words = gr_sb_str(&words),
-                          .ref_cached = ro.cached, .ref_cache_path = ro.cache_on ? ro.cache_path : NULL,
-                          .ref_cache_note = ro.note[0] ? ro.note : NULL, .ref_seconds = t_ref,
-                          .compare_seconds = t_cmp, .ref_exr = "reference.exr", .sequence_json = seq_json,
-                          .sequence_href = seq_json ? "sequence/index.html" : NULL};
-    gr_report_result rres;
-    if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
-    if (snprintf(path, sizeof path, "%s/reference.exr", outdir) >= (int)sizeof path - 48) {
-        gr_fail(&err, GR_E_USAGE, "%s: output directory name too long", outdir);
-        goto fail;
+    for (int k = 0; k < o->nt; k++) names[k] = o->cls[k]->name;
+    gr_sequence_input sin = {.n_frames = nf, .times = o->times, .frame_numbers = o->frames_spec ? o->frame_no : NULL,
+                             .scenes = fs, .refs = frefs, .n_techniques = o->nt, .names = names,
+                             .tests = (const gr_image *const *)rs->seq_test, .up_href = "../index.html",
+                             .command_line = gr_sb_str(&rs->cmdline)};
+    char path[4300];
+    if (snprintf(path, sizeof path, "%s/sequence", outdir) >= (int)sizeof path - 48)
+        return gr_fail(err, GR_E_USAGE, "%s: output directory name too long", outdir);
+    return gr_sequence_write(path, &sin, &rs->seq_json, &rs->sres, err);
+}
+
+/* The report folder. The report links the EXRs; they are written first so that a finished
+ * index.html never points at a missing file. */
+static gr_status write_report(const run_opts *o, run_state *rs, const char *outdir, gr_report_result *rres,
+                              gr_error *err)
+{
+    if (!o->quiet) fprintf(stderr, "godrays run: writing the report...\n");
+    gr_status st = o->nf > 1 ? write_sequence(o, rs, outdir, err) : GR_OK;
+    if (st != GR_OK) return st;
+    const ref_out *ro = &rs->ro;
+    gr_report_input in = {.scene = rs->scene0, .ref = ro->img, .ref_meta = &ro->meta, .n_techniques = o->nt,
+                          .techniques = rs->ts, .command_line = gr_sb_str(&rs->cmdline),
+                          .scene_words = gr_sb_str(&rs->words), .ref_cached = ro->cached,
+                          .ref_cache_path = ro->cache_on ? ro->cache_path : NULL,
+                          .ref_cache_note = ro->note[0] ? ro->note : NULL, .ref_seconds = rs->t_ref,
+                          .compare_seconds = rs->t_cmp, .ref_exr = "reference.exr", .sequence_json = rs->seq_json,
+                          .sequence_href = rs->seq_json ? "sequence/index.html" : NULL};
+    if ((st = gr_report_make_dir(outdir, err)) != GR_OK) return st;
+    char path[4300];
+    if (snprintf(path, sizeof path, "%s/reference.exr", outdir) >= (int)sizeof path - 48)
+        return gr_fail(err, GR_E_USAGE, "%s: output directory name too long", outdir);
+    if ((st = gr_exr_write(path, ro->img, &ro->meta, err)) != GR_OK) return st;
+    for (int k = 0; k < o->nt; k++) {
+        snprintf(path, sizeof path, "%s/%s", outdir, rs->exr_names[k]);
+        if ((st = gr_exr_write(path, rs->test[k], &rs->smeta[k], err)) != GR_OK) return st;
     }
-    if (gr_exr_write(path, ro.img, &ro.meta, &err) != GR_OK) goto fail;
-    for (int k = 0; k < nt; k++) {
-        snprintf(path, sizeof path, "%s/%s", outdir, exr_names[k]);
-        if (gr_exr_write(path, test[k], &smeta[k], &err) != GR_OK) goto fail;
-    }
-    if (gr_report_write(outdir, &in, &rres, &err) != GR_OK) goto fail;
-    if (!quiet && !rres.labelled)
+    if ((st = gr_report_write(outdir, &in, rres, err)) != GR_OK) return st;
+    if (!o->quiet && !rres->labelled)
         fprintf(stderr, "godrays run: note: no font for OpenImageIO's text: summary.png is unlabelled\n");
-    if (!quiet && rres.charts == 0) fprintf(stderr, "godrays run: note: charts not drawn (see index.html)\n");
-    print_summary(outdir, scene0, ts, nt, rres.order, &ro, t_ref);
-    if (nf > 1) {
-        printf("\nsequence: %d frames, t = %g .. %g s; ground truths %.1f s in all\n", nf, times[0], times[nf - 1],
-               t_refs);
-        printf("  %-24s %10s %14s %12s %14s\n", "technique", "a", "diff. error", "flicker", "drift err deg");
-        for (int k = 0; k < nt; k++)
-            printf("  %-24s %10.4g %14.4g %12.4g %14.3g\n", cls[k]->name, sres.scale[k], sres.rel_diff_rmse[k],
-                   sres.flicker_ratio[k], sres.drift_err_deg[k]);
-        printf("sequence report: %s/sequence/index.html (%d charts, %d animations)\n", outdir, sres.charts,
-               sres.animations);
+    if (!o->quiet && rres->charts == 0) fprintf(stderr, "godrays run: note: charts not drawn (see index.html)\n");
+    return GR_OK;
+}
+
+/* The sequence's table (after print_summary). */
+static void print_sequence(const run_opts *o, const run_state *rs, const char *outdir)
+{
+    const int nf = o->nf;
+    printf("\nsequence: %d frames, t = %g .. %g s; ground truths %.1f s in all\n", nf, o->times[0], o->times[nf - 1],
+           rs->t_refs);
+    printf("  %-24s %10s %14s %12s %14s\n", "technique", "a", "diff. error", "flicker", "drift err deg");
+    for (int k = 0; k < o->nt; k++)
+        printf("  %-24s %10.4g %14.4g %12.4g %14.3g\n", o->cls[k]->name, rs->sres.scale[k], rs->sres.rel_diff_rmse[k],
+               rs->sres.flicker_ratio[k], rs->sres.drift_err_deg[k]);
+    printf("sequence report: %s/sequence/index.html (%d charts, %d animations)\n", outdir, rs->sres.charts,
+           rs->sres.animations);
+}
+
+static void run_free(const run_opts *o, run_state *rs)
+{
+    const int nf = o->nf;
+    free(rs->angles);
+    gr_image_destroy(rs->ro.img);
+    gr_meta_free(&rs->ro.meta);
+    for (int i = 1; rs->seq_ref && i < nf; i++) {
+        gr_image_destroy(rs->seq_ref[i].img);
+        gr_meta_free(&rs->seq_ref[i].meta);
     }
-    goto done;
-fail:
-    rc = gr_cli_report(cmd, &err);
-done:
-    free(angles);
-    gr_gl_destroy(gl);
-    gr_image_destroy(ro.img);
-    gr_meta_free(&ro.meta);
-    for (int i = 1; seq_ref && i < nf; i++) {
-        gr_image_destroy(seq_ref[i].img);
-        gr_meta_free(&seq_ref[i].meta);
-    }
-    for (int k = 0; seq_test && k < nt; k++)
-        for (int i = 1; i < nf; i++) gr_image_destroy(seq_test[k * nf + i]);
-    free(seq_test);
-    free(seq_ref);
-    free(cases);
-    free(seq_json);
+    for (int k = 0; rs->seq_test && k < o->nt; k++)
+        for (int i = 1; i < nf; i++) gr_image_destroy(rs->seq_test[k * nf + i]);
+    free(rs->seq_test);
+    free(rs->seq_ref);
+    free(rs->cases);
+    free(rs->seq_json);
     for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) {
-        gr_image_destroy(test[k]);
-        gr_meta_free(&smeta[k]);
+        gr_image_destroy(rs->test[k]);
+        gr_meta_free(&rs->smeta[k]);
     }
-    free(mets);
-    free(scene);
-    gr_sb_free(&cmdline);
-    gr_sb_free(&words);
+    free(rs->mets);
+    free(rs->scene);
+    gr_sb_free(&rs->cmdline);
+    gr_sb_free(&rs->words);
+    free(rs);
+}
+
+/* Everything after the command line: scene, techniques, ground truths, metrics, report. */
+static int run_scene(gr_args *args, run_opts *o, run_state *rs)
+{
+    const char *cmd = "run";
+    gr_error err = {GR_OK, ""};
+    int rc = 0;
+    char dirbuf[4096];
+    if (!(rs->mets = calloc((size_t)o->nt, sizeof *rs->mets))) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        return gr_cli_report(cmd, &err);
+    }
+    if ((rc = gr_args_load_scene(args, &rs->scene)) != 0) return rc;
+    if (o->n_times > 0 && make_cases(o, rs, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    rs->scene0 = rs->cases ? &rs->cases[0] : rs->scene;
+    /* Bad settings are bad input (exit 2) before any slow or GL work. */
+    for (int k = 0; k < o->nt; k++)
+        if (gr_technique_check(o->cls[k], gr_technique_scene_settings(o->cls[k], rs->scene), &err) != GR_OK)
+            return gr_cli_report(cmd, &err);
+    /* The ground truth takes minutes: a folder that cannot be made is refused before it. */
+    const char *outdir = NULL;
+    if ((rc = gr_args_output_dir(args, rs->scene, o->outdir, NULL, dirbuf, sizeof dirbuf, &outdir)) != 0) return rc;
+    command_line(args->argc, args->argv, &rs->cmdline);
+    gr_args_scene_words(args, &rs->words);
+    if (gr_sb_status(&rs->cmdline, "the command line", &err) != GR_OK ||
+        gr_sb_status(&rs->words, "the command line", &err) != GR_OK)
+        return gr_cli_report(cmd, &err);
+    if (render_techniques(o, rs, &err) != GR_OK || get_references(o, rs, &err) != GR_OK)
+        return gr_cli_report(cmd, &err);
+    if (!o->quiet) fprintf(stderr, "godrays run: comparing...\n");
+    double t = now_s();
+    if (compute_metrics(o, rs, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    rs->t_cmp = now_s() - t;
+    gr_report_result rres;
+    if (write_report(o, rs, outdir, &rres, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    print_summary(outdir, rs->scene0, rs->ts, o->nt, rres.order, &rs->ro, rs->t_ref);
+    if (o->nf > 1) print_sequence(o, rs, outdir);
+    return 0;
+}
+
+/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
+static int run_with(gr_args *args)
+{
+    run_opts o;
+    memset(&o, 0, sizeof o);
+    o.use_cache = 1;
+    int rc = parse_args(args, &o);
+    if (rc || o.help) return rc;
+    if ((rc = gr_args_need_scene(args)) != 0) return rc;
+    /* user techniques before the scene, whose sections they add */
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    if ((rc = parse_choices(&o)) != 0) return rc;
+    run_state *rs = calloc(1, sizeof *rs);
+    if (!rs) {
+        gr_error err = {GR_E_NOMEM, "out of memory"};
+        return gr_cli_report("run", &err);
+    }
+    for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) gr_meta_init(&rs->smeta[k]);
+    gr_meta_init(&rs->ro.meta);
+    gr_sb_init(&rs->cmdline);
+    gr_sb_init(&rs->words);
+    rc = run_scene(args, &o, rs);
+    run_free(&o, rs);
     return rc;
 }
 

@@ -65,7 +65,7 @@ static void usage(FILE *f)
 /* The objective, recording every evaluation into trace.csv. */
 typedef struct traced {
     gr_tune_problem *p;
-    FILE *trace;        /* trace.f: the temporary file (common/outfile), renamed at the end */
+    FILE *trace;        /* the temporary file of trace.csv (common/outfile), renamed at the end */
     int n;
     int progress;
     gr_tune_budget *budget; /* the estimate after the first evaluation; NULL: none (-q) */
@@ -172,347 +172,450 @@ static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune
     return st;
 }
 
-/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
-static int tune_with(gr_args *args)
-{
-    const char *cmd = "tune", *outopt = NULL;
-    const int argc = args->argc;
-    char **argv = args->argv;
+/* What the command line asks for, besides the options sweep shares (gr_tune_cli). */
+typedef struct tune_opts {
     gr_tune_cli c;
-    gr_tune_cli_init(&c);
+    const char *outopt, *params_spec;
+    const char *bounds[32], *starts[32];
+    int n_bounds, n_start_specs;
+    int n_starts, max_evals, coarse, screen, help;
+    unsigned long long seed;
+    gr_opt_method method;
+} tune_opts;
+
+/* The search's box and its result. */
+typedef struct tune_run {
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
-    int n_params = 0, n_starts = 4, max_evals = 0, rc = 0, coarse = -1, screen = -1;
-    unsigned long long seed = 0;
-    gr_opt_method method = GR_OPT_NELDER_MEAD;
-    const char *bounds[32], *starts[32], *params_spec = NULL;
-    int n_bounds = 0, n_start_specs = 0;
+    int n_params;
+    double x0[GR_TUNE_MAX_PARAMS];
+    int have_x0[GR_TUNE_MAX_PARAMS];
+    double lo[GR_TUNE_MAX_PARAMS], hi[GR_TUNE_MAX_PARAMS], xb[GR_TUNE_MAX_PARAMS]; /* xb: the scene's own */
+    double before[GR_TUNE_MAX_CASES], after[GR_TUNE_MAX_CASES], sc_b[GR_TUNE_MAX_CASES], sc_a[GR_TUNE_MAX_CASES];
+    double fb, fa;                          /* the mean error before and after */
+    gr_opt_result res;
+    double spread[GR_TUNE_MAX_PARAMS];      /* of the starts that agree (fraction of the box) */
+    int agreeing;
+    gr_opt_options oo;                      /* the search's options, known before the ground truths */
+    gr_tune_budget budget;                  /* its count and estimate (tune/budget.h) */
+    long long renders0;                     /* the problem's counters before the search */
+    double render_s0, metrics_s0;
+    char *snippet;
+} tune_run;
+
+/* One of tune's own options with a value (argv[args->i]); *rc the exit code. 0: not one. */
+static int take_own_option(gr_args *args, tune_opts *t, int *rc)
+{
+    static const char *const own[] = {"--params", "--bounds", "--start", "--starts", "--max-evals",
+                                      "--coarse", "--seed",   "--method", "--screen"};
+    const char *cmd = "tune", *a = args->argv[args->i], *v = NULL;
+    size_t k = 0;
+    while (k < sizeof own / sizeof own[0] && strcmp(a, own[k])) k++;
+    if (k == sizeof own / sizeof own[0]) return 0;
+    if ((*rc = gr_args_value(args, &v)) != 0) return 1;
+    if (!strcmp(a, "--params")) {
+        if (t->params_spec) *rc = gr_cli_usage_error(cmd, "--params given twice");
+        t->params_spec = v; /* parsed after the loop, once --technique-dir is known */
+    } else if (!strcmp(a, "--bounds")) {
+        if (t->n_bounds >= 32) *rc = gr_cli_usage_error(cmd, "--bounds: too many");
+        else t->bounds[t->n_bounds++] = v;
+    } else if (!strcmp(a, "--start")) {
+        if (t->n_start_specs >= 32) *rc = gr_cli_usage_error(cmd, "--start: too many");
+        else t->starts[t->n_start_specs++] = v;
+    } else if (!strcmp(a, "--starts")) {
+        if (parse_count(v, 1, GR_OPT_MAX_STARTS, &t->n_starts))
+            *rc = gr_cli_usage_error(cmd, "--starts %s: expected an integer in [1, %d]", v, GR_OPT_MAX_STARTS);
+    } else if (!strcmp(a, "--method")) {
+        if (!strcmp(v, "nelder-mead")) t->method = GR_OPT_NELDER_MEAD;
+        else if (!strcmp(v, "cmaes")) t->method = GR_OPT_CMAES;
+        else *rc = gr_cli_usage_error(cmd, "--method %s: expected nelder-mead or cmaes", v);
+    } else if (!strcmp(a, "--screen")) {
+        if (parse_count(v, 0, GR_OPT_MAX_STARTS, &t->screen))
+            *rc = gr_cli_usage_error(cmd, "--screen %s: expected an integer in [0, %d]", v, GR_OPT_MAX_STARTS);
+    } else if (!strcmp(a, "--coarse")) {
+        if (parse_count(v, 0, 100000, &t->coarse))
+            *rc = gr_cli_usage_error(cmd, "--coarse %s: expected an integer in [0, 100000]", v);
+    } else if (!strcmp(a, "--seed")) {
+        char *end = NULL;
+        if (!v[0] || v[0] == '-' || (t->seed = strtoull(v, &end, 10), *end))
+            *rc = gr_cli_usage_error(cmd, "--seed %s: expected an integer >= 0", v);
+    } else if (parse_count(v, 4, 1000000, &t->max_evals)) {
+        *rc = gr_cli_usage_error(cmd, "--max-evals %s: expected an integer >= 4", v);
+    }
+    return 1;
+}
+
+/* The argument loop; returns the exit code (t->help: the help was printed). */
+static int parse_args(gr_args *args, tune_opts *t)
+{
+    const char *cmd = "tune";
     gr_error err = {GR_OK, ""};
+    gr_tune_cli_init(&t->c);
+    t->n_starts = 4;
+    t->coarse = t->screen = -1;
+    t->method = GR_OPT_NELDER_MEAD;
     /* tune's default is the weighted objective (sweep keeps rmse: a map of one error) */
-    c.metric = GR_TM_WEIGHTED;
-    if (gr_tune_weights_parse("--objective", GR_TUNE_DEFAULT_OBJECTIVE, c.weights, &err) != GR_OK)
+    t->c.metric = GR_TM_WEIGHTED;
+    if (gr_tune_weights_parse("--objective", GR_TUNE_DEFAULT_OBJECTIVE, t->c.weights, &err) != GR_OK)
         return gr_cli_report(cmd, &err);
-    for (; args->i < argc; args->i++) {
-        const char *a = argv[args->i], *v = NULL;
+    for (; args->i < args->argc; args->i++) {
+        const char *a = args->argv[args->i];
+        int rc = 0, taken = 0;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
+            t->help = 1;
             return 0;
         }
-        if (!strcmp(a, "--params") || !strcmp(a, "--bounds") || !strcmp(a, "--start") || !strcmp(a, "--starts") ||
-            !strcmp(a, "--max-evals") || !strcmp(a, "--coarse") || !strcmp(a, "--seed") || !strcmp(a, "--method") || !strcmp(a, "--screen")) {
-            if ((rc = gr_args_value(args, &v)) != 0) return rc;
-            if (!strcmp(a, "--params")) {
-                if (params_spec) return gr_cli_usage_error(cmd, "--params given twice");
-                params_spec = v; /* parsed after the loop, once --technique-dir is known */
-            } else if (!strcmp(a, "--bounds")) {
-                if (n_bounds >= 32) return gr_cli_usage_error(cmd, "--bounds: too many");
-                bounds[n_bounds++] = v;
-            } else if (!strcmp(a, "--start")) {
-                if (n_start_specs >= 32) return gr_cli_usage_error(cmd, "--start: too many");
-                starts[n_start_specs++] = v;
-            } else if (!strcmp(a, "--starts")) {
-                if (parse_count(v, 1, GR_OPT_MAX_STARTS, &n_starts))
-                    return gr_cli_usage_error(cmd, "--starts %s: expected an integer in [1, %d]", v, GR_OPT_MAX_STARTS);
-            } else if (!strcmp(a, "--method")) {
-                if (!strcmp(v, "nelder-mead")) method = GR_OPT_NELDER_MEAD;
-                else if (!strcmp(v, "cmaes")) method = GR_OPT_CMAES;
-                else return gr_cli_usage_error(cmd, "--method %s: expected nelder-mead or cmaes", v);
-            } else if (!strcmp(a, "--screen")) {
-                if (parse_count(v, 0, GR_OPT_MAX_STARTS, &screen))
-                    return gr_cli_usage_error(cmd, "--screen %s: expected an integer in [0, %d]", v, GR_OPT_MAX_STARTS);
-            } else if (!strcmp(a, "--coarse")) {
-                if (parse_count(v, 0, 100000, &coarse))
-                    return gr_cli_usage_error(cmd, "--coarse %s: expected an integer in [0, 100000]", v);
-            } else if (!strcmp(a, "--seed")) {
-                char *end = NULL;
-                if (!v[0] || v[0] == '-' || (seed = strtoull(v, &end, 10), *end))
-                    return gr_cli_usage_error(cmd, "--seed %s: expected an integer >= 0", v);
-            } else {
-                if (parse_count(v, 4, 1000000, &max_evals))
-                    return gr_cli_usage_error(cmd, "--max-evals %s: expected an integer >= 4", v);
-            }
+        if (take_own_option(args, t, &rc)) {
+            if (rc) return rc;
             continue;
         }
-        int taken = 0;
-        if ((rc = gr_args_take_common(args, &outopt, &c.so.gl_platform, &taken)) == 0 && !taken) {
-            int r = gr_tune_cli_option(&c, argc, argv, &args->i, &err);
+        if ((rc = gr_args_take_common(args, &t->outopt, &t->c.so.gl_platform, &taken)) == 0 && !taken) {
+            int r = gr_tune_cli_option(&t->c, args->argc, args->argv, &args->i, &err);
             if (r < 0) return gr_cli_report(cmd, &err);
             if (r == 0) rc = gr_args_take_scene(args);
         }
         if (rc) return rc;
     }
-    if ((rc = gr_args_need_scene(args)) != 0) return rc;
-    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    return 0;
+}
+
+/* --params (default: the technique's own list), --bounds and --start; an exit code. */
+static int parse_params(tune_opts *t, tune_run *r)
+{
+    const char *cmd = "tune";
+    gr_error err = {GR_OK, ""};
     char default_params[1024];
-    if (!params_spec) {
+    if (!t->params_spec) {
         /* the technique's own list (--technique, else the first registered) */
-        const gr_technique_class *cls = c.technique_name ? gr_technique_find(c.technique_name) : gr_technique_at(0);
-        if (!cls) return gr_cli_usage_error(cmd, "--technique %s: unknown technique", c.technique_name);
+        const char *tn = t->c.technique_name;
+        const gr_technique_class *cls = tn ? gr_technique_find(tn) : gr_technique_at(0);
+        if (!cls) return gr_cli_usage_error(cmd, "--technique %s: unknown technique", tn);
         if (gr_tune_default_params(cls, default_params, sizeof default_params))
             return gr_cli_usage_error(cmd, "no --params given and technique %s has no settings to tune by default",
                                       cls->name);
-        params_spec = default_params;
+        t->params_spec = default_params;
     }
-    if (gr_tune_param_parse_list("--params", params_spec, params, GR_TUNE_MAX_PARAMS, &n_params, &err) != GR_OK)
+    if (gr_tune_param_parse_list("--params", t->params_spec, r->params, GR_TUNE_MAX_PARAMS, &r->n_params, &err) != GR_OK)
         return gr_cli_report(cmd, &err);
-    for (int b = 0; b < n_bounds; b++)
-        if (gr_tune_param_parse_bounds("--bounds", bounds[b], params, n_params, &err) != GR_OK)
+    t->params_spec = NULL; /* default_params ends here */
+    for (int b = 0; b < t->n_bounds; b++)
+        if (gr_tune_param_parse_bounds("--bounds", t->bounds[b], r->params, r->n_params, &err) != GR_OK)
             return gr_cli_report(cmd, &err);
-    for (int k = 0; k < n_params; k++)
-        if (!(params[k].lo < params[k].hi))
-            return gr_cli_usage_error(cmd, "--params %s: no default bounds; give --bounds %s=LO:HI", params[k].key,
-                                      params[k].key);
-    double x0[GR_TUNE_MAX_PARAMS];
-    int have_x0[GR_TUNE_MAX_PARAMS] = {0};
-    for (int b = 0; b < n_start_specs; b++) {
+    for (int k = 0; k < r->n_params; k++)
+        if (!(r->params[k].lo < r->params[k].hi))
+            return gr_cli_usage_error(cmd, "--params %s: no default bounds; give --bounds %s=LO:HI", r->params[k].key,
+                                      r->params[k].key);
+    for (int b = 0; b < t->n_start_specs; b++) {
         char key[64];
         double v;
-        if (parse_kv(starts[b], key, sizeof key, &v))
-            return gr_cli_usage_error(cmd, "--start %s: expected TECHNIQUE.KEY=VALUE", starts[b]);
+        if (parse_kv(t->starts[b], key, sizeof key, &v))
+            return gr_cli_usage_error(cmd, "--start %s: expected TECHNIQUE.KEY=VALUE", t->starts[b]);
         int idx = -1;
-        for (int k = 0; k < n_params; k++)
-            if (!strcmp(params[k].key, key)) idx = k;
-        if (idx < 0) return gr_cli_usage_error(cmd, "--start %s: %s is not among the --params", starts[b], key);
-        x0[idx] = v;
-        have_x0[idx] = 1;
+        for (int k = 0; k < r->n_params; k++)
+            if (!strcmp(r->params[k].key, key)) idx = k;
+        if (idx < 0) return gr_cli_usage_error(cmd, "--start %s: %s is not among the --params", t->starts[b], key);
+        r->x0[idx] = v;
+        r->have_x0[idx] = 1;
     }
-    if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
-    gr_opt_options oo;
-    gr_tune_search_defaults(&oo, n_params, x0);
-    oo.method = method;
-    oo.n_starts = n_starts;
-    oo.screen = screen >= 0 ? screen : (4 * n_starts <= GR_OPT_MAX_STARTS ? 4 * n_starts : GR_OPT_MAX_STARTS);
-    oo.seed = seed;
-    if (max_evals > 0) {
-        oo.max_evals = oo.polish = max_evals;
-        if (oo.screen_evals > max_evals) oo.screen_evals = max_evals; /* a small budget stays small */
-    }
-    if (coarse >= 0) oo.coarse = coarse;
-    if (coarse == 0) oo.polish = 0, oo.screen = 0; /* the fixed-lattice search of before */
-    gr_tune_budget budget; /* the count before the ground truths (tune/budget.h) */
-    if (gr_tune_budget_init(&budget, "godrays tune", "evaluations", gr_tune_budget_search(&oo, n_params),
-                            gr_tune_budget_cases(&c.so), c.yes, &err) != GR_OK)
-        return gr_cli_report(cmd, &err);
-    c.so.scene_path = args->scene_path;
-    c.so.sets = gr_args_sets(args);
-    c.so.n_sets = args->n_sets;
-    c.so.progress_label = "godrays tune";
+    return 0;
+}
 
-    gr_tune_session s;
-    memset(&s, 0, sizeof s);
-    gr_tune_problem *p = calloc(1, sizeof *p);
-    char dirbuf[4096], path[4300];
-    char *json = NULL, *snippet = NULL;
-    gr_outfile trace = {.slot = -1}; /* a new trace replaces the old one only once complete */
-    cJSON *root = NULL;
-    const char *outdir = NULL;
-    if (!p) {
-        gr_fail(&err, GR_E_NOMEM, "out of memory");
-        goto fail;
-    }
-    /* The ground truths take minutes: a folder that cannot be made is refused before them. */
-    if ((rc = gr_args_output_dir(args, NULL, outopt, "tune", dirbuf, sizeof dirbuf, &outdir)) != 0) goto done;
-    if (gr_tune_cli_open(&c, params, n_params, &s, p, &err) != GR_OK) goto fail;
-    double lo[GR_TUNE_MAX_PARAMS], hi[GR_TUNE_MAX_PARAMS], xb[GR_TUNE_MAX_PARAMS];
-    for (int k = 0; k < n_params; k++) {
-        lo[k] = params[k].lo;
-        hi[k] = params[k].hi;
-        xb[k] = gr_tune_param_current(&params[k], p->base.bytes, p->base.bytes); /* the scene's own value */
-        if (!have_x0[k]) x0[k] = fmin(hi[k], fmax(lo[k], xb[k]));
-        gr_section_store t = p->base;
+/* The box, the scene's own point xb and the first start x0 (clamped into the box); a bound
+ * that the setting refuses is bad usage. */
+static gr_status set_box(gr_tune_problem *p, tune_run *r, gr_error *err)
+{
+    for (int k = 0; k < r->n_params; k++) {
+        r->lo[k] = r->params[k].lo;
+        r->hi[k] = r->params[k].hi;
+        r->xb[k] = gr_tune_param_current(&r->params[k], p->base.bytes, p->base.bytes); /* the scene's own value */
+        if (!r->have_x0[k]) r->x0[k] = fmin(r->hi[k], fmax(r->lo[k], r->xb[k]));
+        gr_section_store s = p->base;
         for (int e = 0; e < 2; e++)
-            if (gr_tune_param_apply(&params[k], p->base.bytes, e ? hi[k] : lo[k], t.bytes, &err) != GR_OK) {
-                err.status = GR_E_USAGE;
-                gr_error_prefix(&err, "bounds of %s", params[k].key);
-                goto fail;
+            if (gr_tune_param_apply(&r->params[k], p->base.bytes, e ? r->hi[k] : r->lo[k], s.bytes, err) != GR_OK) {
+                err->status = GR_E_USAGE;
+                return gr_error_prefix(err, "bounds of %s", r->params[k].key);
             }
     }
-    if (gr_report_make_dir(outdir, &err) != GR_OK) goto fail;
-    snprintf(path, sizeof path, "%s/trace.csv", outdir);
-    if (gr_outfile_open_stream(&trace, path, &err) != GR_OK) goto fail;
-    fprintf(trace.f, "eval");
-    for (int k = 0; k < n_params; k++) fprintf(trace.f, ",%s", params[k].key);
-    fprintf(trace.f, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
+    return GR_OK;
+}
 
-    double before[GR_TUNE_MAX_CASES], after[GR_TUNE_MAX_CASES], sc_b[GR_TUNE_MAX_CASES], sc_a[GR_TUNE_MAX_CASES];
-    double fb = 0, fa = 0;
-    if (gr_tune_evaluate(p, xb, &fb, before, sc_b, &err) != GR_OK) goto fail;
-    traced t = {.p = p, .trace = trace.f, .progress = !c.quiet && isatty(2), .budget = c.quiet ? NULL : &budget};
-    char plan[512];
-    gr_tune_budget_plan_line(&budget, plan, sizeof plan);
-    if (!c.quiet) fprintf(stderr, "%s (at most)\n", plan);
-    gr_tune_budget_start(&budget);
-    gr_opt_result res;
-    double t_opt = (double)p->renders, render_s0 = p->render_s, metrics_s0 = p->metrics_s;
-    if (gr_opt_minimize(n_params, lo, hi, traced_objective, &t, &oo, &res, &err) != GR_OK) goto fail;
-    if (t.progress) fprintf(stderr, "\rgodrays tune: %d evaluations\n", t.n);
-    if (gr_outfile_commit(&trace, 0, &err) != GR_OK) goto fail;
-    if (gr_tune_evaluate(p, res.x, &fa, after, sc_a, &err) != GR_OK) goto fail;
-    double scale_mean = 0.0;
-    for (int i = 0; i < s.n_cases; i++) scale_mean += sc_a[i] / s.n_cases;
-    snippet = gr_tune_snippet(p, res.x, p->fit ? scale_mean : 0.0);
-    if (!snippet) {
-        gr_fail(&err, GR_E_NOMEM, "out of memory");
-        goto fail;
+/* The search's options, and its count against the budget, before any ground truth. */
+static gr_status plan_search(const tune_opts *t, tune_run *r, gr_error *err)
+{
+    gr_opt_options *oo = &r->oo;
+    gr_tune_search_defaults(oo, r->n_params, r->x0);
+    oo->method = t->method;
+    oo->n_starts = t->n_starts;
+    oo->screen = t->screen >= 0 ? t->screen : (4 * t->n_starts <= GR_OPT_MAX_STARTS ? 4 * t->n_starts : GR_OPT_MAX_STARTS);
+    oo->seed = t->seed;
+    if (t->max_evals > 0) {
+        oo->max_evals = oo->polish = t->max_evals;
+        if (oo->screen_evals > t->max_evals) oo->screen_evals = t->max_evals; /* a small budget stays small */
     }
+    if (t->coarse >= 0) oo->coarse = t->coarse;
+    if (t->coarse == 0) oo->polish = 0, oo->screen = 0; /* the fixed-lattice search of before */
+    return gr_tune_budget_init(&r->budget, "godrays tune", "evaluations", gr_tune_budget_search(oo, r->n_params),
+                               gr_tune_budget_cases(&t->c.so), t->c.yes, err);
+}
+
+/* The search itself (trace.csv, every evaluation), the errors before and after, the snippet
+ * and the agreement of the starts. */
+static gr_status search(const tune_opts *t, const gr_tune_session *s, gr_tune_problem *p, tune_run *r,
+                        const char *outdir, gr_error *err)
+{
+    const int n = r->n_params;
+    char path[4300];
+    snprintf(path, sizeof path, "%s/trace.csv", outdir);
+    gr_outfile trace = {.slot = -1}; /* a new trace replaces the old one only once complete */
+    gr_status st = gr_outfile_open_stream(&trace, path, err);
+    if (st != GR_OK) return st;
+    fprintf(trace.f, "eval");
+    for (int k = 0; k < n; k++) fprintf(trace.f, ",%s", r->params[k].key);
+    fprintf(trace.f, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
+    st = gr_tune_evaluate(p, r->xb, &r->fb, r->before, r->sc_b, err);
+    traced tr = {.p = p, .trace = trace.f, .progress = !t->c.quiet && isatty(2), .budget = t->c.quiet ? NULL : &r->budget};
+    char plan[512];
+    gr_tune_budget_plan_line(&r->budget, plan, sizeof plan);
+    if (!t->c.quiet) fprintf(stderr, "%s (at most)\n", plan);
+    gr_tune_budget_start(&r->budget);
+    r->renders0 = p->renders;
+    r->render_s0 = p->render_s;
+    r->metrics_s0 = p->metrics_s;
+    if (st == GR_OK) st = gr_opt_minimize(n, r->lo, r->hi, traced_objective, &tr, &r->oo, &r->res, err);
+    if (st == GR_OK && tr.progress) fprintf(stderr, "\rgodrays tune: %d evaluations\n", tr.n);
+    if (st == GR_OK) st = gr_outfile_commit(&trace, 0, err);
+    gr_outfile_abort(&trace);
+    if (st == GR_OK) st = gr_tune_evaluate(p, r->res.x, &r->fa, r->after, r->sc_a, err);
+    if (st != GR_OK) return st;
+    double scale_mean = 0.0;
+    for (int i = 0; i < s->n_cases; i++) scale_mean += r->sc_a[i] / s->n_cases;
+    if (!(r->snippet = gr_tune_snippet(p, r->res.x, p->fit ? scale_mean : 0.0)))
+        return gr_fail(err, GR_E_NOMEM, "out of memory");
     /* Agreement of the starts: the spread (fraction of each box side) of the results of the
      * starts that reached the best value within 2 %. */
-    double spread[GR_TUNE_MAX_PARAMS] = {0};
-    int agreeing = 0;
-    for (int j = 0; j < res.n_starts; j++) {
-        if (!(res.starts[j].f <= res.f * 1.02 + 1e-300)) continue;
-        agreeing++;
-        for (int k = 0; k < n_params; k++)
-            spread[k] = fmax(spread[k], fabs(res.starts[j].x[k] - res.x[k]) / (hi[k] - lo[k]));
+    for (int j = 0; j < r->res.n_starts; j++) {
+        if (!(r->res.starts[j].f <= r->res.f * 1.02 + 1e-300)) continue;
+        r->agreeing++;
+        for (int k = 0; k < n; k++)
+            r->spread[k] = fmax(r->spread[k], fabs(r->res.starts[j].x[k] - r->res.x[k]) / (r->hi[k] - r->lo[k]));
     }
-    if (write_images(outdir, &s, p, xb, res.x, &err) != GR_OK) goto fail;
+    return GR_OK;
+}
 
-    root = cJSON_CreateObject();
-    if (root) {
-        cJSON_AddStringToObject(root, "scene", s.base->name);
-        cJSON_AddStringToObject(root, "technique", p->cls->name);
-        cJSON_AddStringToObject(root, "scene_file", s.base->source_path);
-        cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
-        cJSON_AddStringToObject(root, "channel", "Y");
-        cJSON_AddBoolToObject(root, "fit_scale", p->fit);
-        cJSON_AddBoolToObject(root, "normalized", p->normalize);
-        cJSON_AddNumberToObject(root, "width", s.base->camera.width);
-        cJSON_AddNumberToObject(root, "height", s.base->camera.height);
-        cJSON *pa = cJSON_AddArrayToObject(root, "params");
-        for (int k = 0; pa && k < n_params; k++) {
-            cJSON *o = cJSON_CreateObject();
-            if (!o) break;
-            cJSON_AddStringToObject(o, "key", params[k].key);
-            cJSON_AddStringToObject(o, "meaning", params[k].kind == GR_TK_RGB_SCALE ? "scale on the scene's RGB value"
-                                                                                    : "setting value");
-            cJSON_AddNumberToObject(o, "lo", lo[k]);
-            cJSON_AddNumberToObject(o, "hi", hi[k]);
-            cJSON_AddNumberToObject(o, "before", xb[k]);
-            cJSON_AddNumberToObject(o, "after", res.x[k]);
-            cJSON_AddNumberToObject(o, "start_spread_fraction", spread[k]);
-            cJSON_AddItemToArray(pa, o);
-        }
-        cJSON *st = cJSON_AddArrayToObject(root, "starts");
-        for (int j = 0; st && j < res.n_starts; j++) {
-            cJSON *o = cJSON_CreateObject();
-            if (!o) break;
-            cJSON_AddItemToObject(o, "x0", cJSON_CreateDoubleArray(res.starts[j].x0, n_params));
-            cJSON_AddItemToObject(o, "x", cJSON_CreateDoubleArray(res.starts[j].x, n_params));
-            cJSON_AddNumberToObject(o, "f", res.starts[j].f);
-            cJSON_AddNumberToObject(o, "evals", res.starts[j].evals);
-            cJSON_AddBoolToObject(o, "converged", res.starts[j].converged);
-            cJSON_AddNumberToObject(o, "f0", res.starts[j].f0);
-            cJSON_AddNumberToObject(o, "sample_rank", res.starts[j].coarse_rank);
-            cJSON_AddItemToArray(st, o);
-        }
-        cJSON *cs = cJSON_AddArrayToObject(root, "cases");
-        for (int i = 0; cs && i < s.n_cases; i++) {
-            cJSON *o = cJSON_CreateObject();
-            if (!o) break;
-            cJSON_AddStringToObject(o, "label", s.labels[i]);
-            cJSON_AddNumberToObject(o, "time_s", s.cases[i].water.time_s);
-            cJSON_AddNumberToObject(o, "yaw_deg", s.cases[i].camera.yaw_deg);
-            cJSON_AddNumberToObject(o, "pitch_deg", s.cases[i].camera.pitch_deg);
-            cJSON_AddNumberToObject(o, "before", before[i]);
-            cJSON_AddNumberToObject(o, "after", after[i]);
-            cJSON_AddNumberToObject(o, "scale_before", sc_b[i]);
-            cJSON_AddNumberToObject(o, "scale_after", sc_a[i]);
-            cJSON_AddBoolToObject(o, "ground_truth_cached", s.truth[i].cached);
-            cJSON_AddItemToArray(cs, o);
-        }
-        cJSON_AddNumberToObject(root, "before", fb);
-        cJSON_AddNumberToObject(root, "after", fa);
-        cJSON_AddNumberToObject(root, "evaluations", res.evals);
-        cJSON_AddNumberToObject(root, "sample_evaluations", res.coarse_evals);
-        cJSON_AddNumberToObject(root, "screened", res.n_screened);
-        cJSON_AddNumberToObject(root, "screen_evaluations", res.screen_evals);
-        cJSON_AddNumberToObject(root, "polish_evaluations", res.polish_evals);
-        cJSON_AddNumberToObject(root, "seed", (double)seed);
-        cJSON_AddNumberToObject(root, "starts_agreeing", agreeing);
-        cJSON *sn = cJSON_Parse(snippet);
-        if (sn) cJSON_AddItemToObject(root, "snippet", sn);
-        cJSON *tm = cJSON_AddObjectToObject(root, "timing");
-        if (tm) {
-            cJSON_AddNumberToObject(tm, "renders", (double)p->renders - t_opt);
-            cJSON_AddNumberToObject(tm, "render_readback_s", p->render_s - render_s0);
-            cJSON_AddNumberToObject(tm, "metrics_s", p->metrics_s - metrics_s0);
-            cJSON_AddNumberToObject(tm, "ground_truth_s", s.truth_seconds);
-            cJSON_AddStringToObject(tm, "gl_renderer", gr_gl_renderer(gr_technique_gl(p->renderer)));
-        }
-        json = cJSON_Print(root);
+/* tune.json's "params", "starts" and "cases" arrays. */
+static void json_arrays(cJSON *root, const gr_tune_session *s, const tune_run *r)
+{
+    const gr_opt_result *res = &r->res;
+    cJSON *pa = cJSON_AddArrayToObject(root, "params");
+    for (int k = 0; pa && k < r->n_params; k++) {
+        cJSON *o = cJSON_CreateObject();
+        if (!o) break;
+        cJSON_AddStringToObject(o, "key", r->params[k].key);
+        cJSON_AddStringToObject(o, "meaning", r->params[k].kind == GR_TK_RGB_SCALE ? "scale on the scene's RGB value"
+                                                                                  : "setting value");
+        cJSON_AddNumberToObject(o, "lo", r->lo[k]);
+        cJSON_AddNumberToObject(o, "hi", r->hi[k]);
+        cJSON_AddNumberToObject(o, "before", r->xb[k]);
+        cJSON_AddNumberToObject(o, "after", res->x[k]);
+        cJSON_AddNumberToObject(o, "start_spread_fraction", r->spread[k]);
+        cJSON_AddItemToArray(pa, o);
     }
-    if (!json) {
-        gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
-        goto fail;
+    cJSON *st = cJSON_AddArrayToObject(root, "starts");
+    for (int j = 0; st && j < res->n_starts; j++) {
+        cJSON *o = cJSON_CreateObject();
+        if (!o) break;
+        cJSON_AddItemToObject(o, "x0", cJSON_CreateDoubleArray(res->starts[j].x0, r->n_params));
+        cJSON_AddItemToObject(o, "x", cJSON_CreateDoubleArray(res->starts[j].x, r->n_params));
+        cJSON_AddNumberToObject(o, "f", res->starts[j].f);
+        cJSON_AddNumberToObject(o, "evals", res->starts[j].evals);
+        cJSON_AddBoolToObject(o, "converged", res->starts[j].converged);
+        cJSON_AddNumberToObject(o, "f0", res->starts[j].f0);
+        cJSON_AddNumberToObject(o, "sample_rank", res->starts[j].coarse_rank);
+        cJSON_AddItemToArray(st, o);
     }
+    cJSON *cs = cJSON_AddArrayToObject(root, "cases");
+    for (int i = 0; cs && i < s->n_cases; i++) {
+        cJSON *o = cJSON_CreateObject();
+        if (!o) break;
+        cJSON_AddStringToObject(o, "label", s->labels[i]);
+        cJSON_AddNumberToObject(o, "time_s", s->cases[i].water.time_s);
+        cJSON_AddNumberToObject(o, "yaw_deg", s->cases[i].camera.yaw_deg);
+        cJSON_AddNumberToObject(o, "pitch_deg", s->cases[i].camera.pitch_deg);
+        cJSON_AddNumberToObject(o, "before", r->before[i]);
+        cJSON_AddNumberToObject(o, "after", r->after[i]);
+        cJSON_AddNumberToObject(o, "scale_before", r->sc_b[i]);
+        cJSON_AddNumberToObject(o, "scale_after", r->sc_a[i]);
+        cJSON_AddBoolToObject(o, "ground_truth_cached", s->truth[i].cached);
+        cJSON_AddItemToArray(cs, o);
+    }
+}
+
+/* tune.json as text (NULL: out of memory). */
+static char *tune_json(const tune_opts *t, const gr_tune_session *s, const gr_tune_problem *p, const tune_run *r)
+{
+    const gr_opt_result *res = &r->res;
+    cJSON *root = cJSON_CreateObject();
+    if (!root) return NULL;
+    cJSON_AddStringToObject(root, "scene", s->base->name);
+    cJSON_AddStringToObject(root, "technique", p->cls->name);
+    cJSON_AddStringToObject(root, "scene_file", s->base->source_path);
+    cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
+    cJSON_AddStringToObject(root, "channel", "Y");
+    cJSON_AddBoolToObject(root, "fit_scale", p->fit);
+    cJSON_AddBoolToObject(root, "normalized", p->normalize);
+    cJSON_AddNumberToObject(root, "width", s->base->camera.width);
+    cJSON_AddNumberToObject(root, "height", s->base->camera.height);
+    json_arrays(root, s, r);
+    cJSON_AddNumberToObject(root, "before", r->fb);
+    cJSON_AddNumberToObject(root, "after", r->fa);
+    cJSON_AddNumberToObject(root, "evaluations", res->evals);
+    cJSON_AddNumberToObject(root, "sample_evaluations", res->coarse_evals);
+    cJSON_AddNumberToObject(root, "screened", res->n_screened);
+    cJSON_AddNumberToObject(root, "screen_evaluations", res->screen_evals);
+    cJSON_AddNumberToObject(root, "polish_evaluations", res->polish_evals);
+    cJSON_AddNumberToObject(root, "seed", (double)t->seed);
+    cJSON_AddNumberToObject(root, "starts_agreeing", r->agreeing);
+    cJSON *sn = cJSON_Parse(r->snippet);
+    if (sn) cJSON_AddItemToObject(root, "snippet", sn);
+    cJSON *tm = cJSON_AddObjectToObject(root, "timing");
+    if (tm) {
+        cJSON_AddNumberToObject(tm, "renders", (double)(p->renders - r->renders0));
+        cJSON_AddNumberToObject(tm, "render_readback_s", p->render_s - r->render_s0);
+        cJSON_AddNumberToObject(tm, "metrics_s", p->metrics_s - r->metrics_s0);
+        cJSON_AddNumberToObject(tm, "ground_truth_s", s->truth_seconds);
+        cJSON_AddStringToObject(tm, "gl_renderer", gr_gl_renderer(gr_technique_gl(p->renderer)));
+    }
+    char *json = cJSON_Print(root);
+    cJSON_Delete(root);
+    return json;
+}
+
+/* The summary printed and shown on the page. */
+static void tune_summary(const tune_opts *t, const gr_tune_session *s, const gr_tune_problem *p, const tune_run *r,
+                         const char *outdir, gr_strbuf *sum)
+{
+    const gr_opt_result *res = &r->res;
+    const int n = r->n_params;
+    gr_sb_printf(sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
+                 s->base->name, s->base->camera.width, s->base->camera.height, s->n_cases,
+                 gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+                 p->normalize ? ", / mean reference Y per case" : "");
+    gr_sb_printf(sum, "%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
+    for (int k = 0; k < n; k++)
+        gr_sb_printf(sum, "%-28s %12.5g %12.5g    [%g, %g]%s\n", r->params[k].key, r->xb[k], res->x[k], r->lo[k],
+                     r->hi[k], r->params[k].kind == GR_TK_RGB_SCALE ? " (scale)" : "");
+    if (res->coarse_evals > 0)
+        gr_sb_printf(sum, "first stage: %d sample points (seed %llu), best error %.6g\n", res->coarse_evals, t->seed,
+                     res->coarse_best);
+    if (res->n_screened > 0)
+        gr_sb_printf(sum, "screening: %d candidates, %d evaluations; the %d best continue\n", res->n_screened,
+                     res->screen_evals, res->n_starts);
+    gr_sb_printf(sum, "starts:\n");
+    for (int j = 0; j < res->n_starts; j++) {
+        const gr_opt_start *sj = &res->starts[j];
+        if (sj->coarse_rank >= 0) gr_sb_printf(sum, "  %d: sample #%d, from (", j, sj->coarse_rank + 1);
+        else gr_sb_printf(sum, "  %d: from (", j);
+        for (int k = 0; k < n; k++) gr_sb_printf(sum, "%s%.4g", k ? ", " : "", sj->x0[k]);
+        gr_sb_printf(sum, ") to (");
+        for (int k = 0; k < n; k++) gr_sb_printf(sum, "%s%.5g", k ? ", " : "", sj->x[k]);
+        gr_sb_printf(sum, ") error %.6g, %d evaluations%s\n", sj->f, sj->evals, sj->converged ? "" : " (budget reached)");
+    }
+    if (res->polish_evals > 0)
+        gr_sb_printf(sum, "polish (compass search from the best): %d evaluations, error lowered by %.3g\n",
+                     res->polish_evals, res->polish_gain);
+    gr_sb_printf(sum, "%d of %d starts reached the best value within 2 %%; their spread:", r->agreeing, res->n_starts);
+    for (int k = 0; k < n; k++) gr_sb_printf(sum, " %s %.2f %%", r->params[k].key, 100.0 * r->spread[k]);
+    gr_sb_printf(sum, " of the box\n");
+    gr_sb_printf(sum, "error per case (%s):        before        after\n", gr_tune_metric_name(p->metric));
+    for (int i = 0; i < s->n_cases; i++)
+        gr_sb_printf(sum, "  %-24s %12.6g %12.6g\n", s->labels[i], r->before[i], r->after[i]);
+    gr_sb_printf(sum, "  %-24s %12.6g %12.6g (%.1f %% lower)\n", "mean", r->fb, r->fa,
+                 r->fb > 0 ? 100.0 * (1.0 - r->fa / r->fb) : 0.0);
+    gr_sb_printf(sum, "%d evaluations (%lld renders) in %.1f s; ground truth %.1f s\n", res->evals, p->renders,
+                 p->render_s + p->metrics_s, s->truth_seconds);
+    gr_sb_printf(sum, "best settings for the scene:\n%s\n", r->snippet);
+    gr_sb_printf(sum, "written: %s/tune.json, trace.csv, compare.png, reference_NN.png, before_NN.png, after_NN.png\n",
+                 outdir);
+}
+
+/* DIR/index.html: the contact sheet, the other cases' after images, the summary. */
+static gr_status write_page(const gr_tune_session *s, const char *summary, const char *outdir, gr_error *err)
+{
+    gr_strbuf pg;
+    gr_sb_init(&pg);
+    gr_tune_page_begin(&pg, outdir, "godrays tune: %s", s->base->name);
+    gr_tune_page_figure(&pg, "compare.png", "ground truth | the technique before | after tuning (case 0)");
+    for (int i = 1; i < s->n_cases && i < 8; i++) {
+        char f[64], cap[128];
+        snprintf(f, sizeof f, "after_%02d.png", i);
+        snprintf(cap, sizeof cap, "after tuning, %s (reference_%02d.png, before_%02d.png beside)", s->labels[i], i, i);
+        gr_tune_page_figure(&pg, f, cap);
+    }
+    return gr_tune_page_write(&pg, summary, "tune.json,trace.csv", outdir, err);
+}
+
+/* The session (ground truths, renderer), the search and every output. */
+static gr_status tune_outputs(tune_opts *t, tune_run *r, gr_tune_session *s, gr_tune_problem *p, const char *outdir,
+                              gr_error *err)
+{
+    gr_status st = gr_tune_cli_open(&t->c, r->params, r->n_params, s, p, err);
+    if (st == GR_OK) st = set_box(p, r, err);
+    if (st == GR_OK) st = gr_report_make_dir(outdir, err);
+    if (st == GR_OK) st = search(t, s, p, r, outdir, err);
+    if (st == GR_OK) st = write_images(outdir, s, p, r->xb, r->res.x, err);
+    if (st != GR_OK) return st;
+    char *json = tune_json(t, s, p, r);
+    if (!json) return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
+    char path[4300];
     snprintf(path, sizeof path, "%s/tune.json", outdir);
-    if (gr_tune_write_text(path, json, &err) != GR_OK) goto fail;
-
+    st = gr_tune_write_text(path, json, err);
+    free(json);
+    if (st != GR_OK) return st;
     gr_strbuf sum;
     gr_sb_init(&sum);
-    gr_sb_printf(&sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
-           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
-           p->normalize ? ", / mean reference Y per case" : "");
-    gr_sb_printf(&sum, "%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
-    for (int k = 0; k < n_params; k++)
-        gr_sb_printf(&sum, "%-28s %12.5g %12.5g    [%g, %g]%s\n", params[k].key, xb[k], res.x[k], lo[k], hi[k],
-               params[k].kind == GR_TK_RGB_SCALE ? " (scale)" : "");
-    if (res.coarse_evals > 0)
-        gr_sb_printf(&sum, "first stage: %d sample points (seed %llu), best error %.6g\n", res.coarse_evals, seed,
-                     res.coarse_best);
-    if (res.n_screened > 0)
-        gr_sb_printf(&sum, "screening: %d candidates, %d evaluations; the %d best continue\n", res.n_screened,
-                     res.screen_evals, res.n_starts);
-    gr_sb_printf(&sum, "starts:\n");
-    for (int j = 0; j < res.n_starts; j++) {
-        if (res.starts[j].coarse_rank >= 0)
-            gr_sb_printf(&sum, "  %d: sample #%d, from (", j, res.starts[j].coarse_rank + 1);
-        else
-            gr_sb_printf(&sum, "  %d: from (", j);
-        for (int k = 0; k < n_params; k++) gr_sb_printf(&sum, "%s%.4g", k ? ", " : "", res.starts[j].x0[k]);
-        gr_sb_printf(&sum, ") to (");
-        for (int k = 0; k < n_params; k++) gr_sb_printf(&sum, "%s%.5g", k ? ", " : "", res.starts[j].x[k]);
-        gr_sb_printf(&sum, ") error %.6g, %d evaluations%s\n", res.starts[j].f, res.starts[j].evals,
-               res.starts[j].converged ? "" : " (budget reached)");
-    }
-    if (res.polish_evals > 0)
-        gr_sb_printf(&sum, "polish (compass search from the best): %d evaluations, error lowered by %.3g\n",
-                     res.polish_evals, res.polish_gain);
-    gr_sb_printf(&sum, "%d of %d starts reached the best value within 2 %%; their spread:", agreeing, res.n_starts);
-    for (int k = 0; k < n_params; k++) gr_sb_printf(&sum, " %s %.2f %%", params[k].key, 100.0 * spread[k]);
-    gr_sb_printf(&sum, " of the box\n");
-    gr_sb_printf(&sum, "error per case (%s):        before        after\n", gr_tune_metric_name(p->metric));
-    for (int i = 0; i < s.n_cases; i++) gr_sb_printf(&sum, "  %-24s %12.6g %12.6g\n", s.labels[i], before[i], after[i]);
-    gr_sb_printf(&sum, "  %-24s %12.6g %12.6g (%.1f %% lower)\n", "mean", fb, fa, fb > 0 ? 100.0 * (1.0 - fa / fb) : 0.0);
-    gr_sb_printf(&sum, "%d evaluations (%lld renders) in %.1f s; ground truth %.1f s\n", res.evals, p->renders,
-           p->render_s + p->metrics_s, s.truth_seconds);
-    gr_sb_printf(&sum, "best settings for the scene:\n%s\n", snippet);
-    gr_sb_printf(&sum, "written: %s/tune.json, trace.csv, compare.png, reference_NN.png, before_NN.png, after_NN.png\n", outdir);
+    tune_summary(t, s, p, r, outdir, &sum);
     fputs(gr_sb_str(&sum), stdout);
-    {
-        gr_strbuf pg;
-        gr_sb_init(&pg);
-        gr_tune_page_begin(&pg, outdir, "godrays tune: %s", s.base->name);
-        gr_tune_page_figure(&pg, "compare.png", "ground truth | the technique before | after tuning (case 0)");
-        for (int i = 1; i < s.n_cases && i < 8; i++) {
-            char f[64], cap[128];
-            snprintf(f, sizeof f, "after_%02d.png", i);
-            snprintf(cap, sizeof cap, "after tuning, %s (reference_%02d.png, before_%02d.png beside)", s.labels[i], i, i);
-            gr_tune_page_figure(&pg, f, cap);
-        }
-        gr_status pst = gr_tune_page_write(&pg, gr_sb_str(&sum), "tune.json,trace.csv", outdir, &err);
-        gr_sb_free(&sum);
-        if (pst != GR_OK) goto fail;
+    st = write_page(s, gr_sb_str(&sum), outdir, err);
+    gr_sb_free(&sum);
+    return st;
+}
+
+/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
+static int tune_with(gr_args *args)
+{
+    const char *cmd = "tune";
+    tune_opts *t = calloc(1, sizeof *t);
+    tune_run *r = calloc(1, sizeof *r);
+    gr_tune_problem *p = calloc(1, sizeof *p);
+    gr_tune_session s;
+    memset(&s, 0, sizeof s);
+    gr_error err = {GR_OK, ""};
+    int rc = 0;
+    if (!t || !r || !p) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        rc = gr_cli_report(cmd, &err);
     }
-    goto done;
-fail:
-    rc = gr_cli_report(cmd, &err);
-done:
-    gr_outfile_abort(&trace);
-    cJSON_Delete(root);
-    free(json);
-    free(snippet);
+    if (!rc) rc = parse_args(args, t);
+    if (!rc && !t->help && (rc = gr_args_need_scene(args)) == 0 && (rc = gr_args_add_technique_dirs(args)) == 0 &&
+        (rc = parse_params(t, r)) == 0) {
+        if (gr_tune_cli_finish(&t->c, &err) != GR_OK || plan_search(t, r, &err) != GR_OK) rc = gr_cli_report(cmd, &err);
+    }
+    char dirbuf[4096];
+    const char *outdir = NULL;
+    if (!rc && !t->help) {
+        t->c.so.scene_path = args->scene_path;
+        t->c.so.sets = gr_args_sets(args);
+        t->c.so.n_sets = args->n_sets;
+        t->c.so.progress_label = "godrays tune";
+        /* The ground truths take minutes: a folder that cannot be made is refused before them. */
+        rc = gr_args_output_dir(args, NULL, t->outopt, "tune", dirbuf, sizeof dirbuf, &outdir);
+        if (!rc && tune_outputs(t, r, &s, p, outdir, &err) != GR_OK) rc = gr_cli_report(cmd, &err);
+    }
+    if (r) free(r->snippet);
     if (p) gr_tune_problem_free(p);
     free(p);
+    free(r);
+    free(t);
     gr_tune_session_close(&s);
     return rc;
 }

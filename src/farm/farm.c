@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #include "common/outfile.h"
-#include "report/cache.h"
+#include "reference/cache.h"
 #include "tune/objective.h"
 #include "tune/session.h"
 

@@ -1,6 +1,6 @@
 /* `godrays farm`: ground truths of a sequence of frames and views, split into parts
  * (src/farm/parts.h) and run as a Slurm job array, merged into the ground-truth cache
- * (src/report/cache.h) where run, sweep, tune and pareto find them. docs/farm.md.
+ * (reference/cache.h) where run, sweep, tune and pareto find them. docs/farm.md.
  *
  * A farm folder holds everything the jobs need, readable and submittable by hand:
  *   scene.json   the scene as normalized JSON (overrides applied): what every job renders

@@ -9,7 +9,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "report/cache.h"
+#include "reference/cache.h"
+#include "reference/truth.h"
 
 #define PART_MAGIC "GODRAYS-PART 1\n"
 
@@ -321,7 +322,6 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
     gr_status st = GR_OK;
     int *owner = NULL;
     gr_ref_sums *sums = NULL;
-    gr_ref_renderer *r = NULL;
     for (int i = 0; i < n && st == GR_OK; i++) st = part_read(paths[i], &ps[i], err);
     /* one scene, one set of settings, one image size (the cache key covers the scene's
      * content and every reference setting but threads) */
@@ -466,13 +466,7 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
     if (st == GR_OK && strcmp(k, str(p0->h, "cache_key")) != 0)
         st = gr_fail(err, GR_E_INPUT, "%s: its scene reloads with cache key %s, not %s (another godrays version?)", p0->path,
                      k, str(p0->h, "cache_key"));
-    if (st == GR_OK) {
-        gr_ref_options o;
-        gr_ref_options_default(&o);
-        o.progress = 0;
-        st = gr_ref_create(scene, &o, &r, err);
-    }
-    if (st == GR_OK) st = gr_ref_assemble(r, sums, wall, out, err);
+    if (st == GR_OK) st = gr_truth_assemble(scene, sums, wall, out, err);
     if (st == GR_OK) {
         gr_meta_set_int(&out->meta, "godrays:merged_parts", n);
         gr_meta_set_string(&out->meta, "godrays:wall_s_note", "wall_s: the parts' wall times added up");
@@ -491,7 +485,6 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
         if (st != GR_OK) gr_ref_result_free(out);
         else if (key) snprintf(key, key_n, "%s", k);
     }
-    gr_ref_destroy(r);
     gr_ref_sums_destroy(sums);
     free(owner);
     for (int i = 0; i < n; i++) part_free(&ps[i]);

@@ -32,6 +32,8 @@ const char gr_tune_cli_help[] =
     "  --view YAW,PITCH     an extra camera view (degrees, the scene camera's position and fov;\n"
     "                       repeatable; the scene's own view is always included)\n"
     "  --no-cache           render the ground truths even if cached, and do not store them\n"
+    "  --max-memory SIZE    refuse (exit 2) a ground truth estimated to need more (e.g. 8G;\n"
+    "                       default $GODRAYS_MAX_MEMORY, else 80 % of the memory)\n"
     "  --gl-platform P      auto, surfaceless or device\n"
     "  --yes                start more than 20000 technique renders (without it such a run is\n"
     "                       refused before the ground truths; docs/tuning.md \"Budgets\")\n"

@@ -135,7 +135,11 @@ gr_status gr_tune_session_open(const gr_tune_session_options *o, gr_tune_session
         if (o->progress)
             fprintf(stderr, "%s: ground truth %d/%d (%s, %dx%d)...\n", label, i + 1, s->n_cases, s->labels[i],
                     s->cases[i].camera.width, s->cases[i].camera.height);
-        st = gr_truth_get(&s->cases[i], o->use_cache, o->progress, &s->refs[i], &s->truth[i], err);
+        gr_truth_options to;
+        gr_truth_options_default(&to);
+        to.use_cache = o->use_cache;
+        to.ref.progress = o->progress;
+        st = gr_truth_image(&s->cases[i], &to, &s->refs[i], &s->truth[i], err);
         if (st != GR_OK) return st;
         s->truth_seconds += s->truth[i].seconds;
         if (o->progress && s->truth[i].cached) fprintf(stderr, "%s:   from the cache %s\n", label, s->truth[i].path);

@@ -9,7 +9,7 @@
 #include "realtime/technique.h"
 #include "scene/scene.h"
 #include "tune/objective.h"
-#include "tune/truth.h"
+#include "reference/truth.h"
 
 #define GR_TUNE_MAX_TIMES 16
 #define GR_TUNE_MAX_VIEWS 8

@@ -25,25 +25,7 @@ bad() { echo "FAIL: $*"; fail=1; }
 ok() { echo "ok: $*"; }
 now() { date +%s.%N; }
 since() { awk -v a="$1" -v b="$(now)" 'BEGIN{printf "%.1f", b - a}'; }
-# wait_gone PID SECONDS: 0 when PID ended within SECONDS
-wait_gone() {
-    n=0
-    while kill -0 "$1" 2>/dev/null; do
-        n=$((n + 1))
-        [ "$n" -gt $(($2 * 20)) ] && return 1
-        sleep 0.05
-    done
-    return 0
-}
-# wait_for TEXT FILE SECONDS
-wait_for() {
-    n=0
-    until grep -q "$1" "$2" 2>/dev/null; do
-        n=$((n + 1))
-        [ "$n" -gt $(($3 * 20)) ] && return 1
-        sleep 0.05
-    done
-}
+. "$(dirname "$0")/wait.sh" # wait_gone, wait_for
 # wait_cpu PID SECONDS: until PID has used SECONDS of CPU time (then it is past its start-up
 # and inside the render or the beam build, whatever the machine's load); 1 if it ended first
 tck=$(getconf CLK_TCK)

@@ -1,6 +1,6 @@
 /* Acceptance (issue 12): the `flux` variant (docs/realtime-shafts.md "flux": each depth slab's
  * irradiance from the area ratio of the shaft's top face and its cross-section, the sun disc
- * as regularizer) against the Embree ground truth (tune/truth.h, cached):
+ * as regularizer) against the Embree ground truth (reference/truth.h, cached):
  *  - flat water (data/scenes/flat.json, 320 x 180): the area ratio is the constant
  *    cos(theta_i) / cos(theta_t), so flux must be exact like path: relative RMSE <= 5 %, no fit;
  *  - default scene: at the settings `godrays tune` found for each variant (docs: the table and
@@ -25,7 +25,7 @@
 #include "realtime/shafts.h"
 #include "scene/scene.h"
 #include "scene_test.h"
-#include "tune/truth.h"
+#include "reference/truth.h"
 
 static int reduced(void)
 {
@@ -120,7 +120,7 @@ static double measure(gr_shafts *r, const char *scene, int w, int h, const char 
     gr_image *truth = NULL, *img = gr_image_create(w, h, 3, NULL);
     gr_truth_info info;
     double e = -1.0;
-    CHECK_OK(gr_truth_get(s, 1, 0, &truth, &info, &err), err);
+    CHECK_OK(gr_truth_image(s, NULL, &truth, &info, &err), err);
     CHECK_OK(gr_shafts_render(r, s, NULL, img, NULL, &err), err);
     CHECK_OK(gr_image_check_finite(img, "flux layer", &err), err);
     if (truth) e = err_of(truth, img, fit);

@@ -2,7 +2,7 @@
  * default scene.
  *  - Structure: the band-pass energy (streak contrast, compare/structure.h: RMS of the local
  *    band-pass contrast of the de-glowed luminance) of the default render is within a factor
- *    2 of the ground truth's. The oracle is the Embree ground truth (tune/truth.h: from the
+ *    2 of the ground truth's. The oracle is the Embree ground truth (reference/truth.h: from the
  *    reference cache, rendered and stored when absent).
  *  - Shadows: removing both occluders changes the layer by more than 2 % of its mean
  *    (mean |dY| / mean Y, Rec. 709 luminance), i.e. the 8-bit target does not saturate.
@@ -18,7 +18,7 @@
 #include "realtime/shafts.h"
 #include "report/profile.h"
 #include "scene/scene.h"
-#include "tune/truth.h"
+#include "reference/truth.h"
 
 static int reduced(void)
 {
@@ -71,7 +71,7 @@ int main(void)
     /* structure: band-pass energy within a factor 2 of the truth's */
     gr_image *truth = NULL;
     gr_truth_info info;
-    CHECK_OK(gr_truth_get(s, 1, 0, &truth, &info, &err), err);
+    CHECK_OK(gr_truth_image(s, NULL, &truth, &info, &err), err);
     if (truth) {
         printf("truth %d x %d %s (%.1f s)\n", w, h, info.cached ? "from the cache" : "rendered", info.seconds);
         float *ang = malloc((size_t)w * h * sizeof(float));

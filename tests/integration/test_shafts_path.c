@@ -2,7 +2,7 @@
  * traversed, weighted by the attenuation, docs/realtime-shafts.md "path") is exact in the
  * flat-water limit: on data/scenes/flat.json, with shafts that tile the grid (width 1) and a
  * grid that covers the view (K 4, length 40 m, past the seabed), its relative RMSE against
- * the Embree ground truth (closed form on flat water; tune/truth.h, cached) is at most 5 %,
+ * the Embree ground truth (closed form on flat water; reference/truth.h, cached) is at most 5 %,
  * with no scale fit. Also: the seed variant is far from it on the same view (the oracle is
  * the truth, not this code), and `path` writes no NaN or Inf. ~10 s of Embree at 320 x 180 (at 160 x 90 the truth's Monte Carlo noise at the sun's peak alone is ~4 %). */
 #include "check.h"
@@ -14,7 +14,7 @@
 #include "realtime/shafts.h"
 #include "scene/scene.h"
 #include "scene_test.h"
-#include "tune/truth.h"
+#include "reference/truth.h"
 
 static gr_scene *load(const char *const *extra, int n_extra)
 {
@@ -49,7 +49,7 @@ int main(void)
     gr_scene *sp = load(path_sets, 4), *ss = load(seed_sets, 3);
     gr_image *truth = NULL;
     gr_truth_info info;
-    CHECK_OK(gr_truth_get(sp, 1, 0, &truth, &info, &err), err);
+    CHECK_OK(gr_truth_image(sp, NULL, &truth, &info, &err), err);
     if (truth) {
         gr_image *img = gr_image_create(320, 180, 3, NULL), *seed = gr_image_create(320, 180, 3, NULL);
         CHECK_OK(gr_shafts_render(r, sp, NULL, img, NULL, &err), err);

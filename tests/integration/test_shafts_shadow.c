@@ -20,7 +20,7 @@
 
 #include "realtime/shafts.h"
 #include "scene/scene.h"
-#include "tune/truth.h"
+#include "reference/truth.h"
 
 static int W = 160, H = 90;
 
@@ -88,8 +88,8 @@ int main(void)
     gr_scene *sa = load("shafts.variant=seed", 0, 1), *sb = load("shafts.variant=seed", 0, 0);
     gr_image *ta = NULL, *tb = NULL;
     gr_truth_info info;
-    CHECK_OK(gr_truth_get(sa, 1, 0, &ta, &info, &err), err);
-    CHECK_OK(gr_truth_get(sb, 1, 0, &tb, &info, &err), err);
+    CHECK_OK(gr_truth_image(sa, NULL, &ta, &info, &err), err);
+    CHECK_OK(gr_truth_image(sb, NULL, &tb, &info, &err), err);
     if (!ta || !tb) return 1;
     lum(ta, a);
     lum(tb, b);

@@ -31,7 +31,7 @@
 #include "realtime/shafts.h"
 #include "scene_test.h"
 #include "scene/scene.h"
-#include "tune/truth.h"
+#include "reference/truth.h"
 
 static int reduced(void)
 {
@@ -86,8 +86,8 @@ static void truth_pair(const double right[3], double *ra, double *rb)
     gr_scene *a = load(0, 0, 0), *b = load(0, 0.3 * right[0], 0.3 * right[2]);
     gr_image *ta = NULL, *tb = NULL;
     gr_truth_info info;
-    CHECK_OK(gr_truth_get(a, 1, 0, &ta, &info, &err), err);
-    CHECK_OK(gr_truth_get(b, 1, 0, &tb, &info, &err), err);
+    CHECK_OK(gr_truth_image(a, NULL, &ta, &info, &err), err);
+    CHECK_OK(gr_truth_image(b, NULL, &tb, &info, &err), err);
     if (!ta || !tb) exit(1);
     blur_lum(ta, 0, ra);
     blur_lum(tb, 0, rb);

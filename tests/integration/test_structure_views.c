@@ -22,7 +22,7 @@
 #include "realtime/shafts.h"
 #include "report/profile.h"
 #include "scene/scene.h"
-#include "tune/truth.h"
+#include "reference/truth.h"
 
 static int reduced(void)
 {
@@ -63,7 +63,7 @@ int main(void)
         gr_scene *s = load(w, h, side, 0), *sb = load(w, h, side, 1);
         gr_image *truth = NULL;
         gr_truth_info info;
-        CHECK_OK(gr_truth_get(s, 1, 0, &truth, &info, &err), err);
+        CHECK_OK(gr_truth_image(s, NULL, &truth, &info, &err), err);
         if (!truth) break;
         printf("%s view %d x %d: truth %s (%.1f s)\n", side ? "side" : "default", w, h,
                info.cached ? "from the cache" : "rendered", info.seconds);

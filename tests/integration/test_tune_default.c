@@ -23,7 +23,7 @@
 #include "compare/structure.h"
 #include "report/profile.h"
 #include "tune/cliopts.h"
-#include "tune/truth.h"
+#include "reference/truth.h"
 #include "tune_test.h"
 
 /* docs/metrics.md: S = ((1 - corr) / 2 + min(|ln ratio|, 3) / 3 + min(LSD, 3) / 3) / 3 */
@@ -42,7 +42,7 @@ int main(void)
     gr_scene *s = tune_test_default_scene(w, h, NULL, 0);
     gr_image *truth = NULL;
     gr_truth_info info;
-    CHECK_OK(gr_truth_get(s, 1, 0, &truth, &info, &err), err);
+    CHECK_OK(gr_truth_image(s, NULL, &truth, &info, &err), err);
     if (!truth) CHECK_DONE();
     printf("default scene %d x %d: truth %s (%.1f s)\n", w, h, info.cached ? "from the cache" : "rendered",
            info.seconds);

@@ -10,7 +10,7 @@
 
 #include "check.h"
 #include "tune/optimize.h"
-#include "tune/truth.h"
+#include "reference/truth.h"
 #include "tune_test.h"
 
 int main(void)
@@ -20,10 +20,13 @@ int main(void)
     gr_scene *scene = tune_test_default_scene(160, 90, q, 4);
     gr_error err;
     gr_image *truth = NULL;
-    double secs = 0;
-    CHECK_OK(gr_truth_render(scene, 0, &truth, &secs, &err), err);
+    gr_truth_options to;
+    gr_truth_options_default(&to);
+    to.use_cache = 0;
+    gr_truth_info info;
+    CHECK_OK(gr_truth_image(scene, &to, &truth, &info, &err), err);
     if (!truth) return 1;
-    printf("ground truth 160x90 in %.1f s\n", secs);
+    printf("ground truth 160x90 in %.1f s\n", info.seconds);
     gr_technique *r = tune_test_renderer();
     gr_tune_problem *p = calloc(1, sizeof *p);
     if (!p) return 1;

@@ -1,5 +1,5 @@
 /* The ground-truth cache (see cache.h for the key and the checks). */
-#include "report/cache.h"
+#include "reference/cache.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -16,6 +16,7 @@
 #include "image/exr.h"
 #include "scene/params.h"
 #include "scene/settings.h"
+#include "truth_digest.h" /* GR_TRUTH_DIGEST, generated at build time (scripts/truth_digest.cmake) */
 
 #ifndef GR_VERSION
 #define GR_VERSION "unknown"
@@ -37,7 +38,14 @@ static unsigned long long hash_str(unsigned long long h, const char *s)
     return gr_fnv1a64(h, s, strlen(s) + 1); /* the terminator separates fields */
 }
 
+const char *gr_cache_digest(void) { return GR_TRUTH_DIGEST; }
+
 gr_status gr_cache_key(const gr_scene *s, char *key, gr_error *err)
+{
+    return gr_cache_key_digest(s, GR_TRUTH_DIGEST, key, err);
+}
+
+gr_status gr_cache_key_digest(const gr_scene *s, const char *digest, char *key, gr_error *err)
 {
     char *json = gr_scene_to_json(s);
     if (!json) return gr_fail(err, GR_E_NOMEM, "cache key: out of memory printing the scene");
@@ -56,7 +64,8 @@ gr_status gr_cache_key(const gr_scene *s, char *key, gr_error *err)
     const unsigned long long hs = hash_str(GR_FNV_BASIS, content);
     cJSON_free(content);
 
-    unsigned long long hr = hash_str(GR_FNV_BASIS, GR_CACHE_FORMAT);
+    /* the code that renders it: any edit of the ground truth's sources is another key */
+    unsigned long long hr = hash_str(GR_FNV_BASIS, digest);
     hr = hash_str(hr, GR_VERSION);
     const gr_param_table *t = &gr_reference_param_table;
     for (size_t i = 0; i < t->count; i++) {

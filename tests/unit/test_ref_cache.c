@@ -1,7 +1,7 @@
-/* report/cache: the ground-truth cache of `godrays run`.
+/* reference/cache: the ground-truth cache.
  *  - the key changes with everything the ground truth renders (waves, sun, medium, camera,
  *    occluders, reference quality settings) and with nothing it does not (scene name, shaft
- *    settings, reference.threads);
+ *    settings, reference.threads), and with the build digest of the ground truth's sources;
  *  - FNV-1a 64 against the published test vectors (offset basis for "", "a" -> af63dc4c8601ec8c);
  *  - the directory rule ($GODRAYS_CACHE, then $XDG_CACHE_HOME or $HOME, then ./.godrays-cache);
  *  - store + load gives back the same bytes; every failed check of a read (key attribute,
@@ -16,7 +16,7 @@
 #include "check.h"
 #include "realtime/technique.h"
 #include "image/exr.h"
-#include "report/cache.h"
+#include "reference/cache.h"
 #include "scene/scene.h"
 
 static const char *BASE =
@@ -84,6 +84,22 @@ int main(void)
         CHECK_MSG(scene_part ? (strncmp(k0, k1, 16) != 0 && !strcmp(k0 + 17, k1 + 17))
                              : (!strncmp(k0, k1, 16) && strcmp(k0 + 17, k1 + 17) != 0),
                   "%s: %s vs %s", differ[i][0], k0, k1);
+    }
+
+    /* the build digest of the ground truth's sources is in the settings part: another digest
+     * (another integrator) is another key, this build's is gr_cache_key's */
+    {
+        gr_scene *s = calloc(1, sizeof *s);
+        gr_error err = {GR_OK, ""};
+        CHECK_OK(gr_scene_load_string(BASE, "t", NULL, 0, s, &err), err);
+        const char *d = gr_cache_digest();
+        CHECK_MSG(strlen(d) == 16 && strspn(d, "0123456789abcdef") == 16, "digest '%s': 16 hex digits", d);
+        char kd[GR_CACHE_KEY_LEN + 1], ke[GR_CACHE_KEY_LEN + 1];
+        CHECK_OK(gr_cache_key_digest(s, d, kd, &err), err);
+        CHECK(!strcmp(kd, k0));
+        CHECK_OK(gr_cache_key_digest(s, "0000000000000000", ke, &err), err);
+        CHECK_MSG(!strncmp(ke, k0, 16) && strcmp(ke + 17, k0 + 17) != 0, "another digest: %s vs %s", ke, k0);
+        free(s);
     }
 
     /* directory rule */

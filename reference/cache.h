@@ -1,6 +1,7 @@
-/* The ground-truth cache of `godrays run`: a reference render is slow (about 2 minutes on the
- * default scene on 2 cores) and depends only on the scene's content and the reference
- * settings, so it is stored as an EXR and reused while neither changes. docs/report.md.
+/* The ground-truth cache: a reference render is slow (about 2 minutes on the default scene on
+ * 2 cores) and depends only on the scene's content, the reference settings and the code that
+ * renders it, so it is stored as an EXR and reused while none of them changes. Reads and
+ * writes go through the ground-truth provider (reference/truth.h); docs/reference.md.
  *
  * Key = "SCENEHASH-SETTINGSHASH" (16 hex digits each, FNV-1a 64):
  *  - SCENEHASH: the normalized scene JSON (every default filled in, stable key order) without
@@ -8,8 +9,10 @@
  *    (scene/sections.h): what the ground truth renders. A change of the real-time settings or
  *    of the scene's label does not invalidate the reference.
  *  - SETTINGSHASH: every reference.* setting except `threads` (the integrator gives the same
- *    bytes for any thread count), plus the cache format and the godrays version (a new build of
- *    the integrator may render differently).
+ *    bytes for any thread count), plus the godrays version and the build digest of the ground
+ *    truth's sources (gr_cache_digest: scripts/truth_digest.cmake hashes reference/, src/core,
+ *    src/scene and src/image/image.* at build time), so an edit of the integrator or of the
+ *    settings table invalidates every older entry with no constant to bump by hand.
  * The file is CACHEDIR/reference-KEY.exr and carries the key in its "godrays:cache_key"
  * attribute; a read checks that key, the size, the channels, that the render was complete and
  * the checksum of the pixels (GR_CACHE_META_CHECKSUM), and treats any mismatch as a miss (with
@@ -24,14 +27,6 @@
 
 #define GR_CACHE_KEY_LEN 33          /* 16 + 1 + 16 hex characters */
 #define GR_CACHE_META_KEY "godrays:cache_key"
-/* Bumped when what an entry holds changes, so older entries are rendered again: 2 = bias.R/G/B
- * channels, godrays:stderr_dof, the three-level bias probe, a checksum of the pixels; 3 = the
- * lookups' libm-free disc areas (pixels differ in the last bits); 4 = steps allotted along the
- * ray, the lookup grid, the disc area by one boundary walk (docs/reference.md 2.2, 2.4, 2.5);
- * 5 = each triangle's cross-section coefficients and the phase's constants once per g (pixels
- * differ in the last bits); 6 = the camera cone (docs/reference.md 2.2): only the rays within
- * refine_angle of +-T0 look up the refined tessellation. */
-#define GR_CACHE_FORMAT "godrays-reference-cache-6"
 /* FNV-1a 64 of the pixel bytes (16 hex digits), checked on every read (docs/reliability.md) */
 #define GR_CACHE_META_CHECKSUM "godrays:pixel_fnv1a64"
 
@@ -39,8 +34,14 @@
 #define GR_FNV_BASIS 14695981039346656037ull
 unsigned long long gr_fnv1a64(unsigned long long h, const void *data, size_t n);
 
-/* The cache key of s's ground truth into key[GR_CACHE_KEY_LEN + 1]. GR_E_NOMEM. */
+/* The build digest of the ground truth's sources (16 hex digits; scripts/truth_digest.cmake). */
+const char *gr_cache_digest(void);
+
+/* The cache key of s's ground truth into key[GR_CACHE_KEY_LEN + 1], with this build's digest.
+ * GR_E_NOMEM. */
 gr_status gr_cache_key(const gr_scene *s, char *key, gr_error *err);
+/* The same with another build digest (what another build's key would be; tests). */
+gr_status gr_cache_key_digest(const gr_scene *s, const char *digest, char *key, gr_error *err);
 
 /* Chooses and creates the cache directory: $GODRAYS_CACHE if set and non-empty, else
  * $XDG_CACHE_HOME/godrays or $HOME/.cache/godrays, else ./.godrays-cache (relative to the
