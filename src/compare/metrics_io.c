@@ -279,8 +279,9 @@ void gr_metrics_print_summary(FILE *f, const gr_metrics *m, unsigned costs)
         }
         fprintf(f, "  %-34s %11s", lab, v[0]);
         if (fit) fprintf(f, " %11s", v[1]);
-        fprintf(f, "   %s is better%s\n", gr_metric_better_name(d->better),
-                d->unit == GR_METRIC_RADIANCE ? "; image units" : "");
+        if (d->better == GR_METRIC_NEARER) fprintf(f, "   nearer %g is better", d->best);
+        else fprintf(f, "   %s is better", gr_metric_better_name(d->better));
+        fprintf(f, "%s\n", d->unit == GR_METRIC_RADIANCE ? "; image units" : "");
     }
 }
 
