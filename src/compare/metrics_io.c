@@ -66,7 +66,7 @@ static cJSON *set_json(const gr_metrics *m, const gr_metrics_set *s)
              add_num(sj, "contrast_log_error", s->structure_contrast_err) &&
              add_num(sj, "log_spectral_distance", s->structure_lsd);
     }
-    cJSON *reg = ok ? cJSON_AddObjectToObject(o, "metrics") : NULL;
+    cJSON *reg = ok ? cJSON_AddObjectToObject(o, "registry") : NULL;
     ok = ok && reg;
     for (int i = 0; ok && i < gr_metric_count(); i++) ok = add_num(reg, gr_metric_at(i)->key, gr_metric_value(s, i));
     for (int c = 0; ok && c < GR_MCH_COUNT; c++) {
@@ -81,7 +81,7 @@ static cJSON *set_json(const gr_metrics *m, const gr_metrics_set *s)
     return o;
 }
 
-/* The registry's descriptors: what each key of a set's "metrics" object means. */
+/* The registry's descriptors: what each key of a set's "registry" object means. */
 static cJSON *registry_json(void)
 {
     cJSON *o = cJSON_CreateObject();
@@ -134,7 +134,7 @@ static cJSON *conventions_json(const gr_metrics *m)
          add_num(o, "ssim_K2", GR_SSIM_K2) && add_num(o, "ssim_L", m->ssim_L) && add_num(o, "ssim_C1", m->ssim_c1) &&
          add_num(o, "ssim_C2", m->ssim_c2);
     cJSON *reg = ok ? registry_json() : NULL;
-    if (reg && !cJSON_AddItemToObject(o, "metrics", reg)) cJSON_Delete(reg), reg = NULL;
+    if (reg && !cJSON_AddItemToObject(o, "registry", reg)) cJSON_Delete(reg), reg = NULL;
     ok = ok && reg;
     if (!ok) {
         cJSON_Delete(o);

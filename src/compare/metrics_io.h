@@ -13,8 +13,8 @@
 
 /* A new JSON object with every field of m and the conventions used (luminance weights, rel
  * MSE epsilon rule, PSNR peaks, SSIM constants, blur sigmas, stderr z and bound). Each set
- * ("raw", "fit") carries "metrics": every registered metric by key (compare/registry.h),
- * described under conventions.metrics. +inf PSNR and metrics not computed are written as
+ * ("metrics": as given, "fitted") carries "registry": every registered metric by key
+ * (compare/registry.h), each described under conventions.registry. +inf PSNR and metrics not computed are written as
  * null (JSON has no infinity). NULL if out of memory. */
 cJSON *gr_metrics_to_json(const gr_metrics *m);
 
