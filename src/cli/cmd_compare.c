@@ -413,8 +413,10 @@ static gr_status need_scored(const compare_opts *o, compare_state *s, gr_error *
 }
 
 /* FLIP on a * TEST (a = the fitted scale when asked for, else 1), pooled over the pixels the
- * other metrics score; the mode follows REF's format unless given. The result goes into the
- * metric set it belongs to, so that the registry's "flip" reads it like any other metric. */
+ * other metrics score; the mode follows REF's format unless given. With its own options and
+ * map it is reported in its own block ("flip"), not in the metric sets: those stay what
+ * `godrays run` writes for the same pair (tests/cli/test_run.sh), where the registry's "flip"
+ * is not computed. */
 static gr_status compute_flip(compare_opts *o, compare_state *s, gr_error *err)
 {
     const gr_image *ref = s->ref, *test = s->test;
@@ -452,14 +454,7 @@ static gr_status compute_flip(compare_opts *o, compare_state *s, gr_error *err)
         st = gr_flip_compute(ref, ft, &o->fopt, s->flipmap, &s->fres, err);
     }
     s->t_flip = now_s() - t1;
-    if (st != GR_OK || !o->do_flip) return st;
-    gr_metrics_set *sets[2] = {&s->m.raw, &s->m.fit};
-    for (int k = 0; k < 2; k++) {
-        if (sets[k]->scale != s->scale || (k == 1 && !s->m.have_fit)) continue;
-        sets[k]->have_flip = 1;
-        sets[k]->flip = s->fres;
-    }
-    return GR_OK;
+    return st;
 }
 
 /* Every number computed: the metrics (with the registry's), FLIP and the structure details. */

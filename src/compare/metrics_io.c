@@ -264,7 +264,8 @@ void gr_metrics_print_summary(FILE *f, const gr_metrics *m, unsigned costs)
     int shown = 0;
     for (int i = 0; i < gr_metric_count(); i++) {
         const gr_metric_desc *d = gr_metric_at(i);
-        if (!(costs & (1u << d->cost))) continue;
+        const double x[2] = {gr_metric_value(&m->raw, i), fit ? gr_metric_value(&m->fit, i) : NAN};
+        if (!(costs & (1u << d->cost)) || (isnan(x[0]) && isnan(x[1]))) continue;
         if (!shown++) {
             fprintf(f, "metrics (docs/metrics.md)           %11s", "as given");
             if (fit) fprintf(f, " %11s", "x scale");
@@ -272,7 +273,6 @@ void gr_metrics_print_summary(FILE *f, const gr_metrics *m, unsigned costs)
         }
         char lab[64], v[2][32];
         snprintf(lab, sizeof lab, "%s (%s)", d->label, d->key);
-        const double x[2] = {gr_metric_value(&m->raw, i), fit ? gr_metric_value(&m->fit, i) : NAN};
         for (int k = 0; k < 2; k++) {
             if (isnan(x[k])) snprintf(v[k], sizeof v[k], "n/a");
             else snprintf(v[k], sizeof v[k], "%.6g", x[k]);

@@ -23,8 +23,8 @@ cJSON *gr_metrics_to_json(const gr_metrics *m);
 void gr_metrics_print_table(FILE *f, const gr_metrics *m);
 
 /* The registry's metrics (compare/registry.h) whose cost class is in costs (bit 1 << cost;
- * ~0u: all): one line each with the value as given and after the scale fit ("n/a": not
- * computed), under a header line. Nothing when no metric is selected. */
+ * ~0u: all) and that were computed: one line each with the value as given and after the scale
+ * fit ("n/a": not computed for that set), under a header line. Nothing when none is left. */
 void gr_metrics_print_summary(FILE *f, const gr_metrics *m, unsigned costs);
 
 /* FLIP (compare/flip.h) as JSON: mode, ppd, tone mapper and exposures (HDR), the scale the
