@@ -24,6 +24,7 @@
 #include "compare/metrics.h"
 #include "image/exr.h"
 #include "compare/metrics_io.h"
+#include "compare/registry.h"
 #include "image/oiio.h"
 #include "report/report.h"
 
@@ -39,7 +40,8 @@ static void usage(FILE *f)
             "R, G, B by name, else the first three, a 1-channel image is gray. If REF has\n"
             "stderr.R/G/B channels, differences within 2 standard errors are reported as not\n"
             "significant and pixels whose reference is too noisy are not scored (counted).\n"
-            "Formulas and conventions: docs/metrics.md.\n"
+            "Then one line per metric of the metric registry (rmse, ssim, flip, structure, ...;\n"
+            "in the JSON: \"registry\" in each set). Formulas and conventions: docs/metrics.md.\n"
             "\n"
             "options:\n"
             "  -o, --output DIR     write DIR/metrics.json (every number), DIR/diff.png (|dY|,\n"
@@ -138,414 +140,477 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-int cmd_compare(int argc, char **argv)
+/* What the command line asked for. */
+typedef struct compare_opts {
+    const char *cmd;
+    const char *paths[2], *outdir, *mask_path, *scene_path;
+    const char *sets[32];
+    int n_sets, npos, json, linearize, do_basic, do_flip;
+    int do_struct;                /* -1: when a vanishing point is given */
+    int have_vp;
+    double vp[2];
+    int flip_mode;                /* -1: from REF's file extension */
+    gr_metrics_options opt;
+    gr_flip_options fopt;
+} compare_opts;
+
+/* What the comparison read, computed and owns (freed by state_free). */
+typedef struct compare_state {
+    gr_image *ref, *test, *mask, *diff[3], *scaled;
+    unsigned char *scored;
+    float *flipmap, *angles;
+    gr_structure_options so;
+    gr_metrics m;
+    double scale;                 /* the test's factor for FLIP and the difference images */
+    gr_flip_result fres;
+    gr_structure_compare sres;
+    double t_metrics, t_flip, t_struct;
+    char flip_skipped[GR_ERROR_MSG_MAX];
+    cJSON *root;
+    char *text;
+} compare_state;
+
+static void state_free(compare_state *s)
 {
-    const char *cmd = "compare";
-    const char *paths[2] = {NULL, NULL}, *outdir = NULL, *mask_path = NULL;
-    int npos = 0, json = 0, linearize = 1, do_basic = 1, do_flip = 1;
-    int do_struct = -1; /* -1: when a vanishing point is given */
-    int have_vp = 0;
-    double vp[2] = {0.0, 0.0};
-    const char *scene_path = NULL, *sets[32];
-    int n_sets = 0;
-    int flip_mode = -1; /* -1: from REF's file extension */
-    char flip_skipped[GR_ERROR_MSG_MAX] = "";
-    gr_metrics_options opt = {0};
-    gr_flip_options fopt = {0};
-    gr_args args; /* no overrides: nothing to free */
-    gr_args_create(&args, cmd, argc, argv);
-    for (; args.i < argc; args.i++) {
-        const char *a = argv[args.i], *v = NULL;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            usage(stdout);
-            return 0;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--mask") ||
-                   !strcmp(a, "--stderr-bound")) {
-            const int rc = gr_args_value(&args, &v);
-            if (rc) return rc;
-            if (!strcmp(a, "--mask")) {
-                mask_path = v;
-            } else if (!strcmp(a, "--stderr-bound")) {
-                char *end = NULL;
-                errno = 0;
-                double b = strtod(v, &end);
-                if (errno || end == v || *end || isnan(b) || b <= 0.0)
-                    return gr_cli_usage_error(cmd, "--stderr-bound '%s' is not a number > 0 (or inf)", v);
-                opt.stderr_bound = b;
-            } else {
-                outdir = v;
-            }
-        } else if (!strcmp(a, "--vp") || !strcmp(a, "--scene") || !strcmp(a, "--set")) {
-            const int rc = gr_args_value(&args, &v);
-            if (rc) return rc;
-            if (!strcmp(a, "--set")) {
-                if (n_sets >= (int)(sizeof sets / sizeof sets[0]))
-                    return gr_cli_usage_error(cmd, "--set: at most %d overrides", (int)(sizeof sets / sizeof sets[0]));
-                sets[n_sets++] = v;
-            } else if (!strcmp(a, "--scene")) {
-                scene_path = v;
-            } else {
-                int used = 0;
-                if (sscanf(v, "%lf,%lf%n", &vp[0], &vp[1], &used) != 2 || v[used] != '\0' || !isfinite(vp[0]) ||
-                    !isfinite(vp[1]))
-                    return gr_cli_usage_error(cmd, "--vp '%s': need X,Y (two numbers)", v);
-                have_vp = 1;
-            }
-        } else if (!strcmp(a, "--metric") || !strcmp(a, "--flip-mode") || !strcmp(a, "--ppd") ||
-                   !strcmp(a, "--tone-mapper") || !strcmp(a, "--exposures")) {
-            const int rc = gr_args_value(&args, &v);
-            if (rc) return rc;
-            if (!strcmp(a, "--metric")) {
-                do_basic = do_flip = do_struct = 0;
-                char buf[256];
-                if (strlen(v) >= sizeof buf) return gr_cli_usage_error(cmd, "--metric '%s': too long", v);
-                strcpy(buf, v);
-                for (char *save = NULL, *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
-                    if (!strcmp(t, "basic")) do_basic = 1;
-                    else if (!strcmp(t, "flip")) do_flip = 1;
-                    else if (!strcmp(t, "structure")) do_struct = 1;
-                    else if (!strcmp(t, "all")) do_basic = do_flip = 1, do_struct = -1;
-                    else
-                        return gr_cli_usage_error(cmd, "--metric '%s': unknown metric '%s' (basic, flip, structure, all)",
-                                                  v, t);
-                }
-                if (!do_basic && !do_flip && !do_struct) return gr_cli_usage_error(cmd, "--metric '%s': names no metric", v);
-            } else if (!strcmp(a, "--flip-mode")) {
-                if (!strcmp(v, "ldr")) flip_mode = GR_FLIP_LDR;
-                else if (!strcmp(v, "hdr")) flip_mode = GR_FLIP_HDR;
-                else return gr_cli_usage_error(cmd, "--flip-mode '%s': use ldr or hdr", v);
-            } else if (!strcmp(a, "--tone-mapper")) {
-                if (!strcmp(v, "aces")) fopt.tonemapper = GR_FLIP_TM_ACES;
-                else if (!strcmp(v, "reinhard")) fopt.tonemapper = GR_FLIP_TM_REINHARD;
-                else return gr_cli_usage_error(cmd, "--tone-mapper '%s': use aces or reinhard", v);
-            } else if (!strcmp(a, "--ppd")) {
-                char *end = NULL;
-                errno = 0;
-                const double d = strtod(v, &end);
-                if (errno || end == v || *end || !isfinite(d) || d <= 0.0)
-                    return gr_cli_usage_error(cmd, "--ppd '%s' is not a number > 0", v);
-                fopt.ppd = d;
-            } else {
-                double e0, e1;
-                int k, used = 0;
-                if (sscanf(v, "%lf:%lf:%d%n", &e0, &e1, &k, &used) != 3 || v[used] != '\0' || !isfinite(e0) ||
-                    !isfinite(e1) || e1 < e0 || k < 1)
-                    return gr_cli_usage_error(cmd, "--exposures '%s': need START:STOP:COUNT, START <= STOP, COUNT >= 1", v);
-                fopt.exposures_given = 1, fopt.start_exposure = e0, fopt.stop_exposure = e1, fopt.n_exposures = k;
-            }
-        } else if (!strcmp(a, "--max-memory")) {
-            const int vrc = gr_args_value(&args, &v);
-            if (vrc) return vrc;
-            gr_error merr;
-            double bytes;
-            if (gr_memlimit_parse("--max-memory", v, &bytes, &merr) != GR_OK) return gr_cli_usage_error(cmd, "%s", merr.msg);
-            gr_memlimit_set(bytes);
-        } else if (!strcmp(a, "--fit-scale")) {
-            opt.fit_scale = 1;
-        } else if (!strcmp(a, "--json")) {
-            json = 1;
-        } else if (!strcmp(a, "--no-linearize")) {
-            linearize = 0;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return gr_cli_usage_error(cmd, "unknown option '%s'", a);
-        } else {
-            if (npos >= 2) return gr_cli_usage_error(cmd, "unexpected argument '%s': give REF and TEST only", a);
-            paths[npos++] = a;
-        }
+    cJSON_free(s->text);
+    cJSON_Delete(s->root);
+    gr_image_destroy(s->ref);
+    gr_image_destroy(s->test);
+    gr_image_destroy(s->mask);
+    for (int k = 0; k < 3; k++) gr_image_destroy(s->diff[k]);
+    gr_image_destroy(s->scaled);
+    free(s->scored);
+    free(s->flipmap);
+    free(s->angles);
+}
+
+/* --metric LIST: the groups to compute. */
+static int parse_metric_list(compare_opts *o, const char *v)
+{
+    o->do_basic = o->do_flip = o->do_struct = 0;
+    char buf[256];
+    if (strlen(v) >= sizeof buf) return gr_cli_usage_error(o->cmd, "--metric '%s': too long", v);
+    strcpy(buf, v);
+    for (char *save = NULL, *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+        if (!strcmp(t, "basic")) o->do_basic = 1;
+        else if (!strcmp(t, "flip")) o->do_flip = 1;
+        else if (!strcmp(t, "structure")) o->do_struct = 1;
+        else if (!strcmp(t, "all")) o->do_basic = o->do_flip = 1, o->do_struct = -1;
+        else return gr_cli_usage_error(o->cmd, "--metric '%s': unknown metric '%s' (basic, flip, structure, all)", v, t);
     }
-    if (npos != 2) return gr_cli_usage_error(cmd, "need two images, REF and TEST");
-    if (have_vp && scene_path) return gr_cli_usage_error(cmd, "give --vp or --scene, not both");
-    if (n_sets && !scene_path) return gr_cli_usage_error(cmd, "--set needs --scene");
-    if (do_struct == 1 && !have_vp && !scene_path)
-        return gr_cli_usage_error(cmd, "--metric structure needs the vanishing point: --vp X,Y or --scene FILE");
-    if (do_struct == -1) do_struct = have_vp || scene_path;
+    if (!o->do_basic && !o->do_flip && !o->do_struct) return gr_cli_usage_error(o->cmd, "--metric '%s': names no metric", v);
+    return 0;
+}
+
+/* --flip-mode, --tone-mapper, --ppd, --exposures. */
+static int parse_flip_option(compare_opts *o, const char *a, const char *v)
+{
+    if (!strcmp(a, "--flip-mode")) {
+        if (!strcmp(v, "ldr")) o->flip_mode = GR_FLIP_LDR;
+        else if (!strcmp(v, "hdr")) o->flip_mode = GR_FLIP_HDR;
+        else return gr_cli_usage_error(o->cmd, "--flip-mode '%s': use ldr or hdr", v);
+    } else if (!strcmp(a, "--tone-mapper")) {
+        if (!strcmp(v, "aces")) o->fopt.tonemapper = GR_FLIP_TM_ACES;
+        else if (!strcmp(v, "reinhard")) o->fopt.tonemapper = GR_FLIP_TM_REINHARD;
+        else return gr_cli_usage_error(o->cmd, "--tone-mapper '%s': use aces or reinhard", v);
+    } else if (!strcmp(a, "--ppd")) {
+        char *end = NULL;
+        errno = 0;
+        const double d = strtod(v, &end);
+        if (errno || end == v || *end || !isfinite(d) || d <= 0.0)
+            return gr_cli_usage_error(o->cmd, "--ppd '%s' is not a number > 0", v);
+        o->fopt.ppd = d;
+    } else {
+        double e0, e1;
+        int k, used = 0;
+        if (sscanf(v, "%lf:%lf:%d%n", &e0, &e1, &k, &used) != 3 || v[used] != '\0' || !isfinite(e0) ||
+            !isfinite(e1) || e1 < e0 || k < 1)
+            return gr_cli_usage_error(o->cmd, "--exposures '%s': need START:STOP:COUNT, START <= STOP, COUNT >= 1", v);
+        o->fopt.exposures_given = 1, o->fopt.start_exposure = e0, o->fopt.stop_exposure = e1, o->fopt.n_exposures = k;
+    }
+    return 0;
+}
+
+/* An option with a value other than the FLIP ones and --metric. */
+static int parse_value_option(compare_opts *o, const char *a, const char *v)
+{
+    if (!strcmp(a, "--mask")) {
+        o->mask_path = v;
+    } else if (!strcmp(a, "--stderr-bound")) {
+        char *end = NULL;
+        errno = 0;
+        double b = strtod(v, &end);
+        if (errno || end == v || *end || isnan(b) || b <= 0.0)
+            return gr_cli_usage_error(o->cmd, "--stderr-bound '%s' is not a number > 0 (or inf)", v);
+        o->opt.stderr_bound = b;
+    } else if (!strcmp(a, "--set")) {
+        if (o->n_sets >= (int)(sizeof o->sets / sizeof o->sets[0]))
+            return gr_cli_usage_error(o->cmd, "--set: at most %d overrides", (int)(sizeof o->sets / sizeof o->sets[0]));
+        o->sets[o->n_sets++] = v;
+    } else if (!strcmp(a, "--scene")) {
+        o->scene_path = v;
+    } else if (!strcmp(a, "--vp")) {
+        int used = 0;
+        if (sscanf(v, "%lf,%lf%n", &o->vp[0], &o->vp[1], &used) != 2 || v[used] != '\0' || !isfinite(o->vp[0]) ||
+            !isfinite(o->vp[1]))
+            return gr_cli_usage_error(o->cmd, "--vp '%s': need X,Y (two numbers)", v);
+        o->have_vp = 1;
+    } else if (!strcmp(a, "--max-memory")) {
+        gr_error merr;
+        double bytes;
+        if (gr_memlimit_parse("--max-memory", v, &bytes, &merr) != GR_OK) return gr_cli_usage_error(o->cmd, "%s", merr.msg);
+        gr_memlimit_set(bytes);
+    } else if (!strcmp(a, "--metric")) {
+        return parse_metric_list(o, v);
+    } else {
+        return parse_flip_option(o, a, v);
+    }
+    return 0;
+}
+
+/* The argument at args->i; -1 to go on, else the exit code (0 after --help). */
+static int parse_arg(gr_args *args, compare_opts *o)
+{
+    static const char *const with_value[] = {"--mask", "--stderr-bound", "--vp", "--scene", "--set", "--metric",
+                                             "--flip-mode", "--ppd", "--tone-mapper", "--exposures", "--max-memory"};
+    const char *a = args->argv[args->i], *v = NULL;
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+        const int rc = gr_args_value(args, &o->outdir);
+        return rc ? rc : -1;
+    }
+    for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++) {
+        if (strcmp(a, with_value[k])) continue;
+        int rc = gr_args_value(args, &v);
+        if (!rc) rc = parse_value_option(o, a, v);
+        return rc ? rc : -1;
+    }
+    if (!strcmp(a, "--fit-scale")) o->opt.fit_scale = 1;
+    else if (!strcmp(a, "--json")) o->json = 1;
+    else if (!strcmp(a, "--no-linearize")) o->linearize = 0;
+    else if (a[0] == '-' && a[1] != '\0') return gr_cli_usage_error(o->cmd, "unknown option '%s'", a);
+    else if (o->npos >= 2) return gr_cli_usage_error(o->cmd, "unexpected argument '%s': give REF and TEST only", a);
+    else o->paths[o->npos++] = a;
+    return -1;
+}
+
+/* The whole command line into o; -1 to go on, else the exit code. */
+static int parse_args(gr_args *args, compare_opts *o)
+{
+    for (; args->i < args->argc; args->i++) {
+        const int rc = parse_arg(args, o);
+        if (rc >= 0) return rc;
+    }
+    if (o->npos != 2) return gr_cli_usage_error(o->cmd, "need two images, REF and TEST");
+    if (o->have_vp && o->scene_path) return gr_cli_usage_error(o->cmd, "give --vp or --scene, not both");
+    if (o->n_sets && !o->scene_path) return gr_cli_usage_error(o->cmd, "--set needs --scene");
+    if (o->do_struct == 1 && !o->have_vp && !o->scene_path)
+        return gr_cli_usage_error(o->cmd, "--metric structure needs the vanishing point: --vp X,Y or --scene FILE");
+    if (o->do_struct == -1) o->do_struct = o->have_vp || o->scene_path;
     /* no file written into -o DIR may replace an input (common/paths) */
-    if (gr_args_add_input(&args, "REF", paths[0]) || gr_args_add_input(&args, "TEST", paths[1]) ||
-        (scene_path && gr_args_add_input(&args, "--scene", scene_path)))
+    if (gr_args_add_input(args, "REF", o->paths[0]) || gr_args_add_input(args, "TEST", o->paths[1]) ||
+        (o->scene_path && gr_args_add_input(args, "--scene", o->scene_path)))
         return 1;
-    if (outdir) {
-        const int rc = gr_args_check_output_dir(&args, "-o", outdir);
+    if (o->outdir) {
+        const int rc = gr_args_check_output_dir(args, "-o", o->outdir);
         if (rc) return rc;
     }
+    return -1;
+}
 
-    gr_error err = {0};
-    gr_image *ref = NULL, *test = NULL, *mask = NULL, *diff[3] = {NULL, NULL, NULL}, *scaled = NULL;
-    unsigned char *scored = NULL;
-    float *flipmap = NULL, *angles = NULL;
-    cJSON *root = NULL;
-    char *text = NULL;
-    int rc = 0;
-    gr_status st = read_input("reference", paths[0], linearize, &ref, &err);
-    if (st == GR_OK) st = read_input("test", paths[1], linearize, &test, &err);
-    if (st == GR_OK && mask_path) st = read_input("mask", mask_path, 0, &mask, &err);
-    if (st == GR_OK && (ref->width != test->width || ref->height != test->height))
-        st = gr_fail(&err, GR_E_INPUT, "size mismatch: reference %s is %d x %d, test %s is %d x %d", paths[0],
-                     ref->width, ref->height, paths[1], test->width, test->height);
-    if (st == GR_OK && mask && (mask->width != ref->width || mask->height != ref->height))
-        st = gr_fail(&err, GR_E_INPUT, "size mismatch: mask %s is %d x %d, images are %d x %d", mask_path, mask->width,
-                     mask->height, ref->width, ref->height);
+/* Reads REF, TEST and the mask; checks sizes, layouts, the memory estimate and a black
+ * reference. */
+static gr_status read_inputs(const compare_opts *o, compare_state *s, gr_error *err)
+{
+    gr_status st = read_input("reference", o->paths[0], o->linearize, &s->ref, err);
+    if (st == GR_OK) st = read_input("test", o->paths[1], o->linearize, &s->test, err);
+    if (st == GR_OK && o->mask_path) st = read_input("mask", o->mask_path, 0, &s->mask, err);
+    if (st != GR_OK) return st;
+    const gr_image *ref = s->ref, *test = s->test, *mask = s->mask;
+    if (ref->width != test->width || ref->height != test->height)
+        return gr_fail(err, GR_E_INPUT, "size mismatch: reference %s is %d x %d, test %s is %d x %d", o->paths[0],
+                       ref->width, ref->height, o->paths[1], test->width, test->height);
+    if (mask && (mask->width != ref->width || mask->height != ref->height))
+        return gr_fail(err, GR_E_INPUT, "size mismatch: mask %s is %d x %d, images are %d x %d", o->mask_path,
+                       mask->width, mask->height, ref->width, ref->height);
     /* two channels: grey + alpha is compared as grey; anything else (R, G) has no defined
      * luminance, so it is refused rather than compared as grey with a channel dropped */
-    for (int k = 0; st == GR_OK && k < 2; k++) {
+    for (int k = 0; k < 2; k++) {
         const gr_image *im = k ? test : ref;
         if (im->nchannels == 2 && strcmp(im->names[1], "A"))
-            st = gr_fail(&err, GR_E_INPUT, "%s %s: 2 channels (%s, %s): neither grey (+ alpha A) nor RGB; convert it "
-                         "first, e.g. oiiotool IN --ch R,G,B=0 -o OUT.exr", k ? "test" : "reference", paths[k],
-                         im->names[0], im->names[1]);
+            return gr_fail(err, GR_E_INPUT, "%s %s: 2 channels (%s, %s): neither grey (+ alpha A) nor RGB; convert "
+                           "it first, e.g. oiiotool IN --ch R,G,B=0 -o OUT.exr", k ? "test" : "reference", o->paths[k],
+                           im->names[0], im->names[1]);
+    }
+    /* the metrics, blurs and difference images: about 170 bytes per pixel, measured
+     * (2.8 GB for 4096 x 4096; docs/reliability.md); FLIP's working set on top, counted
+     * from its buffers (an upper bound: they are allocated after the metrics' are freed):
+     * 22 double planes, 2 x 3 double colours, 2 float maps, 1 double for the quantiles */
+    const double per_px = 170.0 + (o->do_flip ? 22.0 * 8 + 6.0 * 8 + 2.0 * 4 + 8.0 : 0.0);
+    char detail[96];
+    snprintf(detail, sizeof detail, "%d x %d pixels at about %.0f bytes each", ref->width, ref->height, per_px);
+    st = gr_memlimit_check("the comparison", per_px * ref->width * (double)ref->height, detail, err);
+    if (st == GR_OK && all_zero(ref))
+        st = gr_fail(err, GR_E_INPUT, "reference %s is zero everywhere: no metric can say anything about the test "
+                     "image (camera inside an occluder, a medium without scattering, no light reaching the view?)",
+                     o->paths[0]);
+    return st;
+}
+
+/* The structure metrics' geometry: the vanishing point (--vp, or --scene's refracted sun) and,
+ * with --scene, the angle to that sun per pixel for the de-glow. */
+static gr_status structure_setup(compare_opts *o, compare_state *s, gr_error *err)
+{
+    const gr_image *ref = s->ref;
+    if (o->scene_path) {
+        gr_scene sc;
+        gr_status st = gr_scene_load_file(o->scene_path, o->sets, o->n_sets, &sc, err);
+        if (st == GR_OK) st = gr_structure_scene_vp(&sc, ref->width, ref->height, &o->vp[0], &o->vp[1], err);
+        if (st != GR_OK) {
+            if (st != GR_E_NOMEM) err->status = GR_E_INPUT;
+            gr_error_prefix(err, "--scene %s", o->scene_path);
+            return err->status;
+        }
+        /* de-glow by the angle to the refracted sun, rings one pixel wide */
+        sc.camera.width = ref->width, sc.camera.height = ref->height;
+        s->angles = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
+        if (!s->angles) return gr_fail(err, GR_E_NOMEM, "out of memory for the structure metrics");
+        double dir[3];
+        gr_profile_sun_view_dir(&sc, dir);
+        gr_profile_angles(&sc.camera, dir, s->angles);
+        s->so.radial = s->angles, s->so.radial_bin = sc.camera.fov_deg / ref->height;
+    }
+    s->so.vp_x = o->vp[0], s->so.vp_y = o->vp[1];
+    o->opt.structure = &s->so;
+    return GR_OK;
+}
+
+/* A ground truth's stderr comes from a few batches: its degrees of freedom (Student's t), from
+ * REF's godrays:stderr_dof when it is one of ours; 0 (unknown) otherwise. */
+static int stderr_dof_of(const char *path)
+{
+    gr_metadata meta;
+    gr_meta_init(&meta);
+    gr_image *tmp = NULL;
+    gr_error e2 = {0};
+    int dof = 0;
+    size_t n = strlen(path);
+    if (n > 4 && !strcmp(path + n - 4, ".exr") && gr_exr_read(path, &tmp, &meta, &e2) == GR_OK) {
+        const gr_meta_item *it = gr_meta_get(&meta, "godrays:stderr_dof");
+        if (it && it->type != GR_META_STRING && it->num >= 1.0) dof = (int)it->num;
+    }
+    gr_image_destroy(tmp);
+    gr_meta_free(&meta);
+    return dof;
+}
+
+/* The scored pixels (as the metrics score them), once, for FLIP and the structure details. */
+static gr_status need_scored(const compare_opts *o, compare_state *s, gr_error *err)
+{
+    if (s->scored) return GR_OK;
+    s->scored = malloc((size_t)s->ref->width * (size_t)s->ref->height);
+    if (!s->scored) return gr_fail(err, GR_E_NOMEM, "out of memory for the scored pixels");
+    return gr_metrics_scored_pixels(s->ref, s->mask, o->opt.stderr_bound, s->scored, NULL, NULL, err);
+}
+
+/* FLIP on a * TEST (a = the fitted scale when asked for, else 1), pooled over the pixels the
+ * other metrics score; the mode follows REF's format unless given. With its own options and
+ * map it is reported in its own block ("flip"), not in the metric sets: those stay what
+ * `godrays run` writes for the same pair (tests/cli/test_run.sh), where the registry's "flip"
+ * is not computed. */
+static gr_status compute_flip(compare_opts *o, compare_state *s, gr_error *err)
+{
+    const gr_image *ref = s->ref, *test = s->test;
+    if (o->flip_mode < 0) {
+        const char *dot = strrchr(o->paths[0], '.');
+        o->flip_mode = dot && (!strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr") || !strcasecmp(dot, ".pfm"))
+                           ? GR_FLIP_HDR : GR_FLIP_LDR;
+    }
+    o->fopt.mode = (gr_flip_mode)o->flip_mode;
+    const size_t n = (size_t)ref->width * (size_t)ref->height;
+    s->flipmap = malloc(n * sizeof(float));
+    if (!s->flipmap) return gr_fail(err, GR_E_NOMEM, "out of memory for FLIP");
+    gr_status st = need_scored(o, s, err);
+    if (st != GR_OK) return st;
+    o->fopt.scored = s->scored;
+    const gr_image *ft = test;
+    if (s->scale != 1.0) {
+        s->scaled = gr_image_create(test->width, test->height, test->nchannels, NULL);
+        if (!s->scaled) return gr_fail(err, GR_E_NOMEM, "out of memory for FLIP");
+        memcpy(s->scaled->names, test->names, sizeof test->names);
+        for (size_t i = 0; i < n * (size_t)test->nchannels; i++) s->scaled->pixels[i] = (float)(s->scale * test->pixels[i]);
+        ft = s->scaled;
+    }
+    const double t1 = now_s();
+    gr_error ferr = {GR_OK, ""};
+    double e0, e1;
+    int ne;
+    if (o->fopt.mode == GR_FLIP_HDR && !o->fopt.exposures_given &&
+        gr_flip_exposures(ref, o->fopt.tonemapper, &e0, &e1, &ne, &ferr) != GR_OK) {
+        /* a black reference (all-zero, or a zero median) gives HDR-FLIP no exposure range:
+         * FLIP is left out, said so, instead of failing the whole comparison */
+        snprintf(s->flip_skipped, sizeof s->flip_skipped, "%s", ferr.msg);
+        o->do_flip = 0;
+    } else {
+        st = gr_flip_compute(ref, ft, &o->fopt, s->flipmap, &s->fres, err);
+    }
+    s->t_flip = now_s() - t1;
+    return st;
+}
+
+/* Every number computed: the metrics (with the registry's), FLIP and the structure details. */
+static gr_status compute_all(compare_opts *o, compare_state *s, gr_error *err)
+{
+    gr_status st = GR_OK;
+    if (o->do_struct && (st = structure_setup(o, s, err)) != GR_OK) return st;
+    o->opt.mask = s->mask;
+    if (!o->do_basic) o->opt.skip_ssim = o->opt.skip_blur = o->opt.skip_extra = 1;
+    o->opt.stderr_dof = stderr_dof_of(o->paths[0]);
+    const double t0 = now_s();
+    st = gr_metrics_compute(s->ref, s->test, &o->opt, &s->m, err);
+    s->t_metrics = now_s() - t0;
+    if (st != GR_OK) return st;
+    s->scale = s->m.have_fit && s->m.fit_defined ? s->m.fit.scale : 1.0;
+    if (o->do_flip && (st = compute_flip(o, s, err)) != GR_OK) return st;
+    if (o->do_struct) {
+        if ((st = need_scored(o, s, err)) != GR_OK) return st;
+        s->so.scored = s->scored;
+        const double t2 = now_s();
+        st = gr_structure_compare_images(s->ref, s->test, &s->so, &s->sres, err);
+        s->t_struct = now_s() - t2;
+    }
+    return st;
+}
+
+/* The JSON document (without the difference images' entries). */
+static gr_status build_json(const compare_opts *o, compare_state *s, gr_error *err)
+{
+    cJSON *root = s->root = gr_metrics_to_json(&s->m);
+    cJSON *rj = root ? image_json(o->paths[0], s->ref, s->m.ref_rgb) : NULL;
+    if (rj && !cJSON_AddItemToObject(root, "reference", rj)) cJSON_Delete(rj), rj = NULL;
+    cJSON *tj = rj ? image_json(o->paths[1], s->test, s->m.test_rgb) : NULL;
+    if (tj && !cJSON_AddItemToObject(root, "test", tj)) cJSON_Delete(tj), tj = NULL;
+    if (!tj || !cJSON_AddBoolToObject(root, "linearized_8bit", o->linearize) ||
+        !cJSON_AddNumberToObject(root, "metrics_time_s", s->t_metrics) ||
+        (o->mask_path && !cJSON_AddStringToObject(root, "mask", o->mask_path)))
+        return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
+    cJSON *sj = o->do_struct ? gr_structure_to_json(&s->sres, o->vp[0], o->vp[1]) : NULL;
+    if (o->do_struct && (!sj || !cJSON_AddNumberToObject(sj, "time_s", s->t_struct) ||
+                         !cJSON_AddItemToObject(root, "structure", sj))) {
+        cJSON_Delete(sj);
+        return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
+    }
+    if (s->flip_skipped[0] && !cJSON_AddStringToObject(root, "flip_skipped", s->flip_skipped))
+        return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
+    cJSON *fj = o->do_flip ? gr_flip_to_json(&s->fres, s->scale) : NULL;
+    if (o->do_flip && (!fj || !cJSON_AddNumberToObject(fj, "time_s", s->t_flip) || !cJSON_AddItemToObject(root, "flip", fj))) {
+        cJSON_Delete(fj);
+        return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
+    }
+    return GR_OK;
+}
+
+static const char *const diff_names[3] = {"diff.png", "diff_signed.png", "flip.png"};
+
+/* The difference images (and the FLIP map) and their entries in the JSON. */
+static gr_status make_diff_images(const compare_opts *o, compare_state *s, gr_error *err)
+{
+    cJSON *dj = cJSON_AddObjectToObject(s->root, "difference_images");
+    if (!dj) return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
+    for (int k = 0; k < 2; k++) {
+        gr_diffmap_options dopt = {.kind = k ? GR_DIFFMAP_SIGNED : GR_DIFFMAP_ABS, .scale = s->scale,
+                                   .mask = s->mask, .stderr_bound = o->opt.stderr_bound};
+        gr_diffmap_info info;
+        gr_status st = gr_diffmap_create(s->ref, s->test, &dopt, &s->diff[k], &info, err);
+        if (st != GR_OK) return st;
+        cJSON *one = cJSON_AddObjectToObject(dj, diff_names[k]);
+        if (!one || !cJSON_AddStringToObject(one, "quantity", k ? "scale * Y(test) - Y(ref)" : "|scale * Y(test) - Y(ref)|") ||
+            !cJSON_AddNumberToObject(one, "scale", s->scale) || !cJSON_AddStringToObject(one, "color_map", info.map) ||
+            !cJSON_AddNumberToObject(one, "min", info.vmin) || !cJSON_AddNumberToObject(one, "max", info.vmax) ||
+            !cJSON_AddBoolToObject(one, "colorbar_labelled", info.labelled) ||
+            !cJSON_AddStringToObject(one, "unscored_pixels", "mid gray"))
+            return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
+    }
+    if (!o->do_flip) return GR_OK;
+    gr_status st = gr_flip_heatmap(s->flipmap, s->ref->width, s->ref->height, &s->diff[2], err);
+    if (st != GR_OK) return st;
+    cJSON *one = cJSON_AddObjectToObject(dj, diff_names[2]);
+    if (!one || !cJSON_AddStringToObject(one, "quantity", "FLIP per pixel (of scale * test)") ||
+        !cJSON_AddNumberToObject(one, "scale", s->scale) || !cJSON_AddStringToObject(one, "color_map", "magma") ||
+        !cJSON_AddNumberToObject(one, "min", 0.0) || !cJSON_AddNumberToObject(one, "max", 1.0))
+        return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
+    return GR_OK;
+}
+
+/* -o DIR: everything is computed before the first file is written; each file goes through a
+ * temporary name, so an error leaves no half-written file behind. */
+static gr_status write_outputs(const compare_opts *o, compare_state *s, gr_error *err)
+{
+    gr_status st = gr_report_make_dir(o->outdir, err);
+    char path[4200];
+    for (int k = 0; st == GR_OK && k < 3; k++) {
+        if (!s->diff[k]) continue;
+        if (snprintf(path, sizeof path, "%s/%s", o->outdir, diff_names[k]) >= (int)sizeof path)
+            st = gr_fail(err, GR_E_USAGE, "%s: output directory name too long", o->outdir);
+        else
+            st = gr_oiio_write(path, s->diff[k], err);
     }
     if (st == GR_OK) {
-        /* the metrics, blurs and difference images: about 170 bytes per pixel, measured
-         * (2.8 GB for 4096 x 4096; docs/reliability.md); FLIP's working set on top, counted
-         * from its buffers (an upper bound: they are allocated after the metrics' are freed):
-         * 22 double planes, 2 x 3 double colours, 2 float maps, 1 double for the quantiles */
-        const double per_px = 170.0 + (do_flip ? 22.0 * 8 + 6.0 * 8 + 2.0 * 4 + 8.0 : 0.0);
-        char detail[96];
-        snprintf(detail, sizeof detail, "%d x %d pixels at about %.0f bytes each", ref->width, ref->height, per_px);
-        st = gr_memlimit_check("the comparison", per_px * ref->width * (double)ref->height, detail, &err);
+        snprintf(path, sizeof path, "%s/metrics.json", o->outdir); /* fits: diff_signed.png is longer */
+        st = write_text(path, s->text, err);
     }
-    if (st == GR_OK && all_zero(ref))
-        st = gr_fail(&err, GR_E_INPUT, "reference %s is zero everywhere: no metric can say anything about the test "
-                     "image (camera inside an occluder, a medium without scattering, no light reaching the view?)",
-                     paths[0]);
-    if (st != GR_OK) goto fail;
+    return st;
+}
 
-    /* The structure metrics' geometry first: the metric sets carry their summary (as in
-     * `godrays run`), the "structure" object the details. */
-    gr_structure_options so = {0};
-    if (do_struct) {
-        if (scene_path) {
-            gr_scene sc;
-            st = gr_scene_load_file(scene_path, sets, n_sets, &sc, &err);
-            if (st == GR_OK) st = gr_structure_scene_vp(&sc, ref->width, ref->height, &vp[0], &vp[1], &err);
-            if (st != GR_OK) {
-                if (st != GR_E_NOMEM) err.status = GR_E_INPUT;
-                gr_error_prefix(&err, "--scene %s", scene_path);
-                goto fail;
-            }
-            /* de-glow by the angle to the refracted sun, rings one pixel wide */
-            sc.camera.width = ref->width, sc.camera.height = ref->height;
-            angles = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
-            if (!angles) {
-                st = gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
-                goto fail;
-            }
-            double dir[3];
-            gr_profile_sun_view_dir(&sc, dir);
-            gr_profile_angles(&sc.camera, dir, angles);
-            so.radial = angles, so.radial_bin = sc.camera.fov_deg / ref->height;
-        }
-        so.vp_x = vp[0], so.vp_y = vp[1];
-        opt.structure = &so;
-    }
-    opt.mask = mask;
-    if (!do_basic) opt.skip_ssim = opt.skip_blur = 1;
-    /* a ground truth's stderr comes from a few batches: its degrees of freedom, for Student's t */
-    {
-        gr_metadata meta;
-        gr_meta_init(&meta);
-        gr_image *tmp = NULL;
-        gr_error e2 = {0};
-        size_t n = strlen(paths[0]);
-        if (n > 4 && !strcmp(paths[0] + n - 4, ".exr") && gr_exr_read(paths[0], &tmp, &meta, &e2) == GR_OK) {
-            const gr_meta_item *it = gr_meta_get(&meta, "godrays:stderr_dof");
-            if (it && it->type != GR_META_STRING && it->num >= 1.0) opt.stderr_dof = (int)it->num;
-        }
-        gr_image_destroy(tmp);
-        gr_meta_free(&meta);
-    }
-    gr_metrics m;
-    const double t0 = now_s();
-    st = gr_metrics_compute(ref, test, &opt, &m, &err);
-    const double t_metrics = now_s() - t0;
-    if (st != GR_OK) goto fail;
+/* The tables for people: the groups asked for, then the registry's metrics of those groups. */
+static void print_text(const compare_opts *o, const compare_state *s)
+{
+    const gr_metrics *m = &s->m;
+    printf("reference %s, test %s\n", o->paths[0], o->paths[1]);
+    if (o->do_basic) gr_metrics_print_table(stdout, m);
+    if (o->do_flip) gr_flip_print(stdout, "FLIP", &s->fres, s->scale);
+    if (s->flip_skipped[0]) printf("  FLIP not computed: %s\n", s->flip_skipped);
+    if (o->do_struct) gr_structure_print(stdout, &s->sres, o->vp[0], o->vp[1]);
+    unsigned costs = 0;
+    if (o->do_basic)
+        costs |= 1u << GR_METRIC_COST_PASS | 1u << GR_METRIC_COST_SSIM | 1u << GR_METRIC_COST_BLUR |
+                 1u << GR_METRIC_COST_OWN;
+    if (o->do_flip) costs |= 1u << GR_METRIC_COST_FLIP;
+    if (o->do_struct) costs |= 1u << GR_METRIC_COST_STRUCTURE;
+    gr_metrics_print_summary(stdout, m, costs);
+    if (o->outdir)
+        printf("wrote %s/metrics.json, %s/diff.png, %s/diff_signed.png%s%s%s\n", o->outdir, o->outdir, o->outdir,
+               o->do_flip ? ", " : "", o->do_flip ? o->outdir : "", o->do_flip ? "/flip.png" : "");
+}
 
-    /* FLIP on a * TEST (a = the fitted scale when asked for, else 1), pooled over the pixels
-     * the other metrics score; the mode follows REF's format unless given. */
-    const double scale = m.have_fit && m.fit_defined ? m.fit.scale : 1.0;
-    gr_flip_result fres;
-    double t_flip = 0.0;
-    if (do_flip) {
-        if (flip_mode < 0) {
-            const char *dot = strrchr(paths[0], '.');
-            flip_mode = dot && (!strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr") || !strcasecmp(dot, ".pfm"))
-                            ? GR_FLIP_HDR : GR_FLIP_LDR;
-        }
-        fopt.mode = (gr_flip_mode)flip_mode;
-        const size_t n = (size_t)ref->width * (size_t)ref->height;
-        scored = malloc(n);
-        flipmap = malloc(n * sizeof(float));
-        if (!scored || !flipmap) {
-            st = gr_fail(&err, GR_E_NOMEM, "out of memory for FLIP");
-            goto fail;
-        }
-        st = gr_metrics_scored_pixels(ref, mask, opt.stderr_bound, scored, NULL, NULL, &err);
-        if (st != GR_OK) goto fail;
-        fopt.scored = scored;
-        const gr_image *ft = test;
-        if (scale != 1.0) {
-            scaled = gr_image_create(test->width, test->height, test->nchannels, NULL);
-            if (!scaled) {
-                st = gr_fail(&err, GR_E_NOMEM, "out of memory for FLIP");
-                goto fail;
-            }
-            memcpy(scaled->names, test->names, sizeof test->names);
-            for (size_t i = 0; i < n * (size_t)test->nchannels; i++) scaled->pixels[i] = (float)(scale * test->pixels[i]);
-            ft = scaled;
-        }
-        const double t1 = now_s();
-        gr_error ferr = {GR_OK, ""};
-        double e0, e1;
-        int ne;
-        if (fopt.mode == GR_FLIP_HDR && !fopt.exposures_given &&
-            gr_flip_exposures(ref, fopt.tonemapper, &e0, &e1, &ne, &ferr) != GR_OK) {
-            /* a black reference (all-zero, or a zero median) gives HDR-FLIP no exposure range:
-             * FLIP is left out, said so, instead of failing the whole comparison */
-            snprintf(flip_skipped, sizeof flip_skipped, "%s", ferr.msg);
-            do_flip = 0;
-        } else {
-            st = gr_flip_compute(ref, ft, &fopt, flipmap, &fres, &err);
-        }
-        t_flip = now_s() - t1;
-        if (st != GR_OK) goto fail;
-    }
+int cmd_compare(int argc, char **argv)
+{
+    compare_opts o = {.cmd = "compare", .linearize = 1, .do_basic = 1, .do_flip = 1, .do_struct = -1, .flip_mode = -1};
+    gr_args args; /* no overrides: nothing to free */
+    gr_args_create(&args, o.cmd, argc, argv);
+    int rc = parse_args(&args, &o);
+    if (rc >= 0) return rc;
 
-    gr_structure_compare sres;
-    double t_struct = 0.0;
-    if (do_struct) {
-        if (!scored) {
-            scored = malloc((size_t)ref->width * (size_t)ref->height);
-            if (!scored) {
-                st = gr_fail(&err, GR_E_NOMEM, "out of memory for the structure metrics");
-                goto fail;
-            }
-            st = gr_metrics_scored_pixels(ref, mask, opt.stderr_bound, scored, NULL, NULL, &err);
-            if (st != GR_OK) goto fail;
-        }
-        so.scored = scored;
-        const double t2 = now_s();
-        st = gr_structure_compare_images(ref, test, &so, &sres, &err);
-        t_struct = now_s() - t2;
-        if (st != GR_OK) goto fail;
+    gr_error err = {0};
+    compare_state *s = calloc(1, sizeof *s);
+    if (!s) {
+        gr_fail(&err, GR_E_NOMEM, "out of memory");
+        return gr_cli_report(o.cmd, &err);
     }
-
-    root = gr_metrics_to_json(&m);
-    cJSON *rj = root ? image_json(paths[0], ref, m.ref_rgb) : NULL;
-    cJSON *tj = root ? image_json(paths[1], test, m.test_rgb) : NULL;
-    if (!root || !rj || !tj || !cJSON_AddItemToObject(root, "reference", rj) ||
-        !cJSON_AddItemToObject(root, "test", tj) || !cJSON_AddBoolToObject(root, "linearized_8bit", linearize) ||
-        !cJSON_AddNumberToObject(root, "metrics_time_s", t_metrics) ||
-        (mask_path && !cJSON_AddStringToObject(root, "mask", mask_path))) {
-        st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
-        goto fail;
-    }
-    cJSON *sj = do_struct ? gr_structure_to_json(&sres, vp[0], vp[1]) : NULL;
-    if (do_struct && (!sj || !cJSON_AddNumberToObject(sj, "time_s", t_struct) ||
-                      !cJSON_AddItemToObject(root, "structure", sj))) {
-        cJSON_Delete(sj);
-        st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
-        goto fail;
-    }
-    if (flip_skipped[0] && !cJSON_AddStringToObject(root, "flip_skipped", flip_skipped)) {
-        st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
-        goto fail;
-    }
-    cJSON *fj = do_flip ? gr_flip_to_json(&fres, scale) : NULL;
-    if (do_flip && (!fj || !cJSON_AddNumberToObject(fj, "time_s", t_flip) || !cJSON_AddItemToObject(root, "flip", fj))) {
-        cJSON_Delete(fj);
-        st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
-        goto fail;
-    }
-
-    if (outdir) {
-        /* Everything is computed before the first file is written; each file goes through a
-         * temporary name, so an error leaves no half-written file behind. */
-        static const char *const names[3] = {"diff.png", "diff_signed.png", "flip.png"};
-        cJSON *dj = cJSON_AddObjectToObject(root, "difference_images");
-        if (!dj) {
-            st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
-            goto fail;
-        }
-        for (int k = 0; k < 2; k++) {
-            gr_diffmap_options dopt = {.kind = k ? GR_DIFFMAP_SIGNED : GR_DIFFMAP_ABS, .scale = scale,
-                                       .mask = mask, .stderr_bound = opt.stderr_bound};
-            gr_diffmap_info info;
-            st = gr_diffmap_create(ref, test, &dopt, &diff[k], &info, &err);
-            if (st != GR_OK) goto fail;
-            cJSON *one = cJSON_AddObjectToObject(dj, names[k]);
-            if (!one || !cJSON_AddStringToObject(one, "quantity", k ? "scale * Y(test) - Y(ref)" : "|scale * Y(test) - Y(ref)|") ||
-                !cJSON_AddNumberToObject(one, "scale", scale) || !cJSON_AddStringToObject(one, "color_map", info.map) ||
-                !cJSON_AddNumberToObject(one, "min", info.vmin) || !cJSON_AddNumberToObject(one, "max", info.vmax) ||
-                !cJSON_AddBoolToObject(one, "colorbar_labelled", info.labelled) ||
-                !cJSON_AddStringToObject(one, "unscored_pixels", "mid gray")) {
-                st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
-                goto fail;
-            }
-        }
-        if (do_flip) {
-            st = gr_flip_heatmap(flipmap, ref->width, ref->height, &diff[2], &err);
-            if (st != GR_OK) goto fail;
-            cJSON *one = cJSON_AddObjectToObject(dj, names[2]);
-            if (!one || !cJSON_AddStringToObject(one, "quantity", "FLIP per pixel (of scale * test)") ||
-                !cJSON_AddNumberToObject(one, "scale", scale) || !cJSON_AddStringToObject(one, "color_map", "magma") ||
-                !cJSON_AddNumberToObject(one, "min", 0.0) || !cJSON_AddNumberToObject(one, "max", 1.0)) {
-                st = gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
-                goto fail;
-            }
-        }
-        text = cJSON_Print(root);
-        if (!text) {
-            st = gr_fail(&err, GR_E_NOMEM, "out of memory printing the JSON");
-            goto fail;
-        }
-        st = gr_report_make_dir(outdir, &err);
-        char path[4200];
-        for (int k = 0; st == GR_OK && k < 3; k++) {
-            if (!diff[k]) continue;
-            if (snprintf(path, sizeof path, "%s/%s", outdir, names[k]) >= (int)sizeof path)
-                st = gr_fail(&err, GR_E_USAGE, "%s: output directory name too long", outdir);
-            else
-                st = gr_oiio_write(path, diff[k], &err);
-        }
-        if (st == GR_OK) {
-            snprintf(path, sizeof path, "%s/metrics.json", outdir); /* fits: diff_signed.png is longer */
-            st = write_text(path, text, &err);
-        }
-        if (st != GR_OK) goto fail;
-    } else {
-        text = cJSON_Print(root);
-        if (!text) {
-            st = gr_fail(&err, GR_E_NOMEM, "out of memory printing the JSON");
-            goto fail;
-        }
-    }
-
-    if (json) {
-        printf("%s\n", text);
-    } else {
-        printf("reference %s, test %s\n", paths[0], paths[1]);
-        if (do_basic) gr_metrics_print_table(stdout, &m);
-        if (do_flip) gr_flip_print(stdout, "FLIP", &fres, scale);
-        if (flip_skipped[0]) printf("  FLIP not computed: %s\n", flip_skipped);
-        if (do_struct) gr_structure_print(stdout, &sres, vp[0], vp[1]);
-        if (outdir)
-            printf("wrote %s/metrics.json, %s/diff.png, %s/diff_signed.png%s%s%s\n", outdir, outdir, outdir,
-                   do_flip ? ", " : "", do_flip ? outdir : "", do_flip ? "/flip.png" : "");
-    }
-    goto done;
-fail:
-    rc = gr_cli_report(cmd, &err);
-done:
-    cJSON_free(text);
-    cJSON_Delete(root);
-    gr_image_destroy(ref);
-    gr_image_destroy(test);
-    gr_image_destroy(mask);
-    gr_image_destroy(diff[0]);
-    gr_image_destroy(diff[1]);
-    gr_image_destroy(diff[2]);
-    gr_image_destroy(scaled);
-    free(scored);
-    free(flipmap);
-    free(angles);
+    gr_status st = read_inputs(&o, s, &err);
+    if (st == GR_OK) st = compute_all(&o, s, &err);
+    if (st == GR_OK) st = build_json(&o, s, &err);
+    if (st == GR_OK && o.outdir) st = make_diff_images(&o, s, &err);
+    if (st == GR_OK && !(s->text = cJSON_Print(s->root))) st = gr_fail(&err, GR_E_NOMEM, "out of memory printing the JSON");
+    if (st == GR_OK && o.outdir) st = write_outputs(&o, s, &err);
+    rc = 0;
+    if (st != GR_OK) rc = gr_cli_report(o.cmd, &err);
+    else if (o.json) printf("%s\n", s->text);
+    else print_text(&o, s);
+    state_free(s);
+    free(s);
     return rc;
 }

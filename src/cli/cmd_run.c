@@ -13,6 +13,7 @@
 #include <time.h>
 
 #include "compare/metrics.h"
+#include "compare/registry.h"
 #include "compare/structure.h"
 #include "image/exr.h"
 #include "realtime/technique.h"
@@ -155,8 +156,6 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
     return GR_OK;
 }
 
-static double rel(const gr_channel_metrics *y) { return y->ref_mean != 0 ? y->rmse / fabs(y->ref_mean) : NAN; }
-
 static void print_summary(const char *dir, const gr_scene *scene, const gr_report_technique *ts, int nt,
                           const int *order, const ref_out *ro, double t_ref)
 {
@@ -167,22 +166,17 @@ static void print_summary(const char *dir, const gr_scene *scene, const gr_repor
         const gr_report_technique *t = &ts[order[r]];
         const gr_metrics *m = t->metrics;
         const gr_metrics_set *raw = &m->raw, *fit = m->have_fit ? &m->fit : &m->raw;
-        const gr_channel_metrics *yr = &raw->ch[GR_MCH_Y], *yf = &fit->ch[GR_MCH_Y];
+        const gr_channel_metrics *yf = &fit->ch[GR_MCH_Y];
         const gr_meta_item *g = gr_meta_get(t->meta, "godrays:gpu_ms"), *w = gr_meta_get(t->meta, "godrays:wall_ms");
         printf("\n#%d %s: %.2f s in this run (GPU ", r + 1, t->name, t->seconds);
         if (g && g->type != GR_META_STRING && g->num >= 0) printf("%.2f ms", g->num);
         else printf("n/a");
         printf(", wall %.2f ms per render)\n", w && w->type != GR_META_STRING ? w->num : NAN);
-        printf("luminance Y                  as rendered   x a (a = %.4g)\n", fit->scale);
-#define ROW(label, a, b) printf("  %-24s %12.4g %12.4g\n", label, (double)(a), (double)(b))
-        ROW("bias (mean a t - r)", yr->bias, yf->bias);
-        ROW("RMSE", yr->rmse, yf->rmse);
-        ROW("RMSE / mean reference", rel(yr), rel(yf));
-        ROW("relative MSE", yr->rel_mse, yf->rel_mse);
-        ROW("PSNR dB (ref peak)", yr->psnr_ref_db, yf->psnr_ref_db);
-        ROW("SSIM", raw->ssim_y, fit->ssim_y);
-        ROW("RMSE, blur sigma 16 px", yr->rmse_blur[GR_METRICS_NSCALES - 1], yf->rmse_blur[GR_METRICS_NSCALES - 1]);
-#undef ROW
+        printf("metric (registry)            as rendered   x a (a = %.4g)\n", fit->scale);
+        for (int i = 0; i < gr_metric_count(); i++) { /* those computed in this run */
+            const double vr = gr_metric_value(raw, i), vf = gr_metric_value(fit, i);
+            if (!isnan(vr) || !isnan(vf)) printf("  %-24s %12.4g %12.4g\n", gr_metric_at(i)->label, vr, vf);
+        }
         printf("scored %lld of %lld pixels (%lld not scored: reference rel. std. error > %g)", m->n_scored,
                m->n_pixels, m->n_stderr_excluded, m->stderr_bound);
         if (m->have_stderr && yf->n_samples > 0)
@@ -190,16 +184,20 @@ static void print_summary(const char *dir, const gr_scene *scene, const gr_repor
                    100.0 * (double)yf->n_not_significant / (double)yf->n_samples);
         printf("\n");
     }
-    printf("\nleaderboard (rel. RMSE of Y after the scale fit):\n");
-    printf("  %-4s %-24s %12s %12s %10s %10s %10s\n", "rank", "technique", "rel. RMSE", "after fit", "SSIM fit",
-           "GPU ms", "wall ms");
+    printf("\nleaderboard (rel. RMSE of Y after the scale fit; the registry's leaderboard metrics after the fit):\n");
+    printf("  %-4s %-24s", "rank", "technique");
+    for (int i = 0; i < gr_metric_count(); i++)
+        if (gr_metric_at(i)->leaderboard) printf(" %12s", gr_metric_at(i)->label);
+    printf(" %10s %10s\n", "GPU ms", "wall ms");
     for (int r = 0; r < nt; r++) {
         const gr_report_technique *t = &ts[order[r]];
         const gr_metrics *m = t->metrics;
         const gr_metrics_set *fit = m->have_fit ? &m->fit : &m->raw;
         const gr_meta_item *g = gr_meta_get(t->meta, "godrays:gpu_ms"), *w = gr_meta_get(t->meta, "godrays:wall_ms");
-        printf("  %-4d %-24s %12.4g %12.4g %10.4f %10.3f %10.3f\n", r + 1, t->name, rel(&m->raw.ch[GR_MCH_Y]),
-               rel(&fit->ch[GR_MCH_Y]), fit->ssim_y, g && g->type != GR_META_STRING && g->num >= 0 ? g->num : NAN,
+        printf("  %-4d %-24s", r + 1, t->name);
+        for (int i = 0; i < gr_metric_count(); i++)
+            if (gr_metric_at(i)->leaderboard) printf(" %12.4g", gr_metric_value(fit, i));
+        printf(" %10.3f %10.3f\n", g && g->type != GR_META_STRING && g->num >= 0 ? g->num : NAN,
                w && w->type != GR_META_STRING ? w->num : NAN);
     }
     printf("report: %s/index.html (also summary.png, metrics.json)\n", dir);

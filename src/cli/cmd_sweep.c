@@ -38,7 +38,7 @@ static void usage(FILE *f)
             "  -h, --help           this help\n"
             "\n"
             "Exit codes: 0 ok, 1 runtime failure, 2 bad usage, bad parameter spec or bad scene.\n",
-            gr_tune_cli_help);
+            gr_tune_cli_help());
 }
 
 typedef struct progress_ctx {

@@ -59,7 +59,7 @@ static void usage(FILE *f)
             "  -h, --help           this help\n"
             "\n"
             "Exit codes: 0 ok, 1 runtime failure, 2 bad usage, bad parameter spec or bad scene.\n",
-            GR_TUNE_MAX_PARAMS, GR_OPT_MAX_STARTS, gr_tune_cli_help);
+            GR_TUNE_MAX_PARAMS, GR_OPT_MAX_STARTS, gr_tune_cli_help());
 }
 
 /* The objective, recording every evaluation into trace.csv. */

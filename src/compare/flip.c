@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "compare/metrics.h"
+#include "compare/channels.h"
 #include "image/oiio.h"
 
 #define PI 3.14159265358979323846

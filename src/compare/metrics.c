@@ -6,36 +6,12 @@
 #include <string.h>
 
 #include "compare/blur.h"
+#include "compare/registry.h"
 #include "core/student.h"
 
 const double gr_metrics_blur_sigmas[GR_METRICS_NSCALES] = {1.0, 4.0, 16.0};
 
 static const double lum_w[3] = {GR_LUM_R, GR_LUM_G, GR_LUM_B};
-
-const char *gr_metric_channel_name(gr_metric_channel ch)
-{
-    switch (ch) {
-    case GR_MCH_R: return "R";
-    case GR_MCH_G: return "G";
-    case GR_MCH_B: return "B";
-    case GR_MCH_RGB: return "RGB";
-    case GR_MCH_Y: return "Y";
-    case GR_MCH_COUNT: break;
-    }
-    return "?";
-}
-
-void gr_metrics_pick_rgb(const gr_image *img, int rgb[3])
-{
-    rgb[0] = rgb[1] = rgb[2] = 0;
-    if (!img) return;
-    int r = gr_image_channel(img, "R"), g = gr_image_channel(img, "G"), b = gr_image_channel(img, "B");
-    if (r >= 0 && g >= 0 && b >= 0) {
-        rgb[0] = r, rgb[1] = g, rgb[2] = b;
-    } else if (img->nchannels >= 3) {
-        rgb[0] = 0, rgb[1] = 1, rgb[2] = 2;
-    }
-}
 
 /* Everything a metrics set needs, shared between the raw and the fitted pass. */
 typedef struct ctx {
@@ -238,6 +214,30 @@ static gr_status blurred_rmse(const ctx *cx, const int rr[3], const int tr[3], d
     return GR_OK;
 }
 
+/* The registry's metrics that come with their own compute function (registry.h), on this
+ * set's scaling; the others are read from the set's fields by their extract functions. */
+static gr_status own_metrics(const ctx *cx, const int rr[3], const int tr[3], double scale, gr_metrics_set *set,
+                             gr_error *err)
+{
+    set->n_extra = gr_metric_count();
+    for (int i = 0; i < GR_METRIC_MAX; i++) set->extra[i] = NAN;
+    if (cx->opt->skip_extra) return GR_OK;
+    gr_metric_input in = {.ref = cx->ref, .test = cx->test, .scale = scale, .scored = cx->scored,
+                          .n_scored = cx->n_scored};
+    memcpy(in.ref_rgb, rr, sizeof in.ref_rgb);
+    memcpy(in.test_rgb, tr, sizeof in.test_rgb);
+    for (int i = 0; i < set->n_extra; i++) {
+        const gr_metric_desc *d = gr_metric_at(i);
+        if (!d->compute) continue;
+        gr_status st = d->compute(&in, d->user, &set->extra[i], err);
+        if (st != GR_OK) {
+            gr_error_prefix(err, "metric %s", d->key);
+            return st;
+        }
+    }
+    return GR_OK;
+}
+
 static gr_status compute_set(const ctx *cx, const int rr[3], const int tr[3], double scale, gr_metrics_set *set,
                              gr_error *err)
 {
@@ -289,7 +289,7 @@ static gr_status compute_set(const ctx *cx, const int rr[3], const int tr[3], do
         if (st != GR_OK) return st;
         set->have_flip = 1;
     }
-    return GR_OK;
+    return own_metrics(cx, rr, tr, scale, set, err);
 }
 
 double gr_structure_score(const gr_structure_compare *c)

@@ -3,6 +3,8 @@
 
 #include <math.h>
 
+#include "compare/registry.h"
+
 /* JSON has no infinity: a non-finite number (only PSNR of identical images, or an unbounded
  * stderr bound) is written as null, documented in docs/metrics.md. */
 static int add_num(cJSON *o, const char *k, double v)
@@ -64,10 +66,34 @@ static cJSON *set_json(const gr_metrics *m, const gr_metrics_set *s)
              add_num(sj, "contrast_log_error", s->structure_contrast_err) &&
              add_num(sj, "log_spectral_distance", s->structure_lsd);
     }
+    cJSON *reg = ok ? cJSON_AddObjectToObject(o, "registry") : NULL;
+    ok = ok && reg;
+    for (int i = 0; ok && i < gr_metric_count(); i++) ok = add_num(reg, gr_metric_at(i)->key, gr_metric_value(s, i));
     for (int c = 0; ok && c < GR_MCH_COUNT; c++) {
         cJSON *cj = channel_json(&s->ch[c], m->have_stderr, s->have_blur);
         ok = cj && cJSON_AddItemToObject(chs, gr_metric_channel_name((gr_metric_channel)c), cj);
         if (!ok) cJSON_Delete(cj);
+    }
+    if (!ok) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
+}
+
+/* The registry's descriptors: what each key of a set's "registry" object means. */
+static cJSON *registry_json(void)
+{
+    cJSON *o = cJSON_CreateObject();
+    int ok = o != NULL;
+    for (int i = 0; ok && i < gr_metric_count(); i++) {
+        const gr_metric_desc *d = gr_metric_at(i);
+        cJSON *one = cJSON_AddObjectToObject(o, d->key);
+        ok = one && cJSON_AddStringToObject(one, "label", d->label) && cJSON_AddStringToObject(one, "doc", d->doc) &&
+             cJSON_AddStringToObject(one, "unit", gr_metric_unit_name(d->unit)) &&
+             cJSON_AddStringToObject(one, "better", gr_metric_better_name(d->better)) && add_num(one, "best", d->best) &&
+             cJSON_AddStringToObject(one, "cost", gr_metric_cost_name(d->cost)) &&
+             cJSON_AddBoolToObject(one, "needs_scene", d->needs_scene);
     }
     if (!ok) {
         cJSON_Delete(o);
@@ -107,6 +133,9 @@ static cJSON *conventions_json(const gr_metrics *m)
          add_num(o, "significance_z", m->stderr_z) && add_num(o, "ssim_K1", GR_SSIM_K1) &&
          add_num(o, "ssim_K2", GR_SSIM_K2) && add_num(o, "ssim_L", m->ssim_L) && add_num(o, "ssim_C1", m->ssim_c1) &&
          add_num(o, "ssim_C2", m->ssim_c2);
+    cJSON *reg = ok ? registry_json() : NULL;
+    if (reg && !cJSON_AddItemToObject(o, "registry", reg)) cJSON_Delete(reg), reg = NULL;
+    ok = ok && reg;
     if (!ok) {
         cJSON_Delete(o);
         return NULL;
@@ -225,6 +254,34 @@ void gr_metrics_print_table(FILE *f, const gr_metrics *m)
                     m->fit.scale);
         else fprintf(f, "\nbest scale fit undefined (the test image is zero over the scored pixels): scale 1\n");
         if (m->fit_defined) print_set(f, m, &m->fit);
+    }
+}
+
+void gr_metrics_print_summary(FILE *f, const gr_metrics *m, unsigned costs)
+{
+    if (!f || !m) return;
+    const int fit = m->have_fit && m->fit_defined;
+    int shown = 0;
+    for (int i = 0; i < gr_metric_count(); i++) {
+        const gr_metric_desc *d = gr_metric_at(i);
+        const double x[2] = {gr_metric_value(&m->raw, i), fit ? gr_metric_value(&m->fit, i) : NAN};
+        if (!(costs & (1u << d->cost)) || (isnan(x[0]) && isnan(x[1]))) continue;
+        if (!shown++) {
+            fprintf(f, "metrics (docs/metrics.md)           %11s", "as given");
+            if (fit) fprintf(f, " %11s", "x scale");
+            fprintf(f, "\n");
+        }
+        char lab[64], v[2][32];
+        snprintf(lab, sizeof lab, "%s (%s)", d->label, d->key);
+        for (int k = 0; k < 2; k++) {
+            if (isnan(x[k])) snprintf(v[k], sizeof v[k], "n/a");
+            else snprintf(v[k], sizeof v[k], "%.6g", x[k]);
+        }
+        fprintf(f, "  %-34s %11s", lab, v[0]);
+        if (fit) fprintf(f, " %11s", v[1]);
+        if (d->better == GR_METRIC_NEARER) fprintf(f, "   nearer %g is better", d->best);
+        else fprintf(f, "   %s is better", gr_metric_better_name(d->better));
+        fprintf(f, "%s\n", d->unit == GR_METRIC_RADIANCE ? "; image units" : "");
     }
 }
 

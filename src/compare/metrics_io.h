@@ -12,13 +12,20 @@
 #include "compare/structure.h"
 
 /* A new JSON object with every field of m and the conventions used (luminance weights, rel
- * MSE epsilon rule, PSNR peaks, SSIM constants, blur sigmas, stderr z and bound). +inf PSNR
- * is written as null (JSON has no infinity). NULL if out of memory. */
+ * MSE epsilon rule, PSNR peaks, SSIM constants, blur sigmas, stderr z and bound). Each set
+ * ("metrics": as given, "fitted") carries "registry": every registered metric by key
+ * (compare/registry.h), each described under conventions.registry. +inf PSNR and metrics not computed are written as
+ * null (JSON has no infinity). NULL if out of memory. */
 cJSON *gr_metrics_to_json(const gr_metrics *m);
 
 /* Prints the metrics as an aligned table (rows: metrics, columns R G B RGB Y) with the
  * scoring counts, exclusions and conventions stated; the fitted table follows if present. */
 void gr_metrics_print_table(FILE *f, const gr_metrics *m);
+
+/* The registry's metrics (compare/registry.h) whose cost class is in costs (bit 1 << cost;
+ * ~0u: all) and that were computed: one line each with the value as given and after the scale
+ * fit ("n/a": not computed for that set), under a header line. Nothing when none is left. */
+void gr_metrics_print_summary(FILE *f, const gr_metrics *m, unsigned costs);
 
 /* FLIP (compare/flip.h) as JSON: mode, ppd, tone mapper and exposures (HDR), the scale the
  * test was multiplied by, and the pooled statistics. NULL if out of memory. */

@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "compare/blur.h"
-#include "compare/metrics.h"
+#include "compare/channels.h"
 #include "core/optics.h"
 #include "core/vec.h"
 

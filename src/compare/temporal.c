@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "compare/metrics.h"
+#include "compare/channels.h"
 
 double gr_temporal_profile_drift(const double *f0, const unsigned char *v0, const double *f1, const unsigned char *v1,
                                  int n_theta, double max_deg)

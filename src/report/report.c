@@ -16,6 +16,7 @@
 #include "compare/diffmap.h"
 #include "compare/flip.h"
 #include "compare/metrics_io.h"
+#include "compare/registry.h"
 #include "image/oiio.h"
 #include "report/html.h"
 #include "report/plot.h"
@@ -600,6 +601,30 @@ static void html_metrics_table(gr_strbuf *b, const gr_metrics *m, const gr_metri
                  s->have_ssim ? fmt(s->ssim_y, t[0], sizeof t[0]) : "not computed");
 }
 
+/* Every metric of the registry (compare/registry.h): as rendered and after the scale fit. */
+static void html_registry_table(gr_strbuf *b, const gr_metrics *m)
+{
+    char t[2][64];
+    const gr_metrics_set *fs = m->have_fit ? &m->fit : &m->raw;
+    gr_sb_puts(b, "<table><caption class=\"sub\">The metrics of the registry (n/a: not computed in this run)"
+                  "</caption><tr><th class=\"l\">metric</th><th class=\"l\">key</th><th>a = 1</th><th>x a</th>"
+                  "<th class=\"l\">better</th><th class=\"l\">unit</th><th class=\"l\">what</th></tr>\n");
+    for (int i = 0; i < gr_metric_count(); i++) {
+        const gr_metric_desc *d = gr_metric_at(i);
+        gr_sb_puts(b, "<tr><td class=\"l\">");
+        gr_sb_html(b, d->label);
+        gr_sb_puts(b, "</td><td class=\"l\"><code>");
+        gr_sb_html(b, d->key);
+        gr_sb_printf(b, "</code></td><td>%s</td><td>%s</td><td class=\"l\">%s</td><td class=\"l\">%s</td>"
+                        "<td class=\"l\">", fmt(gr_metric_value(&m->raw, i), t[0], sizeof t[0]),
+                     fmt(gr_metric_value(fs, i), t[1], sizeof t[1]), gr_metric_better_name(d->better),
+                     gr_metric_unit_name(d->unit));
+        gr_sb_html(b, d->doc);
+        gr_sb_puts(b, "</td></tr>\n");
+    }
+    gr_sb_puts(b, "</table>\n");
+}
+
 static void html_settings_table(gr_strbuf *b, const gr_param_table *t, const void *settings)
 {
     gr_sb_puts(b, "<table><tr><th class=\"l\">setting</th><th>value</th><th class=\"l\">unit</th>"
@@ -721,11 +746,8 @@ typedef struct ctx {
     char lines[2][512];            /* scene, reference */
 } ctx;
 
-static double rel_rmse_y(const gr_metrics_set *s)
-{
-    const gr_channel_metrics *y = &s->ch[GR_MCH_Y];
-    return y->ref_mean != 0 ? y->rmse / fabs(y->ref_mean) : NAN;
-}
+/* The leaderboard's ranking metric (compare/registry.h: RMSE of Y over |mean reference Y|). */
+static double rel_rmse_y(const gr_metrics_set *s) { return gr_metric_value(s, GR_METRIC_REL_RMSE); }
 
 static const gr_metrics_set *fit_set(const gr_metrics *m) { return m->have_fit ? &m->fit : &m->raw; }
 
@@ -799,13 +821,12 @@ static cJSON *technique_json(const ctx *c, int k, int rank)
     /* the headline errors (luminance), raw and after the fit */
     cJSON *e = cJSON_CreateObject();
     jadd(o, "errors_y", e, &ok);
-    jnum(e, "rmse", m->raw.ch[GR_MCH_Y].rmse, &ok);
-    jnum(e, "rmse_fit", fit_set(m)->ch[GR_MCH_Y].rmse, &ok);
-    jnum(e, "rel_rmse", rel_rmse_y(&m->raw), &ok);
-    jnum(e, "rel_rmse_fit", rel_rmse_y(fit_set(m)), &ok);
-    jnum(e, "ssim", m->raw.have_ssim ? m->raw.ssim_y : NAN, &ok);
-    jnum(e, "ssim_fit", fit_set(m)->have_ssim ? fit_set(m)->ssim_y : NAN, &ok);
-    jnum(e, "bias_fit", fit_set(m)->ch[GR_MCH_Y].bias, &ok);
+    for (int i = 0; ok && i < gr_metric_count(); i++) { /* every registered metric: KEY and KEY_fit */
+        char key[GR_METRIC_KEY_MAX + 8];
+        snprintf(key, sizeof key, "%s_fit", gr_metric_at(i)->key);
+        jnum(e, gr_metric_at(i)->key, gr_metric_value(&m->raw, i), &ok);
+        jnum(e, key, gr_metric_value(fit_set(m), i), &ok);
+    }
     /* every metric, as `godrays compare --json` writes it */
     jadd(o, "compare", gr_metrics_to_json(m), &ok);
     cJSON *pv = cJSON_CreateObject();
@@ -1062,11 +1083,18 @@ static void html_tuning_pages(gr_strbuf *b, const ctx *c)
 static void html_leaderboard(gr_strbuf *b, const ctx *c)
 {
     const gr_report_input *in = c->in;
-    char t[10][48];
+    char t[48];
     gr_sb_puts(b, "<h2 id=\"leaderboard\">Leaderboard</h2>\n<table class=\"lb\"><tr><th>rank</th><th class=\"l\">"
-                  "technique</th><th class=\"l\">image (x a)</th><th>RMSE Y</th><th>RMSE Y<br>after fit</th>"
-                  "<th>rel. RMSE Y</th><th>rel. RMSE Y<br>after fit</th><th>SSIM</th><th>SSIM<br>after fit</th>"
-                  "<th>scale a</th><th>GPU ms<br>(passes)</th><th>wall ms<br>(render)</th><th>s in<br>this run</th></tr>\n");
+                  "technique</th><th class=\"l\">image (x a)</th>");
+    for (int i = 0; i < gr_metric_count(); i++) { /* the registry's leaderboard metrics, raw and after the fit */
+        if (!gr_metric_at(i)->leaderboard) continue;
+        for (int f = 0; f < 2; f++) {
+            gr_sb_puts(b, "<th>");
+            gr_sb_html(b, gr_metric_at(i)->label);
+            gr_sb_puts(b, f ? "<br>after fit</th>" : "</th>");
+        }
+    }
+    gr_sb_puts(b, "<th>scale a</th><th>GPU ms<br>(passes)</th><th>wall ms<br>(render)</th><th>s in<br>this run</th></tr>\n");
     for (int r = 0; r < in->n_techniques; r++) {
         const tctx *tc = &c->t[c->order[r]];
         const gr_metrics *m = tc->t->metrics;
@@ -1082,10 +1110,13 @@ static void html_leaderboard(gr_strbuf *b, const ctx *c)
         gr_sb_puts(b, "\" class=\"thumb\" alt=\"");
         gr_sb_html(b, tc->t->name);
         gr_sb_printf(b, "\" width=\"%d\" height=\"%d\"></td>", tc->disp_fit->width, tc->disp_fit->height);
-        const double v[10] = {m->raw.ch[GR_MCH_Y].rmse, fs->ch[GR_MCH_Y].rmse, rel_rmse_y(&m->raw), rel_rmse_y(fs),
-                              m->raw.have_ssim ? m->raw.ssim_y : NAN, fs->have_ssim ? fs->ssim_y : NAN, tc->a,
-                              tc->gpu_ms, tc->wall_ms, tc->t->seconds >= 0 ? tc->t->seconds : NAN};
-        for (int i = 0; i < 10; i++) gr_sb_printf(b, "<td>%s</td>", fmt(v[i], t[i], sizeof t[i]));
+        for (int i = 0; i < gr_metric_count(); i++) {
+            if (!gr_metric_at(i)->leaderboard) continue;
+            gr_sb_printf(b, "<td>%s</td>", fmt(gr_metric_value(&m->raw, i), t, sizeof t));
+            gr_sb_printf(b, "<td>%s</td>", fmt(gr_metric_value(fs, i), t, sizeof t));
+        }
+        const double v[4] = {tc->a, tc->gpu_ms, tc->wall_ms, tc->t->seconds >= 0 ? tc->t->seconds : NAN};
+        for (int i = 0; i < 4; i++) gr_sb_printf(b, "<td>%s</td>", fmt(v[i], t, sizeof t));
         gr_sb_puts(b, "</tr>\n");
     }
     gr_sb_puts(b, "</table>\n<p class=\"sub\">Ranked by the relative RMSE of luminance after the best scale fit "
@@ -1168,7 +1199,9 @@ static void html_technique(ctx *c, gr_strbuf *b, int k)
                    "standard error of luminance exceeds %s). Y = 0.2126 R + 0.7152 G + 0.0722 B; RGB pools the "
                    "three channels as OpenImageIO idiff does. Formulas and conventions: docs/metrics.md.",
                 m->n_scored, m->n_pixels, m->n_masked_out, m->n_stderr_excluded, fmt(m->stderr_bound, tt[0], sizeof tt[0]));
-    gr_sb_puts(b, "</p>\n<div class=\"grid\">\n<div>\n");
+    gr_sb_puts(b, "</p>\n");
+    html_registry_table(b, m);
+    gr_sb_puts(b, "<div class=\"grid\">\n<div>\n");
     if (m->have_fit) {
         char capt[160];
         snprintf(capt, sizeof capt, "After the best scale fit: test x a, a = <t, r> / <t, t> = %.6g%s", m->fit.scale,

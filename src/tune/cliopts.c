@@ -7,22 +7,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char gr_tune_cli_help[] =
-    "  -o, --output DIR     report folder (default: out/SCENE_NAME/COMMAND)\n"
-    "  --metric M           rmse (sweep's default), relmse, ssim (scored as 1 - SSIM), msrmse (mean RMSE\n"
-    "                       after blurs at 1, 4, 16 px), all on luminance Y; flip (mean HDR-FLIP)\n"
-    "                       or structure (beam-structure score in [0, 1]): docs/metrics.md\n"
-    "  --objective W        a weighted sum instead (tune's default: " GR_TUNE_DEFAULT_OBJECTIVE "),\n"
-    "                       e.g. rmse=1,structure=1,flip=0.5: each class\n"
-    "                       dimensionless (rmse, msrmse relative to the mean reference Y), the\n"
-    "                       weights normalized to sum 1 (docs/tuning.md)\n"
+/* The options after --metric and --objective (which list the registry's keys). */
+static const char help_rest[] =
     "  --technique NAME     the real-time technique (default: the one the parameters name, else\n"
     "                       the first of `godrays techniques`); its settings are NAME.KEY\n"
     "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
     "  --fit / --no-fit     score the technique after the best scale fit a = <t,r>/<t,t>\n"
     "                       (default: on, unless its gain setting, e.g. intensity, is a parameter)\n"
-    "  --normalize          divide rmse/msrmse by each case's mean reference Y, so that every\n"
-    "                       frame and view weighs the same in the mean\n"
+    "  --normalize          divide a metric in image units (rmse, msrmse) by each case's mean\n"
+    "                       reference Y, so that every frame and view weighs the same in the mean\n"
     "  --set KEY=VALUE      override a scene value before validation (repeatable), e.g.\n"
     "                       reference.spp=2 or NAME.KEY=V\n"
     "  --size WxH           image size (camera.width/height)\n"
@@ -39,10 +32,38 @@ const char gr_tune_cli_help[] =
     "                       refused before the ground truths; docs/tuning.md \"Budgets\")\n"
     "  -q, --quiet          no progress messages\n";
 
+const char *gr_tune_cli_help(void)
+{
+    static char text[4096];
+    char keys[512], wrapped[768];
+    gr_metric_keys(keys, sizeof keys, ", ", 1);
+    /* the keys wrapped under the option column */
+    size_t w = 0, col = 23;
+    w += (size_t)snprintf(wrapped + w, sizeof wrapped - w, "%23s", "");
+    for (char *save = NULL, *t = strtok_r(keys, " ", &save); t && w < sizeof wrapped; t = strtok_r(NULL, " ", &save)) {
+        if (col + strlen(t) + 1 > 96) w += (size_t)snprintf(wrapped + w, sizeof wrapped - w, "\n%23s", ""), col = 23;
+        if (w < sizeof wrapped) w += (size_t)snprintf(wrapped + w, sizeof wrapped - w, "%s%s", col > 23 ? " " : "", t);
+        col += strlen(t) + 1;
+    }
+    snprintf(text, sizeof text,
+             "  -o, --output DIR     report folder (default: out/SCENE_NAME/COMMAND)\n"
+             "  --metric M           the error, a key of the metric registry (docs/metrics.md):\n"
+             "%s\n"
+             "                       (rmse: sweep's default; a higher-is-better metric is scored as\n"
+             "                       best - value, ssim as 1 - SSIM; flip: mean HDR-FLIP)\n"
+             "  --objective W        a weighted sum instead (tune's default: " GR_TUNE_DEFAULT_OBJECTIVE "),\n"
+             "                       e.g. rmse=1,structure=1,flip=0.5: each class\n"
+             "                       dimensionless (those in image units, rmse, msrmse, relative to the\n"
+             "                       mean reference Y), the weights normalized to sum 1 (docs/tuning.md)\n"
+             "%s",
+             wrapped, help_rest);
+    return text;
+}
+
 void gr_tune_cli_init(gr_tune_cli *c)
 {
     memset(c, 0, sizeof *c);
-    c->metric = GR_TM_RMSE;
+    c->metric = GR_METRIC_RMSE;
     c->fit = -1;
     c->fps = 30.0;
     c->so.use_cache = 1;

@@ -1,7 +1,7 @@
 /* Command-line options shared by `godrays sweep` and `godrays tune` (frames, views, metric,
  * scale fit, cache), parsed in one place so that both commands accept and check them the same
  * way. The options every command shares (-o, --set, --size, --gl-platform) are read by the
- * command line's own src/cli/args.h; gr_tune_cli_help lists both. */
+ * command line's own src/cli/args.h; gr_tune_cli_help() lists both. */
 #ifndef GR_TUNE_CLIOPTS_H
 #define GR_TUNE_CLIOPTS_H
 
@@ -13,7 +13,7 @@
 typedef struct gr_tune_cli {
     gr_tune_session_options so;   /* sets, n_sets, gl_platform, scene_path: the caller's */
     gr_tune_metric metric;
-    double weights[GR_TM_COUNT];  /* --objective (metric GR_TM_WEIGHTED) */
+    double weights[GR_METRIC_MAX]; /* --objective (metric GR_TM_WEIGHTED) */
     int fit;                      /* -1: auto (on unless the gain_key setting is a parameter) */
     int normalize;                /* --normalize */
     int quiet;
@@ -48,7 +48,7 @@ gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_pa
  * 4 best (x0's always) continued for up to 60 + 40 n evaluations each; a polish of as many. */
 void gr_tune_search_defaults(gr_opt_options *o, int n_params, const double *x0);
 
-/* The help text of the shared options. */
-extern const char gr_tune_cli_help[];
+/* The help text of the shared options (--metric lists the metric registry's keys). */
+const char *gr_tune_cli_help(void);
 
 #endif

@@ -11,24 +11,21 @@
 
 #include "report/profile.h"
 
-static const char *const metric_names[GR_TM_COUNT] = {"rmse", "relmse", "ssim", "msrmse", "flip", "structure",
-                                                      "objective"};
-
 gr_status gr_tune_metric_parse(const char *flag, const char *s, gr_tune_metric *m, gr_error *err)
 {
-    for (int i = 0; i < GR_TM_WEIGHTED; i++) {
-        if (!strcmp(s, metric_names[i])) {
-            *m = (gr_tune_metric)i;
-            return GR_OK;
-        }
+    const int i = gr_metric_find(s);
+    if (i >= 0 && gr_metric_is_objective(gr_metric_at(i))) {
+        *m = i;
+        return GR_OK;
     }
-    return gr_fail(err, GR_E_USAGE, "%s %s: unknown metric (expected rmse, relmse, ssim, msrmse, flip or structure)",
-                   flag, s);
+    char keys[512];
+    gr_metric_keys(keys, sizeof keys, ", ", 1);
+    return gr_fail(err, GR_E_USAGE, "%s %s: unknown metric (expected one of %s)", flag, s, keys);
 }
 
-gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_TM_COUNT], gr_error *err)
+gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_METRIC_MAX], gr_error *err)
 {
-    for (int k = 0; k < GR_TM_COUNT; k++) w[k] = 0.0;
+    for (int k = 0; k < GR_METRIC_MAX; k++) w[k] = 0.0;
     char buf[512];
     if (!s || strlen(s) >= sizeof buf) return gr_fail(err, GR_E_USAGE, "%s: missing or too long", flag);
     strcpy(buf, s);
@@ -37,7 +34,7 @@ gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_TM_
         char *eq = strchr(t, '=');
         if (!eq) return gr_fail(err, GR_E_USAGE, "%s %s: '%s' is not NAME=WEIGHT", flag, s, t);
         *eq = '\0';
-        gr_tune_metric m = GR_TM_RMSE;
+        gr_tune_metric m = 0;
         if (gr_tune_metric_parse(flag, t, &m, err) != GR_OK) return err->status;
         char *end = NULL;
         const double v = strtod(eq + 1, &end);
@@ -52,33 +49,29 @@ gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_TM_
 
 const char *gr_tune_metric_name(gr_tune_metric m)
 {
-    return (m >= 0 && m < GR_TM_COUNT) ? metric_names[m] : "?";
+    if (m == GR_TM_WEIGHTED) return "objective";
+    const gr_metric_desc *d = gr_metric_at(m);
+    return d ? d->key : "?";
 }
 
 double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m)
 {
-    const gr_channel_metrics *y = &set->ch[GR_MCH_Y];
-    double v;
-    switch (m) {
-    case GR_TM_RELMSE: v = y->rel_mse; break;
-    case GR_TM_SSIM: v = 1.0 - set->ssim_y; break;
-    case GR_TM_MSRMSE:
-        v = 0.0;
-        for (int k = 0; k < GR_METRICS_NSCALES; k++) v += y->rmse_blur[k];
-        v /= GR_METRICS_NSCALES;
-        break;
-    case GR_TM_FLIP: v = set->have_flip ? set->flip.mean : 1.0; break;
-    case GR_TM_STRUCTURE: v = set->have_structure ? set->structure_score : 1.0; break;
-    case GR_TM_WEIGHTED: v = 1e300; break;
-    default: v = y->rmse; break;
-    }
+    const double v = gr_metric_loss(gr_metric_at(m), gr_metric_value(set, m));
     return isfinite(v) ? v : 1e300;
 }
 
-/* Whether metric k enters the problem's value. */
-static int uses(const gr_tune_problem *p, gr_tune_metric k)
+/* Whether registry metric k enters the problem's value. */
+static int uses(const gr_tune_problem *p, int k)
 {
     return p->metric == k || (p->metric == GR_TM_WEIGHTED && p->weights[k] > 0.0);
+}
+
+/* Whether any metric the problem uses needs the scene (the beams' vanishing point). */
+static int uses_scene(const gr_tune_problem *p)
+{
+    for (int k = 0; k < gr_metric_count(); k++)
+        if (uses(p, k) && gr_metric_at(k)->needs_scene) return 1;
+    return 0;
 }
 
 double gr_tune_value(const gr_tune_problem *p, const gr_metrics_set *set)
@@ -87,41 +80,55 @@ double gr_tune_value(const gr_tune_problem *p, const gr_metrics_set *set)
     if (p->metric != GR_TM_WEIGHTED) {
         double v = gr_tune_metric_value(set, p->metric);
         /* relative error: a bright view (toward the sun) would otherwise outweigh the rest */
-        if (p->normalize && (p->metric == GR_TM_RMSE || p->metric == GR_TM_MSRMSE) && mean_y > 0) v /= mean_y;
+        const gr_metric_desc *d = gr_metric_at(p->metric);
+        if (p->normalize && d && d->unit == GR_METRIC_RADIANCE && mean_y > 0) v /= mean_y;
         return v;
     }
-    /* each class made dimensionless (rmse, msrmse relative to the mean reference Y; relmse,
-     * 1 - SSIM, FLIP and the structure score already are), then weighted (docs/tuning.md) */
+    /* each class made dimensionless (those in image units relative to the mean reference Y;
+     * relmse, 1 - SSIM, FLIP and the structure score already are), then weighted
+     * (docs/tuning.md); the registry's order is the order of the sum */
     double sum = 0.0, wsum = 0.0;
-    for (int k = 0; k < GR_TM_WEIGHTED; k++) {
+    for (int k = 0; k < gr_metric_count(); k++) {
         if (!(p->weights[k] > 0.0)) continue;
-        if (k == GR_TM_STRUCTURE && !set->have_structure) continue; /* no vanishing point (no_vp) */
-        double v = gr_tune_metric_value(set, (gr_tune_metric)k);
-        if ((k == GR_TM_RMSE || k == GR_TM_MSRMSE) && mean_y > 0) v /= mean_y;
+        const gr_metric_desc *d = gr_metric_at(k);
+        if (d->needs_scene && isnan(gr_metric_value(set, k))) continue; /* no vanishing point (no_vp) */
+        double v = gr_tune_metric_value(set, k);
+        if (d->unit == GR_METRIC_RADIANCE && mean_y > 0) v /= mean_y;
         sum += p->weights[k] * v, wsum += p->weights[k];
     }
     const double v = wsum > 0 ? sum / wsum : 1e300;
     return isfinite(v) ? v : 1e300;
 }
 
-/* The metrics options of case i for the problem's metric(s); fo and so are the caller's. */
+/* The metrics options of case i for the problem's metric(s): only the parts (cost classes)
+ * they need; fo and so are the caller's. */
 static void case_options(const gr_tune_problem *p, int i, gr_metrics_options *opt, gr_flip_options *fo,
                          gr_structure_options *so)
 {
-    if (uses(p, GR_TM_FLIP)) {
-        memset(fo, 0, sizeof *fo);
-        fo->mode = GR_FLIP_HDR;
-        opt->flip = fo;
+    for (int k = 0; k < gr_metric_count(); k++) {
+        if (!uses(p, k)) continue;
+        switch (gr_metric_at(k)->cost) {
+        case GR_METRIC_COST_FLIP:
+            memset(fo, 0, sizeof *fo);
+            fo->mode = GR_FLIP_HDR;
+            opt->flip = fo;
+            break;
+        case GR_METRIC_COST_STRUCTURE:
+            if (!p->no_vp[i]) {
+                const gr_camera *c = &p->scenes[i]->camera;
+                memset(so, 0, sizeof *so);
+                so->vp_x = p->vp[i][0], so->vp_y = p->vp[i][1];
+                so->radial = p->angles[i], so->radial_bin = c->fov_deg / c->height;
+                opt->structure = so;
+            }
+            break;
+        case GR_METRIC_COST_SSIM: opt->skip_ssim = 0; break;
+        case GR_METRIC_COST_BLUR: opt->skip_blur = 0; break;
+        case GR_METRIC_COST_OWN: opt->skip_extra = 0; break;
+        case GR_METRIC_COST_PASS:
+        case GR_METRIC_COST_COUNT: break;
+        }
     }
-    if (uses(p, GR_TM_STRUCTURE) && !p->no_vp[i]) {
-        const gr_camera *c = &p->scenes[i]->camera;
-        memset(so, 0, sizeof *so);
-        so->vp_x = p->vp[i][0], so->vp_y = p->vp[i][1];
-        so->radial = p->angles[i], so->radial_bin = c->fov_deg / c->height;
-        opt->structure = so;
-    }
-    if (uses(p, GR_TM_SSIM)) opt->skip_ssim = 0;
-    if (uses(p, GR_TM_MSRMSE)) opt->skip_blur = 0;
 }
 
 gr_status gr_tune_make_case(const gr_scene *base, double time_s, const gr_tune_view *view, gr_scene *out,
@@ -175,7 +182,7 @@ gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
     p->base = r;
     p->scratch = gr_image_create(c0->width, c0->height, 3, NULL);
     if (!p->scratch) return gr_fail(err, GR_E_NOMEM, "tuning: out of memory for a %dx%d frame", c0->width, c0->height);
-    if (uses(p, GR_TM_STRUCTURE)) {
+    if (uses_scene(p)) {
         /* the structure metrics' geometry per case: the vanishing point of the refracted sun's
          * rays and the angle to the sun (their de-glow), once */
         for (int i = 0; i < p->n_cases; i++) {
@@ -183,8 +190,8 @@ gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
             gr_status st = gr_structure_scene_vp(p->scenes[i], c->width, c->height, &p->vp[i][0], &p->vp[i][1], err);
             p->no_vp[i] = 0;
             double others = 0.0;
-            for (int k = 0; k < GR_TM_WEIGHTED; k++)
-                if (k != GR_TM_STRUCTURE) others += p->weights[k];
+            for (int k = 0; k < gr_metric_count(); k++)
+                if (!gr_metric_at(k)->needs_scene) others += p->weights[k];
             if (st == GR_E_INPUT && p->metric == GR_TM_WEIGHTED && others > 0.0) {
                 p->no_vp[i] = 1; /* the other terms carry this case */
                 continue;
@@ -268,7 +275,7 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
         gr_structure_options so;
         opt.stderr_bound = p->stderr_bound;
         opt.fit_scale = p->fit;
-        opt.skip_ssim = opt.skip_blur = 1;
+        opt.skip_ssim = opt.skip_blur = opt.skip_extra = 1;
         case_options(p, i, &opt, &fo, &so);
         gr_metrics m;
         if ((st = render_score(p, i, s.bytes, p->scratch, &opt, &m, err)) != GR_OK) return st;

@@ -7,6 +7,7 @@
 
 #include "common/status.h"
 #include "compare/metrics.h"
+#include "compare/registry.h"
 #include "image/image.h"
 #include "realtime/technique.h"
 #include "scene/scene.h"
@@ -14,30 +15,28 @@
 
 #define GR_TUNE_MAX_CASES 64
 
-typedef enum gr_tune_metric {
-    GR_TM_RMSE = 0,   /* RMSE of luminance Y */
-    GR_TM_RELMSE = 1, /* relative MSE of Y (docs/metrics.md) */
-    GR_TM_SSIM = 2,   /* 1 - SSIM of Y (so that lower is better, 0 = identical) */
-    GR_TM_MSRMSE = 3, /* mean of the RMSEs of Y after blurs at sigma 1, 4, 16 px */
-    GR_TM_FLIP = 4,   /* mean HDR-FLIP (compare/flip.h) */
-    GR_TM_STRUCTURE = 5, /* structure score (compare/structure.h via gr_metrics_set), in [0, 1] */
-    GR_TM_WEIGHTED = 6,  /* sum_k w_k v_k / sum_k w_k over the metrics above (problem.weights),
-                            rmse and msrmse relative to the case's mean reference Y */
-    GR_TM_COUNT
-} gr_tune_metric;
+/* The metric a problem minimizes: a registry index (compare/registry.h: "rmse", "ssim",
+ * "flip", "structure", ... and any registered one), or GR_TM_WEIGHTED: sum_k w_k v_k /
+ * sum_k w_k over the registry's metrics (problem.weights), those in image units (unit
+ * "radiance": rmse, msrmse, ...) relative to the case's mean reference Y. Every value is the
+ * metric's loss: lower is better, 0 for identical images (1 - SSIM for SSIM). */
+typedef int gr_tune_metric;
+#define GR_TM_WEIGHTED (-1)
 
-/* "rmse", "relmse", "ssim", "msrmse", "flip", "structure" ("objective" is the weighted sum,
- * chosen by gr_tune_weights_parse). GR_E_USAGE naming flag for anything else. */
+/* A registered metric's key that can be minimized (a finite best value); GR_E_USAGE naming
+ * flag and listing the keys for anything else. ("objective", the weighted sum, is chosen by
+ * gr_tune_weights_parse.) */
 gr_status gr_tune_metric_parse(const char *flag, const char *s, gr_tune_metric *m, gr_error *err);
-const char *gr_tune_metric_name(gr_tune_metric m);
-/* The metric's value from a computed set (raw or fit): lower is better, always finite.
- * GR_TM_FLIP / GR_TM_STRUCTURE need the set computed with them (else 1); GR_TM_WEIGHTED
- * needs the weights: use gr_tune_value. */
+const char *gr_tune_metric_name(gr_tune_metric m); /* the key; "objective" for GR_TM_WEIGHTED */
+/* The metric's loss from a computed set (raw or fit): lower is better, always finite (1e300
+ * for a value that is not finite or not computed: FLIP, structure and the registry's own-
+ * function metrics need the set computed with them); GR_TM_WEIGHTED needs the weights: use
+ * gr_tune_value. */
 double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m);
 
-/* "rmse=1,structure=0.5,flip=0.5": weights w[GR_TM_COUNT] (unnamed metrics 0; each >= 0,
- * finite, at least one > 0). GR_E_USAGE naming flag and the bad part. */
-gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_TM_COUNT], gr_error *err);
+/* "rmse=1,structure=0.5,flip=0.5": weights w[GR_METRIC_MAX] by registry index (unnamed
+ * metrics 0; each >= 0, finite, at least one > 0). GR_E_USAGE naming flag and the bad part. */
+gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_METRIC_MAX], gr_error *err);
 
 /* `godrays tune`'s default objective (docs/tuning.md "The default objective"): the relative
  * RMSE of Y after the scale fit (the radiance error, dominated by the low frequencies: the
@@ -67,15 +66,16 @@ typedef struct gr_tune_problem {
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
     gr_tune_metric metric;
     int fit;                            /* score the test after the best scale fit */
-    int normalize;                      /* rmse/msrmse divided by the case's mean reference Y,
-                                           so that every frame and view weighs the same */
-    double weights[GR_TM_COUNT];        /* GR_TM_WEIGHTED: each metric's weight */
-    /* filled by gr_tune_problem_init when FLIP or structure is needed: per case, the beams'
-     * vanishing point and the angle to the sun per pixel (the structure de-glow) */
+    int normalize;                      /* a metric in image units (rmse, msrmse) divided by the
+                                           case's mean reference Y, so that every frame and view
+                                           weighs the same */
+    double weights[GR_METRIC_MAX];      /* GR_TM_WEIGHTED: each registry metric's weight */
+    /* filled by gr_tune_problem_init when a metric that needs the scene (structure) is used:
+     * per case, the beams' vanishing point and the angle to the sun per pixel (its de-glow) */
     double vp[GR_TUNE_MAX_CASES][2];
     int no_vp[GR_TUNE_MAX_CASES];       /* 1: the case's god rays have no vanishing point on its
                                            image (sun direction across the view); a weighted
-                                           objective then leaves its structure term out there */
+                                           objective then leaves its needs-scene terms out there */
     float *angles[GR_TUNE_MAX_CASES];
     double stderr_bound;                /* passed to the metrics (0: default) */
     /* filled by gr_tune_problem_init */

@@ -37,7 +37,7 @@ int main(void)
         p->params[i].lo = lo[i];
         p->params[i].hi = hi[i];
     }
-    p->metric = GR_TM_RMSE;
+    p->metric = GR_METRIC_RMSE;
     p->fit = 0;
     gr_image *truth = gr_image_create(160, 90, 3, NULL);
     p->refs[0] = truth;

@@ -27,7 +27,7 @@ static void identify(gr_technique *r, const char *format, double k_true, double 
     CHECK_OK(gr_tune_param_lookup("--params", "shafts.extinction", &p->params[1], &err), err);
     p->params[0].lo = 0.4, p->params[0].hi = 1.6;
     p->params[1].lo = 0.3, p->params[1].hi = 3.0;
-    p->metric = GR_TM_RMSE;
+    p->metric = GR_METRIC_RMSE;
     p->fit = 0;
 
     /* the "ground truth": the same renderer at the known settings */

@@ -35,8 +35,8 @@ int main(void)
     p->fit = 1;
     p->metric = GR_TM_WEIGHTED;
     CHECK_OK(gr_tune_weights_parse("--objective", "rmse=1,flip=0.5,structure=2", p->weights, &err), err);
-    CHECK(p->weights[GR_TM_RMSE] == 1.0 && p->weights[GR_TM_FLIP] == 0.5 && p->weights[GR_TM_STRUCTURE] == 2.0 &&
-          p->weights[GR_TM_SSIM] == 0.0);
+    CHECK(p->weights[GR_METRIC_RMSE] == 1.0 && p->weights[GR_METRIC_FLIP] == 0.5 && p->weights[GR_METRIC_STRUCTURE] == 2.0 &&
+          p->weights[GR_METRIC_SSIM] == 0.0);
     gr_image *truth = gr_image_create(160, 90, 3, NULL);
     p->refs[0] = truth;
     CHECK_OK(gr_tune_problem_init(p, &err), err);
@@ -82,15 +82,15 @@ int main(void)
     CHECK(fr.mean > 0.0 && s_score > 0.0);
 
     /* one metric alone */
-    p->metric = GR_TM_STRUCTURE;
+    p->metric = GR_METRIC_STRUCTURE;
     CHECK_OK(gr_tune_evaluate(p, x, &f, NULL, NULL, &err), err);
     CHECK_NEAR(f, s_score, 1e-12);
-    p->metric = GR_TM_FLIP;
+    p->metric = GR_METRIC_FLIP;
     CHECK_OK(gr_tune_evaluate(p, x, &f, NULL, NULL, &err), err);
     CHECK_NEAR(f, fr.mean, 1e-12);
 
     /* the parser's errors */
-    double w[GR_TM_COUNT];
+    double w[GR_METRIC_MAX];
     CHECK(gr_tune_weights_parse("--objective", "rmse=-1", w, &err) == GR_E_USAGE && strstr(err.msg, "'-1'"));
     CHECK(gr_tune_weights_parse("--objective", "bogus=1", w, &err) == GR_E_USAGE && strstr(err.msg, "bogus"));
     CHECK(gr_tune_weights_parse("--objective", "rmse=0", w, &err) == GR_E_USAGE && strstr(err.msg, "no weight"));

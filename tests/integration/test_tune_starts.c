@@ -38,7 +38,7 @@ int main(void)
     p->n_params = 2;
     CHECK_OK(gr_tune_param_lookup("--params", "shafts.K", &p->params[0], &err), err);
     CHECK_OK(gr_tune_param_lookup("--params", "shafts.extinction", &p->params[1], &err), err);
-    p->metric = GR_TM_RMSE;
+    p->metric = GR_METRIC_RMSE;
     p->fit = 1;
     CHECK_OK(gr_tune_problem_init(p, &err), err);
     double lo[2] = {p->params[0].lo, p->params[1].lo}, hi[2] = {p->params[0].hi, p->params[1].hi};

@@ -27,7 +27,7 @@ int main(void)
     p->n_params = 2;
     CHECK_OK(gr_tune_param_parse_sweep("--param", "shafts.K=0.5:1.1:4", &p->params[0], &err), err);
     CHECK_OK(gr_tune_param_parse_sweep("--param", "shafts.extinction=0.5:2:4", &p->params[1], &err), err);
-    p->metric = GR_TM_RMSE;
+    p->metric = GR_METRIC_RMSE;
     p->fit = 0;
     CHECK_OK(gr_tune_problem_init(p, &err), err);
     /* truth = grid point (ix 2, iy 1): K = 0.9, extinction x 1.0 */

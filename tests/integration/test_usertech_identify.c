@@ -51,7 +51,7 @@ int main(void)
             p->params[k].lo = lo[k];
             p->params[k].hi = hi[k];
         }
-        p->metric = GR_TM_RMSE;
+        p->metric = GR_METRIC_RMSE;
         p->fit = 0;
         gr_image *truth = gr_image_create(W, H, 3, NULL);
         p->refs[0] = truth;
