@@ -2,7 +2,6 @@
 
 #include <float.h>
 #include <pthread.h>
-#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 

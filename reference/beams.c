@@ -1,8 +1,5 @@
 #include "reference/beam_grid.h"
 
-#include <float.h>
-#include <pthread.h>
-#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
