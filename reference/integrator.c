@@ -450,7 +450,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             char note[64];
             snprintf(note, sizeof note, "pass %d/%d%s", pp + 1, P, rounds > 1 ? " (refining)" : "");
             int complete = 0;
-            /* the probe's passes: the first min(P, PROBE_PASSES) (surface_bias_probe) */
+            /* the probe's passes: the first min(P, PROBE_PASSES) (gr_ref_probe_run, probe.c) */
             r->probe_capture = cap.sum && pass < (P < PROBE_PASSES ? P : PROBE_PASSES) ? &cap : NULL;
             st = gr_ref_march_pass(r, &acc, pass, pass % acc.B, 1, 0, r->opt.row0, r->opt.row1, pool, prog,
                                 mainw * (rounds > 1 ? pp : pass) / P, mainw / P, note, &tot, &complete, err);

@@ -91,7 +91,8 @@ gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *cap
     }
     int complete = 1;
     /* a part probes its own rows' probe pixels */
-    int y0 = gr_ref_probe_row(r->opt.row0, PROBE_STRIDE, off, a[0].H), y1 = gr_ref_probe_row(r->opt.row1, PROBE_STRIDE, off, a[0].H);
+    int y0 = gr_ref_probe_row(r->opt.row0, PROBE_STRIDE, off, a[0].H);
+    int y1 = gr_ref_probe_row(r->opt.row1, PROBE_STRIDE, off, a[0].H);
     for (int p = 0; p < passes && st == GR_OK && complete; p++)
         for (int k = k0; k < NL && st == GR_OK && complete; k++) {
             r->set.surface_res = lres[k];

@@ -45,7 +45,7 @@ enum { SEGMENTS = 8 };
 /* the march's unit of work: bands of MARCH_TILE rows, walked in square tiles (worker; the
  * pilot's of MARCH_TILE / PILOT_STRIDE pilot pixels: the same image area) */
 #define MARCH_TILE 16
-/* the surface-bias probe's pixel grid and passes (surface_bias_probe) */
+/* the surface-bias probe's pixel grid and passes (gr_ref_probe_run, reference/probe.c) */
 enum { PROBE_STRIDE = 5, PROBE_PASSES = 4 };
 
 typedef struct ref_light {
@@ -98,7 +98,7 @@ struct gr_ref_renderer {
     /* While the main passes 0 .. PROBE_PASSES - 1 run: the probe's level-h accumulator (NULL
      * otherwise). A probe pixel's level-h value is exactly the main pass's (the same beam set,
      * steps and random numbers), so it is taken there instead of building the beam set again;
-     * probe_captured has bit p set once pass p was taken (surface_bias_probe) */
+     * probe_captured has bit p set once pass p was taken (gr_ref_probe_run, reference/probe.c) */
     struct ref_accum *probe_capture;
     int probe_capture_off;
     unsigned probe_captured;

@@ -227,7 +227,7 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
         }
     }
     /* bias next to the noise (docs/reference.md section 4): the surface tessellation is the
-     * only discretization bias; measured on this scene by the probe (surface_bias_probe) */
+     * only discretization bias; measured on this scene by the probe (gr_ref_probe_run, probe.c) */
     SET(gr_meta_set_double(m, "godrays:bias_surface_rel_est", finite_or(r->bias_rel, -1.0)));
     if (r->bias_rel >= 0.0 && !r->flat) SET(gr_meta_set_double(m, "godrays:bias_surface_order", finite_or(r->bias_order, -1.0)));
     /* the bound: twice the estimate (unit.ref_convergence checks that the estimate is at least

@@ -377,7 +377,8 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
         if (probe) {
             for (int y = 0; y < ph && st == GR_OK; y++) {
                 int have = 0;
-                for (int i = 0; i < n && !have; i++) have = ps[i].s.probe && y >= ps[i].rc.probe_row0 && y < ps[i].rc.probe_row1;
+                for (int i = 0; i < n && !have; i++)
+                    have = ps[i].s.probe && y >= ps[i].rc.probe_row0 && y < ps[i].rc.probe_row1;
                 if (!have) st = gr_fail(err, GR_E_INPUT, "merge: surface-bias probe row %d is in no part", y);
             }
         }
