@@ -20,6 +20,7 @@
 #include "common/status.h"
 #include "core/vec.h"
 #include "image/image.h"
+#include "reference/sums.h"
 #include "scene/scene.h"
 
 typedef struct gr_ref_options {
@@ -52,39 +53,8 @@ typedef struct gr_ref_renderer gr_ref_renderer;
 gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_renderer **out, gr_error *err);
 void gr_ref_destroy(gr_ref_renderer *r); /* accepts NULL */
 
-/* The raw sums a render's image, error bars and statistics are computed from: per pixel and
- * batch the RGB sums of the camera samples and their count, and the surface-bias probe's two
- * sparse accumulators (surface_res and surface_res / 2). gr_ref_assemble turns full sums
- * back into the result a single render gives, bit for bit (src/farm/parts.h merges them). */
-#define GR_REF_PROBE_MAX_LEVELS 4
-typedef struct gr_ref_sums {
-    int W, H, B;            /* image size, batches */
-    double *sum;            /* [(pixel * B + batch) * 3 + c] */
-    uint32_t *count;        /* [pixel * B + batch] */
-    int passes;             /* main passes done (every batch) */
-    int probe;              /* 1: the probe ran (the probe_* fields are set) */
-    int probe_w, probe_h, probe_stride, probe_off, probe_passes;
-    int probe_levels;       /* its accumulators: surface_res, surface_res / 2 (, ...) */
-    double *probe_sum[GR_REF_PROBE_MAX_LEVELS];   /* [probe pixel * 3 + c] per level */
-    uint32_t *probe_count[GR_REF_PROBE_MAX_LEVELS];
-    double probe_s;         /* probe time */
-    double beam_cell_m;     /* the main passes' last beam set (0: none) */
-    long long beam_prims;
-    /* its local refinement (docs/reference.md 2.2; factor 1: none) */
-    int beam_refine_factor;
-    double beam_refine_radius_m;
-    long long beam_refined_cells, beam_transition_cells, beam_triangles;
-    double beam_build_s, march_s;
-    long long queries, shadows, overflows;
-    /* adaptive steps (docs/reference.md 2.5): the sum of the pixels' march steps over the
-     * pixels counted, their extremes, the pilot's steps (0: none) and time */
-    double steps_sum, steps_pixels;
-    int steps_min, steps_max, pilot_steps;
-    double pilot_s;
-} gr_ref_sums;
-/* Zeroed sums; probe_levels accumulators of probe_w x probe_h (0: none). NULL if no memory. */
-gr_ref_sums *gr_ref_sums_create(int W, int H, int B, int probe_levels, int probe_w, int probe_h);
-void gr_ref_sums_destroy(gr_ref_sums *s); /* accepts NULL */
+/* The raw sums a render's image, error bars and statistics are computed from (gr_ref_sums)
+ * and the table of their fields: reference/sums.h. */
 
 typedef struct gr_ref_result {
     gr_image *image;        /* R, G, B, stderr.R, stderr.G, stderr.B [, transmittance, ray_length]

@@ -20,36 +20,64 @@ void gr_part_rows(int i, int n, int h, int *row0, int *row1)
     *row1 = (int)((long long)(i + 1) * h / n);
 }
 
-/* First probe row at or below image row `row` (probe rows are y stride + off), as the
- * integrator's probe restricts itself to a part's rows. */
-static int probe_row(int row, int stride, int off, int h)
-{
-    int y = row <= off ? 0 : (row - off + stride - 1) / stride;
-    return y < h ? y : h;
-}
-
-/* ---- a growing byte buffer ---- */
-typedef struct buf { unsigned char *p; size_t n, cap; int bad; } buf;
-
-static void put(buf *b, const void *d, size_t n)
-{
-    if (b->bad) return;
-    if (b->n + n > b->cap) {
-        size_t c = b->cap ? b->cap : 1 << 16;
-        while (c < b->n + n) c *= 2;
-        unsigned char *q = realloc(b->p, c);
-        if (!q) { b->bad = 1; return; }
-        b->p = q;
-        b->cap = c;
-    }
-    memcpy(b->p + b->n, d, n);
-    b->n += n;
-}
+/* ---- a byte buffer ---- */
+typedef struct buf { unsigned char *p; size_t n; int bad; } buf;
 
 static int little_endian(void)
 {
     const uint16_t one = 1;
     return *(const unsigned char *)&one == 1;
+}
+
+/* ---- the sums' fields through their table (reference/sums.h), both directions ---- */
+
+/* The payload of rectangle rc of s: every array field of gr_ref_sums_fields in the table's
+ * order, per pixel and batch the rows [row0, row1) x the batches [batch0, batch1), then
+ * (rc->probe) per probe level each probe array's rows [probe_row0, probe_row1). Copies
+ * between s and bytes (to_sums: into s; bytes NULL: only counts); returns the byte count. */
+static size_t payload_walk(gr_ref_sums *s, const gr_ref_sums_rect *rc, unsigned char *bytes, int to_sums)
+{
+    size_t n = 0, nb = (size_t)(rc->batch1 - rc->batch0);
+    for (int pass = 0; pass < 2; pass++) /* 0: the image arrays, 1: the probe's */
+        for (int k = 0; k < (pass ? (rc->probe ? s->probe_levels : 0) : 1); k++)
+            for (size_t i = 0; i < gr_ref_sums_nfields; i++) {
+                const gr_ref_sums_field *f = &gr_ref_sums_fields[i];
+                if (f->shape != (pass ? GR_SUMS_PROBE_PIXEL : GR_SUMS_PIXEL_BATCH)) continue;
+                size_t e = gr_ref_sums_elem_bytes(f);
+                unsigned char *a = bytes ? gr_ref_sums_array(s, f, k) : NULL;
+                /* runs of elements: nb per image pixel, or whole probe rows */
+                size_t run = pass ? (size_t)(rc->probe_row1 - rc->probe_row0) * s->probe_w * e : nb * e;
+                size_t first = pass ? (size_t)rc->probe_row0 * s->probe_w : (size_t)rc->row0 * s->W;
+                size_t runs = pass ? 1 : (size_t)(rc->row1 - rc->row0) * s->W;
+                for (size_t q = 0; q < runs; q++, n += run) {
+                    if (!bytes) continue;
+                    size_t at = pass ? first * e : ((first + q) * s->B + rc->batch0) * e;
+                    if (to_sums) memcpy(a + at, bytes + n, run);
+                    else memcpy(bytes + n, a + at, run);
+                }
+            }
+    return n;
+}
+
+/* The header keys of every scalar of s (gr_ref_sums_fields' names). */
+static void header_put_sums(cJSON *h, const gr_ref_sums *s)
+{
+    for (size_t i = 0; i < gr_ref_sums_nfields; i++)
+        if (gr_ref_sums_fields[i].shape == GR_SUMS_SCALAR)
+            cJSON_AddNumberToObject(h, gr_ref_sums_fields[i].name, gr_ref_sums_get(s, &gr_ref_sums_fields[i]));
+}
+
+/* Every scalar of s from the header's keys. A size or the probe's layout must be there (*ok
+ * = 0 if not); a tally missing (a part written before it existed) reads 0. */
+static void header_get_sums(const cJSON *h, gr_ref_sums *s, int *ok)
+{
+    for (size_t i = 0; i < gr_ref_sums_nfields; i++) {
+        const gr_ref_sums_field *f = &gr_ref_sums_fields[i];
+        if (f->shape != GR_SUMS_SCALAR) continue;
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(h, f->name);
+        if (cJSON_IsNumber(v)) gr_ref_sums_set(s, f, v->valuedouble);
+        else if (!gr_ref_sums_is_tally(f)) *ok = 0;
+    }
 }
 
 gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_options *o, const gr_ref_result *res,
@@ -58,29 +86,16 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
     const gr_ref_sums *s = res->sums;
     if (!s) return gr_fail(err, GR_E_USAGE, "%s: the render kept no sums (gr_ref_options.keep_sums)", path);
     if (!little_endian()) return gr_fail(err, GR_E_RUNTIME, "%s: part files are little-endian; this machine is not", path);
-    int W = s->W, B = s->B;
-    int row0 = o->row0, row1 = o->row1 ? o->row1 : s->H, b0 = o->batch0, b1 = o->batch1 ? o->batch1 : B;
-    buf pay = {0};
-    for (int y = row0; y < row1; y++)
-        for (int x = 0; x < W; x++) {
-            size_t p = (size_t)y * W + x;
-            put(&pay, s->sum + (p * B + b0) * 3, (size_t)(b1 - b0) * 3 * sizeof(double));
-        }
-    for (int y = row0; y < row1; y++)
-        for (int x = 0; x < W; x++) {
-            size_t p = (size_t)y * W + x;
-            put(&pay, s->count + p * B + b0, (size_t)(b1 - b0) * sizeof(uint32_t));
-        }
-    int py0 = 0, py1 = 0;
+    gr_ref_sums_rect rc = {o->row0, o->row1 ? o->row1 : s->H, o->batch0, o->batch1 ? o->batch1 : s->B, s->probe, 0, 0};
     if (s->probe) {
-        py0 = probe_row(row0, s->probe_stride, s->probe_off, s->probe_h);
-        py1 = probe_row(row1, s->probe_stride, s->probe_off, s->probe_h);
-        for (int k = 0; k < s->probe_levels; k++) {
-            size_t a = (size_t)py0 * s->probe_w, e = (size_t)py1 * s->probe_w;
-            put(&pay, s->probe_sum[k] + a * 3, (e - a) * 3 * sizeof(double));
-            put(&pay, s->probe_count[k] + a, (e - a) * sizeof(uint32_t));
-        }
+        rc.probe_row0 = gr_ref_probe_row(rc.row0, s->probe_stride, s->probe_off, s->probe_h);
+        rc.probe_row1 = gr_ref_probe_row(rc.row1, s->probe_stride, s->probe_off, s->probe_h);
     }
+    buf pay = {0};
+    size_t pn = payload_walk((gr_ref_sums *)s, &rc, NULL, 0);
+    pay.p = malloc(pn + 1);
+    if (pay.p) pay.n = payload_walk((gr_ref_sums *)s, &rc, pay.p, 0);
+    else pay.bad = 1;
     char key[GR_CACHE_KEY_LEN + 1];
     gr_status st = pay.bad ? gr_fail(err, GR_E_NOMEM, "%s: out of memory", path) : gr_cache_key(scene, key, err);
     char *scene_json = st == GR_OK ? gr_scene_to_json(scene) : NULL;
@@ -99,43 +114,13 @@ gr_status gr_part_write(const char *path, const gr_scene *scene, const gr_ref_op
         cJSON_AddStringToObject(h, "cache_key", key);
         cJSON_AddStringToObject(h, "scene_path", scene->source_path);
         cJSON_AddStringToObject(h, "scene", scene_json);
-        cJSON_AddNumberToObject(h, "width", W);
-        cJSON_AddNumberToObject(h, "height", s->H);
-        cJSON_AddNumberToObject(h, "batches", B);
-        cJSON_AddNumberToObject(h, "row0", row0);
-        cJSON_AddNumberToObject(h, "row1", row1);
-        cJSON_AddNumberToObject(h, "batch0", b0);
-        cJSON_AddNumberToObject(h, "batch1", b1);
-        cJSON_AddNumberToObject(h, "passes", s->passes);
-        cJSON_AddNumberToObject(h, "probe", s->probe);
-        cJSON_AddNumberToObject(h, "probe_levels", s->probe_levels);
-        cJSON_AddNumberToObject(h, "probe_w", s->probe_w);
-        cJSON_AddNumberToObject(h, "probe_h", s->probe_h);
-        cJSON_AddNumberToObject(h, "probe_stride", s->probe_stride);
-        cJSON_AddNumberToObject(h, "probe_off", s->probe_off);
-        cJSON_AddNumberToObject(h, "probe_passes", s->probe_passes);
-        cJSON_AddNumberToObject(h, "probe_row0", py0);
-        cJSON_AddNumberToObject(h, "probe_row1", py1);
-        cJSON_AddNumberToObject(h, "probe_s", s->probe_s);
-        cJSON_AddNumberToObject(h, "beam_cell_m", s->beam_cell_m);
-        cJSON_AddNumberToObject(h, "beam_prims", (double)s->beam_prims);
-        cJSON_AddNumberToObject(h, "beam_refine_factor", s->beam_refine_factor);
-        cJSON_AddNumberToObject(h, "beam_refine_radius_m", s->beam_refine_radius_m);
-        cJSON_AddNumberToObject(h, "beam_refined_cells", (double)s->beam_refined_cells);
-        cJSON_AddNumberToObject(h, "beam_transition_cells", (double)s->beam_transition_cells);
-        cJSON_AddNumberToObject(h, "beam_triangles", (double)s->beam_triangles);
-        cJSON_AddNumberToObject(h, "beam_build_s", s->beam_build_s);
-        cJSON_AddNumberToObject(h, "march_s", s->march_s);
-        cJSON_AddNumberToObject(h, "queries", (double)s->queries);
-        cJSON_AddNumberToObject(h, "shadows", (double)s->shadows);
-        cJSON_AddNumberToObject(h, "overflows", (double)s->overflows);
-        /* adaptive steps: the part's rows' steps and its pilot (docs/reference.md 2.5) */
-        cJSON_AddNumberToObject(h, "steps_sum", s->steps_sum);
-        cJSON_AddNumberToObject(h, "steps_pixels", s->steps_pixels);
-        cJSON_AddNumberToObject(h, "steps_min", s->steps_min);
-        cJSON_AddNumberToObject(h, "steps_max", s->steps_max);
-        cJSON_AddNumberToObject(h, "pilot_steps", s->pilot_steps);
-        cJSON_AddNumberToObject(h, "pilot_s", s->pilot_s);
+        header_put_sums(h, s);
+        cJSON_AddNumberToObject(h, "row0", rc.row0);
+        cJSON_AddNumberToObject(h, "row1", rc.row1);
+        cJSON_AddNumberToObject(h, "batch0", rc.batch0);
+        cJSON_AddNumberToObject(h, "batch1", rc.batch1);
+        cJSON_AddNumberToObject(h, "probe_row0", rc.probe_row0);
+        cJSON_AddNumberToObject(h, "probe_row1", rc.probe_row1);
         cJSON *pv = cJSON_AddObjectToObject(h, "provenance");
         if (pv) {
             cJSON_AddStringToObject(pv, "host", host);
@@ -191,7 +176,8 @@ typedef struct part {
     unsigned char *data; /* the whole file */
     const unsigned char *pay;
     size_t pay_n;
-    int W, H, B, row0, row1, b0, b1, passes, probe, plevels, pw, ph, pstride, poff, ppasses, py0, py1;
+    gr_ref_sums s;          /* the header's scalars (no arrays) */
+    gr_ref_sums_rect rc;    /* its rectangle */
 } part;
 
 static double num(const cJSON *h, const char *k, int *ok)
@@ -266,35 +252,28 @@ static gr_status part_read(const char *path, part *p, gr_error *err)
         return gr_fail(err, GR_E_INPUT, "%s: format is not %s", path, GR_PART_FORMAT);
     }
     int ok = 1;
-    p->W = (int)num(p->h, "width", &ok);
-    p->H = (int)num(p->h, "height", &ok);
-    p->B = (int)num(p->h, "batches", &ok);
-    p->row0 = (int)num(p->h, "row0", &ok);
-    p->row1 = (int)num(p->h, "row1", &ok);
-    p->b0 = (int)num(p->h, "batch0", &ok);
-    p->b1 = (int)num(p->h, "batch1", &ok);
-    p->passes = (int)num(p->h, "passes", &ok);
-    p->probe = (int)num(p->h, "probe", &ok);
-    p->plevels = (int)num(p->h, "probe_levels", &ok);
-    p->pw = (int)num(p->h, "probe_w", &ok);
-    p->ph = (int)num(p->h, "probe_h", &ok);
-    p->pstride = (int)num(p->h, "probe_stride", &ok);
-    p->poff = (int)num(p->h, "probe_off", &ok);
-    p->ppasses = (int)num(p->h, "probe_passes", &ok);
-    p->py0 = (int)num(p->h, "probe_row0", &ok);
-    p->py1 = (int)num(p->h, "probe_row1", &ok);
+    const gr_ref_sums *hs = &p->s;
+    gr_ref_sums_rect *rc = &p->rc;
+    header_get_sums(p->h, &p->s, &ok);
+    rc->row0 = (int)num(p->h, "row0", &ok);
+    rc->row1 = (int)num(p->h, "row1", &ok);
+    rc->batch0 = (int)num(p->h, "batch0", &ok);
+    rc->batch1 = (int)num(p->h, "batch1", &ok);
+    rc->probe = hs->probe;
+    rc->probe_row0 = (int)num(p->h, "probe_row0", &ok);
+    rc->probe_row1 = (int)num(p->h, "probe_row1", &ok);
     double pn = num(p->h, "payload_bytes", &ok);
     const char *fnv = str(p->h, "payload_fnv1a64");
-    if (!ok || !fnv || !str(p->h, "cache_key") || !str(p->h, "scene") || p->W < 1 || p->H < 1 || p->B < 2 ||
-        p->row0 < 0 || p->row1 > p->H || p->row0 >= p->row1 || p->b0 < 0 || p->b1 > p->B || p->b0 >= p->b1 ||
-        (p->probe && (p->plevels < 1 || p->plevels > GR_REF_PROBE_MAX_LEVELS || p->pw < 1 || p->ph < 1 || p->py0 < 0 ||
-                      p->py1 > p->ph || p->py0 > p->py1))) {
+    if (!ok || !fnv || !str(p->h, "cache_key") || !str(p->h, "scene") || hs->W < 1 || hs->H < 1 || hs->B < 2 ||
+        rc->row0 < 0 || rc->row1 > hs->H || rc->row0 >= rc->row1 || rc->batch0 < 0 || rc->batch1 > hs->B ||
+        rc->batch0 >= rc->batch1 ||
+        (hs->probe && (hs->probe_levels < 1 || hs->probe_levels > GR_REF_PROBE_MAX_LEVELS || hs->probe_w < 1 ||
+                       hs->probe_h < 1 || rc->probe_row0 < 0 || rc->probe_row1 > hs->probe_h ||
+                       rc->probe_row0 > rc->probe_row1))) {
         part_free(p);
         return gr_fail(err, GR_E_INPUT, "%s: header fields missing or out of range", path);
     }
-    size_t npix = (size_t)(p->row1 - p->row0) * p->W * (p->b1 - p->b0);
-    size_t expect = npix * (3 * sizeof(double) + sizeof(uint32_t));
-    if (p->probe) expect += (size_t)p->plevels * (size_t)(p->py1 - p->py0) * p->pw * (3 * sizeof(double) + sizeof(uint32_t));
+    size_t expect = payload_walk(&p->s, rc, NULL, 0);
     if ((double)expect != pn || total - hn != expect) {
         part_free(p);
         return gr_fail(err, GR_E_INPUT, "%s: payload is %zu bytes, the header says %.15g (expected %zu): truncated or damaged",
@@ -331,18 +310,18 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
         if (strcmp(str(p->h, "cache_key"), str(p0->h, "cache_key")) != 0)
             st = gr_fail(err, GR_E_INPUT, "%s: another scene or settings than %s (cache key %s, not %s)", p->path,
                          p0->path, str(p->h, "cache_key"), str(p0->h, "cache_key"));
-        else if (p->W != p0->W || p->H != p0->H || p->B != p0->B)
-            st = gr_fail(err, GR_E_INPUT, "%s: %dx%d with %d batches, %s is %dx%d with %d", p->path, p->W, p->H, p->B,
-                         p0->path, p0->W, p0->H, p0->B);
+        else if (p->s.W != p0->s.W || p->s.H != p0->s.H || p->s.B != p0->s.B)
+            st = gr_fail(err, GR_E_INPUT, "%s: %dx%d with %d batches, %s is %dx%d with %d", p->path, p->s.W, p->s.H,
+                         p->s.B, p0->path, p0->s.W, p0->s.H, p0->s.B);
     }
-    int W = p0->W, H = p0->H, B = p0->B;
+    int W = p0->s.W, H = p0->s.H, B = p0->s.B;
     /* coverage: every (row, batch) once */
     if (st == GR_OK && !(owner = malloc((size_t)H * B * sizeof *owner))) st = gr_fail(err, GR_E_NOMEM, "merge: out of memory");
     if (st == GR_OK) {
         for (size_t k = 0; k < (size_t)H * B; k++) owner[k] = -1;
         for (int i = 0; i < n && st == GR_OK; i++)
-            for (int y = ps[i].row0; y < ps[i].row1 && st == GR_OK; y++)
-                for (int b = ps[i].b0; b < ps[i].b1; b++) {
+            for (int y = ps[i].rc.row0; y < ps[i].rc.row1 && st == GR_OK; y++)
+                for (int b = ps[i].rc.batch0; b < ps[i].rc.batch1; b++) {
                     int o = owner[(size_t)y * B + b];
                     if (o >= 0) {
                         st = gr_fail(err, GR_E_INPUT,
@@ -365,82 +344,32 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
     /* the probe: the parts that hold batch 0 carry it, for their rows */
     int probe = 0, pw = 0, ph = 0, plevels = 0;
     for (int i = 0; i < n && st == GR_OK; i++)
-        if (ps[i].probe) {
+        if (ps[i].s.probe) {
+            const gr_ref_sums *q = &ps[i].s;
             if (!probe) {
                 probe = 1;
-                pw = ps[i].pw;
-                ph = ps[i].ph;
-                plevels = ps[i].plevels;
-            } else if (ps[i].pw != pw || ps[i].ph != ph || ps[i].plevels != plevels) {
-                st = gr_fail(err, GR_E_INPUT, "%s: probe grid %dx%d, other parts %dx%d", ps[i].path, ps[i].pw, ps[i].ph, pw, ph);
+                pw = q->probe_w;
+                ph = q->probe_h;
+                plevels = q->probe_levels;
+            } else if (q->probe_w != pw || q->probe_h != ph || q->probe_levels != plevels) {
+                st = gr_fail(err, GR_E_INPUT, "%s: probe grid %dx%d, other parts %dx%d", ps[i].path, q->probe_w, q->probe_h,
+                             pw, ph);
             }
         }
     for (int i = 0; i < n && st == GR_OK && probe; i++)
-        if (ps[i].b0 == 0 && !ps[i].probe)
+        if (ps[i].rc.batch0 == 0 && !ps[i].s.probe)
             st = gr_fail(err, GR_E_INPUT, "%s: holds batch 0 but no surface-bias probe, other parts do", ps[i].path);
     if (st == GR_OK && !(sums = gr_ref_sums_create(W, H, B, probe ? plevels : 0, probe ? pw : 0, probe ? ph : 0)))
         st = gr_fail(err, GR_E_NOMEM, "merge: out of memory for %dx%d pixels x %d batches", W, H, B);
     double wall = 0.0;
     if (st == GR_OK) {
-        int ok = 1;
+        int ok = 1, batch0_parts = 0;
         for (int i = 0; i < n; i++) {
-            const part *p = &ps[i];
-            const unsigned char *q = p->pay;
-            size_t nb = (size_t)(p->b1 - p->b0);
-            for (int y = p->row0; y < p->row1; y++)
-                for (int x = 0; x < W; x++) {
-                    size_t px = (size_t)y * W + x;
-                    memcpy(sums->sum + (px * B + p->b0) * 3, q, nb * 3 * sizeof(double));
-                    q += nb * 3 * sizeof(double);
-                }
-            for (int y = p->row0; y < p->row1; y++)
-                for (int x = 0; x < W; x++) {
-                    size_t px = (size_t)y * W + x;
-                    memcpy(sums->count + px * B + p->b0, q, nb * sizeof(uint32_t));
-                    q += nb * sizeof(uint32_t);
-                }
-            if (p->probe) {
-                size_t a = (size_t)p->py0 * pw, e = (size_t)p->py1 * pw;
-                for (int k = 0; k < p->plevels; k++) {
-                    memcpy(sums->probe_sum[k] + a * 3, q, (e - a) * 3 * sizeof(double));
-                    q += (e - a) * 3 * sizeof(double);
-                    memcpy(sums->probe_count[k] + a, q, (e - a) * sizeof(uint32_t));
-                    q += (e - a) * sizeof(uint32_t);
-                }
-                sums->probe = 1;
-                sums->probe_stride = p->pstride;
-                sums->probe_off = p->poff;
-                sums->probe_passes = p->ppasses;
-                sums->probe_s += num(p->h, "probe_s", &ok);
-            }
-            /* passes: every batch's passes, counted once per batch (tile 0 of each batch range) */
-            if (p->row0 == 0) sums->passes += p->passes;
-            if (p->b1 == B && p->row0 == 0) { /* the main passes' last beam set: the last batch's */
-                sums->beam_cell_m = num(p->h, "beam_cell_m", &ok);
-                sums->beam_prims = (long long)num(p->h, "beam_prims", &ok);
-                sums->beam_refine_factor = (int)num(p->h, "beam_refine_factor", &ok);
-                sums->beam_refine_radius_m = num(p->h, "beam_refine_radius_m", &ok);
-                sums->beam_refined_cells = (long long)num(p->h, "beam_refined_cells", &ok);
-                sums->beam_transition_cells = (long long)num(p->h, "beam_transition_cells", &ok);
-                sums->beam_triangles = (long long)num(p->h, "beam_triangles", &ok);
-            }
-            sums->beam_build_s += num(p->h, "beam_build_s", &ok);
-            sums->march_s += num(p->h, "march_s", &ok);
-            sums->queries += (long long)num(p->h, "queries", &ok);
-            sums->shadows += (long long)num(p->h, "shadows", &ok);
-            sums->overflows += (long long)num(p->h, "overflows", &ok);
-            /* adaptive steps: every part with the same rows has the same steps (the pilot depends
-             * on the seed and the pixel only): count each row range once, from its batch-0 part */
-            if (p->b0 == 0) {
-                int smin = (int)num(p->h, "steps_min", &ok), smax = (int)num(p->h, "steps_max", &ok);
-                if (sums->steps_pixels == 0.0 || smin < sums->steps_min) sums->steps_min = smin;
-                if (smax > sums->steps_max) sums->steps_max = smax;
-                sums->steps_sum += num(p->h, "steps_sum", &ok);
-                sums->steps_pixels += num(p->h, "steps_pixels", &ok);
-            }
-            sums->pilot_steps = (int)num(p->h, "pilot_steps", &ok);
-            sums->pilot_s += num(p->h, "pilot_s", &ok);
-            const cJSON *pv = cJSON_GetObjectItemCaseSensitive(p->h, "provenance");
+            /* each part's sums where a single render accumulates them; its scalars by the
+             * table's rules (reference/sums.h), in the parts' order */
+            payload_walk(sums, &ps[i].rc, (unsigned char *)ps[i].pay, 1);
+            gr_ref_sums_merge_scalars(sums, &ps[i].s, &ps[i].rc, &batch0_parts);
+            const cJSON *pv = cJSON_GetObjectItemCaseSensitive(ps[i].h, "provenance");
             if (pv) wall += num(pv, "wall_s", &ok);
         }
         (void)ok;
@@ -448,7 +377,8 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
         if (probe) {
             for (int y = 0; y < ph && st == GR_OK; y++) {
                 int have = 0;
-                for (int i = 0; i < n && !have; i++) have = ps[i].probe && y >= ps[i].py0 && y < ps[i].py1;
+                for (int i = 0; i < n && !have; i++)
+                    have = ps[i].s.probe && y >= ps[i].rc.probe_row0 && y < ps[i].rc.probe_row1;
                 if (!have) st = gr_fail(err, GR_E_INPUT, "merge: surface-bias probe row %d is in no part", y);
             }
         }
@@ -477,7 +407,7 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
             char mk[48], line[1024];
             snprintf(mk, sizeof mk, "godrays:part.%d", i);
             snprintf(line, sizeof line, "%s: rows [%d, %d) batches [%d, %d) host %s pid %.15g date %s wall_s %.6g threads %.15g",
-                     ps[i].path, ps[i].row0, ps[i].row1, ps[i].b0, ps[i].b1, host ? host : "?",
+                     ps[i].path, ps[i].rc.row0, ps[i].rc.row1, ps[i].rc.batch0, ps[i].rc.batch1, host ? host : "?",
                      pv ? num(pv, "pid", &ok) : 0.0, date ? date : "?", pv ? num(pv, "wall_s", &ok) : 0.0,
                      pv ? num(pv, "threads", &ok) : 0.0);
             if (gr_meta_set_string(&out->meta, mk, line) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "merge: out of memory");

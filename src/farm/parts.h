@@ -14,10 +14,13 @@
  *           width, height, batches, row0, row1, batch0, batch1, passes, probe fields
  *           (levels, grid, its rows), timing counters, provenance (host, pid, date, wall_s,
  *           threads, version, command), payload_bytes, payload_fnv1a64
+ *           (the sums' scalars under their names in reference/sums.h's table, which the
+ *           writer, the reader and the merge all go through)
  *   payload for rows y in [row0, row1), x in [0, W), batches b in [batch0, batch1):
  *           3 doubles (RGB sums), then the same order again as uint32 sample counts; if the
  *           part ran the probe (it holds batch 0), for each of its probe_levels accumulators the
  *           probe rows inside [row0, row1): 3 doubles per probe pixel, then uint32 counts.
+ *           (the table's arrays in its order.)
  * Files are written to a temporary name and renamed: never half a part. */
 #ifndef GR_FARM_PARTS_H
 #define GR_FARM_PARTS_H

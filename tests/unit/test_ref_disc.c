@@ -3,7 +3,7 @@
  * 50 deg elevation, 20 deg azimuth, so the disc's image in the water is an ellipse. On one
  * surface tessellation the horizontal irradiance is computed two ways:
  *  - convolved: the central sun direction, each beam's footprint convolved analytically
- *    with the disc's image (reference/beams.c, first order in the disc radius);
+ *    with the disc's image (reference/beam_grid.c, first order in the disc radius);
  *  - brute force: point-sun beams built for N directions spread uniformly over the disc
  *    (a sunflower spiral), their irradiance averaged: the disc average of the same
  *    tessellation with no first-order assumption, converging as N grows (N and N/4 are

@@ -1,0 +1,99 @@
+/* The beam sets' internals (internal to reference/), shared by the build (beams.c: the
+ * surface, its refinement, the beams and their slabs) and the lookups (beam_grid.c: the
+ * slab boxes, the uniform grid over them, the exact per-beam test with the sun-disc kernel).
+ * The public API: reference/beams.h. */
+#ifndef GR_REF_BEAM_GRID_H
+#define GR_REF_BEAM_GRID_H
+
+#include <math.h>
+#include <stdint.h>
+#include "reference/beams.h"
+
+/* Per grid vertex, in the sheared local frame: surface point (pu, py, pw); the beam edge
+ * through it is (pu + au (y - py), y, pw + aw (y - py)); path length (y - py) * ity. */
+typedef struct beam_vertex {
+    float pu, py, pw;
+    float au, aw;        /* Tx/Ty - shear_x, Tz/Ty - shear_z: drift per metre of height */
+    float ity;           /* 1 / T_y (< 0) */
+    float tx, ty, tz;    /* refracted direction T */
+    float ft;            /* Fresnel transmittance; < 0 marks an unusable vertex */
+} beam_vertex;
+
+/* Per triangle, packed in two cache lines for the lookups' exact test. */
+typedef struct beam_tri {
+    float phi;               /* F_t |I . a| (0 = no beam) */
+    float ytop, dy;          /* top of the beam, slab height */
+    /* sun-disc kernel (zero without it): M = R J (2x2, row-major: shift in u, w per unit
+     * depth for a unit offset in the disc frame); ybar = the mean height of the surface
+     * vertices, from which the kernel's depth d = ybar - y is measured; kr = rho |M|_F, a
+     * bound of the kernel's radius per unit depth */
+    float kern[4], ybar, kr;
+    uint32_t vi[3];          /* its vertices, wound so that the area vector points down */
+    uint32_t first, nslab;   /* its primitives: first, count */
+    /* the cross-section at height y, d = y - ytop (the lookups' test reads no vertex): vertex
+     * 0 at (c[0] + c[2] d, c[1] + c[3] d), vertices 1 and 2 relative to it at
+     * (c[4] + c[6] d, c[5] + c[7] d) and (c[8] + c[10] d, c[9] + c[11] d), the differences
+     * taken in double (edges a few cm long, positions tens of metres from the origin) */
+    float c[12];
+    float pad_[6];
+} beam_tri;
+_Static_assert(sizeof(beam_tri) == 128, "beam_tri fills two cache lines (aligned_alloc needs a multiple of 64)");
+
+/* A primitive as the lookups read it: its box in 16-bit units {u, y, w} lower then upper, and
+ * its triangle (in the same 16 bytes: one load serves the box test and the triangle's address). */
+typedef struct beam_qbox {
+    uint16_t q[6];
+    uint32_t tri;
+} beam_qbox;
+
+struct gr_beams {
+    gr_beam_stats stats;
+    int nu, nw;              /* cells of the base grid */
+    size_t nv, ntri;         /* vertices (the grid's (nu + 1) (nw + 1) first), triangles */
+    beam_vertex *v;          /* per vertex */
+    beam_tri *tri;           /* per triangle */
+    int disc;                /* 1: the sun-disc kernel is on */
+
+    uint32_t *prim_tri;      /* per primitive: its triangle */
+    float *box;              /* per primitive: its box, sheared {u, y, w} lower then upper */
+    double y_min;
+    float sx, sz;            /* shear: T0x / T0y, T0z / T0y */
+    /* the lookup grid (docs/reference.md 2.2, "Lookups"): a uniform grid over the primitives'
+     * boxes in sheared {u, y, w}; cell c lists the primitives whose boxes overlap it,
+     * cell_prim[cell_first[c] .. cell_first[c + 1]), in increasing primitive id */
+    float g0[3], ginv[3];    /* lower corner, 1 / cell size */
+    int gn[3];               /* cells per axis */
+    uint32_t *cell_first;    /* gn[0] gn[1] gn[2] + 1 */
+    uint32_t *cell_prim;
+    /* the boxes as the lookups test them: 16-bit units of the grid's span per axis, lower
+     * ends rounded down and upper ends up, one unit wider each side (half the bytes of the
+     * float boxes: fewer cache misses in the candidate loop) */
+    beam_qbox *qbox;         /* per primitive */
+    float q0[3], qinv[3];
+    RTCScene surface;
+};
+
+/* Triangle t's vertices (explicit: the regular grid's cells, refined cells and the
+ * transition fans around them, section 2.2 "Local refinement"). */
+static inline void tri_vertices(const gr_beams *b, uint32_t t, uint32_t idx[3])
+{
+    const beam_tri *bt = &b->tri[t];
+    idx[0] = bt->vi[0];
+    idx[1] = bt->vi[1];
+    idx[2] = bt->vi[2];
+}
+
+/* Slab k of triangle t spans [lo, hi); the top slab is open upward and the bottom one
+ * downward, so each point of the beam belongs to exactly one slab (no double counting). */
+static inline void slab_range(const gr_beams *b, uint32_t t, uint32_t k, uint32_t nslab, float *lo, float *hi)
+{
+    *hi = k == 0 ? INFINITY : b->tri[t].ytop - (float)k * b->tri[t].dy;
+    *lo = k + 1 == nslab ? -INFINITY : b->tri[t].ytop - (float)(k + 1) * b->tri[t].dy;
+}
+
+/* The lookup structure of b's np primitives (b->prim_tri and the triangles set): their
+ * boxes, then the grid over them, on up to `threads` threads (the result does not depend on
+ * them). GR_E_NOMEM naming the grid. */
+gr_status gr_beams_index(gr_beams *b, uint32_t np, int threads, gr_error *err);
+
+#endif

@@ -1,0 +1,257 @@
+#include "reference/pilot.h"
+
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "reference/march.h"
+
+typedef struct pilot_job {
+    gr_ref_renderer *r;
+    int pw, ph;         /* the pilot grid: one ray per PILOT_STRIDE^2 block of pixels */
+    int jb0, jb1;       /* pilot rows needed in full (a part's rows and their neighbours) */
+    int n0;             /* the pilot's steps (even) */
+    double *pl, *pv;    /* per pilot pixel: L (RGB mean), the step-noise variance estimate V */
+    double *pvs;        /* per pilot pixel and segment: the part of V from the segment's strata */
+    gr_ref_work w;      /* the pilot rows, stop, counters */
+} pilot_job;
+
+/* Pilot rows [jb0, jb1) in full; elsewhere every PILOT_MEAN_STRIDE-th row and column (the
+ * image mean). Each pilot pixel's ray is keyed by (seed, STREAM_PILOT, its index), so every
+ * part computes the same values. */
+static void *pilot_worker(void *arg)
+{
+    pilot_job *job = arg;
+    const gr_ref_renderer *r = job->r;
+    const int W = r->scene.camera.width, H = r->scene.camera.height, n0 = job->n0;
+    ref_scratch sc;
+    ref_counters cnt = {0, 0, 0};
+    double *ck = malloc((size_t)n0 * sizeof *ck);
+    if (!ck || gr_ref_scratch_alloc(&sc, n0) != 0) {
+        free(ck);
+        atomic_store(&job->w.stop, 2);
+        return NULL;
+    }
+    for (;;) {
+        if (atomic_load(&job->w.stop) || (r->opt.interrupt && *r->opt.interrupt)) break;
+        /* bands of pilot rows in square tiles, as the march's (worker) */
+        const int pt = MARCH_TILE / PILOT_STRIDE;
+        int jb = atomic_fetch_add(&job->w.next_row, pt), oom = 0;
+        if (jb >= job->ph) break;
+        int je = job->ph - jb < pt ? job->ph : jb + pt;
+        for (int ib = 0; ib < job->pw && !oom; ib += pt)
+        for (int j = jb; j < je && !oom; j++)
+        for (int i = ib; i < job->pw && i < ib + pt && !oom; i++) {
+            int full = j >= job->jb0 && j < job->jb1;
+            if (!full && (j % PILOT_MEAN_STRIDE || i % PILOT_MEAN_STRIDE)) continue;
+            size_t q = (size_t)j * job->pw + i;
+            ref_rng g = rng_make(r->set.seed, STREAM_PILOT, q);
+            /* uniform over the pilot pixel's block of image pixels */
+            int bw = W - i * PILOT_STRIDE < PILOT_STRIDE ? W - i * PILOT_STRIDE : PILOT_STRIDE;
+            int bh = H - j * PILOT_STRIDE < PILOT_STRIDE ? H - j * PILOT_STRIDE : PILOT_STRIDE;
+            double fx = i * PILOT_STRIDE + bw * rng_u(&g), fy = j * PILOT_STRIDE + bh * rng_u(&g);
+            double L[3], tr, len;
+            if (gr_ref_march_ray(r, fx, fy, n0, NULL, &g, L, &tr, &len, &cnt, &sc, ck) != 0) { oom = 1; break; }
+            /* collapsed strata: the strata 2i and 2i + 1 merged into one holding two samples,
+             * whose variance (c_2i - c_2i+1)^2 estimates without bias and that of the stratified
+             * pair at most (docs/reference.md 2.5) */
+            double v = 0.0;
+            for (int k = 0; k + 1 < n0; k += 2) v += (ck[k] - ck[k + 1]) * (ck[k] - ck[k + 1]);
+            /* per segment (where along the ray the noise is): every stratum's squared differences
+             * to both neighbours, halved twice (each difference is counted by two strata, and
+             * the expectation of a difference holds two strata's variances), so that a jump
+             * between merged pairs is seen as well as one inside a pair */
+            double *vs = job->pvs + q * SEGMENTS;
+            for (int k = 0; k < n0; k++) {
+                double dl = k > 0 ? ck[k] - ck[k - 1] : ck[k] - ck[k + 1], dr = k + 1 < n0 ? ck[k] - ck[k + 1] : dl;
+                vs[(size_t)k * SEGMENTS / (size_t)n0] += 0.25 * (dl * dl + dr * dr);
+            }
+            job->pl[q] = (L[0] + L[1] + L[2]) / 3.0;
+            job->pv[q] = v;
+        }
+        if (oom) { atomic_store(&job->w.stop, 2); break; }
+        if (r->opt.interrupt && *r->opt.interrupt) break;
+        atomic_fetch_add(&job->w.rows_done, je - jb);
+    }
+    atomic_fetch_add(&job->w.queries, cnt.queries);
+    atomic_fetch_add(&job->w.shadow_rays, cnt.shadow_rays);
+    gr_ref_scratch_free(&sc);
+    free(ck);
+    return NULL;
+}
+
+/* Steps along the ray (docs/reference.md 2.5, "Steps along the ray"). Segment s holds m[s]
+ * pilot strata whose step noise was V[s]; with n_s strata its noise is V[s] (m[s] / n_s)^2
+ * (the model, alpha = 2), and the least total sum n_s for sum V[s] (m[s] / n_s)^2 <= T is
+ * n_s = c (V[s] m[s]^2)^(1/3), c = sqrt(sum (V m^2)^(1/3) / T) (Lagrange). Rounded up, at
+ * least one stratum per segment (unbiased), the total clamped to [nmin, nmax]. Returns the
+ * total. */
+static int allot_segments(const double V[SEGMENTS], const int m[SEGMENTS], double T, int nmin, int nmax, double floor_n,
+                          uint16_t n[SEGMENTS])
+{
+    double x[SEGMENTS], sx = 0.0, sc = 0.0;
+    for (int k = 0; k < SEGMENTS; k++) {
+        x[k] = V[k] > 0.0 ? cbrt(V[k] * (double)m[k] * (double)m[k]) : 0.0;
+        sc += x[k];
+    }
+    double c = T > 0.0 ? sqrt(sc / T) : 0.0;
+    int tot = 0;
+    for (int k = 0; k < SEGMENTS; k++) {
+        x[k] *= c;
+        sx += x[k];
+        double v = ceil(fmax(x[k], floor_n * m[k])); /* fmax: NaN gives the floor */
+        n[k] = (uint16_t)(v > 1.0 ? (v < 65535.0 ? v : 65535.0) : 1.0);
+        tot += n[k];
+    }
+    if (tot > nmax) {
+        /* over the cap: the same proportions within it (at least one each) */
+        double f = sx > 0.0 ? (double)(nmax - SEGMENTS) / sx : 0.0; /* the floors sum to at most nmax / 4 */
+        tot = 0;
+        for (int k = 0; k < SEGMENTS; k++) {
+            n[k] = (uint16_t)(1.0 + floor(f * x[k]));
+            tot += n[k];
+        }
+    }
+    while (tot < nmin) {
+        /* under the floor: one more where the strata are scarcest against x */
+        int best = 0;
+        for (int k = 1; k < SEGMENTS; k++)
+            if ((x[k] + 1e-300) / n[k] > (x[best] + 1e-300) / n[best]) best = k;
+        n[best]++;
+        tot++;
+    }
+    return tot;
+}
+
+/* The steps of each pixel of the rows [row0, row1) from the pilot (docs/reference.md 2.5):
+ * with V and L the means of the pilot's variances and values over the pilot neighbourhood,
+ * norm = max(L, pilot image mean), N camera samples per pixel in a round, the
+ * step noise V (n0 / n)^alpha / N of the finished pixel is at most (step_error norm)^2 for
+ * n = n0 (V / (N step_error^2 norm^2))^(1 / alpha), clamped to [min_steps, steps]. */
+static void pilot_steps_map(gr_ref_renderer *r, const pilot_job *job)
+{
+    const int W = r->scene.camera.width, pw = job->pw, ph = job->ph;
+    double msum = 0.0;
+    long long mn = 0;
+    for (int j = 0; j < ph; j += PILOT_MEAN_STRIDE)
+        for (int i = 0; i < pw; i += PILOT_MEAN_STRIDE) {
+            msum += job->pl[(size_t)j * pw + i];
+            mn++;
+        }
+    double mean = mn ? msum / (double)mn : 0.0;
+    double N = (double)r->passes_per_round * r->spp_pass, tau = r->set.step_error;
+    int nmax = r->set.steps, nmin = r->set.min_steps < nmax ? r->set.min_steps : nmax;
+    int m[SEGMENTS] = {0}; /* pilot strata per segment (pairs assigned by their first stratum) */
+    for (int k = 0; k + 1 < job->n0; k += 2) m[(size_t)k * SEGMENTS / (size_t)job->n0] += 2;
+    r->tally.steps_sum = r->tally.steps_pixels = 0.0;
+    r->tally.steps_min = INT_MAX;
+    r->tally.steps_max = 0;
+    for (int py = r->opt.row0; py < r->opt.row1; py++)
+        for (int px = 0; px < W; px++) {
+            /* the pilot neighbourhood, clamped to the pilot grid: its means of V, L and (with
+             * the allotment) the segments' V */
+            int i0 = px / PILOT_STRIDE, j0 = py / PILOT_STRIDE;
+            int ia = i0 - PILOT_RADIUS > 0 ? i0 - PILOT_RADIUS : 0, ib = i0 + PILOT_RADIUS < pw - 1 ? i0 + PILOT_RADIUS : pw - 1;
+            int ja = j0 - PILOT_RADIUS > 0 ? j0 - PILOT_RADIUS : 0, jb = j0 + PILOT_RADIUS < ph - 1 ? j0 + PILOT_RADIUS : ph - 1;
+            int nq = (ib - ia + 1) * (jb - ja + 1);
+            double vsum = 0.0, lsum = 0.0, V[SEGMENTS] = {0};
+            for (int j = ja; j <= jb; j++)
+                for (int i = ia; i <= ib; i++) {
+                    size_t q = (size_t)j * pw + i;
+                    vsum += job->pv[q];
+                    lsum += job->pl[q];
+                    if (r->alloc_px)
+                        for (int k = 0; k < SEGMENTS; k++) V[k] += job->pvs[q * SEGMENTS + (size_t)k];
+                }
+            double v = vsum / nq, norm = fmax(lsum / nq, mean);
+            /* the even spread's steps (its floor below, or the pixel's steps without the allotment) */
+            double n = job->n0 * pow(v / (N * tau * tau * norm * norm), 1.0 / PILOT_ALPHA);
+            int ni;
+            if (r->alloc_px) {
+                /* the steps along the ray, segment by segment */
+                for (int k = 0; k < SEGMENTS; k++) V[k] /= nq;
+                /* the floor: ALLOT_FLOOR of the uniform allocation's steps per pilot stratum (a part
+                 * the pilot saw as quiet keeps some strata: its noise is at most 1 / ALLOT_FLOOR^2
+                 * times what the uniform march would leave there) */
+                double nu = v > 0.0 ? (n < nmax ? n : nmax) : nmin; /* also NaN: the most */
+                ni = allot_segments(V, m, N * tau * tau * norm * norm, nmin, nmax, ALLOT_FLOOR * nu / job->n0,
+                                    r->alloc_px + ((size_t)py * W + px) * SEGMENTS);
+            } else {
+                if (v == 0.0) ni = nmin;
+                else if (!(n < (double)nmax)) ni = nmax; /* also NaN: the most steps */
+                else ni = n > nmin ? (int)ceil(n) : nmin;
+            }
+            r->steps_px[(size_t)py * W + px] = ni;
+            r->tally.steps_sum += ni;
+            r->tally.steps_pixels += 1.0;
+            if (ni < r->tally.steps_min) r->tally.steps_min = ni;
+            if (ni > r->tally.steps_max) r->tally.steps_max = ni;
+        }
+}
+
+/* Adaptive steps: the pilot rays and the steps map, or r->steps_px = NULL (fixed steps:
+ * adaptive_steps off, or steps no more than min_steps). *complete = 0 when interrupted. */
+gr_status gr_ref_step_pilot(gr_ref_renderer *r, gr_ref_pool *pool, gr_progress *prog, int *complete, gr_error *err)
+{
+    const int W = r->scene.camera.width, H = r->scene.camera.height;
+    free(r->steps_px);
+    r->steps_px = NULL;
+    free(r->alloc_px);
+    r->alloc_px = NULL;
+    r->tally.pilot_steps = 0;
+    r->tally.pilot_s = 0.0;
+    r->tally.steps_min = r->tally.steps_max = r->set.steps;
+    r->tally.steps_pixels = (double)W * (r->opt.row1 - r->opt.row0);
+    r->tally.steps_sum = r->tally.steps_pixels * r->set.steps;
+    *complete = 1;
+    if (!r->set.adaptive_steps || r->set.steps <= r->set.min_steps) return GR_OK;
+    double t0 = gr_ref_mono_s();
+    pilot_job job;
+    memset(&job, 0, sizeof job);
+    job.r = r;
+    job.n0 = (r->set.pilot_steps < r->set.steps ? r->set.pilot_steps : r->set.steps) & ~1;
+    if (job.n0 < 2) job.n0 = 2;
+    job.pw = (W + PILOT_STRIDE - 1) / PILOT_STRIDE;
+    job.ph = (H + PILOT_STRIDE - 1) / PILOT_STRIDE;
+    job.jb0 = r->opt.row0 / PILOT_STRIDE - PILOT_RADIUS;
+    if (job.jb0 < 0) job.jb0 = 0;
+    job.jb1 = (r->opt.row1 - 1) / PILOT_STRIDE + PILOT_RADIUS + 1;
+    if (job.jb1 > job.ph) job.jb1 = job.ph;
+    size_t nq = (size_t)job.pw * job.ph;
+    job.pl = calloc(nq, sizeof *job.pl);
+    job.pv = calloc(nq, sizeof *job.pv);
+    job.pvs = calloc(nq * SEGMENTS, sizeof *job.pvs);
+    r->steps_px = calloc((size_t)W * H, sizeof *r->steps_px);
+    /* steps along the ray: when every segment can take a stratum within [min_steps, steps]
+     * and the pilot has one per segment at least */
+    int allot = r->set.steps_along_ray && r->set.min_steps >= SEGMENTS && job.n0 >= 2 * SEGMENTS;
+    if (allot) r->alloc_px = calloc((size_t)W * H * SEGMENTS, sizeof *r->alloc_px);
+    if (!job.pl || !job.pv || !job.pvs || !r->steps_px || (allot && !r->alloc_px)) {
+        free(job.pl); free(job.pv); free(job.pvs);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the step pilot (%dx%d)", W, H);
+    }
+    gr_status st = gr_ref_prepare_pass(r, PILOT_PASS, err);
+    if (st == GR_E_INTERRUPTED) { *complete = 0; st = GR_OK; goto out; }
+    if (st != GR_OK) goto out;
+    gr_ref_work_init(&job.w, 0);
+    st = gr_ref_pool_run(pool, pilot_worker, &job, &job.w, job.ph, r->opt.interrupt, prog, 0.0, 0.0, "step pilot", err);
+    if (st != GR_OK) goto out;
+    if (atomic_load(&job.w.rows_done) < job.ph) { *complete = 0; goto out; } /* interrupted: partial */
+    r->tally.pilot_steps = job.n0;
+    pilot_steps_map(r, &job);
+out:
+    if (st != GR_OK || !*complete) { /* no steps map: nothing is rendered after this */
+        free(r->steps_px);
+        r->steps_px = NULL;
+        free(r->alloc_px);
+        r->alloc_px = NULL;
+        r->tally.steps_sum = r->tally.steps_pixels = 0.0; /* steps_mean -1: none taken */
+        r->tally.steps_min = r->tally.steps_max = 0;
+    }
+    free(job.pl);
+    free(job.pv);
+    free(job.pvs);
+    r->tally.pilot_s = gr_ref_mono_s() - t0;
+    return st;
+}

@@ -1,0 +1,99 @@
+#include "reference/pool.h"
+
+#include <stdlib.h>
+#include <time.h>
+#if defined(__SSE2__)
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+#endif
+
+struct gr_ref_pool {
+    int threads;
+    pthread_t *th;
+};
+
+typedef struct pool_call {
+    void *(*fn)(void *);
+    void *arg;
+} pool_call;
+
+double gr_ref_mono_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Every worker thread: flush denormals, so deep, murky water does not slow down (hard case
+ * sigma_t = 20 /m). */
+static void flush_denormals(void)
+{
+#if defined(__SSE2__)
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#endif
+}
+
+static void *pool_main(void *arg)
+{
+    const pool_call *c = arg;
+    flush_denormals();
+    return c->fn(c->arg);
+}
+
+void gr_ref_work_init(gr_ref_work *w, int row0)
+{
+    atomic_init(&w->next_row, row0);
+    atomic_init(&w->rows_done, 0);
+    atomic_init(&w->stop, 0);
+    atomic_init(&w->queries, 0);
+    atomic_init(&w->shadow_rays, 0);
+    atomic_init(&w->max_hits, 0);
+}
+
+gr_ref_pool *gr_ref_pool_create(int threads)
+{
+    gr_ref_pool *p = calloc(1, sizeof *p);
+    if (!p) return NULL;
+    p->threads = threads > 0 ? threads : 1;
+    p->th = calloc((size_t)p->threads, sizeof *p->th);
+    if (!p->th) {
+        free(p);
+        return NULL;
+    }
+    return p;
+}
+
+void gr_ref_pool_destroy(gr_ref_pool *p)
+{
+    if (!p) return;
+    free(p->th);
+    free(p);
+}
+
+gr_status gr_ref_pool_run(gr_ref_pool *p, void *(*fn)(void *), void *arg, gr_ref_work *w, int rows,
+                          volatile sig_atomic_t *interrupt, gr_progress *prog, double frac0, double span,
+                          const char *note, gr_error *err)
+{
+    pool_call call = {fn, arg};
+    double t0 = gr_ref_mono_s();
+    int started = 0;
+    for (int i = 0; i < p->threads; i++) {
+        if (pthread_create(&p->th[i], NULL, pool_main, &call) != 0) break;
+        started++;
+    }
+    if (!started)
+        return gr_fail(err, GR_E_RUNTIME, "reference: could not start worker threads (reference.threads = %d)", p->threads);
+    for (;;) {
+        int done = atomic_load(&w->rows_done);
+        gr_progress_update(prog, frac0 + span * (double)done / rows, note);
+        if (done >= rows || atomic_load(&w->stop) || (interrupt && *interrupt)) break;
+        /* short sleeps first so tiny renders (tests) do not wait on the poll */
+        double waited = gr_ref_mono_s() - t0;
+        struct timespec ts = {0, waited < 0.05 ? 500 * 1000 : 20 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+    }
+    for (int i = 0; i < started; i++) pthread_join(p->th[i], NULL);
+    if (atomic_load(&w->stop) == 2) return gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
+    return GR_OK;
+}

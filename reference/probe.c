@@ -1,0 +1,171 @@
+#include "reference/probe.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "reference/stats.h"
+
+int gr_ref_probe_stats(gr_ref_renderer *r, double *const sum[3], uint32_t *const cnt[3], size_t np, int pw, int ph, int off)
+{
+    enum { NL = 3 };
+    float *bpx = malloc(np * 3 * sizeof *bpx + 1);
+    if (!bpx) return -1;
+    double d1 = 0.0, d2 = 0.0, v = 0.0;
+    for (size_t i = 0; i < np; i++) {
+        double l[NL] = {0.0, 0.0, 0.0};
+        for (int k = 0; k < NL; k++)
+            for (int c = 0; c < 3; c++) l[k] += cnt[k][i] ? sum[k][i * 3 + c] / (3.0 * cnt[k][i]) : 0.0;
+        d1 += fabs(l[1] - l[0]);
+        d2 += fabs(l[2] - l[1]);
+        v += l[0];
+    }
+    /* the measured order of convergence, clamped to [1, 2] */
+    double ratio = d1 > 0.0 ? d2 / d1 : 4.0, order = ratio > 0.0 ? log2(ratio) : 2.0;
+    if (!(order <= 2.0)) order = 2.0;
+    if (!(order >= 1.0)) order = 1.0;
+    double div = pow(2.0, order) - 1.0; /* Richardson: e_h = (L_2h - L_h) / (2^p - 1) */
+    for (size_t i = 0; i < np; i++)
+        for (int c = 0; c < 3; c++) {
+            double lh = cnt[0][i] ? sum[0][i * 3 + c] / cnt[0][i] : 0.0, l2h = cnt[1][i] ? sum[1][i * 3 + c] / cnt[1][i] : 0.0;
+            double e = (l2h - lh) / div; /* signed, per channel */
+            bpx[i * 3 + c] = isfinite(e) ? (float)e : 0.0f;
+        }
+    /* the estimate: the asymptotic order 2 (divide by 3); the conservative figure: the
+     * measured order (convergence accelerates as h shrinks, so the order measured on the
+     * coarser pair is a lower bound of the order at h and the figure an upper one) */
+    r->bias_rel = v > 0.0 && isfinite(d1) ? d1 / 3.0 / v : (d1 > 0.0 ? -1.0 : 0.0);
+    r->bias_rel_cons = v > 0.0 && isfinite(d1) ? d1 / div / v : (d1 > 0.0 ? -1.0 : 0.0);
+    r->bias_ratio = ratio;
+    r->bias_order = order;
+    r->bias_probe_pixels = (long long)np;
+    free(r->bias_px);
+    r->bias_px = bpx;
+    r->bias_pw = pw;
+    r->bias_ph = ph;
+    r->bias_poff = off;
+    return 0;
+}
+
+void gr_ref_probe_grid(const gr_ref_renderer *r, int *off, int *pw, int *ph)
+{
+    int W = r->scene.camera.width, H = r->scene.camera.height;
+    *off = W > PROBE_STRIDE / 2 && H > PROBE_STRIDE / 2 ? PROBE_STRIDE / 2 : 0;
+    *pw = (W - *off + PROBE_STRIDE - 1) / PROBE_STRIDE;
+    *ph = (H - *off + PROBE_STRIDE - 1) / PROBE_STRIDE;
+}
+
+gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *captured, gr_ref_pool *pool,
+                           gr_progress *prog, double frac0, double span, ref_march_totals *tot, gr_error *err)
+{
+    enum { NL = 3 }; /* levels h, 2h, 4h */
+    int off, pw, ph;
+    gr_ref_probe_grid(r, &off, &pw, &ph);
+    int res = r->set.surface_res, lres[NL];
+    for (int k = 0; k < NL; k++) lres[k] = (res >> k) > 2 ? res >> k : 2;
+    int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
+    ref_accum a[NL];
+    memset(a, 0, sizeof a);
+    for (int k = 0; k < NL; k++) {
+        a[k].W = pw;
+        a[k].H = ph;
+        a[k].B = 1; /* the passes summed: the sums a part file carries (src/farm/parts.h) */
+    }
+    size_t np = (size_t)a[0].W * a[0].H;
+    gr_status st = GR_OK;
+    /* level h taken from the main passes when every probe pass ran there (a part whose batches
+     * miss some of them renders level h here, as the others) */
+    int k0 = 0;
+    unsigned want = (1u << passes) - 1u;
+    if (captured && captured->sum && (r->probe_captured & want) == want) {
+        a[0].sum = captured->sum;
+        a[0].count = captured->count;
+        captured->sum = NULL;
+        captured->count = NULL;
+        k0 = 1;
+    }
+    for (int k = k0; k < NL && st == GR_OK; k++) {
+        a[k].sum = calloc(np * 3, sizeof *a[k].sum);
+        a[k].count = calloc(np, sizeof *a[k].count);
+        if (!a[k].sum || !a[k].count) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
+    }
+    int complete = 1;
+    /* a part probes its own rows' probe pixels */
+    int y0 = gr_ref_probe_row(r->opt.row0, PROBE_STRIDE, off, a[0].H);
+    int y1 = gr_ref_probe_row(r->opt.row1, PROBE_STRIDE, off, a[0].H);
+    for (int p = 0; p < passes && st == GR_OK && complete; p++)
+        for (int k = k0; k < NL && st == GR_OK && complete; k++) {
+            r->set.surface_res = lres[k];
+            r->beams_pass = -1; /* another resolution: rebuild */
+            st = gr_ref_prepare_pass(r, p, err);
+            if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; break; }
+            if (st == GR_OK)
+                st = gr_ref_march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, y0, y1, pool, prog,
+                                frac0 + span * ((NL - k0) * p + k - k0) / ((NL - k0) * (double)passes),
+                                span / ((NL - k0) * (double)passes),
+                                "surface-bias probe", tot, &complete, err);
+        }
+    r->set.surface_res = res;
+    r->beams_pass = -1;
+    if (st == GR_OK && complete) {
+        double *sums[NL] = {a[0].sum, a[1].sum, a[2].sum};
+        uint32_t *cnts[NL] = {a[0].count, a[1].count, a[2].count};
+        if (gr_ref_probe_stats(r, sums, cnts, np, a[0].W, a[0].H, off) != 0)
+            st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
+        r->bias_probe_passes = passes;
+        if (st == GR_OK && keep) { /* hand the sums over */
+            keep->probe_w = a[0].W;
+            keep->probe_h = a[0].H;
+            keep->probe_levels = NL;
+            for (int k = 0; k < NL; k++) {
+                free(keep->probe_sum[k]);
+                free(keep->probe_count[k]);
+                keep->probe_sum[k] = a[k].sum;
+                keep->probe_count[k] = a[k].count;
+                a[k].sum = NULL;
+                a[k].count = NULL;
+            }
+            keep->probe = 1;
+            keep->probe_stride = PROBE_STRIDE;
+            keep->probe_off = off;
+            keep->probe_passes = passes;
+        }
+    }
+    for (int k = 0; k < NL; k++) {
+        free(a[k].sum);
+        free(a[k].count);
+    }
+    return st;
+}
+
+void gr_ref_block_bias(gr_ref_renderer *r, const gr_image *img, double image_mean)
+{
+    r->bias_block_p95 = -1.0;
+    r->bias_blocks = 0;
+    if (!r->bias_px || !img) return;
+    int bw = (r->bias_pw + 1) / 2, bh = (r->bias_ph + 1) / 2, bs = 2 * PROBE_STRIDE;
+    double *v = malloc((size_t)bw * bh * sizeof *v);
+    if (!v) return;
+    size_t n = 0;
+    for (int J = 0; J < bh; J++)
+        for (int I = 0; I < bw; I++) {
+            double b = 0.0, m = 0.0;
+            int nb = 0, nm = 0;
+            for (int j = 2 * J; j < 2 * J + 2 && j < r->bias_ph; j++)
+                for (int i = 2 * I; i < 2 * I + 2 && i < r->bias_pw; i++, nb++)
+                    for (int c = 0; c < 3; c++) b += r->bias_px[((size_t)j * r->bias_pw + (size_t)i) * 3 + c] / 3.0;
+            for (int y = J * bs; y < (J + 1) * bs && y < img->height; y++)
+                for (int x = I * bs; x < (I + 1) * bs && x < img->width; x++, nm++) {
+                    const float *px = gr_image_pixel((gr_image *)img, x, y);
+                    m += (px[0] + px[1] + px[2]) / 3.0;
+                }
+            if (!nb || !nm) continue;
+            double den = fmax(m / nm, image_mean);
+            if (den > 0.0) v[n++] = fabs(b / nb) / den;
+        }
+    if (n) {
+        r->bias_block_p95 = gr_ref_percentile(v, n, 0.95);
+        r->bias_blocks = (int)n;
+    }
+    free(v);
+}

@@ -1,0 +1,325 @@
+#include "reference/stats.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/student.h"
+#include "reference/probe.h"
+#include "scene/settings.h"
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+double gr_ref_percentile(double *v, size_t n, double q)
+{
+    if (!n) return 0.0;
+    qsort(v, n, sizeof *v, cmp_double);
+    double pos = q * (double)(n - 1);
+    size_t i = (size_t)pos;
+    if (i + 1 >= n) return v[n - 1];
+    double f = pos - (double)i;
+    return v[i] * (1.0 - f) + v[i + 1] * f;
+}
+
+static const double *sort_v; /* values that cmp_by_value orders indices by (one caller at a time) */
+static int cmp_by_value(const void *a, const void *b)
+{
+    double x = sort_v[*(const size_t *)a], y = sort_v[*(const size_t *)b];
+    return (x > y) - (x < y);
+}
+
+int gr_ref_target_met(const ref_errors *e, int batches, double target)
+{
+    double k = gr_student_t975(batches - 1) / GR_NORMAL_Q975;
+    return k * e->rel_mean < target && k * e->rel_p95 < target;
+}
+
+gr_status gr_ref_image_errors(const ref_accum *acc, ref_errors *e)
+{
+    size_t np = (size_t)acc->W * acc->H;
+    int B = acc->B;
+    double *tmp = malloc(np * sizeof *tmp), *Mb = calloc((size_t)B, sizeof *Mb), *Qb = calloc((size_t)B, sizeof *Qb);
+    double *v = malloc(np * sizeof *v), *se = malloc(np * sizeof *se);
+    if (!tmp || !Mb || !Qb || !v || !se) {
+        free(tmp); free(Mb); free(Qb); free(v); free(se);
+        return GR_E_NOMEM;
+    }
+    int nb = 0;
+    for (int b = 0; b < B; b++) {
+        size_t k = 0;
+        double m = 0.0;
+        for (size_t p = 0; p < np; p++) {
+            uint32_t c = acc->count[p * B + b];
+            if (!c) continue;
+            const double *s = acc->sum + (p * B + b) * 3;
+            tmp[k++] = (s[0] + s[1] + s[2]) / (3.0 * c);
+            m += tmp[k - 1];
+        }
+        if (k < np) continue; /* an unfinished batch (interrupted) does not enter image errors */
+        Mb[nb] = m / (double)k;
+        nb++;
+    }
+    double mean = 0.0;
+    size_t nr = 0; /* rendered pixels */
+    for (size_t p = 0; p < np; p++) {
+        double s = 0.0, s2 = 0.0;
+        uint32_t n = 0;
+        int kb = 0;
+        double tot = 0.0;
+        for (int b = 0; b < B; b++) {
+            uint32_t c = acc->count[p * B + b];
+            if (!c) continue;
+            const double *sm = acc->sum + (p * B + b) * 3;
+            double mb = (sm[0] + sm[1] + sm[2]) / (3.0 * c);
+            s += mb;
+            s2 += mb * mb;
+            kb++;
+            n += c;
+            tot += sm[0] + sm[1] + sm[2];
+        }
+        v[p] = n ? tot / (3.0 * n) : 0.0;
+        double mm = kb ? s / kb : 0.0;
+        se[p] = kb >= 2 ? sqrt(fmax(0.0, (s2 - kb * mm * mm) / (kb - 1)) / kb) : fabs(v[p]);
+        if (!n) se[p] = -1.0; /* not rendered (interrupted): no estimate, not "converged" */
+        mean += v[p];
+        nr += n > 0;
+    }
+    mean /= (double)(nr ? nr : 1);
+    size_t ok = 0;
+    for (size_t p = 0; p < np; p++) ok += se[p] >= 0.0 && se[p] <= 0.01 * fmax(v[p], mean);
+    e->mean = mean;
+    e->frac_1pct = (double)ok / (double)np; /* unrendered pixels count as not within 1 % */
+    memcpy(tmp, v, np * sizeof *v);
+    e->p95 = gr_ref_percentile(tmp, np, 0.95);
+    if (nb >= 2) {
+        double a = 0.0, a2 = 0.0;
+        for (int b = 0; b < nb; b++) { a += Mb[b]; a2 += Mb[b] * Mb[b]; }
+        a /= nb;
+        double sdm = sqrt(fmax(0.0, (a2 - nb * a * a) / (nb - 1)) / nb);
+        e->rel_mean = mean > 0.0 ? sdm / mean : (sdm > 0.0 ? INFINITY : 0.0);
+        /* The 95th-percentile pixel: the pixels ranked within +-1% (at least one) around the
+         * 95th percentile of the final image, their RMS standard error over their RMS value.
+         * (The spread of the batch images' own percentiles would mix in the upward bias that
+         * noise gives an order statistic, and does not shrink like the noise.) */
+        size_t *ord = malloc(np * sizeof *ord);
+        if (!ord) { free(tmp); free(Mb); free(Qb); free(v); free(se); return GR_E_NOMEM; }
+        for (size_t p = 0; p < np; p++) ord[p] = p;
+        sort_v = v;
+        qsort(ord, np, sizeof *ord, cmp_by_value);
+        size_t c = (size_t)(0.95 * (double)(np - 1)), band = np / 100;
+        size_t lo = c > band ? c - band : 0, hi = c + band < np ? c + band : np - 1;
+        double sv = 0.0, ss = 0.0;
+        for (size_t i = lo; i <= hi; i++) { sv += v[ord[i]] * v[ord[i]]; ss += se[ord[i]] * se[ord[i]]; }
+        free(ord);
+        e->rel_p95 = sv > 0.0 ? sqrt(ss / sv) : (ss > 0.0 ? INFINITY : 0.0);
+    } else {
+        e->rel_mean = e->rel_p95 = INFINITY;
+    }
+    free(tmp); free(Mb); free(Qb); free(v); free(se);
+    return GR_OK;
+}
+
+static gr_status build_image(const gr_ref_renderer *r, const ref_accum *acc, gr_ref_result *out, gr_error *err)
+{
+    static const char *const names[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "transmittance", "ray_length"};
+    static const char *const names_b[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "bias.R", "bias.G", "bias.B"};
+    static const char *const names_ab[] = {"R", "G", "B", "stderr.R", "stderr.G", "stderr.B", "transmittance", "ray_length",
+                                           "bias.R", "bias.G", "bias.B"};
+    /* bias.R/G/B (the surface-bias probe's signed estimate of the pixel's 5 x 5 block) come last */
+    int bias = r->bias_px != NULL && r->bias_pw > 0 && r->bias_ph > 0;
+    int nch = (acc->aov ? 8 : 6) + (bias ? 3 : 0), B = acc->B;
+    gr_image *img = gr_image_create(acc->W, acc->H, nch, bias ? (acc->aov ? names_ab : names_b) : names);
+    if (!img) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for a %dx%d image", acc->W, acc->H);
+    uint32_t min_n = UINT32_MAX;
+    for (int y = 0; y < acc->H; y++)
+        for (int x = 0; x < acc->W; x++) {
+            size_t p = (size_t)y * acc->W + x;
+            float *px = gr_image_pixel(img, x, y);
+            uint32_t n = 0;
+            for (int b = 0; b < B; b++) n += acc->count[p * B + b];
+            if (n < min_n) min_n = n;
+            for (int c = 0; c < 3; c++) {
+                double tot = 0.0, s = 0.0, s2 = 0.0;
+                int kb = 0;
+                for (int b = 0; b < B; b++) {
+                    uint32_t k = acc->count[p * B + b];
+                    if (!k) continue;
+                    double v = acc->sum[(p * B + b) * 3 + c];
+                    tot += v;
+                    s += v / k;
+                    s2 += (v / k) * (v / k);
+                    kb++;
+                }
+                double mean = n ? tot / n : 0.0, mm = kb ? s / kb : 0.0;
+                double se = kb >= 2 ? sqrt(fmax(0.0, (s2 - kb * mm * mm) / (kb - 1)) / kb) : fabs(mean);
+                /* nothing non-finite may reach an image */
+                px[c] = isfinite(mean) ? (float)mean : 0.0f;
+                px[3 + c] = isfinite(se) ? (float)se : 0.0f;
+            }
+            if (acc->aov) {
+                px[6] = n ? (float)(acc->aov[p * 2] / n) : 0.0f;
+                px[7] = n ? (float)(acc->aov[p * 2 + 1] / n) : 0.0f;
+            }
+            if (bias)
+                for (int c = 0; c < 3; c++) px[nch - 3 + c] = bias_at(r, x, y, c);
+        }
+    out->image = img;
+    out->spp = min_n == UINT32_MAX ? 0 : (int)min_n;
+    return GR_OK;
+}
+
+static double finite_or(double v, double alt) { return isfinite(v) ? v : alt; }
+
+static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, const ref_errors *e, double qps)
+{
+    gr_metadata *m = &out->meta;
+    gr_status st = GR_OK;
+    char key[64], buf[256];
+#define SET(call) do { if (st == GR_OK) st = (call); } while (0)
+    SET(gr_meta_set_string(m, "godrays:renderer", "reference (Embree ray-marched single scattering, beam prisms)"));
+    SET(gr_meta_set_string(m, "godrays:layer", "in-scattered radiance of refracted sunlight (single scattering)"));
+    SET(gr_meta_set_string(m, "godrays:scene", r->scene.source_path[0] ? r->scene.source_path : r->scene.name));
+    SET(gr_meta_set_string(m, "godrays:scene_hash", r->scene.hash));
+    const gr_param_table *t = &gr_reference_param_table;
+    for (size_t i = 0; i < t->count; i++) {
+        snprintf(key, sizeof key, "godrays:reference.%s", t->params[i].name);
+        double v = gr_param_get_number(&t->params[i], &r->set, 0);
+        if (t->params[i].type == GR_PT_DOUBLE) SET(gr_meta_set_double(m, key, v));
+        else if (t->params[i].type == GR_PT_ENUM && t->params[i].enum_names) /* the name, as in the scene */
+            SET(gr_meta_set_string(m, key, t->params[i].enum_names[(int)v]));
+        else SET(gr_meta_set_int(m, key, (long long)v));
+    }
+    SET(gr_meta_set_int(m, "godrays:spp", out->spp));
+    SET(gr_meta_set_int(m, "godrays:passes", out->passes));
+    SET(gr_meta_set_int(m, "godrays:passes_per_round", r->passes_per_round));
+    SET(gr_meta_set_int(m, "godrays:spp_per_pass", r->spp_pass));
+    SET(gr_meta_set_int(m, "godrays:partial", out->partial));
+    SET(gr_meta_set_int(m, "godrays:flat_water_closed_form", r->flat));
+    SET(gr_meta_set_int(m, "godrays:threads", r->threads));
+    SET(gr_meta_set_double(m, "godrays:wall_s", out->wall_s));
+    SET(gr_meta_set_double(m, "godrays:rel_stderr_mean", finite_or(e->rel_mean, -1.0)));
+    SET(gr_meta_set_double(m, "godrays:rel_stderr_p95", finite_or(e->rel_p95, -1.0)));
+    SET(gr_meta_set_double(m, "godrays:image_mean", e->mean));
+    SET(gr_meta_set_double(m, "godrays:image_p95", e->p95));
+    SET(gr_meta_set_double(m, "godrays:frac_pixels_stderr_le_1pct", e->frac_1pct));
+    SET(gr_meta_set_double(m, "godrays:cutoff_distance_m", r->cutoff_d));
+    SET(gr_meta_set_double(m, "godrays:preview_exposure", out->preview_exposure));
+    SET(gr_meta_set_double(m, "godrays:queries_per_s", qps));
+    SET(gr_meta_set_double(m, "godrays:beam_build_s", r->tally.beam_build_s));
+    snprintf(buf, sizeof buf, "u [%.3f, %.3f] w [%.3f, %.3f] y_min %.3f pad %.3f (local sheared, m)",
+             r->region.u0, r->region.u1, r->region.w0, r->region.w1, r->region.y_min, r->pad);
+    SET(gr_meta_set_string(m, "godrays:lit_region", buf));
+    if (r->have_main_beams) {
+        const gr_ref_sums *bs = &r->tally;
+        SET(gr_meta_set_double(m, "godrays:surface_cell_m", bs->beam_cell_m));
+        SET(gr_meta_set_int(m, "godrays:beam_prims", bs->beam_prims));
+        if (bs->beam_refine_factor > 1) { /* local refinement (docs/reference.md 2.2) */
+            snprintf(buf, sizeof buf, "camera rays within %g deg of +-T0: factor %d within %.3f m of P_s, %lld cells refined, "
+                     "%lld transition cells, %lld triangles; the other rays: the plain grid",
+                     r->set.refine_angle_deg, bs->beam_refine_factor, bs->beam_refine_radius_m, bs->beam_refined_cells,
+                     bs->beam_transition_cells, bs->beam_triangles);
+            SET(gr_meta_set_string(m, "godrays:surface_refine", buf));
+        }
+    }
+    /* bias next to the noise (docs/reference.md section 4): the surface tessellation is the
+     * only discretization bias; measured on this scene by the probe (gr_ref_probe_run, probe.c) */
+    SET(gr_meta_set_double(m, "godrays:bias_surface_rel_est", finite_or(r->bias_rel, -1.0)));
+    if (r->bias_rel >= 0.0 && !r->flat) SET(gr_meta_set_double(m, "godrays:bias_surface_order", finite_or(r->bias_order, -1.0)));
+    /* the bound: twice the estimate (unit.ref_convergence checks that the estimate is at least
+     * half the bias measured against a 2x finer tessellation), or the figure with the measured
+     * order where that is larger (cells that do not resolve the waves yet: docs/reference.md) */
+    SET(gr_meta_set_double(m, "godrays:bias_surface_rel_bound",
+                           r->bias_rel >= 0.0 ? finite_or(r->flat ? 0.0 : fmax(2.0 * r->bias_rel, r->bias_rel_cons), -1.0) : -1.0));
+    if (r->bias_rel >= 0.0 && !r->flat)
+        SET(gr_meta_set_double(m, "godrays:bias_surface_rel_measured_order", finite_or(r->bias_rel_cons, -1.0)));
+    if (r->flat)
+        snprintf(buf, sizeof buf, "none: flat water takes the closed form (no tessellation)");
+    else if (r->bias_rel >= 0.0)
+        snprintf(buf, sizeof buf,
+                 "Richardson from %lld pixels (every %dth) x %d passes at surface_res %d, %d and %d: difference ratio "
+                 "%.2f, measured order %.2f (clamped to [1, 2]), %.2f s",
+                 r->bias_probe_pixels, PROBE_STRIDE, r->bias_probe_passes, r->set.surface_res,
+                 r->set.surface_res / 2 > 2 ? r->set.surface_res / 2 : 2, r->set.surface_res / 4 > 2 ? r->set.surface_res / 4 : 2,
+                 r->bias_ratio, r->bias_order, r->tally.probe_s);
+    else
+        snprintf(buf, sizeof buf, "not estimated (reference.bias_probe = false or interrupted); -1");
+    SET(gr_meta_set_string(m, "godrays:bias_surface_probe", buf));
+    /* per-block bias next to the mean's (bias.R/G/B channels; 10 x 10 pixel blocks) */
+    SET(gr_meta_set_double(m, "godrays:bias_block_p95_rel", r->bias_px ? finite_or(r->bias_block_p95, -1.0) : (r->flat ? 0.0 : -1.0)));
+    SET(gr_meta_set_int(m, "godrays:stderr_dof", r->batches - 1));
+    /* adaptive steps (docs/reference.md 2.5): march steps per camera ray over the pixels, the
+     * pilot's steps (0: no pilot, the same steps everywhere) and its share of the wall time */
+    const gr_ref_sums *ty = &r->tally;
+    SET(gr_meta_set_double(m, "godrays:steps_mean", ty->steps_pixels > 0.0 ? ty->steps_sum / ty->steps_pixels : -1.0));
+    SET(gr_meta_set_int(m, "godrays:steps_min", ty->steps_min));
+    SET(gr_meta_set_int(m, "godrays:steps_max", ty->steps_max));
+    SET(gr_meta_set_int(m, "godrays:pilot_steps", ty->pilot_steps));
+    SET(gr_meta_set_double(m, "godrays:pilot_s", ty->pilot_s));
+    SET(gr_meta_set_double(m, "godrays:pilot_share", out->wall_s > 0.0 ? ty->pilot_s / out->wall_s : 0.0));
+    SET(gr_meta_set_string(m, "godrays:bias_note",
+                           "bias_surface_rel_est = mean |pixel bias| / image mean from the surface tessellation "
+                           "(measured here with order 2, see bias_surface_probe; bound = max(2x the estimate, the figure with "
+                           "the measured order, bias_surface_rel_measured_order); bias.* channels and bias_block_p95_rel "
+                           "use the measured order; march steps: unbiased (jittered strata; per-pixel counts "
+                           "from an independent pilot), noise only; sun disc: convolved to first order, error "
+                           "below 0.3 % L1 (sun_disc = sample: unbiased); cutoff tail <= transmittance_cutoff * "
+                           "S_max / sigma_t (docs/reference.md)"));
+    SET(gr_meta_set_string(m, "godrays:error_bars",
+                           r->bias_px ? "stderr.* channels: batch-mean spread (noise only; Student t with stderr_dof "
+                                        "degrees of freedom); bias.* channels: the surface bias of the pixel's 5x5 block "
+                                        "(signed Richardson estimate from the probe; |bias| + t stderr bounds the error)"
+                                      : "stderr.* channels: batch-mean spread (noise only; Student t with stderr_dof "
+                                        "degrees of freedom); discretization bias: docs/reference.md"));
+#undef SET
+    return st;
+}
+
+gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_march_totals *tot, double wall_s,
+                        gr_ref_result *out, gr_error *err)
+{
+    size_t np = (size_t)acc->W * acc->H;
+    int P = r->passes_per_round;
+    ref_errors e;
+    memset(&e, 0, sizeof e);
+    gr_status st = GR_OK;
+    if (gr_ref_image_errors(acc, &e) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
+    if (st == GR_OK) st = build_image(r, acc, out, err);
+    if (st != GR_OK) return st;
+    gr_ref_block_bias(r, out->image, e.mean);
+    out->bias_block_p95 = r->bias_block_p95;
+    out->target_met = r->set.target_error > 0.0 ? gr_ref_target_met(&e, acc->B, r->set.target_error) : 1;
+    out->wall_s = wall_s;
+    out->rel_se_mean = e.rel_mean;
+    out->rel_se_p95 = e.rel_p95;
+    out->frac_se_1pct = e.frac_1pct;
+    out->queries_per_s = tot->march_s > 0.0 ? (double)tot->queries / tot->march_s : 0.0;
+    out->shadow_rays_per_s = tot->march_s > 0.0 ? (double)tot->shadows / tot->march_s : 0.0;
+    out->beam_build_s = r->tally.beam_build_s;
+    out->bias_surface_rel = r->bias_rel;
+    out->steps_mean = r->tally.steps_pixels > 0.0 ? r->tally.steps_sum / r->tally.steps_pixels : -1.0;
+    out->rounds = P > 0 ? (out->passes + P - 1) / P : 0;
+    out->max_rounds = r->set.target_error > 0.0 ? r->opt.max_rounds : 1;
+    /* preview: the 99th percentile of the brightest channel maps to 0.8 */
+    double *v = malloc(np * sizeof *v);
+    out->preview_exposure = 1.0;
+    if (v) {
+        for (size_t p = 0; p < np; p++) {
+            const float *px = out->image->pixels + p * out->image->nchannels;
+            v[p] = fmax(px[0], fmax(px[1], px[2]));
+        }
+        double p99 = gr_ref_percentile(v, np, 0.99);
+        if (p99 > 0.0 && isfinite(p99)) out->preview_exposure = 0.8 / p99;
+        free(v);
+    }
+    if (fill_metadata(r, out, &e, out->queries_per_s) != GR_OK)
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for metadata");
+    gr_meta_set_double(&out->meta, "godrays:shadow_rays_per_s", out->shadow_rays_per_s);
+    /* the most beams at one march point (the list grows; -1: not carried through parts) */
+    gr_meta_set_int(&out->meta, "godrays:beam_max_hits", tot->max_hits);
+    return GR_OK;
+}

@@ -1,0 +1,27 @@
+/* The image and its statistics (internal to reference/): from a render's sums (or merged
+ * parts') to the pixels, the per-pixel standard errors, the image-level errors, the
+ * metadata; the same code and floating-point order either way (docs/reference.md,
+ * "Error bars"). */
+#ifndef GR_REF_STATS_H
+#define GR_REF_STATS_H
+
+#include "reference/march.h"
+#include "reference/renderer.h"
+
+typedef struct ref_errors { double rel_mean, rel_p95, frac_1pct, mean, p95; } ref_errors;
+
+/* The q-quantile of v[0 .. n) (sorts v; linear between ranks). */
+double gr_ref_percentile(double *v, size_t n, double q);
+/* --target-error E: the relative standard errors come from B batch means, B - 1 degrees of
+ * freedom; the target is met when their Student-t 95 % half-widths are within those a
+ * known standard error E would give, t_{0.975, B-1} se <= 1.96 E (docs/reference.md). */
+int gr_ref_target_met(const ref_errors *e, int batches, double target);
+/* Image-level error estimates from the batch images (docs/reference.md, "Error bars").
+ * GR_E_NOMEM (no message) when out of memory. */
+gr_status gr_ref_image_errors(const ref_accum *acc, ref_errors *e);
+/* The end of a render from its sums: image, error bars, statistics, metadata (shared by
+ * gr_ref_render and gr_ref_assemble, so merged parts give the same bytes). */
+gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_march_totals *tot, double wall_s,
+                        gr_ref_result *out, gr_error *err);
+
+#endif
