@@ -7,6 +7,8 @@
  * estimate, never allocated. Corpus: tests/fuzz/corpus/parts/ (tiny parts from
  * `godrays reference --tile/--batch-part`). Checks beyond the sanitizers: the message is one
  * terminated line; a merged image is finite. */
+#include "fuzz_file.h" /* first: it defines _GNU_SOURCE (memfd_create) */
+
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -14,7 +16,6 @@
 #include <string.h>
 
 #include "farm/parts.h"
-#include "fuzz_file.h"
 #include "report/cache.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
