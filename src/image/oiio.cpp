@@ -244,12 +244,12 @@ gr_status check_declared_size(const char *path, const OIIO::ImageSpec &spec, gr_
     const double decoded = static_cast<double>(spec.image_bytes());
     struct stat sb;
     if (stat(path, &sb) == 0 && decoded > 4096.0 * static_cast<double>(sb.st_size) + 65536.0)
-        return gr_fail(err, GR_E_INPUT, "%s: declares %d x %d pixels of %d channels (%.0f bytes of samples) in a %lld-byte "
+        return gr_fail(err, GR_E_INPUT, "%s: declares %d x %d pixels of %d channel%s (%.0f bytes of samples) in a %lld-byte "
                        "file: no image format compresses that much; damaged or forged", path, spec.width, spec.height,
-                       spec.nchannels, decoded, static_cast<long long>(sb.st_size));
+                       spec.nchannels, spec.nchannels == 1 ? "" : "s", decoded, static_cast<long long>(sb.st_size));
     char what[300], detail[160];
     std::snprintf(what, sizeof what, "reading %s", path);
-    std::snprintf(detail, sizeof detail, "%d x %d pixels x %d channels as float, and the file's samples", spec.width,
+    std::snprintf(detail, sizeof detail, "%d x %d pixels x %d channel(s) as float, and the file's samples", spec.width,
                   spec.height, spec.nchannels);
     return gr_memlimit_check(what, 4.0 * spec.image_pixels() * spec.nchannels + decoded, detail, err);
 }

@@ -16,27 +16,11 @@
 #     16384x16384`: exit 2 naming the GL limit where this GL cannot hold the target (main:
 #     "framebuffer incomplete (0x8cd6)", exit 1), or a render where it can.
 set -u
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
-src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/lib.sh"
 cd "$dir" || exit 1
 export GODRAYS_CACHE="$dir/cache"
 scene="$src/data/scenes/default.json"
-fail=0
 bad() { echo "FAIL: $*"; fail=1; }
-ok() { echo "ok: $*"; }
-# expect CODE TEXT ARGS...: exit CODE within 20 s, stderr's last line contains TEXT, and
-# stderr holds no other error line
-expect() {
-    code=$1 text=$2
-    shift 2
-    timeout 20 "$bin" "$@" >out.txt 2>err.txt
-    rc=$?
-    if [ "$rc" -eq "$code" ] && [ "$(grep -c "^godrays" err.txt)" -le 1 ] && tail -1 err.txt | grep -qF -- "$text"; then
-        ok "$(tail -1 err.txt | cut -c1-200)"
-    else bad "godrays $(echo "$*" | cut -c1-100): exit $rc (want $code; 124: hung), stderr: $(cut -c1-300 err.txt)"; fi
-}
 
 # ---- 7: TIFFs ----
 python3 - <<'EOF' || { echo "FAIL: python3 cannot build the TIFFs"; exit 1; }
@@ -56,7 +40,7 @@ open('past.tif', 'wb').write(tiff(4, 4, off=1000))
 open('huge.tif', 'wb').write(tiff(8192, 8192, nbytes=16, data=bytes(16)))
 open('big.tif', 'wb').write(tiff(512, 512))
 EOF
-"$bin" compare ok.tif ok.tif >out.txt 2>err.txt && ok "an honest 4 x 4 TIFF compares" || bad "ok.tif: $(cat err.txt)"
+ck "an honest 4 x 4 TIFF compares" "$bin" compare ok.tif ok.tif -o tif
 expect 2 "past.tif: reading pixels (truncated or damaged file): TIFFReadEncodedStrip failed" compare ok.tif past.tif
 expect 2 "huge.tif: declares 8192 x 8192 pixels" compare huge.tif huge.tif
 GODRAYS_MAX_MEMORY=512K expect 2 "reading big.tif needs about" compare big.tif big.tif
@@ -69,7 +53,7 @@ expect 2 "multi.exr: a multi-part EXR file of 2 parts" compare rgb.exr multi.exr
 expect 2 "test r1.exr: 1 channel (R): neither grey" compare rgb.exr r1.exr
 timeout 20 "$bin" compare rgb.exr y1.exr >out.txt 2>err.txt
 rc=$?
-if [ "$rc" -eq 0 ] && grep -qF "test y1.exr: grey (channel Y), compared in R, G and B alike" err.txt; then ok "grey stated"
+if [ "$rc" -eq 0 ] && grep -qF "test y1.exr: grey (channel Y), compared in R, G and B alike" err.txt; then echo "ok: grey stated"
 else bad "compare of a grey image: exit $rc, stderr: $(cat err.txt)"; fi
 
 # ---- 5: export estimates ----
@@ -86,8 +70,8 @@ expect 2 "-o x.png: the merged ground truth is an EXR file" merge p.part -o x.pn
 timeout 300 "$bin" render shafts "$scene" --size 16384x16384 -o big.exr -q >out.txt 2>err.txt
 rc=$?
 if grep -q "framebuffer incomplete" err.txt; then bad "16384 x 16384: $(cat err.txt)"
-elif [ "$rc" -eq 2 ] && grep -qF "camera.width/height: a 16384x16384 render target" err.txt; then ok "$(cut -c1-200 err.txt)"
-elif [ "$rc" -eq 0 ]; then ok "16384 x 16384 rendered (this GL holds it)"
+elif [ "$rc" -eq 2 ] && grep -qF "camera.width/height: a 16384x16384 render target" err.txt; then echo "ok: $(cat err.txt)"
+elif [ "$rc" -eq 0 ]; then echo "ok: 16384 x 16384 rendered (this GL holds it)"
 else bad "16384 x 16384: exit $rc, stderr: $(cat err.txt)"; fi
 rm -f big.exr big.png
 exit $fail
