@@ -2,6 +2,7 @@
 
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -234,17 +235,17 @@ static gr_status part_check_fields(const cJSON *h, const char *path, gr_error *e
     static const struct { const char *key; double lo, hi; int integer; } f[] = {
         {"width", 1, PART_MAX_SIDE, 1}, {"height", 1, PART_MAX_SIDE, 1}, {"batches", 2, PART_MAX_BATCHES, 1},
         {"row0", 0, PART_MAX_SIDE, 1}, {"row1", 1, PART_MAX_SIDE, 1}, {"batch0", 0, PART_MAX_BATCHES, 1},
-        {"batch1", 1, PART_MAX_BATCHES, 1}, {"passes", 1, 1 << 30, 1}, {"probe", 0, 1, 1},
+        {"batch1", 1, PART_MAX_BATCHES, 1}, {"passes", 1, INT_MAX, 1}, {"probe", 0, 1, 1},
         {"probe_levels", 0, GR_REF_PROBE_MAX_LEVELS, 1}, {"probe_w", 0, PART_MAX_SIDE, 1},
         {"probe_h", 0, PART_MAX_SIDE, 1}, {"probe_stride", 0, PART_MAX_SIDE, 1}, {"probe_off", 0, PART_MAX_SIDE, 1},
-        {"probe_passes", 0, 1 << 30, 1}, {"probe_row0", 0, PART_MAX_SIDE, 1}, {"probe_row1", 0, PART_MAX_SIDE, 1},
+        {"probe_passes", 0, INT_MAX, 1}, {"probe_row0", 0, PART_MAX_SIDE, 1}, {"probe_row1", 0, PART_MAX_SIDE, 1},
         {"probe_s", 0, 1e300, 0}, {"beam_cell_m", 0, 1e300, 0}, {"beam_prims", 0, 9007199254740992.0, 1},
-        {"beam_refine_factor", 0, 1 << 30, 1}, {"beam_refine_radius_m", 0, 1e300, 0},
+        {"beam_refine_factor", 0, INT_MAX, 1}, {"beam_refine_radius_m", 0, 1e300, 0},
         {"beam_refined_cells", 0, 9007199254740992.0, 1}, {"beam_transition_cells", 0, 9007199254740992.0, 1},
         {"beam_triangles", 0, 9007199254740992.0, 1}, {"beam_build_s", 0, 1e300, 0}, {"march_s", 0, 1e300, 0},
         {"queries", 0, 9007199254740992.0, 1}, {"shadows", 0, 9007199254740992.0, 1},
         {"overflows", 0, 9007199254740992.0, 1}, {"steps_sum", 0, 1e300, 0}, {"steps_pixels", 0, 1e300, 0},
-        {"steps_min", 0, 1 << 30, 1}, {"steps_max", 0, 1 << 30, 1}, {"pilot_steps", 0, 1 << 30, 1},
+        {"steps_min", 0, INT_MAX, 1}, {"steps_max", 0, INT_MAX, 1}, {"pilot_steps", 0, INT_MAX, 1},
         {"pilot_s", 0, 1e300, 0}, {"payload_bytes", 0, 9007199254740992.0, 1}};
     for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
         const cJSON *v = cJSON_GetObjectItemCaseSensitive(h, f[i].key);
