@@ -148,14 +148,19 @@ gr_status gr_truth_image(const gr_scene *scene, const gr_truth_options *o, gr_im
     return st;
 }
 
-gr_status gr_truth_assemble(const gr_scene *scene, const gr_ref_sums *sums, double wall_s, gr_ref_result *out,
-                            gr_error *err)
+gr_status gr_truth_assemble(const gr_scene *scene, const gr_ref_sums *sums, double wall_s, gr_truth_sums_check check,
+                            void *user, gr_ref_result *out, gr_error *err)
 {
     gr_ref_options o;
     gr_ref_options_default(&o);
     o.progress = 0;
     gr_ref_renderer *r = NULL;
     gr_status st = gr_ref_create(scene, &o, &r, err);
+    if (st == GR_OK && check) {
+        gr_ref_info info;
+        gr_ref_get_info(r, &info);
+        st = check(user, &info, err);
+    }
     if (st == GR_OK) st = gr_ref_assemble(r, sums, wall_s, out, err);
     gr_ref_destroy(r);
     return st;

@@ -58,11 +58,15 @@ gr_status gr_truth_get(const gr_scene *scene, const gr_truth_options *o, gr_ref_
 gr_status gr_truth_image(const gr_scene *scene, const gr_truth_options *o, gr_image **img, gr_truth_info *info,
                          gr_error *err);
 
+/* What a render of the scene gives (its passes and samples per pass), for checking sums
+ * that came from elsewhere before they are assembled; a status other than GR_OK stops. */
+typedef gr_status (*gr_truth_sums_check)(void *user, const gr_ref_info *info, gr_error *err);
+
 /* The result a single render of scene gives, from its full sums (merged farm parts,
- * src/farm/parts.h): a renderer with the default options, no pass rendered, then
- * gr_ref_assemble (the same bytes). wall_s is the parts' time. */
-gr_status gr_truth_assemble(const gr_scene *scene, const gr_ref_sums *sums, double wall_s, gr_ref_result *out,
-                            gr_error *err);
+ * src/farm/parts.h): a renderer with the default options, no pass rendered, check (may be
+ * NULL) on the sums, then gr_ref_assemble (the same bytes). wall_s is the parts' time. */
+gr_status gr_truth_assemble(const gr_scene *scene, const gr_ref_sums *sums, double wall_s, gr_truth_sums_check check,
+                            void *user, gr_ref_result *out, gr_error *err);
 
 /* Stores img and meta as scene's ground truth in the cache, under scene's key (a truth that
  * did not come from gr_truth_get, e.g. merged parts); info->path names the entry. GR_E_IO

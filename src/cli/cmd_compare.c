@@ -37,7 +37,8 @@ static void usage(FILE *f)
             "Rec. 709 luminance: bias, MAE, RMSE, relative MSE, PSNR (reference-peak and idiff\n"
             "conventions), max error and where, SSIM on luminance, RMSE after Gaussian blur at\n"
             "sigma 1, 4, 16 px. Any format OpenImageIO reads (EXR, PNG, TIFF, HDR, ...); channels\n"
-            "R, G, B by name, else the first three, a 1-channel image is gray. If REF has\n"
+            "R, G, B by name, else the first three; one channel (+ alpha) is grey (a lone R, G or\n"
+            "B is refused: docs/images.md). If REF has\n"
             "stderr.R/G/B channels, differences within 2 standard errors are reported as not\n"
             "significant and pixels whose reference is too noisy are not scored (counted).\n"
             "Then one line per metric of the metric registry (rmse, ssim, flip, structure, ...;\n"
@@ -101,6 +102,26 @@ static gr_status read_input(const char *role, const char *path, int linearize, g
     if (st != GR_E_NOMEM) err->status = GR_E_INPUT;
     gr_error_prefix(err, "%s", role);
     return err->status;
+}
+
+/* Images of one or two channels (docs/images.md, "Grey images"): one channel, or grey + alpha
+ * A, is grey and compared as such (the channel in R, G and B), which is stated on stderr; a
+ * lone colour channel (R, G or B) or any other pair such as (R, G) is part of an RGB image
+ * with no defined luminance, refused rather than compared as grey (issue 15 finding 10 refused
+ * (R, G), issue 31 found R alone copied into G and B). */
+static gr_status check_grey(const char *role, const char *path, const gr_image *im, gr_error *err)
+{
+    if (im->nchannels > 2) return GR_OK;
+    const char *c0 = im->names[0];
+    const int colour = !strcmp(c0, "R") || !strcmp(c0, "G") || !strcmp(c0, "B");
+    if (colour || (im->nchannels == 2 && strcmp(im->names[1], "A")))
+        return gr_fail(err, GR_E_INPUT, "%s %s: %d channel%s (%s%s%s): neither grey (one channel, + alpha A) nor RGB; "
+                       "convert it first, e.g. oiiotool IN --ch R,G,B=0 -o OUT.exr", role, path, im->nchannels,
+                       im->nchannels == 2 ? "s" : "", c0, im->nchannels == 2 ? ", " : "",
+                       im->nchannels == 2 ? im->names[1] : "");
+    fprintf(stderr, "godrays compare: %s %s: grey (channel %s%s), compared in R, G and B alike\n", role, path, c0,
+            im->nchannels == 2 ? " + alpha A" : "");
+    return GR_OK;
 }
 
 static cJSON *image_json(const char *path, const gr_image *img, const int rgb[3])
@@ -336,15 +357,8 @@ static gr_status read_inputs(const compare_opts *o, compare_state *s, gr_error *
     if (mask && (mask->width != ref->width || mask->height != ref->height))
         return gr_fail(err, GR_E_INPUT, "size mismatch: mask %s is %d x %d, images are %d x %d", o->mask_path,
                        mask->width, mask->height, ref->width, ref->height);
-    /* two channels: grey + alpha is compared as grey; anything else (R, G) has no defined
-     * luminance, so it is refused rather than compared as grey with a channel dropped */
-    for (int k = 0; k < 2; k++) {
-        const gr_image *im = k ? test : ref;
-        if (im->nchannels == 2 && strcmp(im->names[1], "A"))
-            return gr_fail(err, GR_E_INPUT, "%s %s: 2 channels (%s, %s): neither grey (+ alpha A) nor RGB; convert "
-                           "it first, e.g. oiiotool IN --ch R,G,B=0 -o OUT.exr", k ? "test" : "reference", o->paths[k],
-                           im->names[0], im->names[1]);
-    }
+    for (int k = 0; k < 2; k++)
+        if ((st = check_grey(k ? "test" : "reference", o->paths[k], k ? test : ref, err)) != GR_OK) return st;
     /* the metrics, blurs and difference images: about 170 bytes per pixel, measured
      * (2.8 GB for 4096 x 4096; docs/reliability.md); FLIP's working set on top, counted
      * from its buffers (an upper bound: they are allocated after the metrics' are freed):

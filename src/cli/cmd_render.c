@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gl/gl.h"
+#include "gl/glctx.h"
 #include "image/exr.h"
 #include "image/oiio.h"
 #include "realtime/technique.h"
@@ -209,6 +211,11 @@ static int render_with(gr_args *args)
     memset(&opts, 0, sizeof opts);
     opts.shader_dir = shader_dir;
     if (gr_gl_create(&glo, &gl, &err) != GR_OK) goto fail;
+    /* the god-ray layer's float target must fit this GL (a 16384 x 16384 one failed late as
+     * "framebuffer incomplete"): said up front, with the limit */
+    if (gr_gl_check_target_size("camera.width/height", scene->camera.width, scene->camera.height, GL_RGBA32F, &err) !=
+        GR_OK)
+        goto fail;
     if (gr_technique_create(cls, gl, &opts, &r, &err) != GR_OK) goto fail;
     img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
     runs = calloc((size_t)repeat, sizeof *runs);

@@ -2,6 +2,8 @@
 
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <limits.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,6 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "common/memlimit.h"
 #include "reference/cache.h"
 #include "reference/truth.h"
 
@@ -200,6 +203,133 @@ static void part_free(part *p)
     memset(p, 0, sizeof *p);
 }
 
+/* ---- checks of a part's header, size and sums (docs/reliability.md, "Issue 31") ---- */
+
+/* The largest image side and batch count a scene allows (scene/scene.c camera.width/height,
+ * scene/settings.c reference.batches): a header over them describes no render. */
+#define PART_MAX_SIDE 16384
+#define PART_MAX_BATCHES 1024
+/* A batch sum over its sample count: no radiance comes near 1e30, and the squares of batch
+ * means (the error bars) then stay finite; NaN, Inf or 1e308 merged into zero pixels. */
+#define PART_MAX_MEAN 1e30
+
+/* Every number of the header: present where required, finite, integral where an integer, and
+ * within the range its use needs, so that the (int) and (long long) conversions below are
+ * defined (a double out of an integer type's range converts with undefined behaviour) and a
+ * forged size is refused before anything is allocated for it. */
+static gr_status part_check_fields(const cJSON *h, const char *path, gr_error *err)
+{
+    static const struct { const char *key; double lo, hi; int integer; } f[] = {
+        {"width", 1, PART_MAX_SIDE, 1}, {"height", 1, PART_MAX_SIDE, 1}, {"batches", 2, PART_MAX_BATCHES, 1},
+        {"row0", 0, PART_MAX_SIDE, 1}, {"row1", 1, PART_MAX_SIDE, 1}, {"batch0", 0, PART_MAX_BATCHES, 1},
+        {"batch1", 1, PART_MAX_BATCHES, 1}, {"passes", 1, INT_MAX, 1}, {"probe", 0, 1, 1},
+        {"probe_levels", 0, GR_REF_PROBE_MAX_LEVELS, 1}, {"probe_w", 0, PART_MAX_SIDE, 1},
+        {"probe_h", 0, PART_MAX_SIDE, 1}, {"probe_stride", 0, PART_MAX_SIDE, 1}, {"probe_off", 0, PART_MAX_SIDE, 1},
+        {"probe_passes", 0, INT_MAX, 1}, {"probe_row0", 0, PART_MAX_SIDE, 1}, {"probe_row1", 0, PART_MAX_SIDE, 1},
+        {"probe_s", 0, 1e300, 0}, {"beam_cell_m", 0, 1e300, 0}, {"beam_prims", 0, 9007199254740992.0, 1},
+        {"beam_refine_factor", 0, INT_MAX, 1}, {"beam_refine_radius_m", 0, 1e300, 0},
+        {"beam_refined_cells", 0, 9007199254740992.0, 1}, {"beam_transition_cells", 0, 9007199254740992.0, 1},
+        {"beam_triangles", 0, 9007199254740992.0, 1}, {"beam_build_s", 0, 1e300, 0}, {"march_s", 0, 1e300, 0},
+        {"queries", 0, 9007199254740992.0, 1}, {"shadows", 0, 9007199254740992.0, 1},
+        {"overflows", 0, 9007199254740992.0, 1}, {"steps_sum", 0, 1e300, 0}, {"steps_pixels", 0, 1e300, 0},
+        {"steps_min", 0, INT_MAX, 1}, {"steps_max", 0, INT_MAX, 1}, {"pilot_steps", 0, INT_MAX, 1},
+        {"pilot_s", 0, 1e300, 0}, {"payload_bytes", 0, 9007199254740992.0, 1}};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(h, f[i].key);
+        if (!cJSON_IsNumber(v)) return gr_fail(err, GR_E_INPUT, "%s: header field %s missing or not a number", path, f[i].key);
+        const double d = v->valuedouble;
+        if (!isfinite(d) || d < f[i].lo || d > f[i].hi || (f[i].integer && d != floor(d)))
+            return gr_fail(err, GR_E_INPUT, "%s: header field %s is %.17g, expected %s in [%.17g, %.17g]", path, f[i].key,
+                           d, f[i].integer ? "an integer" : "a number", f[i].lo, f[i].hi);
+    }
+    const cJSON *pv = cJSON_GetObjectItemCaseSensitive(h, "provenance");
+    const cJSON *w = pv ? cJSON_GetObjectItemCaseSensitive(pv, "wall_s") : NULL;
+    if (w && (!cJSON_IsNumber(w) || !isfinite(w->valuedouble) || w->valuedouble < 0.0))
+        return gr_fail(err, GR_E_INPUT, "%s: header field provenance.wall_s is not a finite number >= 0", path);
+    return GR_OK;
+}
+
+/* What the merge of the render that a part describes needs, from its header alone, against
+ * the memory limit (common/memlimit), before its payload is read: the merged sums (3 doubles
+ * and a count per pixel and batch), the coverage map (an int per row and batch), the probe's
+ * accumulators, the assembled image and its statistics (at most 11 float channels and 4
+ * doubles per pixel) and this part's payload. */
+static gr_status part_check_memory(const char *path, int W, int H, int B, int plevels, int pw, int ph, size_t payload,
+                                   gr_error *err)
+{
+    const double px = (double)W * H;
+    const double need = px * (28.0 * B + 11.0 * 4 + 4.0 * 8) + 4.0 * H * B + 28.0 * plevels * pw * (double)ph + (double)payload;
+    char what[300], detail[160];
+    snprintf(what, sizeof what, "merging %s", path);
+    snprintf(detail, sizeof detail, "a %dx%d render with %d batches, as its header says", W, H, B);
+    return gr_memlimit_check(what, need, detail, err);
+}
+
+/* The file's bytes after the header against the payload its header describes, before any of
+ * them is read: a part padded to 12 GB was read whole before its length was compared. */
+static gr_status part_check_size(const char *path, size_t have, size_t expect, double declared, gr_error *err)
+{
+    if ((double)expect == declared && have == expect) return GR_OK;
+    return gr_fail(err, GR_E_INPUT, "%s: payload is %zu bytes, the header says %.0f (expected %zu): truncated or damaged, or padded",
+                   path, have, declared, expect);
+}
+
+/* The merged sums before they are assembled: a render gives every pixel of every batch
+ * exactly passes-per-batch x samples-per-pass samples, and sums that are finite, >= 0 (the
+ * in-scattered radiance is) and at most PART_MAX_MEAN per sample. Forged parts with a valid
+ * checksum and NaN, 1e308, negative sums or zero counts merged into zero pixels or "0 spp"
+ * (and, with --cache, into the cache). owner: the part of each (row, batch). */
+static gr_status parts_check_sums(const gr_ref_sums *s, const int *owner, const part *ps, int n,
+                                  const gr_ref_info *info, gr_error *err)
+{
+    const int B = s->B, per_batch = info->passes_per_round / B;
+    const uint32_t want = (uint32_t)per_batch * (uint32_t)info->spp_per_pass;
+    for (int i = 0; i < n; i++)
+        if (ps[i].s.passes != (ps[i].rc.batch1 - ps[i].rc.batch0) * per_batch)
+            return gr_fail(err, GR_E_INPUT, "%s: %d passes for %d batches; its scene gives every batch %d passes", ps[i].path,
+                           ps[i].s.passes, ps[i].rc.batch1 - ps[i].rc.batch0, per_batch);
+    for (int y = 0; y < s->H; y++)
+        for (int x = 0; x < s->W; x++)
+            for (int b = 0; b < B; b++) {
+                const size_t k = ((size_t)y * s->W + x) * B + b;
+                const uint32_t c = s->count[k];
+                const double *v = s->sum + k * 3;
+                const char *path = ps[owner[(size_t)y * B + b]].path;
+                if (c != want)
+                    return gr_fail(err, GR_E_INPUT, "%s: pixel (%d, %d) of batch %d has %u samples; its scene gives %u "
+                                   "(%d passes x %d samples): damaged or forged", path, x, y, b, c, want, per_batch,
+                                   info->spp_per_pass);
+                for (int ch = 0; ch < 3; ch++)
+                    if (!(v[ch] >= 0.0 && v[ch] <= PART_MAX_MEAN * c)) /* also NaN */
+                        return gr_fail(err, GR_E_INPUT, "%s: pixel (%d, %d) of batch %d: sum %.17g is not a finite radiance "
+                                       "sum in [0, %g x %u samples]: damaged or forged", path, x, y, b, v[ch], PART_MAX_MEAN, c);
+            }
+    for (int k = 0; s->probe && k < s->probe_levels; k++)
+        for (size_t q = 0; q < (size_t)s->probe_w * s->probe_h * 3; q++) {
+            const double v = s->probe_sum[k][q];
+            const double c = s->probe_count[k][q / 3];
+            if (!(v >= 0.0 && v <= PART_MAX_MEAN * (c > 1.0 ? c : 1.0)))
+                return gr_fail(err, GR_E_INPUT, "merge: surface-bias probe level %d, probe pixel %zu: sum %.17g is not a "
+                               "finite radiance sum: a part is damaged or forged", k, q / 3, v);
+        }
+    return GR_OK;
+}
+
+/* parts_check_sums through gr_truth_assemble's check (reference/truth.h): the renderer that
+ * assembles the sums says what a render of the scene gives. */
+typedef struct parts_checked {
+    const gr_ref_sums *sums;
+    const int *owner;
+    const part *ps;
+    int n;
+} parts_checked;
+
+static gr_status parts_check_hook(void *user, const gr_ref_info *info, gr_error *err)
+{
+    const parts_checked *c = user;
+    return parts_check_sums(c->sums, c->owner, c->ps, c->n, info, err);
+}
+
 /* Reads and checks one part file (header fields, payload length and checksum). */
 static gr_status part_read(const char *path, part *p, gr_error *err)
 {
@@ -226,30 +356,32 @@ static gr_status part_read(const char *path, part *p, gr_error *err)
         fclose(f);
         return gr_fail(err, GR_E_INPUT, "%s: truncated header", path);
     }
-    size_t want = total;
-    p->data = malloc(want + 1);
+    /* the header first; the payload only once its size matches the file and the memory limit */
+    p->data = malloc(hn + 1);
     if (!p->data) {
         fclose(f);
         return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
     }
-    size_t got = fread(p->data, 1, want, f);
-    fclose(f);
-    if (got != want) {
+    if (fread(p->data, 1, hn, f) != hn) {
+        fclose(f);
         part_free(p);
         return gr_fail(err, GR_E_INPUT, "%s: short read", path);
     }
-    char save = (char)p->data[hn];
     p->data[hn] = '\0';
     p->h = cJSON_Parse((const char *)p->data);
-    p->data[hn] = (unsigned char)save;
     if (!p->h) {
+        fclose(f);
         part_free(p);
         return gr_fail(err, GR_E_INPUT, "%s: header is not JSON", path);
     }
     const char *fmt = str(p->h, "format");
-    if (!fmt || strcmp(fmt, GR_PART_FORMAT) != 0) {
+    gr_status fst = !fmt || strcmp(fmt, GR_PART_FORMAT) != 0
+                        ? gr_fail(err, GR_E_INPUT, "%s: format is not %s", path, GR_PART_FORMAT)
+                        : part_check_fields(p->h, path, err);
+    if (fst != GR_OK) {
+        fclose(f);
         part_free(p);
-        return gr_fail(err, GR_E_INPUT, "%s: format is not %s", path, GR_PART_FORMAT);
+        return fst;
     }
     int ok = 1;
     const gr_ref_sums *hs = &p->s;
@@ -270,14 +402,24 @@ static gr_status part_read(const char *path, part *p, gr_error *err)
         (hs->probe && (hs->probe_levels < 1 || hs->probe_levels > GR_REF_PROBE_MAX_LEVELS || hs->probe_w < 1 ||
                        hs->probe_h < 1 || rc->probe_row0 < 0 || rc->probe_row1 > hs->probe_h ||
                        rc->probe_row0 > rc->probe_row1))) {
+        fclose(f);
         part_free(p);
         return gr_fail(err, GR_E_INPUT, "%s: header fields missing or out of range", path);
     }
     size_t expect = payload_walk(&p->s, rc, NULL, 0);
-    if ((double)expect != pn || total - hn != expect) {
+    gr_status sst = part_check_size(path, total - hn, expect, pn, err);
+    if (sst == GR_OK)
+        sst = part_check_memory(path, hs->W, hs->H, hs->B, hs->probe ? hs->probe_levels : 0, hs->probe_w, hs->probe_h,
+                                expect, err);
+    unsigned char *whole = sst == GR_OK ? realloc(p->data, hn + expect + 1) : NULL;
+    if (sst == GR_OK && !whole) sst = gr_fail(err, GR_E_NOMEM, "%s: out of memory for its %zu-byte payload", path, expect);
+    if (whole) p->data = whole;
+    if (sst == GR_OK && fread(p->data + hn, 1, expect, f) != expect)
+        sst = gr_fail(err, GR_E_INPUT, "%s: short read", path);
+    fclose(f);
+    if (sst != GR_OK) {
         part_free(p);
-        return gr_fail(err, GR_E_INPUT, "%s: payload is %zu bytes, the header says %.15g (expected %zu): truncated or damaged",
-                       path, total - hn, pn, expect);
+        return sst;
     }
     p->pay_n = expect;
     p->pay = p->data + hn;
@@ -352,8 +494,8 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
                 ph = q->probe_h;
                 plevels = q->probe_levels;
             } else if (q->probe_w != pw || q->probe_h != ph || q->probe_levels != plevels) {
-                st = gr_fail(err, GR_E_INPUT, "%s: probe grid %dx%d, other parts %dx%d", ps[i].path, q->probe_w, q->probe_h,
-                             pw, ph);
+                st = gr_fail(err, GR_E_INPUT, "%s: surface-bias probe of %dx%d pixels with %d levels, other parts %dx%d with %d",
+                             ps[i].path, q->probe_w, q->probe_h, q->probe_levels, pw, ph, plevels);
             }
         }
     for (int i = 0; i < n && st == GR_OK && probe; i++)
@@ -396,7 +538,8 @@ gr_status gr_parts_merge(const char *const *paths, int n, gr_scene *scene, gr_re
     if (st == GR_OK && strcmp(k, str(p0->h, "cache_key")) != 0)
         st = gr_fail(err, GR_E_INPUT, "%s: its scene reloads with cache key %s, not %s (another godrays version?)", p0->path,
                      k, str(p0->h, "cache_key"));
-    if (st == GR_OK) st = gr_truth_assemble(scene, sums, wall, out, err);
+    parts_checked pc = {sums, owner, ps, n};
+    if (st == GR_OK) st = gr_truth_assemble(scene, sums, wall, parts_check_hook, &pc, out, err);
     if (st == GR_OK) {
         gr_meta_set_int(&out->meta, "godrays:merged_parts", n);
         gr_meta_set_string(&out->meta, "godrays:wall_s_note", "wall_s: the parts' wall times added up");

@@ -384,3 +384,30 @@ gr_status gr_gl_build_program(const char *name, const char *vert_src, const char
     *program = prog;
     return gr_gl_check(name, err);
 }
+
+gr_status gr_gl_check_target_size(const char *what, int w, int h, unsigned internal_format, gr_error *err)
+{
+    if (w < 1 || h < 1) return gr_fail(err, GR_E_INPUT, "%s: a %dx%d render target is empty", what, w, h);
+    GLint tex = 0, rb = 0, vp[2] = {0, 0};
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &tex);
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &rb);
+    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, vp);
+    const char *rn = (const char *)glGetString(GL_RENDERER);
+    if (!rn) rn = "unknown renderer";
+    if (w > tex || h > tex || w > rb || h > rb || w > vp[0] || h > vp[1])
+        return gr_fail(err, GR_E_INPUT, "%s: a %dx%d render target is over this OpenGL's limits (GL_MAX_TEXTURE_SIZE %d, "
+                       "GL_MAX_RENDERBUFFER_SIZE %d, GL_MAX_VIEWPORT_DIMS %dx%d; %s): use a smaller size", what, w, h,
+                       (int)tex, (int)rb, (int)vp[0], (int)vp[1], rn);
+    /* the driver's answer for this size and format: a proxy texture of width 0 is refused */
+    const int rgba32f = internal_format == GL_RGBA32F;
+    glTexImage2D(GL_PROXY_TEXTURE_2D, 0, (GLint)internal_format, w, h, 0, GL_RGBA, GL_FLOAT, NULL);
+    GLint pw = 0;
+    glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &pw);
+    for (int k = 0; k < 8 && glGetError() != GL_NO_ERROR; k++) { /* a too-large proxy may set one; bounded if lost */
+    }
+    if (pw == 0)
+        return gr_fail(err, GR_E_INPUT, "%s: a %dx%d render target (format 0x%04x%s) is more than this OpenGL holds in one "
+                       "texture (%s; within GL_MAX_TEXTURE_SIZE %d, the driver refuses its memory): use a smaller size",
+                       what, w, h, internal_format, rgba32f ? ", RGBA32F: 16 bytes per pixel" : "", rn, (int)tex);
+    return GR_OK;
+}

@@ -44,4 +44,12 @@ void gr_gl_context_version(const gr_gl *gl, int *major, int *minor);
 gr_status gr_gl_build_program(const char *name, const char *vert_src, const char *frag_src,
                               unsigned *program, gr_error *err);
 
+/* Whether a w x h render target of `internal_format` (GL_RGBA32F for the god-ray layer) fits
+ * this context before it is made: against GL_MAX_TEXTURE_SIZE, GL_MAX_RENDERBUFFER_SIZE and
+ * GL_MAX_VIEWPORT_DIMS, then as a proxy texture (the driver's own refusal: llvmpipe holds at
+ * most 1 GiB in one texture, so a 16384 x 16384 RGBA32F target failed as "framebuffer
+ * incomplete (0x8cd6)"). GR_E_INPUT naming `what` (e.g. "camera.width/height"), the size and
+ * the limit it is over. Needs a current context. */
+gr_status gr_gl_check_target_size(const char *what, int w, int h, unsigned internal_format, gr_error *err);
+
 #endif

@@ -491,6 +491,26 @@ static gr_status probe_file(const char *path, gr_error *err)
     return GR_OK;
 }
 
+/* One part only: a multi-part file's first part was read without a word (issue 31), though
+ * the others may hold what was meant (another view, layer or frame). Refused, naming the parts. */
+static gr_status check_single_part(exr_const_context_t ctx, const char *path, gr_error *err)
+{
+    int n = 0;
+    exr_result_t rv = exr_get_count(ctx, &n);
+    if (rv != EXR_ERR_SUCCESS) return exr_fail(err, path, rv, GR_E_INPUT, "part count");
+    if (n == 1) return GR_OK;
+    char names[160] = "";
+    for (int i = 0; i < n && i < 4; i++) {
+        const char *nm = NULL;
+        if (exr_get_name(ctx, i, &nm) != EXR_ERR_SUCCESS || !nm) nm = "?";
+        size_t l = strlen(names);
+        snprintf(names + l, sizeof names - l, "%s'%.24s'", i ? ", " : "", nm);
+    }
+    return gr_fail(err, GR_E_INPUT, "%s: a multi-part EXR file of %d parts (%s%s); godrays reads single-part files: "
+                   "extract the one meant first, e.g. oiiotool %s --subimage NAME -o ONE.exr", path, n, names,
+                   n > 4 ? ", ..." : "", path);
+}
+
 gr_status gr_exr_check(const char *path, gr_error *err)
 {
     if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "EXR check: no input path");
@@ -507,6 +527,8 @@ gr_status gr_exr_check(const char *path, gr_error *err)
     exr_attr_box2i_t dw;
     if (rv != EXR_ERR_SUCCESS) {
         st = exr_fail(err, path, rv, GR_E_INPUT, "bad header");
+    } else if ((st = check_single_part(ctx, path, err)) != GR_OK) {
+        /* the message is set */
     } else if ((rv = exr_get_storage(ctx, 0, &storage)) != EXR_ERR_SUCCESS) {
         st = exr_fail(err, path, rv, GR_E_INPUT, "storage type");
     } else if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
@@ -539,6 +561,7 @@ gr_status gr_exr_read(const char *path, gr_image **out, gr_metadata *meta, gr_er
     gr_meta_init(&attrs);
     exr_result_t rv = exr_start_read(&ctx, path, &init);
     if (rv != EXR_ERR_SUCCESS) { st = exr_fail(err, path, rv, GR_E_INPUT, "bad header"); goto done; }
+    if ((st = check_single_part(ctx, path, err)) != GR_OK) goto done;
 
     exr_storage_t storage;
     rv = exr_get_storage(ctx, 0, &storage);

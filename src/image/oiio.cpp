@@ -1,6 +1,7 @@
 // OpenImageIO 2.4 behind the C interface of oiio.h: the only C++ in the project.
 // Every extern "C" body is wrapped in try/catch(...) so that no exception reaches C code.
 extern "C" {
+#include "common/memlimit.h"
 #include "common/outfile.h"
 #include "common/status.h"
 #include "image/exr.h"
@@ -16,6 +17,7 @@ extern "C" {
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
@@ -232,6 +234,26 @@ const char *read_format(const char *path)
     return nullptr;
 }
 
+// What a header declares against the file and the memory limit, before anything is allocated
+// (issue 31: a 222-byte TIFF declaring 8192 x 8192 pixels took 1.2 GB and was read as zeros).
+// No codec the reader takes expands its data by more than about 1:2700 (deflate's limit is
+// 1:1032, PNG, TIFF and EXR ZIP; LZW's about 1:2730; JPEG, RLE and PackBits far less), so a
+// file whose decoded samples are over 4096 times its size cannot hold them.
+gr_status check_declared_size(const char *path, const OIIO::ImageSpec &spec, gr_error *err)
+{
+    const double decoded = static_cast<double>(spec.image_bytes());
+    struct stat sb;
+    if (stat(path, &sb) == 0 && decoded > 4096.0 * static_cast<double>(sb.st_size) + 65536.0)
+        return gr_fail(err, GR_E_INPUT, "%s: declares %d x %d pixels of %d channel%s (%.0f bytes of samples) in a %lld-byte "
+                       "file: no image format compresses that much; damaged or forged", path, spec.width, spec.height,
+                       spec.nchannels, spec.nchannels == 1 ? "" : "s", decoded, static_cast<long long>(sb.st_size));
+    char what[300], detail[160];
+    std::snprintf(what, sizeof what, "reading %s", path);
+    std::snprintf(detail, sizeof detail, "%d x %d pixels x %d channel(s) as float, and the file's samples", spec.width,
+                  spec.height, spec.nchannels);
+    return gr_memlimit_check(what, 4.0 * spec.image_pixels() * spec.nchannels + decoded, detail, err);
+}
+
 } // namespace
 
 extern "C" const char *gr_oiio_version(void)
@@ -311,6 +333,8 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         if (cst != GR_OK) return cst;
         if (nc <= 0 || nc > GR_IMAGE_MAX_CHANNELS)
             return gr_fail(err, GR_E_INPUT, "%s: %d channels (1 to %d supported)", path, nc, GR_IMAGE_MAX_CHANNELS);
+        cst = check_declared_size(path, spec, err);
+        if (cst != GR_OK) return cst;
         static const char *const rgba[4] = {"R", "G", "B", "A"};
         std::vector<std::string> names(static_cast<size_t>(nc));
         std::vector<const char *> cnames(static_cast<size_t>(nc));
@@ -333,6 +357,13 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         if (read_ok && native)
             read_ok = OIIO::convert_pixel_values(spec.format, raw.data(), OIIO::TypeDesc::FLOAT, img->pixels,
                                                  static_cast<int>(spec.image_pixels() * static_cast<size_t>(nc)));
+        // A reader may return true and only leave its error behind: libtiff's "Read error at
+        // scanline" for a strip past the end of the file read as zeros (issue 31)
+        std::string late = read_ok ? in->geterror() : std::string();
+        if (!late.empty()) {
+            gr_image_destroy(img);
+            return fail(err, GR_E_INPUT, path, "reading pixels (truncated or damaged file)", late);
+        }
         if (!read_ok) {
             std::string why = in->geterror();
             const std::string lib = cap.take();

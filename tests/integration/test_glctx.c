@@ -147,6 +147,39 @@ static void check_errors(void)
     CHECK(gr_gl_check("after", &err) == GR_OK);
 }
 
+/* gr_gl_check_target_size (issue 31): a small target passes; one past GL_MAX_TEXTURE_SIZE is
+ * refused naming the limit; a 16384 x 16384 RGBA32F target is either refused with the reason
+ * or, where accepted, really makes a complete framebuffer (the check says what the driver
+ * does: llvmpipe failed it late as "framebuffer incomplete (0x8cd6)"); no GL error is left. */
+static void check_target_size(void)
+{
+    gr_error err = {GR_OK, ""};
+    CHECK_OK(gr_gl_check_target_size("small", 64, 36, GL_RGBA32F, &err), err);
+    GLint max = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max);
+    CHECK(gr_gl_check_target_size("wide", max + 1, 4, GL_RGBA32F, &err) == GR_E_INPUT);
+    CHECK_MSG(strstr(err.msg, "wide: a ") && strstr(err.msg, "GL_MAX_TEXTURE_SIZE"), "%s", err.msg);
+    gr_status st = gr_gl_check_target_size("big", 16384, 16384, GL_RGBA32F, &err);
+    if (st == GR_OK) {
+        GLuint tex = 0, fbo = 0;
+        glGenTextures(1, &tex);
+        glBindTexture(GL_TEXTURE_2D, tex);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, 16384, 16384);
+        glGenFramebuffers(1, &fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+        CHECK(glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glDeleteFramebuffers(1, &fbo);
+        glDeleteTextures(1, &tex);
+    } else {
+        CHECK(st == GR_E_INPUT);
+        CHECK_MSG(strstr(err.msg, "big: a 16384x16384 render target"), "%s", err.msg);
+    }
+    printf("16384 x 16384 RGBA32F: %s\n", st == GR_OK ? "held" : err.msg);
+    CHECK(gr_gl_check("after the target checks", &err) == GR_OK);
+}
+
 int main(void)
 {
     gr_error err = {GR_OK, ""};
@@ -182,6 +215,7 @@ int main(void)
     CHECK(profile & GL_CONTEXT_CORE_PROFILE_BIT);
     check_render();
     check_errors();
+    check_target_size();
 
     /* A second context on the same display: destroying it must leave the first usable. */
     gr_gl *gl2 = NULL;
