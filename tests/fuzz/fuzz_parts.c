@@ -16,7 +16,7 @@
 #include <string.h>
 
 #include "farm/parts.h"
-#include "report/cache.h"
+#include "reference/cache.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
