@@ -62,13 +62,14 @@ static int merge_with(gr_args *args)
     if (!rc && !n) rc = gr_cli_usage_error(cmd, "no part files given");
     if (!rc && !out_path && !cache) rc = gr_cli_usage_error(cmd, "no output given (-o OUT.exr or --cache)");
     for (int k = 0; k < n && !rc; k++) rc = gr_args_add_input(args, "part", parts[k]); /* never replaced */
+    /* an input named as the output first: the worse mistake */
+    if (!rc && out_path) rc = gr_args_check_output_file(args, "-o", out_path);
     /* the merge is float pixels and error channels: an EXR, whatever the name said (-o x.png
      * wrote EXR bytes into x.png); the PNG preview goes beside it */
     const size_t ol = out_path ? strlen(out_path) : 0;
     if (!rc && out_path && (ol < 5 || strcasecmp(out_path + ol - 4, ".exr") != 0))
         rc = gr_cli_usage_error(cmd, "-o %s: the merged ground truth is an EXR file: name it OUT.exr (a PNG preview is "
                                 "written beside it)", out_path);
-    if (!rc && out_path) rc = gr_args_check_output_file(args, "-o", out_path);
     if (!rc && out_path && preview) rc = gr_args_note_preview(args, "-o", out_path);
     if (rc) {
         free(parts);

@@ -104,194 +104,226 @@ static double auto_exposure(const gr_image *img)
     return q > 0 ? 1.0 / q : 1.0;
 }
 
-/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
-static int render_with(gr_args *args)
+/* What the command line asks for. */
+typedef struct render_opts {
+    const char *out_path, *shader_dir, *target_path, *tech_name;
+    int preview, quiet, have_time, have_frames, help;
+    double time_s, fps, exposure;
+    long f0, f1, fstep, repeat;
+    gr_gl_platform platform;
+} render_opts;
+
+/* One option with a value (a = its name); returns the exit code, 0 when taken. */
+static int take_value_option(gr_args *args, render_opts *o, const char *a)
 {
-    const char *cmd = "render";
-    const char *out_path = NULL, *shader_dir = NULL, *target_path = NULL, *tech_name = NULL;
+    const char *cmd = "render", *val = NULL;
+    int rc = gr_args_value(args, &val);
+    if (rc) return rc;
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+        o->out_path = val;
+    } else if (!strcmp(a, "--save-target")) {
+        o->target_path = val;
+    } else if (!strcmp(a, "--shader-dir")) {
+        o->shader_dir = val;
+    } else if (!strcmp(a, "--time")) {
+        if (parse_double(val, &o->time_s)) return gr_cli_usage_error(cmd, "--time %s: not a number", val);
+        o->have_time = 1;
+    } else if (!strcmp(a, "--fps")) {
+        if (parse_double(val, &o->fps) || !(o->fps > 0)) return gr_cli_usage_error(cmd, "--fps %s: expected a number > 0", val);
+    } else if (!strcmp(a, "--exposure")) {
+        if (parse_double(val, &o->exposure) || !(o->exposure > 0))
+            return gr_cli_usage_error(cmd, "--exposure %s: expected a number > 0", val);
+    } else if (!strcmp(a, "--repeat")) {
+        if (parse_int(val, &o->repeat) || o->repeat < 1 || o->repeat > 100000)
+            return gr_cli_usage_error(cmd, "--repeat %s: expected an integer in [1, 100000]", val);
+    } else if (!strcmp(a, "--frames")) {
+        char extra;
+        if (sscanf(val, "%ld:%ld:%ld%c", &o->f0, &o->f1, &o->fstep, &extra) != 3 || o->fstep < 1 || o->f1 < o->f0 ||
+            o->f0 < 0)
+            return gr_cli_usage_error(cmd, "--frames %s: expected START:END:STEP with 0 <= START <= END, STEP >= 1", val);
+        if ((o->f1 - o->f0) / o->fstep >= 100000) return gr_cli_usage_error(cmd, "--frames %s: too many frames", val);
+        o->have_frames = 1;
+    } else {
+        return gr_cli_usage_error(cmd, "unknown option %s", a);
+    }
+    return 0;
+}
 
-    const int argc = args->argc;
-    char **argv = args->argv;
-    int preview = 1, quiet = 0, have_time = 0, have_frames = 0, rc = 0;
-    double time_s = 0.0, fps = 30.0, exposure = 0.0;
-    long f0 = 0, f1 = 0, fstep = 1, repeat = 1;
-    gr_gl_platform platform = GR_GL_AUTO;
-
-    for (; args->i < argc; args->i++) {
-        const char *a = argv[args->i], *val = NULL;
+/* The argument loop; returns the exit code (o->help: help printed). */
+static int parse_args(gr_args *args, render_opts *o)
+{
+    int rc = 0;
+    o->preview = 1;
+    o->fps = 30.0;
+    o->fstep = o->repeat = 1;
+    o->platform = GR_GL_AUTO;
+    for (; args->i < args->argc && !rc; args->i++) {
+        const char *a = args->argv[args->i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
+            o->help = 1;
             return 0;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-            quiet = 1;
+            o->quiet = 1;
         } else if (!strcmp(a, "--no-preview")) {
-            preview = 0;
+            o->preview = 0;
         } else if (!strcmp(a, "--set")) {
-            if ((rc = gr_args_take_set(args)) != 0) return rc;
+            rc = gr_args_take_set(args);
         } else if (!strcmp(a, "--gl-platform")) {
-            if ((rc = gr_args_take_gl_platform(args, &platform)) != 0) return rc;
+            rc = gr_args_take_gl_platform(args, &o->platform);
         } else if (!strcmp(a, "--size")) {
-            if ((rc = gr_args_take_size(args)) != 0) return rc;
+            rc = gr_args_take_size(args);
         } else if (!strcmp(a, "--technique-dir")) {
-            if ((rc = gr_args_take_technique_dir(args)) != 0) return rc;
+            rc = gr_args_take_technique_dir(args);
         } else if (a[0] == '-' && a[1] != '\0') {
-            /* every other option takes a value */
-            if ((rc = gr_args_value(args, &val)) != 0) return rc;
-            if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-                out_path = val;
-            } else if (!strcmp(a, "--save-target")) {
-                target_path = val;
-            } else if (!strcmp(a, "--shader-dir")) {
-                shader_dir = val;
-            } else if (!strcmp(a, "--time")) {
-                if (parse_double(val, &time_s)) return gr_cli_usage_error(cmd, "--time %s: not a number", val);
-                have_time = 1;
-            } else if (!strcmp(a, "--fps")) {
-                if (parse_double(val, &fps) || !(fps > 0))
-                    return gr_cli_usage_error(cmd, "--fps %s: expected a number > 0", val);
-            } else if (!strcmp(a, "--exposure")) {
-                if (parse_double(val, &exposure) || !(exposure > 0))
-                    return gr_cli_usage_error(cmd, "--exposure %s: expected a number > 0", val);
-            } else if (!strcmp(a, "--repeat")) {
-                if (parse_int(val, &repeat) || repeat < 1 || repeat > 100000)
-                    return gr_cli_usage_error(cmd, "--repeat %s: expected an integer in [1, 100000]", val);
-            } else if (!strcmp(a, "--frames")) {
-                char extra;
-                if (sscanf(val, "%ld:%ld:%ld%c", &f0, &f1, &fstep, &extra) != 3 || fstep < 1 || f1 < f0 || f0 < 0)
-                    return gr_cli_usage_error(cmd, "--frames %s: expected START:END:STEP with 0 <= START <= END, STEP >= 1", val);
-                if ((f1 - f0) / fstep >= 100000) return gr_cli_usage_error(cmd, "--frames %s: too many frames", val);
-                have_frames = 1;
-            } else {
-                return gr_cli_usage_error(cmd, "unknown option %s", a);
-            }
-        } else if (!tech_name) {
-            tech_name = a; /* the first positional argument */
-        } else if ((rc = gr_args_take_scene(args)) != 0) {
-            return rc;
+            rc = take_value_option(args, o, a); /* every other option takes a value */
+        } else if (!o->tech_name) {
+            o->tech_name = a; /* the first positional argument */
+        } else {
+            rc = gr_args_take_scene(args);
         }
     }
-    if (!tech_name) return gr_cli_usage_error(cmd, "no technique given (`godrays techniques` lists them)");
-    if (!args->scene_path && (strchr(tech_name, '/') || strchr(tech_name, '.')))
-        return gr_cli_usage_error(cmd, "%s: expected TECHNIQUE SCENE, the technique first (`godrays techniques` lists them)",
-                                  tech_name);
-    if ((rc = gr_args_need_scene(args)) != 0) return rc;
-    /* user techniques before the scene, whose sections they add */
-    const gr_technique_class *cls = NULL;
-    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
-    if ((rc = gr_args_find_technique(args, "TECHNIQUE", tech_name, &cls)) != 0) return rc;
-    char default_out[GR_TECH_NAME_MAX + 8];
-    snprintf(default_out, sizeof default_out, "%s.exr", cls->name);
-    if (!out_path) out_path = default_out;
+    if (rc) return rc;
+    if (!o->tech_name) return gr_cli_usage_error("render", "no technique given (`godrays techniques` lists them)");
+    if (!args->scene_path && (strchr(o->tech_name, '/') || strchr(o->tech_name, '.')))
+        return gr_cli_usage_error("render", "%s: expected TECHNIQUE SCENE, the technique first (`godrays techniques` lists them)",
+                                  o->tech_name);
+    if (!o->have_frames) {
+        o->f0 = o->f1 = 0;
+        o->fstep = 1;
+    }
+    return gr_args_need_scene(args);
+}
 
-    gr_error err = {GR_OK, ""};
-    gr_scene *scene = NULL;
+/* The line printed per frame: the pass timings, the wall time and the technique's summary. */
+static void print_frame(const char *path, const gr_technique *r, const gr_technique_class *cls, const gr_scene *scene,
+                        const gr_technique_stats *stats)
+{
+    gr_strbuf line;
+    char extra[512];
+    gr_sb_init(&line);
+    gr_sb_printf(&line, "%s: %s, t = %.4f s, GPU ms:", path, cls->name, scene->water.time_s);
+    for (int p = 0; p < stats->n_passes; p++) {
+        if (stats->gpu_ns[p] >= 0)
+            gr_sb_printf(&line, "%s %s %.3f", p ? "," : "", stats->pass_names[p], (double)stats->gpu_ns[p] * 1e-6);
+        else
+            gr_sb_printf(&line, "%s %s n/a", p ? "," : "", stats->pass_names[p]);
+    }
+    gr_sb_printf(&line, "; wall %.3f ms", stats->wall_ms);
+    if (stats->fragments >= 0) gr_sb_printf(&line, "; fragments %lld", stats->fragments);
+    gr_technique_summary(r, stats, extra, sizeof extra);
+    if (extra[0]) gr_sb_printf(&line, "; %s", extra);
+    printf("%s\n", gr_sb_str(&line));
+    gr_sb_free(&line);
+}
+
+/* One frame's files: the EXR with its metadata, the preview, the intermediate target. */
+static gr_status write_frame(const render_opts *o, gr_technique *r, const gr_scene *scene, long fr, const gr_image *img,
+                             const gr_technique_stats *stats, const char *path, gr_error *err)
+{
+    gr_metadata meta;
+    gr_meta_init(&meta);
+    gr_status st = gr_technique_metadata(r, scene, NULL, stats, &meta, err);
+    if (st == GR_OK && ((o->have_frames && gr_meta_set_int(&meta, "godrays:frame", fr) != GR_OK) ||
+                        (o->repeat > 1 && gr_meta_set_int(&meta, "godrays:timing_repeats", o->repeat) != GR_OK)))
+        st = gr_fail(err, GR_E_NOMEM, "out of memory");
+    if (st == GR_OK) st = gr_exr_write(path, img, &meta, err);
+    if (st == GR_OK && o->preview) {
+        static const int rgb[3] = {0, 1, 2};
+        char png[4200];
+        gr_args_preview_path(path, png, sizeof png);
+        st = gr_oiio_write_preview(png, img, rgb, o->exposure > 0 ? o->exposure : auto_exposure(img), err);
+    }
+    if (st == GR_OK && o->target_path) {
+        char tpath[4096];
+        gr_image *timg = NULL;
+        if (o->have_frames) frame_path(o->target_path, fr, tpath, sizeof tpath);
+        else snprintf(tpath, sizeof tpath, "%s", o->target_path);
+        st = gr_technique_read_target(r, &timg, err);
+        if (st == GR_OK) st = gr_exr_write(tpath, timg, &meta, err);
+        gr_image_destroy(timg);
+    }
+    gr_meta_free(&meta);
+    return st;
+}
+
+/* The GL context, the technique, and every frame (each rendered o->repeat times; the
+ * timings printed and stored are the median's). */
+static gr_status render_frames(const render_opts *o, const gr_technique_class *cls, gr_scene *scene, gr_error *err)
+{
     gr_gl *gl = NULL;
     gr_technique *r = NULL;
     gr_image *img = NULL;
     gr_technique_stats *runs = NULL;
-    gr_metadata meta;
-    gr_meta_init(&meta);
-    if ((rc = gr_args_load_scene(args, &scene)) != 0) goto done;
-    /* Settings are checked before any GL work, so bad input exits 2 even without GL. */
-    if (gr_technique_check(cls, gr_technique_scene_settings(cls, scene), &err) != GR_OK) goto fail;
-    /* So are the outputs (frames and previews go beside OUT). */
-    if ((rc = gr_args_check_output_file(args, "-o", out_path)) != 0) goto done;
-    if (!have_frames && preview && (rc = gr_args_note_preview(args, "-o", out_path)) != 0) goto done;
-    if (target_path && (rc = gr_args_check_output_file(args, "--save-target", target_path)) != 0) goto done;
-    double t_base = have_time ? time_s : scene->water.time_s;
-
-    if (target_path && !cls->read_target) {
-        gr_fail(&err, GR_E_USAGE, "--save-target: technique %s has no intermediate render target to save", cls->name);
-        goto fail;
-    }
+    const double t_base = o->have_time ? o->time_s : scene->water.time_s;
     gr_gl_options glo;
     memset(&glo, 0, sizeof glo);
-    glo.platform = platform;
+    glo.platform = o->platform;
     gr_technique_options opts;
     memset(&opts, 0, sizeof opts);
-    opts.shader_dir = shader_dir;
-    if (gr_gl_create(&glo, &gl, &err) != GR_OK) goto fail;
+    opts.shader_dir = o->shader_dir;
+    gr_status st = gr_gl_create(&glo, &gl, err);
     /* the god-ray layer's float target must fit this GL (a 16384 x 16384 one failed late as
      * "framebuffer incomplete"): said up front, with the limit */
-    if (gr_gl_check_target_size("camera.width/height", scene->camera.width, scene->camera.height, GL_RGBA32F, &err) !=
-        GR_OK)
-        goto fail;
-    if (gr_technique_create(cls, gl, &opts, &r, &err) != GR_OK) goto fail;
-    img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
-    runs = calloc((size_t)repeat, sizeof *runs);
-    if (!img || !runs) {
-        gr_fail(&err, GR_E_NOMEM, "out of memory for a %dx%d image", scene->camera.width, scene->camera.height);
-        goto fail;
+    if (st == GR_OK)
+        st = gr_gl_check_target_size("camera.width/height", scene->camera.width, scene->camera.height, GL_RGBA32F, err);
+    if (st == GR_OK) st = gr_technique_create(cls, gl, &opts, &r, err);
+    if (st == GR_OK) {
+        img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
+        runs = calloc((size_t)o->repeat, sizeof *runs);
+        if (!img || !runs)
+            st = gr_fail(err, GR_E_NOMEM, "out of memory for a %dx%d image", scene->camera.width, scene->camera.height);
     }
-    if (!have_frames) {
-        f0 = f1 = 0;
-        fstep = 1;
-    }
-    for (long fr = f0; fr <= f1; fr += fstep) {
-        char path[4096], png[4200];
-        scene->water.time_s = have_frames ? t_base + (double)fr / fps : t_base;
-        for (long k = 0; k < repeat; k++)
-            if (gr_technique_render(r, scene, NULL, img, &runs[k], &err) != GR_OK) goto fail;
+    for (long fr = o->f0; st == GR_OK && fr <= o->f1; fr += o->fstep) {
+        char path[4096];
+        scene->water.time_s = o->have_frames ? t_base + (double)fr / o->fps : t_base;
+        for (long k = 0; st == GR_OK && k < o->repeat; k++) st = gr_technique_render(r, scene, NULL, img, &runs[k], err);
+        if (st != GR_OK) break;
         gr_technique_stats stats;
-        gr_technique_stats_median(runs, (int)repeat, &stats);
-        if (have_frames) frame_path(out_path, fr, path, sizeof path);
-        else snprintf(path, sizeof path, "%s", out_path);
-        gr_meta_free(&meta);
-        gr_meta_init(&meta);
-        if (gr_technique_metadata(r, scene, NULL, &stats, &meta, &err) != GR_OK) goto fail;
-        if (have_frames && gr_meta_set_int(&meta, "godrays:frame", fr) != GR_OK) {
-            gr_fail(&err, GR_E_NOMEM, "out of memory");
-            goto fail;
-        }
-        if (repeat > 1 && gr_meta_set_int(&meta, "godrays:timing_repeats", repeat) != GR_OK) {
-            gr_fail(&err, GR_E_NOMEM, "out of memory");
-            goto fail;
-        }
-        if (gr_exr_write(path, img, &meta, &err) != GR_OK) goto fail;
-        if (preview) {
-            static const int rgb[3] = {0, 1, 2};
-            gr_args_preview_path(path, png, sizeof png);
-            double e = exposure > 0 ? exposure : auto_exposure(img);
-            if (gr_oiio_write_preview(png, img, rgb, e, &err) != GR_OK) goto fail;
-        }
-        if (target_path) {
-            char tpath[4096];
-            gr_image *timg = NULL;
-            if (have_frames) frame_path(target_path, fr, tpath, sizeof tpath);
-            else snprintf(tpath, sizeof tpath, "%s", target_path);
-            if (gr_technique_read_target(r, &timg, &err) != GR_OK) goto fail;
-            gr_status tst = gr_exr_write(tpath, timg, &meta, &err);
-            gr_image_destroy(timg);
-            if (tst != GR_OK) goto fail;
-        }
-        if (!quiet) {
-            gr_strbuf line;
-            char extra[512];
-            gr_sb_init(&line);
-            gr_sb_printf(&line, "%s: %s, t = %.4f s, GPU ms:", path, cls->name, scene->water.time_s);
-            for (int p = 0; p < stats.n_passes; p++) {
-                if (stats.gpu_ns[p] >= 0)
-                    gr_sb_printf(&line, "%s %s %.3f", p ? "," : "", stats.pass_names[p], (double)stats.gpu_ns[p] * 1e-6);
-                else
-                    gr_sb_printf(&line, "%s %s n/a", p ? "," : "", stats.pass_names[p]);
-            }
-            gr_sb_printf(&line, "; wall %.3f ms", stats.wall_ms);
-            if (stats.fragments >= 0) gr_sb_printf(&line, "; fragments %lld", stats.fragments);
-            gr_technique_summary(r, &stats, extra, sizeof extra);
-            if (extra[0]) gr_sb_printf(&line, "; %s", extra);
-            printf("%s\n", gr_sb_str(&line));
-            gr_sb_free(&line);
-        }
+        gr_technique_stats_median(runs, (int)o->repeat, &stats);
+        if (o->have_frames) frame_path(o->out_path, fr, path, sizeof path);
+        else snprintf(path, sizeof path, "%s", o->out_path);
+        st = write_frame(o, r, scene, fr, img, &stats, path, err);
+        if (st == GR_OK && !o->quiet) print_frame(path, r, cls, scene, &stats);
     }
-    goto done;
-fail:
-    rc = gr_cli_report(cmd, &err);
-done:
-    gr_meta_free(&meta);
     free(runs);
     gr_image_destroy(img);
     gr_technique_destroy(r);
     gr_gl_destroy(gl);
+    return st;
+}
+
+/* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
+static int render_with(gr_args *args)
+{
+    const char *cmd = "render";
+    render_opts o;
+    memset(&o, 0, sizeof o);
+    int rc = parse_args(args, &o);
+    if (rc || o.help) return rc;
+    /* user techniques before the scene, whose sections they add */
+    const gr_technique_class *cls = NULL;
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    if ((rc = gr_args_find_technique(args, "TECHNIQUE", o.tech_name, &cls)) != 0) return rc;
+    char default_out[GR_TECH_NAME_MAX + 8];
+    snprintf(default_out, sizeof default_out, "%s.exr", cls->name);
+    if (!o.out_path) o.out_path = default_out;
+
+    gr_error err = {GR_OK, ""};
+    gr_scene *scene = NULL;
+    if ((rc = gr_args_load_scene(args, &scene)) != 0) return rc;
+    /* Settings are checked before any GL work, so bad input exits 2 even without GL. */
+    gr_status st = gr_technique_check(cls, gr_technique_scene_settings(cls, scene), &err);
+    /* So are the outputs (frames and previews go beside OUT). */
+    if (st == GR_OK) {
+        if (!rc) rc = gr_args_check_output_file(args, "-o", o.out_path);
+        if (!rc && !o.have_frames && o.preview) rc = gr_args_note_preview(args, "-o", o.out_path);
+        if (!rc && o.target_path) rc = gr_args_check_output_file(args, "--save-target", o.target_path);
+        if (!rc && o.target_path && !cls->read_target)
+            st = gr_fail(&err, GR_E_USAGE, "--save-target: technique %s has no intermediate render target to save", cls->name);
+        if (!rc && st == GR_OK) st = render_frames(&o, cls, scene, &err);
+    }
+    if (!rc && st != GR_OK) rc = gr_cli_report(cmd, &err);
     free(scene);
     return rc;
 }
