@@ -7,11 +7,11 @@
 #     after a change of file times only;
 #  b. an edit of reference/*.c, reference/*.h or src/scene/settings.c changes it, an edit of
 #     a file outside the ground truth (src/realtime) does not;
-#  c. (full variant only: it builds the `godrays` target of a copy of the tree, about a minute
-#     on 2 cores) the copy's binary reads the entry this binary stored (same sources, another
-#     path); rebuilt after a touch it still does; rebuilt after an edit of reference/ it misses
-#     and renders again.
-# GODRAYS_TEST_REDUCED=1 runs a and b (seconds).
+#  c. the copy's binary (the `godrays` target of a copy of the tree: about two minutes on 2
+#     cores) reads the entry this binary stored (same sources, another path); rebuilt after a
+#     touch it still does; rebuilt after an edit of reference/ it misses and renders again.
+#     This is issue 25's acceptance itself, so CI runs it too (no reduced variant);
+#     GODRAYS_TRUTH_DIGEST_NO_BUILD=1 skips c when iterating by hand.
 . "$(dirname "$0")/lib.sh"
 [ -n "$src" ] || { echo "FAIL: GODRAYS_SOURCE_DIR is not set"; exit 1; }
 cd "$dir" || exit 1
@@ -47,8 +47,8 @@ done
 ck "an edit outside the ground truth (src/realtime) keeps it" [ "$(changed src/realtime/technique.c)" = "$d0" ]
 
 # ---- c ----
-if [ "${GODRAYS_TEST_REDUCED:-0}" = 1 ] && [ "${GODRAYS_TEST_FULL:-0}" != 1 ]; then
-    echo "reduced: the rebuilt binaries (c) are skipped"
+if [ "${GODRAYS_TRUTH_DIGEST_NO_BUILD:-0}" = 1 ]; then
+    echo "GODRAYS_TRUTH_DIGEST_NO_BUILD=1: the rebuilt binaries (c) are skipped"
     exit $fail
 fi
 small_scene s.json 16 9 '"reference": {"sun_samples": 2, "batches": 2, "steps": 8, "surface_res": 32}'
