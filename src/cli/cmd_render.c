@@ -30,6 +30,7 @@ static void usage(FILE *f)
             "                       medium.g=0.9 (repeatable)\n"
             "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"
             "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
+            "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --shader-dir DIR     GLSL files in DIR replace the technique's embedded ones of the same name\n"
             "  --time T             water time t (s) of eq. 5.5.7 (default: the scene's water.time_s)\n"
             "  --frames A:B:S       render frames A, A+S, ... up to B at time T + frame / fps; the\n"
@@ -132,6 +133,8 @@ static int render_with(gr_args *args)
             if ((rc = gr_args_take_size(args)) != 0) return rc;
         } else if (!strcmp(a, "--technique-dir")) {
             if ((rc = gr_args_take_technique_dir(args)) != 0) return rc;
+        } else if (!strcmp(a, "--time-limit")) {
+            if ((rc = gr_args_take_time_limit(args)) != 0) return rc;
         } else if (a[0] == '-' && a[1] != '\0') {
             /* every other option takes a value */
             if ((rc = gr_args_value(args, &val)) != 0) return rc;

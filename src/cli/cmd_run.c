@@ -49,6 +49,7 @@ static void usage(FILE *f)
             "  -o, --output DIR     report folder (default: out/SCENE_NAME)\n"
             "  --techniques A,B     the techniques to compare (default: every registered one)\n"
             "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
+            "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --set KEY=VALUE      override a scene value before validation, e.g. TECHNIQUE.KEY=V,\n"
             "                       reference.spp=4, medium.g=0.9 (repeatable)\n"
             "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"
@@ -227,6 +228,44 @@ static void print_summary(const char *dir, const gr_scene *scene, const gr_repor
                 "(camera inside an occluder, no scattering, or no light reaching the view?)\n");
 }
 
+/* Issue 31: a technique that fails (a user shader over its time limit, a GL error, a memory
+ * refusal) is left out of the comparison instead of ending the run: a warning now, a row in
+ * the printed summary, exit 1 at the end. Its image and metadata are freed, cls[k] is removed
+ * (the entries after k are not rendered yet), and a context abandoned after a time limit is
+ * replaced by a new one. Ctrl-C still ends the run. */
+typedef struct run_failures {
+    int n;
+    const char *name[GR_REPORT_MAX_TECHNIQUES];
+    char msg[GR_REPORT_MAX_TECHNIQUES][GR_ERROR_MSG_MAX];
+} run_failures;
+
+static gr_status drop_failed(const gr_technique_class **cls, int *nt, int k, gr_image **img, gr_metadata *meta,
+                             gr_gl **gl, run_failures *f, gr_error *err)
+{
+    if (err->status == GR_E_INTERRUPTED) return err->status;
+    fprintf(stderr, "godrays run: warning: %s failed, left out of the comparison: %s\n", cls[k]->name, err->msg);
+    f->name[f->n] = cls[k]->name;
+    snprintf(f->msg[f->n++], GR_ERROR_MSG_MAX, "%s", err->msg);
+    gr_image_destroy(*img);
+    *img = NULL;
+    gr_meta_free(meta);
+    gr_meta_init(meta);
+    memmove(&cls[k], &cls[k + 1], (size_t)(*nt - k - 1) * sizeof *cls);
+    (*nt)--;
+    if (!gr_gl_abandoned(*gl)) return GR_OK;
+    gr_gl_destroy(*gl);
+    *gl = NULL;
+    return gr_gl_create(NULL, gl, err);
+}
+
+static int print_failures(const run_failures *f)
+{
+    if (f->n == 0) return 0;
+    printf("\nfailed, left out of the comparison:\n");
+    for (int i = 0; i < f->n; i++) printf("  %-4s %-24s %s\n", "-", f->name[i], f->msg[i]);
+    return 1;
+}
+
 /* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
 static int run_with(gr_args *args)
 {
@@ -296,6 +335,7 @@ static int run_with(gr_args *args)
     gr_sequence_result sres;
     memset(&sres, 0, sizeof sres);
     gr_gl *gl = NULL;
+    run_failures fails = {0};
     gr_image *test[GR_REPORT_MAX_TECHNIQUES] = {NULL};
     gr_metadata smeta[GR_REPORT_MAX_TECHNIQUES];
     gr_metrics *mets = calloc((size_t)nt, sizeof *mets);
@@ -350,7 +390,26 @@ static int run_with(gr_args *args)
     for (int k = 0; k < nt; k++) {
         if (!quiet) fprintf(stderr, "godrays run: rendering %s...\n", cls[k]->name);
         double t = now_s();
-        if (render_technique(cls[k], gl, scene0, &test[k], &smeta[k], &err) != GR_OK) goto fail;
+        int failed = render_technique(cls[k], gl, scene0, &test[k], &smeta[k], &err) != GR_OK;
+        for (int i = 1; i < nf && !failed; i++) {
+            gr_metadata scratch;
+            gr_meta_init(&scratch);
+            gr_status rst = render_technique(cls[k], gl, &cases[i], &seq_test[k * nf + i], &scratch, &err);
+            gr_meta_free(&scratch);
+            if (rst != GR_OK) {
+                gr_error_prefix(&err, "frame %d (t = %g s)", i, times[i]);
+                failed = 1;
+            }
+        }
+        if (failed) {
+            for (int i = 1; i < nf; i++) {
+                gr_image_destroy(seq_test[k * nf + i]);
+                seq_test[k * nf + i] = NULL;
+            }
+            if (drop_failed(cls, &nt, k, &test[k], &smeta[k], &gl, &fails, &err) != GR_OK) goto fail;
+            k--;
+            continue;
+        }
         ts[k].seconds = now_s() - t;
         ts[k].name = cls[k]->name;
         ts[k].description = cls[k]->description;
@@ -358,18 +417,9 @@ static int run_with(gr_args *args)
         ts[k].meta = &smeta[k];
         snprintf(exr_names[k], sizeof exr_names[k], "%s.exr", cls[k]->name);
         ts[k].exr = exr_names[k];
-        for (int i = 1; i < nf; i++) {
-            gr_metadata scratch;
-            gr_meta_init(&scratch);
-            gr_status rst = render_technique(cls[k], gl, &cases[i], &seq_test[k * nf + i], &scratch, &err);
-            gr_meta_free(&scratch);
-            if (rst != GR_OK) {
-                gr_error_prefix(&err, "frame %d (t = %g s)", i, times[i]);
-                goto fail;
-            }
-        }
         if (nf > 1) seq_test[k * nf] = test[k];
     }
+    if (nt == 0) goto fail; /* every technique failed: the last one's message */
     gr_gl_destroy(gl);
     gl = NULL;
 
@@ -464,6 +514,7 @@ static int run_with(gr_args *args)
         fprintf(stderr, "godrays run: note: no font for OpenImageIO's text: summary.png is unlabelled\n");
     if (!quiet && rres.charts == 0) fprintf(stderr, "godrays run: note: charts not drawn (see index.html)\n");
     print_summary(outdir, scene0, ts, nt, rres.order, &ro, t_ref);
+    rc = print_failures(&fails);
     if (nf > 1) {
         printf("\nsequence: %d frames, t = %g .. %g s; ground truths %.1f s in all\n", nf, times[0], times[nf - 1],
                t_refs);
