@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 secs=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(fuzz_scene fuzz_exr fuzz_image fuzz_parts)
+[ ${#targets[@]} -eq 0 ] && targets=(fuzz_scene fuzz_exr fuzz_image fuzz_parts fuzz_manifest)
 if ! command -v clang >/dev/null 2>&1 || ! command -v clang++ >/dev/null 2>&1; then
   echo "fuzz.sh: clang is not installed: skipped" >&2
   exit 0

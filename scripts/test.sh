@@ -81,7 +81,7 @@ phase "ctest build/ (all)"
 # 60 s each, two at a time.
 if command -v clang >/dev/null 2>&1; then
   FUZZ_JOBS=2 ./scripts/fuzz.sh 60 || { status=1; echo "test.sh: FAILED: fuzzing (build-fuzz/findings/)" >&2; }
-  phase "fuzz (4 targets x 60 s)"
+  phase "fuzz (5 targets x 60 s)"
 fi
 
 summary

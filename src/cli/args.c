@@ -188,6 +188,7 @@ int gr_args_take_common(gr_args *a, const char **dir, gr_gl_platform *platform, 
     if (platform && !strcmp(f, "--gl-platform")) return gr_args_take_gl_platform(a, platform);
     if (!strcmp(f, "--technique-dir")) return gr_args_take_technique_dir(a);
     if (!strcmp(f, "--max-memory")) return gr_args_take_max_memory(a);
+    if (!strcmp(f, "--time-limit")) return gr_args_take_time_limit(a);
     *taken = 0;
     return 0;
 }
@@ -212,6 +213,18 @@ int gr_args_take_technique_dir(gr_args *a)
     if (a->n_tech_dirs >= GR_TECH_MAX)
         return gr_cli_usage_error(a->cmd, "--technique-dir %s: more than %d technique folders", d, GR_TECH_MAX);
     a->tech_dirs[a->n_tech_dirs++] = d;
+    return 0;
+}
+
+int gr_args_take_time_limit(gr_args *a)
+{
+    const char *v = NULL;
+    double s = 0;
+    gr_error err = {GR_OK, ""};
+    int rc = gr_args_value(a, &v);
+    if (rc) return rc;
+    if (gr_technique_parse_time_limit("--time-limit", v, &s, &err) != GR_OK) return gr_cli_usage_error(a->cmd, "%s", err.msg);
+    gr_technique_set_time_limit(s);
     return 0;
 }
 

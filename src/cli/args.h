@@ -61,13 +61,15 @@ int gr_args_take_setting(gr_args *a, const char *key);
 int gr_args_take_gl_platform(gr_args *a, gr_gl_platform *platform);
 /* argv[i] as one of the options of the commands that write a folder from a scene (run,
  * sweep, tune, pareto): -o/--output DIR (into *dir, see gr_args_dir), --set, --size,
- * --technique-dir, --max-memory, and --gl-platform when platform is not NULL. *taken = 0 (and
- * 0 returned) when it is none. */
+ * --technique-dir, --max-memory, --time-limit, and --gl-platform when platform is not NULL.
+ * *taken = 0 (and 0 returned) when it is none. */
 int gr_args_take_common(gr_args *a, const char **dir, gr_gl_platform *platform, int *taken);
 /* --max-memory SIZE: the limit of every memory estimate of the command (common/memlimit). */
 int gr_args_take_max_memory(gr_args *a);
 /* --technique-dir DIR: remembers DIR (repeatable; added by gr_args_add_technique_dirs). */
 int gr_args_take_technique_dir(gr_args *a);
+/* --time-limit SECONDS: every technique render's time limit (gr_technique_set_time_limit). */
+int gr_args_take_time_limit(gr_args *a);
 /* Registers the user technique of every --technique-dir (gr_technique_add_dir), in order;
  * call it once, after the argument loop and BEFORE loading the scene (a user technique's
  * section is unknown to the loader until then). A bad folder or manifest: its message. */

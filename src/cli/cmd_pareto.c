@@ -49,6 +49,7 @@ static void usage(FILE *f)
             "  --techniques A,B   the techniques to place (default: every registered one)\n"
             "  --technique NAME   one technique only (same as --techniques NAME)\n"
             "  --technique-dir DIR  add the user technique in DIR (repeatable)\n"
+            "  --time-limit S     give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --quick            fewer points (q0, q1, the quick levels of each ladder), for tests\n"
             "  --repeat R         renders per setting; time = median (default 5)\n"
             "  --no-cache         render the high-quality ground truth even if cached\n"

@@ -32,6 +32,7 @@ static void usage(FILE *f)
             "                       medium.g=0.9 (repeatable)\n"
             "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"
             "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
+            "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --shader-dir DIR     GLSL files in DIR replace the technique's embedded ones of the same name\n"
             "  --time T             water time t (s) of eq. 5.5.7 (default: the scene's water.time_s)\n"
             "  --frames A:B:S       render frames A, A+S, ... up to B at time T + frame / fps; the\n"
@@ -175,6 +176,8 @@ static int parse_args(gr_args *args, render_opts *o)
             rc = gr_args_take_size(args);
         } else if (!strcmp(a, "--technique-dir")) {
             rc = gr_args_take_technique_dir(args);
+        } else if (!strcmp(a, "--time-limit")) {
+            rc = gr_args_take_time_limit(args);
         } else if (a[0] == '-' && a[1] != '\0') {
             rc = take_value_option(args, o, a); /* every other option takes a value */
         } else if (!o->tech_name) {

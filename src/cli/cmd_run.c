@@ -48,6 +48,7 @@ static void usage(FILE *f)
             "  -o, --output DIR     report folder (default: out/SCENE_NAME)\n"
             "  --techniques A,B     the techniques to compare (default: every registered one)\n"
             "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
+            "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --set KEY=VALUE      override a scene value before validation, e.g. TECHNIQUE.KEY=V,\n"
             "                       reference.spp=4, medium.g=0.9 (repeatable)\n"
             "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"

@@ -79,6 +79,7 @@ const char *gr_status_name(gr_status st)
     case GR_E_GL: return "OpenGL error";
     case GR_E_EMBREE: return "Embree error";
     case GR_E_INTERRUPTED: return "interrupted";
+    case GR_E_TIMEOUT: return "time limit";
     }
     return "unknown error";
 }

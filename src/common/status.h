@@ -17,7 +17,8 @@ typedef enum gr_status {
     GR_E_NOMEM,       /* allocation failed (exit 1) */
     GR_E_GL,          /* OpenGL/EGL failure, shader compile/link error (exit 1) */
     GR_E_EMBREE,      /* Embree reported an error (exit 1) */
-    GR_E_INTERRUPTED  /* stopped by the user (Ctrl-C); partial results may exist (exit 1) */
+    GR_E_INTERRUPTED, /* stopped by the user (Ctrl-C); partial results may exist (exit 1) */
+    GR_E_TIMEOUT      /* a time limit passed (a technique's render: --time-limit) (exit 1) */
 } gr_status;
 
 #define GR_ERROR_MSG_MAX 1024

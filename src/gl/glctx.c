@@ -21,6 +21,7 @@ struct gr_gl {
     EGLContext ctx;
     const char *platform; /* "device" or "surfaceless" */
     int major, minor;
+    int abandoned; /* gr_gl_abandon: the context is never used or destroyed again */
 };
 
 static const char *egl_error_name(EGLint e)
@@ -245,14 +246,27 @@ gr_status gr_gl_create(const gr_gl_options *opts, gr_gl **out, gr_error *err)
 void gr_gl_destroy(gr_gl *gl)
 {
     if (!gl) return;
+    if (gl->abandoned) {
+        free(gl);
+        return;
+    }
     release(gl);
     eglReleaseThread();
     free(gl);
 }
 
+void gr_gl_abandon(gr_gl *gl)
+{
+    if (gl) gl->abandoned = 1;
+}
+
+int gr_gl_abandoned(const gr_gl *gl) { return gl && gl->abandoned; }
+
 gr_status gr_gl_make_current(gr_gl *gl, gr_error *err)
 {
     if (!gl) return gr_fail(err, GR_E_USAGE, "gr_gl_make_current: gl is NULL");
+    if (gl->abandoned)
+        return gr_fail(err, GR_E_GL, "the GL context was abandoned after a render over its time limit: make a new one");
     if (!eglMakeCurrent(gl->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, gl->ctx))
         return gr_fail(err, GR_E_GL, "EGL %s platform: eglMakeCurrent failed (%s)", gl->platform,
                        egl_error_name(eglGetError()));

@@ -34,6 +34,11 @@ gr_status gr_gl_check(const char *what, gr_error *err);
 
 /* Added by the GL module: */
 const char *gr_gl_glsl_version(const gr_gl *gl); /* GL_SHADING_LANGUAGE_VERSION */
+/* Gives up gl for good: work still queued in it (a user shader over its time limit) is never
+ * waited for. Later gr_gl_make_current fails (GR_E_GL) and gr_gl_destroy frees only the
+ * handle, never touching the context (whose destruction could wait for that work). */
+void gr_gl_abandon(gr_gl *gl);
+int gr_gl_abandoned(const gr_gl *gl); /* 1 after gr_gl_abandon */
 /* Makes gl current again on the calling thread (after another gr_gl was created there). */
 gr_status gr_gl_make_current(gr_gl *gl, gr_error *err);
 /* Context version actually obtained (4.5 asked; 4.3 or 3.3 core if the driver refused). */

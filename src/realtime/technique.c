@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gl/gl.h"
 #include "realtime/toolkit.h"
 
 /* ---- the built-in techniques: ONE LINE EACH (their header declares the class) -------- */
@@ -241,12 +242,85 @@ gr_status gr_technique_apply_text(const gr_technique_class *cls, void *settings,
     return GR_OK;
 }
 
+/* ---- time limit ----------------------------------------------------------------------- */
+
+static double time_limit_flag_s; /* gr_technique_set_time_limit; 0: none */
+
+/* The render in progress on this thread (gr_technique_render), for gr_technique_wait_pass:
+ * one context is used from one thread, so each thread has at most one render running. */
+static _Thread_local struct {
+    const char *name;
+    double deadline_ms, limit_s;
+    const char *source;
+} cur_render;
+
+gr_status gr_technique_parse_time_limit(const char *what, const char *text, double *seconds, gr_error *err)
+{
+    char *end = NULL;
+    double v = text ? strtod(text, &end) : NAN;
+    if (!text || end == text || *end || !(v > 0 && v <= GR_TECH_TIME_LIMIT_MAX_S))
+        return gr_fail(err, GR_E_USAGE, "%s %s: expected a number of seconds in (0, %g]", what, text ? text : "",
+                       GR_TECH_TIME_LIMIT_MAX_S);
+    *seconds = v;
+    return GR_OK;
+}
+
+void gr_technique_set_time_limit(double seconds) { time_limit_flag_s = seconds > 0 ? seconds : 0; }
+
+gr_status gr_technique_time_limit(double *seconds, const char **source, gr_error *err)
+{
+    if (time_limit_flag_s > 0) {
+        *seconds = time_limit_flag_s;
+        *source = "--time-limit";
+        return GR_OK;
+    }
+    const char *env = getenv("GODRAYS_TIME_LIMIT");
+    if (env && env[0]) {
+        *source = "GODRAYS_TIME_LIMIT";
+        return gr_technique_parse_time_limit("GODRAYS_TIME_LIMIT", env, seconds, err);
+    }
+    *seconds = GR_TECH_TIME_LIMIT_DEFAULT_S;
+    *source = "default";
+    return GR_OK;
+}
+
+gr_status gr_technique_wait_pass(const char *what, gr_error *err)
+{
+    GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    if (!fence) return gr_gl_check(what, err);
+    /* The first wait flushes, so the fence (and the pass before it) reaches the GPU; short
+     * waits then, so that the deadline is met within 50 ms. */
+    GLbitfield flags = GL_SYNC_FLUSH_COMMANDS_BIT;
+    for (;;) {
+        double left_ms = cur_render.name ? cur_render.deadline_ms - gr_clock_ms() : 50.0;
+        if (left_ms <= 0) break;
+        GLuint64 wait_ns = (GLuint64)((left_ms < 50.0 ? left_ms : 50.0) * 1e6);
+        GLenum r = glClientWaitSync(fence, flags, wait_ns);
+        flags = 0;
+        if (r == GL_ALREADY_SIGNALED || r == GL_CONDITION_SATISFIED) {
+            glDeleteSync(fence);
+            return GR_OK;
+        }
+        if (r == GL_WAIT_FAILED) {
+            glDeleteSync(fence);
+            gr_status st = gr_gl_check(what, err);
+            return st != GR_OK ? st : gr_fail(err, GR_E_GL, "%s: glClientWaitSync failed", what);
+        }
+    }
+    /* the fence is left to the abandoned context: deleting it is GL work there */
+    return gr_fail(err, GR_E_TIMEOUT,
+                   "%s: %s: not done after the time limit of %g s (%s; change it with --time-limit SECONDS): "
+                   "render abandoned with its GL context",
+                   cur_render.name, what, cur_render.limit_s, cur_render.source);
+}
+
 /* ---- instances ------------------------------------------------------------------------ */
 
 struct gr_technique {
     const gr_technique_class *cls;
     gr_gl *gl;
     void *state;
+    int abandoned; /* a render went over the time limit: state and context are never touched again */
 };
 
 gr_status gr_technique_create(const gr_technique_class *cls, gr_gl *gl, const gr_technique_options *opts,
@@ -256,6 +330,9 @@ gr_status gr_technique_create(const gr_technique_class *cls, gr_gl *gl, const gr
     memset(&o, 0, sizeof o);
     if (opts) o = *opts;
     *out = NULL;
+    if (gr_gl_abandoned(gl))
+        return gr_fail(err, GR_E_TIMEOUT, "technique %s: its GL context was abandoned after a render over the time "
+                       "limit; make a new context", cls->name);
     gr_technique *t = calloc(1, sizeof *t);
     if (!t) return gr_fail(err, GR_E_NOMEM, "technique %s: out of memory", cls->name);
     t->cls = cls;
@@ -272,8 +349,10 @@ gr_status gr_technique_create(const gr_technique_class *cls, gr_gl *gl, const gr
 void gr_technique_destroy(gr_technique *t)
 {
     if (!t) return;
-    if (t->gl) gr_gl_make_current(t->gl, NULL);
-    t->cls->destroy(t->state);
+    if (!t->abandoned) { /* an abandoned instance's state stays with its abandoned context */
+        if (t->gl) gr_gl_make_current(t->gl, NULL);
+        t->cls->destroy(t->state);
+    }
     free(t);
 }
 
@@ -300,8 +379,23 @@ gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void
     int ch[3] = {gr_image_channel(out, "R"), gr_image_channel(out, "G"), gr_image_channel(out, "B")};
     if (ch[0] < 0 || ch[1] < 0 || ch[2] < 0)
         return gr_fail(err, GR_E_RUNTIME, "technique %s: output image lacks channels R, G, B", cls->name);
+    if (t->abandoned)
+        return gr_fail(err, GR_E_TIMEOUT, "technique %s: abandoned after a render over the time limit", cls->name);
+    double limit_s = 0;
+    const char *source = NULL;
+    if ((st = gr_technique_time_limit(&limit_s, &source, err)) != GR_OK) return st;
     double t0 = gr_clock_ms();
-    if ((st = cls->render(t->state, scene, rs.bytes, out, stats, err)) != GR_OK) return st;
+    cur_render.name = cls->name;
+    cur_render.limit_s = limit_s;
+    cur_render.source = source;
+    cur_render.deadline_ms = t0 + 1000.0 * limit_s;
+    st = cls->render(t->state, scene, rs.bytes, out, stats, err);
+    cur_render.name = NULL;
+    if (st == GR_E_TIMEOUT) {
+        t->abandoned = 1;
+        gr_gl_abandon(t->gl);
+    }
+    if (st != GR_OK) return st;
     if (!(stats->wall_ms >= 0)) stats->wall_ms = gr_clock_ms() - t0;
     /* The harness's guarantee, whatever the technique (a user's shader included): no NaN
      * or Inf reaches an image. */

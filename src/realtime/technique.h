@@ -147,15 +147,42 @@ int gr_technique_tune_example(const gr_technique_class *cls, const gr_param **ou
  * GR_E_INPUT naming "NAME.KEY" for an unknown key or a bad value. */
 gr_status gr_technique_apply_text(const gr_technique_class *cls, void *settings, const char *text, gr_error *err);
 
+/* ---- time limit ------------------------------------------------------------------------ */
+
+/* Every render has a time limit (docs/techniques.md "Time limit"): gr_technique_set_time_limit
+ * (a command's --time-limit), else $GODRAYS_TIME_LIMIT, else GR_TECH_TIME_LIMIT_DEFAULT_S,
+ * far above what a sensible render takes. A class enforces it by calling
+ * gr_technique_wait_pass after each pass; a render over it fails with GR_E_TIMEOUT, and the
+ * instance and its GL context are abandoned (gr_gl_abandon): work still queued is never
+ * waited for, the context never reused. The user techniques call it; the built-in ones,
+ * whose cost their settings' ranges bound, do not. */
+#define GR_TECH_TIME_LIMIT_DEFAULT_S 60.0
+#define GR_TECH_TIME_LIMIT_MAX_S 86400.0
+/* "SECONDS" (a number in (0, 86400]) into *seconds; GR_E_USAGE naming what otherwise. */
+gr_status gr_technique_parse_time_limit(const char *what, const char *text, double *seconds, gr_error *err);
+void gr_technique_set_time_limit(double seconds); /* <= 0: back to the environment / default */
+/* The limit in seconds and where it comes from ("--time-limit", "GODRAYS_TIME_LIMIT", "the
+ * default"). An unparsable $GODRAYS_TIME_LIMIT is GR_E_USAGE. */
+gr_status gr_technique_time_limit(double *seconds, const char **source, gr_error *err);
+/* For a class's render, after a pass (what names it): flushes the GL work issued so far and
+ * waits until it is done, or until the current render's time limit passes: GR_E_TIMEOUT
+ * "TECHNIQUE: WHAT: not done after the time limit of S s (SOURCE) ...". Outside a render
+ * (gr_technique_render) it waits without a limit. */
+gr_status gr_technique_wait_pass(const char *what, gr_error *err);
+
 /* ---- instances -------------------------------------------------------------------------- */
 
 typedef struct gr_technique gr_technique; /* a class + its GL state; one thread */
 
+/* GR_E_TIMEOUT for a context abandoned after a time limit (gr_gl_abandoned). */
 gr_status gr_technique_create(const gr_technique_class *cls, gr_gl *gl, const gr_technique_options *opts,
                               gr_technique **out, gr_error *err);
 void gr_technique_destroy(gr_technique *t); /* accepts NULL */
 const gr_technique_class *gr_technique_class_of(const gr_technique *t);
-/* settings NULL: the scene's own, resolved. Checks the settings first (GR_E_INPUT). */
+/* settings NULL: the scene's own, resolved. Checks the settings first (GR_E_INPUT). Over the
+ * time limit: GR_E_TIMEOUT, and t and its context are abandoned (every later render of t is
+ * GR_E_TIMEOUT; gr_technique_create refuses the context; destroy t and the context as
+ * usual, neither touches GL then): the caller makes a new context for what follows. */
 gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out,
                               gr_technique_stats *stats, gr_error *err);
 /* "godrays:technique", every setting (resolved, by name), GL strings, per-pass GPU ns, wall ms,

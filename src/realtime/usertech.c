@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/memlimit.h"
 #include "core/optics.h"
 #include "gl/gl.h"
 #include "realtime/frame.h"
@@ -429,6 +430,29 @@ static gr_status ensure_target(ut_state *s, int t, int w, int h, gr_error *err)
     return gr_target_ensure(&s->tgt[t], fmts[tg->format], w, h, tg->linear ? GR_TARGET_LINEAR : 0, what, err);
 }
 
+/* The render's memory before any target is made (docs/reliability.md, issue 31 finding 5: five
+ * 8192^2 rgba32f targets, 7.6 GB, were made under a 1 GB limit): every target at its size and
+ * format, the readback (RGBA float per pixel) and the harness inputs (the shadow map's 32-bit
+ * depth; the eye depth's R32F texture and its 32-bit depth buffer). */
+static gr_status check_memory(const ut_state *s, const void *settings, int W, int H, const int *tw, const int *th,
+                              gr_error *err)
+{
+    static const double px_bytes[] = {4, 8, 16}; /* rgba8, rgba16f, rgba32f */
+    const gr_ut_manifest *m = s->m;
+    double need = 16.0 * W * H;
+    for (int t = 0; t < m->n_targets; t++) need += px_bytes[m->targets[t].format] * tw[t] * (double)th[t];
+    if (m->uses_shadow_map) {
+        double size = value_of(m, settings, &m->shadow_size);
+        need += 4.0 * size * size;
+    }
+    if (m->uses_eye_depth) need += 8.0 * W * H;
+    char what[96], detail[64];
+    snprintf(what, sizeof what, "technique %s", m->name);
+    snprintf(detail, sizeof detail, "%d render target%s, readback and harness inputs", m->n_targets,
+             m->n_targets == 1 ? "" : "s");
+    return gr_memlimit_check(what, need, detail, err);
+}
+
 static void set_matrix(GLint loc, const double m[16])
 {
     float f[16];
@@ -583,6 +607,7 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
             goto done;
         }
     }
+    if ((st = check_memory(s, settings, W, H, tw, th, err)) != GR_OK) goto done;
     if ((st = gr_gl_make_current(s->gl, err)) != GR_OK) goto done;
     for (int t = 0; t < m->n_targets; t++)
         if ((st = ensure_target(s, t, tw[t], th[t], err)) != GR_OK) goto done;
@@ -660,6 +685,11 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
             gr_error_prefix(err, "%s: passes[%d]", m->path, p);
             goto unbind;
         }
+        /* the time limit (technique.h): a pass's shader is the user's and may run for hours */
+        char what[64];
+        snprintf(what, sizeof what, "passes[%d] '%s'", p, ps->name);
+        if ((st = gr_technique_wait_pass(what, err)) == GR_E_TIMEOUT) goto done;
+        if (st != GR_OK) goto unbind;
     }
 
     /* read the output target back (GL rows bottom-up; gr_image top row first) */

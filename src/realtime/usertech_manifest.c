@@ -1,5 +1,7 @@
 /* A user technique's manifest: parsing and validation (usertech_manifest.h,
  * docs/techniques.md). */
+/* realpath (XSI) beside the project's _POSIX_C_SOURCE */
+#define _DEFAULT_SOURCE
 #include "realtime/usertech_manifest.h"
 
 #include <cjson/cJSON.h>
@@ -10,7 +12,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "scene/scene.h"
 
@@ -273,33 +277,80 @@ static gr_status count_at(ut_ctx *c, const gr_ut_manifest *m, const cJSON *v, co
     return GR_OK;
 }
 
-gr_status gr_ut_read_file(const char *path, char **out, char *why, size_t why_n)
+/* 1 when real (a resolved path) is root itself or lies below it. */
+static int path_inside(const char *root, const char *real)
 {
-    FILE *f = fopen(path, "rb");
+    size_t n = strlen(root);
+    if (n == 1 && root[0] == '/') return 1;
+    return !strncmp(root, real, n) && (real[n] == '\0' || real[n] == '/');
+}
+
+gr_status gr_ut_read_file(const char *dir, const char *path, char **out, char *why, size_t why_n)
+{
     *out = NULL;
-    if (!f) {
+    /* Containment (docs/techniques.md "The folder and the manifest"): the file's real path,
+     * symbolic links and ".." resolved, must lie inside the folder's. Checked before the open,
+     * so that nothing outside the folder is read, and no message ever quotes it. */
+    char *root = realpath(dir, NULL), *real = root ? realpath(path, NULL) : NULL;
+    if (!root || !real) {
+        snprintf(why, why_n, "%s", strerror(errno));
+        free(root);
+        return GR_E_IO;
+    }
+    int inside = path_inside(root, real);
+    free(root);
+    if (!inside) {
+        free(real);
+        snprintf(why, why_n, "outside the technique folder (a link or '..' out of it): not read");
+        return GR_E_IO;
+    }
+    /* O_NONBLOCK: a FIFO or a device must not block the open; fstat then refuses them */
+    int fd = open(real, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOFOLLOW);
+    free(real);
+    if (fd < 0) {
         snprintf(why, why_n, "%s", strerror(errno));
         return GR_E_IO;
     }
     struct stat sb;
-    if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode)) {
-        fclose(f);
+    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        close(fd);
         snprintf(why, why_n, "not a regular file");
         return GR_E_IO;
     }
-    size_t cap = (size_t)sb.st_size + 1, len = 0;
+    if (sb.st_size > GR_UT_MAX_FILE_BYTES) {
+        close(fd);
+        snprintf(why, why_n, "%lld bytes, over the cap of %d bytes (%d MiB) for a technique's file",
+                 (long long)sb.st_size, GR_UT_MAX_FILE_BYTES, GR_UT_MAX_FILE_BYTES >> 20);
+        return GR_E_IO;
+    }
+    /* one byte more than the size: a file that grew since fstat is caught, not truncated */
+    size_t cap = (size_t)sb.st_size + 2, len = 0;
     char *buf = malloc(cap);
     if (!buf) {
-        fclose(f);
+        close(fd);
         snprintf(why, why_n, "out of memory");
         return GR_E_NOMEM;
     }
-    len = fread(buf, 1, cap - 1, f);
-    int bad = ferror(f);
-    fclose(f);
+    int bad = 0;
+    for (;;) {
+        ssize_t r = read(fd, buf + len, cap - 1 - len);
+        if (r < 0 && errno == EINTR) continue;
+        if (r < 0) {
+            snprintf(why, why_n, "read error (%s)", strerror(errno));
+            bad = 1;
+            break;
+        }
+        if (r == 0) break;
+        len += (size_t)r;
+        if (len == cap - 1) {
+            snprintf(why, why_n, "changed while read (grew past its size of %lld bytes)", (long long)sb.st_size);
+            bad = 1;
+            break;
+        }
+    }
+    close(fd);
     if (bad) {
         free(buf);
-        snprintf(why, why_n, "read error");
         return GR_E_IO;
     }
     buf[len] = '\0';
@@ -317,9 +368,9 @@ static gr_status shader_file(ut_ctx *c, const gr_ut_manifest *m, const char *fil
 {
     char full[4096], why[256];
     if (!file[0]) return vfail(c, p, "empty file name");
-    if (file[0] == '/') snprintf(full, sizeof full, "%s", file);
-    else snprintf(full, sizeof full, "%s/%s", m->dir, file);
-    gr_status st = gr_ut_read_file(full, src, why, sizeof why);
+    if (file[0] == '/') return vfail(c, p, "'%s': an absolute path; a shader's file is relative to the technique folder", file);
+    if (snprintf(full, sizeof full, "%s/%s", m->dir, file) >= (int)sizeof full) return vfail(c, p, "file name too long");
+    gr_status st = gr_ut_read_file(m->dir, full, src, why, sizeof why);
     if (st == GR_E_NOMEM) return gr_fail(c->err, st, "%s: %s: out of memory", c->path, p);
     if (st) return vfail(c, p, "cannot read shader %s: %s", full, why);
     return GR_OK;
@@ -836,7 +887,7 @@ gr_status gr_ut_manifest_load(const char *dir, gr_ut_manifest **out, gr_error *e
     m->dir[dl] = '\0';
     sprintf(m->path, "%s/%s", m->dir, GR_USERTECH_MANIFEST);
     char *text = NULL, why[256];
-    gr_status st = gr_ut_read_file(m->path, &text, why, sizeof why);
+    gr_status st = gr_ut_read_file(m->dir, m->path, &text, why, sizeof why);
     if (st) {
         st = gr_fail(err, st == GR_E_NOMEM ? GR_E_NOMEM : GR_E_INPUT, "%s: cannot read the manifest: %s", m->path, why);
         gr_ut_manifest_free(m);

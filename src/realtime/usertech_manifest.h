@@ -24,6 +24,7 @@
 #define GR_UT_NAME_MAX 24
 #define GR_UT_MAX_SIZE 16384
 #define GR_UT_MAX_LADDER 16
+#define GR_UT_MAX_FILE_BYTES (1 << 20) /* a manifest or a shader file: 1 MiB at most */
 
 typedef enum { GR_UT_NUMBER, GR_UT_INT, GR_UT_BOOL, GR_UT_RGB } gr_ut_type;
 extern const char *const gr_ut_type_names[];
@@ -122,8 +123,11 @@ gr_status gr_ut_manifest_load(const char *dir, gr_ut_manifest **out, gr_error *e
 void gr_ut_manifest_free(gr_ut_manifest *m); /* accepts NULL */
 
 /* Reads the whole text file at path into *out (malloc'd, NUL-terminated): the one place a
- * manifest's files are opened. GR_E_IO (why: strerror, not a regular file, a NUL byte, a
- * read error) or GR_E_NOMEM, with the reason in why. */
-gr_status gr_ut_read_file(const char *path, char **out, char *why, size_t why_n);
+ * manifest's files are opened. The file must lie inside the folder dir once links and ".."
+ * are resolved (realpath), be a regular file (checked on a non-blocking descriptor, so a
+ * FIFO never blocks) of at most GR_UT_MAX_FILE_BYTES, and hold no NUL byte. GR_E_IO (why:
+ * strerror, outside the folder, not a regular file, over the cap, a NUL byte, a read error;
+ * never the file's contents) or GR_E_NOMEM, with the reason in why. */
+gr_status gr_ut_read_file(const char *dir, const char *path, char **out, char *why, size_t why_n);
 
 #endif

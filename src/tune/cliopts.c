@@ -12,6 +12,7 @@ static const char help_rest[] =
     "  --technique NAME     the real-time technique (default: the one the parameters name, else\n"
     "                       the first of `godrays techniques`); its settings are NAME.KEY\n"
     "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
+    "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
     "  --fit / --no-fit     score the technique after the best scale fit a = <t,r>/<t,t>\n"
     "                       (default: on, unless its gain setting, e.g. intensity, is a parameter)\n"
     "  --normalize          divide a metric in image units (rmse, msrmse) by each case's mean\n"
