@@ -472,18 +472,10 @@ static gr_status compute_metrics(const run_opts *o, run_state *rs, gr_error *err
     /* beam structure around the refracted sun's vanishing point, de-glowed by the angle to
      * the sun (docs/metrics.md), in every technique's metric sets; skipped when the beams have
      * no finite vanishing point (parallel to the image plane) */
-    gr_structure_options so = {.radial_bin = scene->camera.fov_deg / scene->camera.height};
-    int with_structure = 0;
-    gr_error e2 = {GR_OK, ""};
+    gr_structure_options so;
     rs->angles = malloc((size_t)scene->camera.width * (size_t)scene->camera.height * sizeof(float));
     if (!rs->angles) return gr_fail(err, GR_E_NOMEM, "out of memory for the structure metrics");
-    if (gr_structure_scene_vp(scene, scene->camera.width, scene->camera.height, &so.vp_x, &so.vp_y, &e2) == GR_OK) {
-        double dir[3];
-        gr_profile_sun_view_dir(scene, dir);
-        gr_profile_angles(&scene->camera, dir, rs->angles);
-        so.radial = rs->angles;
-        with_structure = 1;
-    }
+    const int with_structure = gr_profile_structure_options(scene, rs->angles, &so);
     gr_metrics_options mopt = {0};
     mopt.fit_scale = 1; /* a technique's intensity is an arbitrary factor (seed 000) */
     if (with_structure) mopt.structure = &so;
