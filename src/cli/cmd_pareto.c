@@ -12,7 +12,9 @@
 #include <time.h>
 
 #include "compare/metrics.h"
+#include "compare/registry.h"
 #include "realtime/technique.h"
+#include "report/profile.h"
 #include "report/report.h"
 #include "tune/page.h"
 #include "tune/budget.h"
@@ -36,7 +38,8 @@ static void usage(FILE *f)
             "  - each real-time technique over its own speed/quality ladder (settings such as a grid\n"
             "    or target size; docs/tuning.md), median time of --repeat renders in one context,\n"
             "    error after the best scale fit.\n"
-            "Error = RMSE of luminance Y / mean Y of the high-quality ground truth. The techniques\n"
+            "Error = the verdict against the high-quality ground truth, the score `godrays run` ranks\n"
+            "by ((RMSE of Y / its mean Y + structure score) / 2; docs/metrics.md). The techniques\n"
             "are ranked by the wall time of a render with readback on llvmpipe, by the GPU time of\n"
             "their GL passes on a hardware GPU (both are listed). Writes DIR/pareto.csv and\n"
             "DIR/pareto.png (every family and its Pareto front, one colour each). docs/tuning.md.\n"
@@ -69,11 +72,21 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Relative RMSE of Y: RMSE / mean reference Y (0 mean: the RMSE itself). */
-static double rel_rmse(const gr_metrics_set *set)
+/* The error axis: the verdict (compare/registry.h), the score `godrays run` ranks by. */
+static double verdict(const gr_metrics_set *set) { return gr_metric_value(set, GR_METRIC_VERDICT); }
+
+/* The metrics the verdict needs against the scene's truth: the pointwise pass and the beam
+ * structure (so, when the beams have a vanishing point); no stderr exclusion (the HQ image is
+ * the reference, its own noise is tiny). */
+static gr_metrics_options verdict_options(const gr_structure_options *so, int fit)
 {
-    const gr_channel_metrics *y = &set->ch[GR_MCH_Y];
-    return y->ref_mean > 0 ? y->rmse / y->ref_mean : y->rmse;
+    gr_metrics_options mo = {0};
+    mo.skip_ssim = 1;
+    mo.skip_blur = 1;
+    mo.fit_scale = fit;
+    mo.stderr_bound = INFINITY;
+    mo.structure = so && so->radial ? so : NULL;
+    return mo;
 }
 
 /* Reference quality ladder (docs/tuning.md), relative to the scene's own reference settings
@@ -188,7 +201,8 @@ static int parse_args(gr_args *args, pareto_opts *o)
 /* The high-quality ground truth (*truth, cached), then the ground truth's own ladder: each
  * level timed (never cached) and scored against it; points appended to pts[*n]. */
 static gr_status reference_points(const pareto_opts *o, const gr_scene *scene, gr_scene *work, gr_image **truth,
-                                  gr_truth_info *ti, gr_pareto_point *pts, int *n, gr_error *err)
+                                  gr_truth_info *ti, const gr_structure_options *so, gr_pareto_point *pts, int *n,
+                                  gr_error *err)
 {
     /* the high-quality ground truth, with its own seed so that no ladder level shares its
      * random numbers (a shared seed would make the lower levels look better than they are) */
@@ -217,11 +231,7 @@ static gr_status reference_points(const pareto_opts *o, const gr_scene *scene, g
         gr_image *ri = NULL;
         gr_truth_info li;
         if ((st = gr_truth_image(work, &to, &ri, &li, err)) != GR_OK) return st;
-        /* no stderr exclusion: the HQ image is the reference, its own noise is tiny */
-        gr_metrics_options ro = {0};
-        ro.skip_ssim = 1;
-        ro.skip_blur = 1;
-        ro.stderr_bound = INFINITY;
+        const gr_metrics_options ro = verdict_options(so, 0);
         gr_metrics m;
         st = gr_metrics_compute(*truth, ri, &ro, &m, err);
         gr_image_destroy(ri);
@@ -235,7 +245,7 @@ static gr_status reference_points(const pareto_opts *o, const gr_scene *scene, g
         p->time_s = li.seconds;
         p->gpu_s = -1;
         p->cost_s = li.seconds;
-        p->error = rel_rmse(&m.raw);
+        p->error = verdict(&m.raw);
     }
     return GR_OK;
 }
@@ -244,8 +254,9 @@ static gr_status reference_points(const pareto_opts *o, const gr_scene *scene, g
  * shader JIT), then o->repeat timed renders (median wall and GPU time) and the error after
  * the best scale fit against truth. times, gpus: o->repeat scratch values each. */
 static gr_status ladder_point(pareto_opts *o, const gr_technique_class *cls, gr_technique *r,
-                              const gr_scene *scene, const char *lvs, const gr_image *truth, gr_image *img,
-                              double *times, double *gpus, gr_pareto_point *p, gr_error *err)
+                              const gr_scene *scene, const char *lvs, const gr_image *truth,
+                              const gr_structure_options *so, gr_image *img, double *times, double *gpus,
+                              gr_pareto_point *p, gr_error *err)
 {
     gr_section_store s;
     memcpy(s.bytes, gr_technique_scene_settings(cls, scene), cls->settings_size);
@@ -268,11 +279,7 @@ static gr_status ladder_point(pareto_opts *o, const gr_technique_class *cls, gr_
     }
     gr_metrics m;
     if (st == GR_OK) {
-        gr_metrics_options fo = {0};
-        fo.skip_ssim = 1;
-        fo.skip_blur = 1;
-        fo.fit_scale = 1;
-        fo.stderr_bound = INFINITY;
+        const gr_metrics_options fo = verdict_options(so, 1);
         st = gr_metrics_compute(truth, img, &fo, &m, err);
     }
     if (st != GR_OK) return st;
@@ -287,13 +294,14 @@ static gr_status ladder_point(pareto_opts *o, const gr_technique_class *cls, gr_
         if (*c == ',') *c = ';';
     p->time_s = times[o->repeat / 2];
     p->gpu_s = gpus[o->repeat / 2];
-    p->error = rel_rmse(&m.fit);
+    p->error = verdict(&m.fit);
     return GR_OK;
 }
 
 /* Each technique over the settings of its ladder, which trade speed for quality; points
  * appended to pts[*n]; *gpu_any = 1 when some GL pass timer worked. */
 static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *gl, const gr_image *truth,
+                                  const gr_structure_options *so,
                                   gr_pareto_point *pts, int *n, int *gpu_any, gr_error *err)
 {
     gr_image *img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
@@ -315,7 +323,7 @@ static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *
             if (o->quick && cls->n_ladder > 0 && !cls->ladder[l].quick) continue;
             if (*n >= MAX_POINTS) break;
             gr_pareto_point *p = &pts[*n];
-            if ((st = ladder_point(o, cls, r, scene, lvs, truth, img, times, gpus, p, err)) != GR_OK) break;
+            if ((st = ladder_point(o, cls, r, scene, lvs, truth, so, img, times, gpus, p, err)) != GR_OK) break;
             (*n)++;
             p->family = 1 + k;
             if (p->gpu_s >= 0) *gpu_any = 1;
@@ -350,7 +358,7 @@ static gr_status write_outputs(const gr_scene *scene, const gr_truth_info *ti, c
     gr_sb_init(&sum);
     gr_sb_printf(&sum, "scene '%s' (%d x %d); high-quality ground truth %.1f s (%s); real time on %s\n", scene->name,
            scene->camera.width, scene->camera.height, ti->seconds, ti->cached ? "from the cache" : "rendered", glr);
-    gr_sb_printf(&sum, "%-16s %-50s %12s %12s %12s %6s\n", "family", "setting", "time ms", "GL timers ms", "rel. RMSE Y", "front");
+    gr_sb_printf(&sum, "%-16s %-50s %12s %12s %12s %6s\n", "family", "setting", "time ms", "GL timers ms", "verdict", "front");
     for (int i = 0; i < n; i++) {
         char g[32];
         if (pts[i].gpu_s >= 0) snprintf(g, sizeof g, "%.3f", 1e3 * pts[i].gpu_s);
@@ -383,10 +391,14 @@ static gr_status pareto_scene(pareto_opts *o, const gr_scene *scene, const char 
     gr_gl_options glo;
     memset(&glo, 0, sizeof glo);
     glo.platform = o->platform;
-    gr_status st = work && pts ? GR_OK : gr_fail(err, GR_E_NOMEM, "out of memory");
+    float *angles = malloc((size_t)scene->camera.width * (size_t)scene->camera.height * sizeof *angles);
+    gr_structure_options so; /* the verdict's structure term (report/profile.h) */
+    gr_status st = work && pts && angles ? GR_OK : gr_fail(err, GR_E_NOMEM, "out of memory");
+    if (st == GR_OK && !gr_profile_structure_options(scene, angles, &so) && !o->quiet)
+        fprintf(stderr, "godrays pareto: the beams have no vanishing point in this view: error = the error term alone\n");
     if (st == GR_OK) st = gr_gl_create(&glo, &gl, err); /* before the slow ground truths */
-    if (st == GR_OK) st = reference_points(o, scene, work, &truth, &ti, pts, &n, err);
-    if (st == GR_OK) st = technique_points(o, scene, gl, truth, pts, &n, &gpu_any, err);
+    if (st == GR_OK) st = reference_points(o, scene, work, &truth, &ti, &so, pts, &n, err);
+    if (st == GR_OK) st = technique_points(o, scene, gl, truth, &so, pts, &n, &gpu_any, err);
     if (st == GR_OK) {
         const char *glr = gr_gl_renderer(gl);
         int is_llvmpipe = glr && strstr(glr, "llvmpipe") != NULL;
@@ -404,6 +416,7 @@ static gr_status pareto_scene(pareto_opts *o, const gr_scene *scene, const char 
     gr_gl_destroy(gl);
     free(pts);
     free(work);
+    free(angles);
     return st;
 }
 

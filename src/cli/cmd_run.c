@@ -12,12 +12,14 @@
 #include <string.h>
 #include <time.h>
 
+#include "compare/baseline.h"
 #include "compare/metrics.h"
 #include "compare/registry.h"
 #include "compare/structure.h"
 #include "image/exr.h"
 #include "realtime/technique.h"
 #include "reference/truth.h"
+#include "report/leaderboard.h"
 #include "report/profile.h"
 #include "report/report.h"
 #include "report/sequence.h"
@@ -33,9 +35,13 @@ static void usage(FILE *f)
             "The main job: renders SCENE with every real-time technique (OpenGL; `godrays techniques`\n"
             "lists them) and as ground truth (Embree single scattering, with error bars), compares\n"
             "each technique against the one ground truth and writes a report with a leaderboard:\n"
-            "  DIR/index.html    the leaderboard (image, errors with and without the scale fit, GPU\n"
-            "                    and wall time per technique), then each technique's images beside the\n"
-            "                    reference, metrics, charts, timings; the scene and settings\n"
+            "  DIR/index.html    the leaderboard: techniques ranked by the verdict (the error after the\n"
+            "                    scale fit + the beam-structure score, tune's default objective; its\n"
+            "                    components beside it), among baselines (black, the constant image at\n"
+            "                    the truth's mean, the truth blurred by 4 px), each technique's\n"
+            "                    equivalent blur (the truth blurred by how much scores the same), a\n"
+            "                    failed row per technique that failed; then each technique's images\n"
+            "                    beside the reference, metrics, charts, timings; the scene and settings\n"
             "  DIR/summary.png   labelled contact sheet, one row per technique\n"
             "  DIR/metrics.json  every number, one entry per technique\n"
             "  DIR/reference.exr, DIR/TECHNIQUE.exr  the linear images (for godrays compare)\n"
@@ -68,7 +74,10 @@ static void usage(FILE *f)
             "\n"
             "Cache directory: $GODRAYS_CACHE, else $XDG_CACHE_HOME/godrays or ~/.cache/godrays, else\n"
             "./.godrays-cache. Ctrl-C stops the ground truth; nothing is cached or reported (exit 1).\n"
-            "Exit codes: 0 ok, 1 runtime failure (GL, I/O, interrupted), 2 bad usage or bad scene.\n");
+            "A technique that fails (shader does not compile, render error or time limit, black or NaN\n"
+            "image) is a failed row with its reason; the other techniques and the report go on.\n"
+            "Exit codes: 0 ok, 3 the report is complete but some technique failed (its row says why),\n"
+            "1 runtime failure (no GL context, I/O, interrupted: no report), 2 bad usage or bad scene.\n");
 }
 
 static double now_s(void)
@@ -157,26 +166,25 @@ static gr_status get_reference(const gr_scene *scene, int use_cache, int quiet, 
     return GR_OK;
 }
 
-static void print_summary(const char *dir, const gr_scene *scene, const gr_report_technique *ts, int nt,
-                          const int *order, const ref_out *ro, double t_ref)
+/* Each technique's registry metrics, as rendered and after the fit. */
+static void print_details(const gr_report_input *in, const gr_leaderboard *lb)
 {
-    printf("scene '%s' (%d x %d): ground truth %.1f s (%s), %d real-time technique%s\n", scene->name,
-           scene->camera.width, scene->camera.height, t_ref, ro->cached ? "from the cache" : "rendered", nt,
-           nt == 1 ? "" : "s");
-    for (int r = 0; r < nt; r++) {
-        const gr_report_technique *t = &ts[order[r]];
+    for (int i = 0; i < lb->n; i++) {
+        const gr_lb_row *row = &lb->rows[i];
+        if (row->kind != GR_LB_TECHNIQUE) continue;
+        const gr_report_technique *t = &in->techniques[row->index];
         const gr_metrics *m = t->metrics;
         const gr_metrics_set *raw = &m->raw, *fit = m->have_fit ? &m->fit : &m->raw;
         const gr_channel_metrics *yf = &fit->ch[GR_MCH_Y];
         const gr_meta_item *g = gr_meta_get(t->meta, "godrays:gpu_ms"), *w = gr_meta_get(t->meta, "godrays:wall_ms");
-        printf("\n#%d %s: %.2f s in this run (GPU ", r + 1, t->name, t->seconds);
+        printf("\n#%d %s: %.2f s in this run (GPU ", row->rank, t->name, t->seconds);
         if (g && g->type != GR_META_STRING && g->num >= 0) printf("%.2f ms", g->num);
         else printf("n/a");
         printf(", wall %.2f ms per render)\n", w && w->type != GR_META_STRING ? w->num : NAN);
         printf("metric (registry)            as rendered   x a (a = %.4g)\n", fit->scale);
-        for (int i = 0; i < gr_metric_count(); i++) { /* those computed in this run */
-            const double vr = gr_metric_value(raw, i), vf = gr_metric_value(fit, i);
-            if (!isnan(vr) || !isnan(vf)) printf("  %-24s %12.4g %12.4g\n", gr_metric_at(i)->label, vr, vf);
+        for (int k = 0; k < gr_metric_count(); k++) { /* those computed in this run */
+            const double vr = gr_metric_value(raw, k), vf = gr_metric_value(fit, k);
+            if (!isnan(vr) || !isnan(vf)) printf("  %-24s %12.4g %12.4g\n", gr_metric_at(k)->label, vr, vf);
         }
         printf("scored %lld of %lld pixels (%lld not scored: reference rel. std. error > %g)", m->n_scored,
                m->n_pixels, m->n_stderr_excluded, m->stderr_bound);
@@ -185,24 +193,62 @@ static void print_summary(const char *dir, const gr_scene *scene, const gr_repor
                    100.0 * (double)yf->n_not_significant / (double)yf->n_samples);
         printf("\n");
     }
-    printf("\nleaderboard (rel. RMSE of Y after the scale fit; the registry's leaderboard metrics after the fit):\n");
-    printf("  %-4s %-24s", "rank", "technique");
+}
+
+/* The leaderboard (report/leaderboard.h): the rows index.html shows, in the same order. */
+static void print_leaderboard(const gr_report_input *in, const gr_leaderboard *lb)
+{
+    printf("\nleaderboard (by the verdict = (error after the fit + structure score) / 2, lower is better; "
+           "baselines among the techniques):\n");
+    printf("  %-4s %-34s %9s %9s %9s %8s %8s %9s %9s %10s", "rank", "technique", "verdict", "err. fit", "structure",
+           "FLIP", "bp corr", "contrast", "scale a", "eq. blur");
     for (int i = 0; i < gr_metric_count(); i++)
-        if (gr_metric_at(i)->leaderboard) printf(" %12s", gr_metric_at(i)->label);
+        if (gr_metric_at(i)->leaderboard && !gr_lb_verdict_column(i)) printf(" %12.12s", gr_metric_at(i)->label);
     printf(" %10s %10s\n", "GPU ms", "wall ms");
-    for (int r = 0; r < nt; r++) {
-        const gr_report_technique *t = &ts[order[r]];
-        const gr_metrics *m = t->metrics;
-        const gr_metrics_set *fit = m->have_fit ? &m->fit : &m->raw;
-        const gr_meta_item *g = gr_meta_get(t->meta, "godrays:gpu_ms"), *w = gr_meta_get(t->meta, "godrays:wall_ms");
-        printf("  %-4d %-24s", r + 1, t->name);
+    for (int r = 0; r < lb->n; r++) {
+        const gr_lb_row *row = &lb->rows[r];
+        char rank[16], name[64], eq[32];
+        if (row->kind == GR_LB_TECHNIQUE) snprintf(rank, sizeof rank, "%d", row->rank);
+        else snprintf(rank, sizeof rank, "%s", row->kind == GR_LB_BASELINE ? "base" : "FAIL");
+        snprintf(name, sizeof name, row->kind == GR_LB_BASELINE ? "(%s)" : "%s", row->kind == GR_LB_BASELINE ? row->text : row->name);
+        printf("  %-4s %-34s", rank, name);
+        if (row->kind == GR_LB_FAILED) {
+            printf(" failed: %s\n", row->text);
+            continue;
+        }
+        printf(" %9.4g %9.4g %9.4g %8.4g %8.3g %9.3g %9.4g %10s", row->verdict, row->error_fit, row->structure, row->flip,
+               row->corr, row->contrast_ratio, row->scale, gr_lb_eq_blur_text(in, row, eq, sizeof eq));
         for (int i = 0; i < gr_metric_count(); i++)
-            if (gr_metric_at(i)->leaderboard) printf(" %12.4g", gr_metric_value(fit, i));
-        printf(" %10.3f %10.3f\n", g && g->type != GR_META_STRING && g->num >= 0 ? g->num : NAN,
+            if (gr_metric_at(i)->leaderboard && !gr_lb_verdict_column(i))
+                printf(" %12.4g", gr_metric_value(row->m->have_fit ? &row->m->fit : &row->m->raw, i));
+        const gr_metadata *meta = row->kind == GR_LB_TECHNIQUE ? in->techniques[row->index].meta : NULL;
+        const gr_meta_item *g = gr_meta_get(meta, "godrays:gpu_ms"), *w = gr_meta_get(meta, "godrays:wall_ms");
+        printf(" %10.3f %10.3f", g && g->type != GR_META_STRING && g->num >= 0 ? g->num : NAN,
                w && w->type != GR_META_STRING ? w->num : NAN);
+        printf("%s\n", row->no_better ? "  <- " GR_LB_NO_BETTER : "");
     }
-    printf("report: %s/index.html (also summary.png, metrics.json)\n", dir);
-    if (nt > 0 && ts[0].metrics->raw.ch[GR_MCH_Y].ref_mean == 0.0) /* the ground truth is >= 0: zero mean = zero everywhere scored */
+}
+
+static void print_summary(const char *dir, const gr_report_input *in, const gr_leaderboard *lb, const ref_out *ro,
+                          double t_ref)
+{
+    const gr_scene *scene = in->scene;
+    const int nt = in->n_techniques + in->n_failed;
+    printf("scene '%s' (%d x %d): ground truth %.1f s (%s), %d real-time technique%s", scene->name,
+           scene->camera.width, scene->camera.height, t_ref, ro->cached ? "from the cache" : "rendered", nt,
+           nt == 1 ? "" : "s");
+    if (in->n_failed > 0) printf(", %d FAILED", in->n_failed);
+    printf("\n");
+    print_details(in, lb);
+    print_leaderboard(in, lb);
+    if (lb->n_flagged > 0)
+        printf("%d technique%s no better than a constant image at the truth's mean (verdict not below its)\n",
+               lb->n_flagged, lb->n_flagged == 1 ? " is" : "s are");
+    if (in->n_failed > 0)
+        printf("%d technique%s FAILED (rows above; exit code 3)\n", in->n_failed, in->n_failed == 1 ? "" : "s");
+    printf("report: %s/index.html (also %smetrics.json)\n", dir, in->n_techniques > 0 ? "summary.png, " : "");
+    const gr_metrics *m0 = in->baselines ? &in->baselines->m[0] : in->n_techniques > 0 ? in->techniques[0].metrics : NULL;
+    if (m0 && m0->raw.ch[GR_MCH_Y].ref_mean == 0.0) /* the ground truth is >= 0: zero mean = zero everywhere scored */
         fprintf(stderr, "godrays run: warning: the ground truth is zero everywhere scored: the metrics say nothing "
                 "(camera inside an occluder, no scattering, or no light reaching the view?)\n");
 }
@@ -233,6 +279,14 @@ typedef struct run_state {
     float *angles;
     gr_report_technique ts[GR_REPORT_MAX_TECHNIQUES];
     char exr_names[GR_REPORT_MAX_TECHNIQUES][48];
+    int failed[GR_REPORT_MAX_TECHNIQUES];     /* 1: technique k has a failed row (reason[k]) */
+    char reason[GR_REPORT_MAX_TECHNIQUES][GR_ERROR_MSG_MAX];
+    int n_failed;
+    gr_baselines *baselines;        /* black, constant, blurred truth, the blur ladder */
+    gr_report_input in;             /* what the report was made of (write_report) */
+    gr_report_technique in_ts[GR_REPORT_MAX_TECHNIQUES]; /* the techniques that rendered, for in */
+    gr_report_failure in_failed[GR_REPORT_MAX_TECHNIQUES];
+    gr_leaderboard lb;              /* the rows printed (report/leaderboard.h) */
     char *seq_json;
     gr_sequence_result sres;
     gr_strbuf cmdline, words;
@@ -316,34 +370,72 @@ static gr_status make_cases(run_opts *o, run_state *rs, gr_error *err)
     return GR_OK;
 }
 
+/* Technique k cannot be scored (it failed to build or render, a time limit included, or its
+ * image is black): a failed row with the one-line reason, and the run goes on without it.
+ * The one place a technique's failure is decided; only Ctrl-C stops the whole run. Returns
+ * the status the run continues with. */
+static gr_status technique_failed(const run_opts *o, run_state *rs, int k, const gr_error *e)
+{
+    if (e->status == GR_E_INTERRUPTED) return e->status;
+    rs->failed[k] = 1;
+    rs->n_failed++;
+    snprintf(rs->reason[k], sizeof rs->reason[k], "%s", e->msg);
+    if (!o->quiet) fprintf(stderr, "godrays run: %s FAILED: %s\n", o->cls[k]->name, e->msg);
+    return GR_OK;
+}
+
+/* GR_E_RUNTIME when img is black (every value 0): nothing to score, the technique's fault. */
+static gr_status check_not_black(const gr_image *img, gr_error *err)
+{
+    const size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->nchannels;
+    for (size_t i = 0; i < n; i++)
+        if (img->pixels[i] != 0.0f) return GR_OK;
+    return gr_fail(err, GR_E_RUNTIME, "rendered a black image (every pixel 0): nothing to score");
+}
+
+/* Technique k on every frame: frame 0 into rs->test[k], the others into rs->seq_test. */
+static gr_status render_one(const run_opts *o, run_state *rs, gr_gl *gl, int k, gr_error *err)
+{
+    const gr_technique_class *cls = o->cls[k];
+    const int nf = o->nf;
+    gr_status st = render_technique(cls, gl, rs->scene0, &rs->test[k], &rs->smeta[k], err);
+    if (st == GR_OK) st = check_not_black(rs->test[k], err);
+    if (st != GR_OK) return st; /* its row names it */
+    for (int i = 1; i < nf && st == GR_OK; i++) {
+        gr_metadata scratch;
+        gr_meta_init(&scratch);
+        st = render_technique(cls, gl, &rs->cases[i], &rs->seq_test[k * nf + i], &scratch, err);
+        gr_meta_free(&scratch);
+        if (st != GR_OK) gr_error_prefix(err, "%s: frame %d (t = %g s)", cls->name, i, o->times[i]);
+    }
+    if (nf > 1) rs->seq_test[k * nf] = rs->test[k];
+    return st;
+}
+
 /* The real-time side: it takes seconds, and a GL failure should not cost the user a
- * two-minute ground truth first. One context, one instance per technique. */
+ * two-minute ground truth first. One context, one instance per technique; a technique that
+ * fails is a failed row (technique_failed). */
 static gr_status render_techniques(const run_opts *o, run_state *rs, gr_error *err)
 {
-    const int nf = o->nf;
     gr_gl *gl = NULL;
     gr_status st = gr_gl_create(NULL, &gl, err);
     for (int k = 0; k < o->nt && st == GR_OK; k++) {
         const gr_technique_class *cls = o->cls[k];
         if (!o->quiet) fprintf(stderr, "godrays run: rendering %s...\n", cls->name);
         double t = now_s();
-        if ((st = render_technique(cls, gl, rs->scene0, &rs->test[k], &rs->smeta[k], err)) != GR_OK) break;
         gr_report_technique *ts = &rs->ts[k];
-        ts->seconds = now_s() - t;
         ts->name = cls->name;
         ts->description = cls->description;
+        gr_error e = {GR_OK, ""};
+        if (render_one(o, rs, gl, k, &e) != GR_OK) {
+            if ((st = technique_failed(o, rs, k, &e)) != GR_OK) *err = e;
+            continue;
+        }
+        ts->seconds = now_s() - t;
         ts->test = rs->test[k];
         ts->meta = &rs->smeta[k];
         snprintf(rs->exr_names[k], sizeof rs->exr_names[k], "%s.exr", cls->name);
         ts->exr = rs->exr_names[k];
-        for (int i = 1; i < nf && st == GR_OK; i++) {
-            gr_metadata scratch;
-            gr_meta_init(&scratch);
-            st = render_technique(cls, gl, &rs->cases[i], &rs->seq_test[k * nf + i], &scratch, err);
-            gr_meta_free(&scratch);
-            if (st != GR_OK) gr_error_prefix(err, "frame %d (t = %g s)", i, o->times[i]);
-        }
-        if (nf > 1) rs->seq_test[k * nf] = rs->test[k];
     }
     gr_gl_destroy(gl);
     return st;
@@ -381,28 +473,26 @@ static gr_status compute_metrics(const run_opts *o, run_state *rs, gr_error *err
     /* beam structure around the refracted sun's vanishing point, de-glowed by the angle to
      * the sun (docs/metrics.md), in every technique's metric sets; skipped when the beams have
      * no finite vanishing point (parallel to the image plane) */
-    gr_structure_options so = {.radial_bin = scene->camera.fov_deg / scene->camera.height};
-    int with_structure = 0;
-    gr_error e2 = {GR_OK, ""};
+    gr_structure_options so;
     rs->angles = malloc((size_t)scene->camera.width * (size_t)scene->camera.height * sizeof(float));
     if (!rs->angles) return gr_fail(err, GR_E_NOMEM, "out of memory for the structure metrics");
-    if (gr_structure_scene_vp(scene, scene->camera.width, scene->camera.height, &so.vp_x, &so.vp_y, &e2) == GR_OK) {
-        double dir[3];
-        gr_profile_sun_view_dir(scene, dir);
-        gr_profile_angles(&scene->camera, dir, rs->angles);
-        so.radial = rs->angles;
-        with_structure = 1;
-    }
+    const int with_structure = gr_profile_structure_options(scene, rs->angles, &so);
+    gr_metrics_options mopt = {0};
+    mopt.fit_scale = 1; /* a technique's intensity is an arbitrary factor (seed 000) */
+    if (with_structure) mopt.structure = &so;
+    if (dof && dof->type != GR_META_STRING && dof->num >= 1.0) mopt.stderr_dof = (int)dof->num;
     for (int k = 0; k < o->nt; k++) {
-        gr_metrics_options mopt = {0};
-        mopt.fit_scale = 1; /* a technique's intensity is an arbitrary factor (seed 000) */
-        if (with_structure) mopt.structure = &so;
-        if (dof && dof->type != GR_META_STRING && dof->num >= 1.0) mopt.stderr_dof = (int)dof->num;
+        if (rs->failed[k]) continue;
         gr_status st = gr_metrics_compute(rs->ro.img, rs->test[k], &mopt, &rs->mets[k], err);
         if (st != GR_OK) return st;
         rs->ts[k].metrics = &rs->mets[k];
     }
-    return GR_OK;
+    /* the baselines, scored exactly as the techniques (and with HDR-FLIP, which the report
+     * computes for each technique from its own map) */
+    gr_flip_options fo = {.mode = GR_FLIP_HDR};
+    mopt.flip = &fo;
+    if (!(rs->baselines = malloc(sizeof *rs->baselines))) return gr_fail(err, GR_E_NOMEM, "out of memory");
+    return gr_baselines_compute(rs->ro.img, &mopt, rs->baselines, err);
 }
 
 /* OUTDIR/sequence (report/sequence.h). */
@@ -413,19 +503,29 @@ static gr_status write_sequence(const run_opts *o, run_state *rs, const char *ou
     const gr_scene *fs[GR_SEQUENCE_MAX_FRAMES];
     const gr_image *frefs[GR_SEQUENCE_MAX_FRAMES];
     const char *names[GR_REPORT_MAX_TECHNIQUES];
+    const gr_image **tests = calloc((size_t)(nf * o->nt), sizeof *tests);
+    if (!tests) return gr_fail(err, GR_E_NOMEM, "out of memory");
     for (int i = 0; i < nf; i++) {
         fs[i] = &rs->cases[i];
         frefs[i] = i ? rs->seq_ref[i].img : rs->ro.img;
     }
-    for (int k = 0; k < o->nt; k++) names[k] = o->cls[k]->name;
+    int n = 0; /* the techniques that rendered every frame */
+    for (int k = 0; k < o->nt; k++) {
+        if (rs->failed[k]) continue;
+        names[n] = o->cls[k]->name;
+        for (int i = 0; i < nf; i++) tests[n * nf + i] = rs->seq_test[k * nf + i];
+        n++;
+    }
     gr_sequence_input sin = {.n_frames = nf, .times = o->times, .frame_numbers = o->frames_spec ? o->frame_no : NULL,
-                             .scenes = fs, .refs = frefs, .n_techniques = o->nt, .names = names,
-                             .tests = (const gr_image *const *)rs->seq_test, .up_href = "../index.html",
+                             .scenes = fs, .refs = frefs, .n_techniques = n, .names = names,
+                             .tests = tests, .up_href = "../index.html",
                              .command_line = gr_sb_str(&rs->cmdline)};
     char path[4300];
-    if (snprintf(path, sizeof path, "%s/sequence", outdir) >= (int)sizeof path - 48)
-        return gr_fail(err, GR_E_USAGE, "%s: output directory name too long", outdir);
-    return gr_sequence_write(path, &sin, &rs->seq_json, &rs->sres, err);
+    gr_status st = snprintf(path, sizeof path, "%s/sequence", outdir) >= (int)sizeof path - 48
+                       ? gr_fail(err, GR_E_USAGE, "%s: output directory name too long", outdir)
+                       : gr_sequence_write(path, &sin, &rs->seq_json, &rs->sres, err);
+    free(tests);
+    return st;
 }
 
 /* The report folder. The report links the EXRs; they are written first so that a finished
@@ -434,11 +534,19 @@ static gr_status write_report(const run_opts *o, run_state *rs, const char *outd
                               gr_error *err)
 {
     if (!o->quiet) fprintf(stderr, "godrays run: writing the report...\n");
-    gr_status st = o->nf > 1 ? write_sequence(o, rs, outdir, err) : GR_OK;
+    gr_status st = o->nf > 1 && rs->n_failed < o->nt ? write_sequence(o, rs, outdir, err) : GR_OK;
     if (st != GR_OK) return st;
     const ref_out *ro = &rs->ro;
-    gr_report_input in = {.scene = rs->scene0, .ref = ro->img, .ref_meta = &ro->meta, .n_techniques = o->nt,
-                          .techniques = rs->ts, .command_line = gr_sb_str(&rs->cmdline),
+    int n_ok = 0, n_failed = 0; /* the techniques that rendered, then the failed rows */
+    for (int k = 0; k < o->nt; k++) {
+        if (!rs->failed[k]) rs->in_ts[n_ok++] = rs->ts[k];
+        else rs->in_failed[n_failed++] = (gr_report_failure){.name = o->cls[k]->name,
+                                                             .description = o->cls[k]->description,
+                                                             .reason = rs->reason[k]};
+    }
+    gr_report_input in = {.scene = rs->scene0, .ref = ro->img, .ref_meta = &ro->meta, .n_techniques = n_ok,
+                          .techniques = rs->in_ts, .n_failed = n_failed, .failed = rs->in_failed,
+                          .baselines = rs->baselines, .command_line = gr_sb_str(&rs->cmdline),
                           .scene_words = gr_sb_str(&rs->words), .ref_cached = ro->cached,
                           .ref_cache_path = ro->cache_on ? ro->cache_path : NULL,
                           .ref_cache_note = ro->note[0] ? ro->note : NULL, .ref_seconds = rs->t_ref,
@@ -450,10 +558,13 @@ static gr_status write_report(const run_opts *o, run_state *rs, const char *outd
         return gr_fail(err, GR_E_USAGE, "%s: output directory name too long", outdir);
     if ((st = gr_exr_write(path, ro->img, &ro->meta, err)) != GR_OK) return st;
     for (int k = 0; k < o->nt; k++) {
+        if (rs->failed[k]) continue;
         snprintf(path, sizeof path, "%s/%s", outdir, rs->exr_names[k]);
         if ((st = gr_exr_write(path, rs->test[k], &rs->smeta[k], err)) != GR_OK) return st;
     }
     if ((st = gr_report_write(outdir, &in, rres, err)) != GR_OK) return st;
+    rs->in = in;
+    gr_leaderboard_build(&rs->in, rres->flip, &rs->lb); /* the report's rows, for the terminal */
     if (!o->quiet && !rres->labelled)
         fprintf(stderr, "godrays run: note: no font for OpenImageIO's text: summary.png is unlabelled\n");
     if (!o->quiet && rres->charts == 0) fprintf(stderr, "godrays run: note: charts not drawn (see index.html)\n");
@@ -467,9 +578,12 @@ static void print_sequence(const run_opts *o, const run_state *rs, const char *o
     printf("\nsequence: %d frames, t = %g .. %g s; ground truths %.1f s in all\n", nf, o->times[0], o->times[nf - 1],
            rs->t_refs);
     printf("  %-24s %10s %14s %12s %14s\n", "technique", "a", "diff. error", "flicker", "drift err deg");
-    for (int k = 0; k < o->nt; k++)
-        printf("  %-24s %10.4g %14.4g %12.4g %14.3g\n", o->cls[k]->name, rs->sres.scale[k], rs->sres.rel_diff_rmse[k],
-               rs->sres.flicker_ratio[k], rs->sres.drift_err_deg[k]);
+    for (int k = 0, j = 0; k < o->nt; k++) { /* j: the sequence's index of the techniques that rendered */
+        if (rs->failed[k]) continue;
+        printf("  %-24s %10.4g %14.4g %12.4g %14.3g\n", o->cls[k]->name, rs->sres.scale[j], rs->sres.rel_diff_rmse[j],
+               rs->sres.flicker_ratio[j], rs->sres.drift_err_deg[j]);
+        j++;
+    }
     printf("sequence report: %s/sequence/index.html (%d charts, %d animations)\n", outdir, rs->sres.charts,
            rs->sres.animations);
 }
@@ -495,6 +609,7 @@ static void run_free(const run_opts *o, run_state *rs)
         gr_meta_free(&rs->smeta[k]);
     }
     free(rs->mets);
+    free(rs->baselines);
     free(rs->scene);
     gr_sb_free(&rs->cmdline);
     gr_sb_free(&rs->words);
@@ -535,9 +650,9 @@ static int run_scene(gr_args *args, run_opts *o, run_state *rs)
     rs->t_cmp = now_s() - t;
     gr_report_result rres;
     if (write_report(o, rs, outdir, &rres, &err) != GR_OK) return gr_cli_report(cmd, &err);
-    print_summary(outdir, rs->scene0, rs->ts, o->nt, rres.order, &rs->ro, rs->t_ref);
-    if (o->nf > 1) print_sequence(o, rs, outdir);
-    return 0;
+    print_summary(outdir, &rs->in, &rs->lb, &rs->ro, rs->t_ref);
+    if (o->nf > 1 && rs->n_failed < o->nt) print_sequence(o, rs, outdir);
+    return rs->n_failed > 0 ? 3 : 0; /* the report is complete; some technique failed (docs/report.md) */
 }
 
 /* The command after gr_args_create; returns the exit code (gr_args_main frees args). */

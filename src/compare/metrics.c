@@ -314,6 +314,7 @@ static gr_status structure_fill(const ctx *cx, gr_metrics *out, gr_error *err)
             sets[k]->have_structure = 1;
             sets[k]->structure_corr = c->bandpass_corr;
             sets[k]->structure_contrast_err = c->contrast_log_err;
+            sets[k]->structure_contrast_ratio = c->contrast_ratio;
             sets[k]->structure_lsd = c->spectrum_log_dist;
             sets[k]->structure_score = gr_structure_score(c);
         }

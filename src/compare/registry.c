@@ -55,14 +55,25 @@ static double x_structure(const gr_metrics_set *s)
     return s->have_structure ? s->structure_score : NAN;
 }
 
+/* The verdict's weights by registry index (registry.h: GR_VERDICT_OBJECTIVE says the same;
+ * unit.verdict checks that both agree with tune's default objective). */
+static const double verdict_w[GR_METRIC_N_BUILTIN] = {[GR_METRIC_RMSE] = 1.0, [GR_METRIC_STRUCTURE] = 1.0};
+
+static double x_verdict(const gr_metrics_set *s)
+{
+    double w[GR_METRIC_MAX];
+    gr_metric_verdict_weights(w);
+    const double v = gr_metric_weighted(s, w);
+    return v < 1e300 ? v : NAN;
+}
+
 /* ---- the registry ------------------------------------------------------------------------ */
 
 /* The built-ins first, in the order of the GR_METRIC_* enum; gr_metric_register appends. */
 static gr_metric_desc table[GR_METRIC_MAX] = {
     {.key = "rmse", .label = "RMSE Y", .doc = "root mean square error of luminance Y",
-     .unit = GR_METRIC_RADIANCE, .better = GR_METRIC_LOWER, .cost = GR_METRIC_COST_PASS, .leaderboard = 1,
-     .extract = x_rmse},
-    {.key = "rel_rmse", .label = "rel. RMSE Y", .doc = "RMSE of Y over |mean reference Y| (the leaderboard's rank)",
+     .unit = GR_METRIC_RADIANCE, .better = GR_METRIC_LOWER, .cost = GR_METRIC_COST_PASS, .extract = x_rmse},
+    {.key = "rel_rmse", .label = "rel. RMSE Y", .doc = "RMSE of Y over |mean reference Y| (the verdict's error term)",
      .unit = GR_METRIC_UNITLESS, .better = GR_METRIC_LOWER, .cost = GR_METRIC_COST_PASS, .leaderboard = 1,
      .extract = x_rel_rmse},
     {.key = "relmse", .label = "rel. MSE Y", .doc = "mean of (t - r)^2 / (r^2 + eps) on Y",
@@ -71,15 +82,20 @@ static gr_metric_desc table[GR_METRIC_MAX] = {
      .unit = GR_METRIC_RADIANCE, .better = GR_METRIC_NEARER, .cost = GR_METRIC_COST_PASS, .extract = x_bias},
     {.key = "ssim", .label = "SSIM", .doc = "mean SSIM of luminance, 11x11 Gaussian window (1 = identical)",
      .unit = GR_METRIC_UNITLESS, .better = GR_METRIC_HIGHER, .best = 1.0, .cost = GR_METRIC_COST_SSIM,
-     .leaderboard = 1, .extract = x_ssim},
+     .extract = x_ssim},
     {.key = "msrmse", .label = "multi-scale RMSE Y", .doc = "mean of the RMSEs of Y after Gaussian blurs at 1, 4, 16 px",
      .unit = GR_METRIC_RADIANCE, .better = GR_METRIC_LOWER, .cost = GR_METRIC_COST_BLUR, .extract = x_msrmse},
     {.key = "flip", .label = "FLIP mean", .doc = "mean FLIP (HDR-FLIP for HDR inputs) over the scored pixels",
-     .unit = GR_METRIC_UNITLESS, .better = GR_METRIC_LOWER, .cost = GR_METRIC_COST_FLIP, .extract = x_flip},
+     .unit = GR_METRIC_UNITLESS, .better = GR_METRIC_LOWER, .cost = GR_METRIC_COST_FLIP, .leaderboard = 1,
+     .extract = x_flip},
     {.key = "structure", .label = "structure score",
      .doc = "beam structure against the truth's in [0, 1]: band-pass correlation, streak contrast, angular spectrum",
      .unit = GR_METRIC_UNITLESS, .better = GR_METRIC_LOWER, .needs_scene = 1, .cost = GR_METRIC_COST_STRUCTURE,
-     .extract = x_structure},
+     .leaderboard = 1, .extract = x_structure},
+    {.key = "verdict", .label = "verdict",
+     .doc = "(rel. RMSE of Y + structure score) / 2: the leaderboard's rank and tune's default objective",
+     .unit = GR_METRIC_UNITLESS, .better = GR_METRIC_LOWER, .needs_scene = 1, .cost = GR_METRIC_COST_STRUCTURE,
+     .leaderboard = 1, .extract = x_verdict},
 };
 static int count = GR_METRIC_N_BUILTIN;
 
@@ -142,6 +158,33 @@ double gr_metric_loss(const gr_metric_desc *d, double v)
     case GR_METRIC_LOWER: break;
     }
     return v - d->best;
+}
+
+void gr_metric_verdict_weights(double w[GR_METRIC_MAX])
+{
+    for (int k = 0; k < GR_METRIC_MAX; k++) w[k] = k < GR_METRIC_N_BUILTIN ? verdict_w[k] : 0.0;
+}
+
+double gr_metric_weighted(const gr_metrics_set *s, const double w[GR_METRIC_MAX])
+{
+    if (!s || !w) return 1e300;
+    const double mean_y = s->ch[GR_MCH_Y].ref_mean;
+    /* each term made dimensionless (image units over the mean reference Y; relmse, 1 - SSIM,
+     * FLIP and the structure score already are), then weighted (docs/tuning.md); the
+     * registry's order is the order of the sum */
+    double sum = 0.0, wsum = 0.0;
+    for (int k = 0; k < count; k++) {
+        if (!(w[k] > 0.0)) continue;
+        const gr_metric_desc *d = &table[k];
+        const double raw = gr_metric_value(s, k);
+        if (d->needs_scene && isnan(raw)) continue; /* no vanishing point: the term is left out */
+        double v = gr_metric_loss(d, raw);
+        if (!isfinite(v)) v = 1e300;
+        if (d->unit == GR_METRIC_RADIANCE && mean_y > 0) v /= mean_y;
+        sum += w[k] * v, wsum += w[k];
+    }
+    const double v = wsum > 0 ? sum / wsum : 1e300;
+    return isfinite(v) ? v : 1e300;
 }
 
 int gr_metric_is_objective(const gr_metric_desc *d) { return d && isfinite(d->best); }

@@ -55,7 +55,8 @@ typedef struct gr_metric_desc {
     double best;                  /* the value of identical images (0 for errors, 1 for SSIM) */
     int needs_scene;              /* needs the scene's geometry (the beams' vanishing point) */
     gr_metric_cost cost;
-    int leaderboard;              /* a column of `godrays run`'s leaderboard (raw and after fit) */
+    int leaderboard;              /* a column of `godrays run`'s leaderboard (after the fit; raw too
+                                     for those that are not the verdict's columns: report/leaderboard.h) */
     /* exactly one of: */
     double (*extract)(const gr_metrics_set *s); /* from a computed set; NaN: its part was not
                                      computed */
@@ -66,8 +67,27 @@ typedef struct gr_metric_desc {
 /* The built-ins, in registry order (registry.c's builtins[]). */
 enum {
     GR_METRIC_RMSE = 0, GR_METRIC_REL_RMSE, GR_METRIC_RELMSE, GR_METRIC_BIAS, GR_METRIC_SSIM, GR_METRIC_MSRMSE,
-    GR_METRIC_FLIP, GR_METRIC_STRUCTURE, GR_METRIC_N_BUILTIN
+    GR_METRIC_FLIP, GR_METRIC_STRUCTURE, GR_METRIC_VERDICT, GR_METRIC_N_BUILTIN
 };
+
+/* The verdict (docs/metrics.md "The verdict"): the one score every ranking uses (`run`'s
+ * leaderboard, `pareto`'s error axis) and `tune`'s default objective, the weighted mean of
+ * these registry metrics' dimensionless losses (gr_metric_weighted): the relative RMSE of Y
+ * (after the fit, on the fit set) and the beam-structure score, equal weights. Without a
+ * vanishing point (no structure computed) it is the relative RMSE alone. The weights by
+ * registry index are gr_metric_verdict_weights'; this text is the same as an --objective. */
+#define GR_VERDICT_OBJECTIVE "rmse=1,structure=1"
+
+/* w[GR_METRIC_MAX]: the verdict's weight per registry index (0 for the metrics it leaves out). */
+void gr_metric_verdict_weights(double w[GR_METRIC_MAX]);
+
+/* The weighted mean sum_k w_k L_k / sum_k w_k of the losses L_k = gr_metric_loss of each metric
+ * with w_k > 0, each made dimensionless: metrics in image units (unit RADIANCE) divided by the
+ * set's mean reference Y when it is > 0. A needs-scene metric that was not computed (NaN: no
+ * vanishing point) is left out with its weight; a loss that is not finite counts 1e300, and so
+ * does a result that is not finite or has no weight left. What `tune --objective` minimizes
+ * per case (tune/objective.h) and, with the verdict's weights, the verdict. */
+double gr_metric_weighted(const gr_metrics_set *s, const double w[GR_METRIC_MAX]);
 
 int gr_metric_count(void);
 const gr_metric_desc *gr_metric_at(int i); /* NULL outside 0..count-1 */

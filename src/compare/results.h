@@ -44,6 +44,7 @@ typedef struct gr_metrics_set {
     int have_structure;           /* options.structure given: (scale-invariant: the same in both sets) */
     double structure_corr;        /* band-pass correlation (compare/structure.h) */
     double structure_contrast_err;/* |ln(streak contrast ratio)| */
+    double structure_contrast_ratio; /* streak contrast, test / truth (1 = as streaky as the truth) */
     double structure_lsd;         /* log-spectral distance */
     double structure_score;       /* ((1 - corr) / 2 + min(contrast_err, 3) / 3 + min(lsd, 3) / 3) / 3,
                                      in [0, 1], 0 = the truth's structure (docs/metrics.md) */

@@ -139,3 +139,20 @@ double gr_profile_bin_width(double max_deg, int target_bins)
         if (steps[i] * p >= raw) return steps[i] * p;
     return 10.0 * p;
 }
+
+int gr_profile_structure_options(const gr_scene *s, float *angles_deg, gr_structure_options *so)
+{
+    const gr_camera *cam = &s->camera;
+    memset(so, 0, sizeof *so);
+    gr_error e = {GR_OK, ""};
+    if (gr_structure_scene_vp(s, cam->width, cam->height, &so->vp_x, &so->vp_y, &e) != GR_OK) {
+        memset(so, 0, sizeof *so);
+        return 0;
+    }
+    double dir[3];
+    gr_profile_sun_view_dir(s, dir);
+    gr_profile_angles(cam, dir, angles_deg);
+    so->radial = angles_deg;
+    so->radial_bin = cam->fov_deg / cam->height;
+    return 1;
+}

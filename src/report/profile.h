@@ -8,6 +8,7 @@
 #define GR_PROFILE_H
 
 #include "common/status.h"
+#include "compare/structure.h"
 #include "image/image.h"
 #include "scene/scene.h"
 
@@ -19,6 +20,14 @@ void gr_profile_sun_view_dir(const gr_scene *s, double out[3]);
  * pixel centre (px + 0.5, py + 0.5)) and the unit direction dir, row-major into
  * angles_deg[width * height]. */
 void gr_profile_angles(const gr_camera *cam, const double dir[3], float *angles_deg);
+
+/* The beam-structure options of scene s's god rays on its camera (compare/structure.h), as
+ * every comparison that computes the verdict uses them: the vanishing point of the refracted
+ * sun and the de-glow by the angle to it, in rings of one pixel (fov / height degrees);
+ * angles_deg (width * height floats) is filled and referenced by *so. Returns 0, *so zeroed,
+ * when the beams have no finite vanishing point (parallel to the image plane): then no
+ * structure is computed and the verdict is the error term alone. */
+int gr_profile_structure_options(const gr_scene *s, float *angles_deg, gr_structure_options *so);
 
 enum { GR_PROFILE_R = 0, GR_PROFILE_G, GR_PROFILE_B, GR_PROFILE_Y, GR_PROFILE_NCH };
 

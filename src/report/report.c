@@ -19,6 +19,7 @@
 #include "compare/registry.h"
 #include "image/oiio.h"
 #include "report/html.h"
+#include "report/leaderboard.h"
 #include "report/plot.h"
 #include "report/profile.h"
 #include "report/viewer.h"
@@ -544,7 +545,8 @@ static const char *const CSS =
     "th{background:#f0f2f5}td.l,th.l{text-align:left}pre{background:#fff;border:1px solid #ddd;padding:10px;"
     "overflow:auto;font-size:.85em;max-height:520px}details{margin:8px 0}summary{cursor:pointer;font-weight:bold}"
     "code{background:#eef0f3;padding:0 3px}"
-    "table.lb td{vertical-align:middle}img.thumb{width:200px;height:auto;image-rendering:pixelated;display:block}";
+    "table.lb td{vertical-align:middle}img.thumb{width:200px;height:auto;image-rendering:pixelated;display:block}"
+    "tr.baseline td{background:#f3f3ee;color:#444}tr.failed td{background:#fdeaea}.flag{color:#b00000;font-weight:bold}";
 
 static void html_metrics_table(gr_strbuf *b, const gr_metrics *m, const gr_metrics_set *s, const char *caption)
 {
@@ -738,6 +740,7 @@ typedef struct ctx {
     gr_image *disp_ref;
     tctx t[GR_REPORT_MAX_TECHNIQUES];
     int order[GR_REPORT_MAX_TECHNIQUES];
+    gr_leaderboard lb;             /* every row: techniques, baselines, failures */
     profiles pr;
     int have_profiles;
     int charts;
@@ -746,7 +749,8 @@ typedef struct ctx {
     char lines[2][512];            /* scene, reference */
 } ctx;
 
-/* The leaderboard's ranking metric (compare/registry.h: RMSE of Y over |mean reference Y|). */
+/* The leaderboard's ranking metric (compare/registry.h: the verdict). */
+static double verdict_of(const gr_metrics_set *s) { return gr_metric_value(s, GR_METRIC_VERDICT); }
 static double rel_rmse_y(const gr_metrics_set *s) { return gr_metric_value(s, GR_METRIC_REL_RMSE); }
 
 static const gr_metrics_set *fit_set(const gr_metrics *m) { return m->have_fit ? &m->fit : &m->raw; }
@@ -757,9 +761,9 @@ void gr_report_rank(const gr_report_technique *techniques, int n, int *order)
     /* insertion sort: stable, n is small */
     for (int i = 1; i < n; i++) {
         int v = order[i], j = i;
-        double ev = rel_rmse_y(fit_set(techniques[v].metrics));
+        double ev = verdict_of(fit_set(techniques[v].metrics));
         while (j > 0) {
-            double eu = rel_rmse_y(fit_set(techniques[order[j - 1]].metrics));
+            double eu = verdict_of(fit_set(techniques[order[j - 1]].metrics));
             int before = isfinite(ev) && (!isfinite(eu) || ev < eu);
             if (!before) break;
             order[j] = order[j - 1];
@@ -773,9 +777,11 @@ static void summary_lines(ctx *c)
 {
     const gr_report_input *in = c->in;
     char t[8][48];
-    snprintf(c->lines[0], sizeof c->lines[0], "scene '%s' (hash %s), %d x %d; godrays %s; %d real-time technique%s",
-             in->scene->name, in->scene->hash, in->ref->width, in->ref->height, GR_VERSION, in->n_techniques,
-             in->n_techniques == 1 ? "" : "s");
+    char failed[48] = "";
+    if (in->n_failed > 0) snprintf(failed, sizeof failed, " (%d FAILED)", in->n_failed);
+    snprintf(c->lines[0], sizeof c->lines[0], "scene '%s' (hash %s), %d x %d; godrays %s; %d real-time technique%s%s",
+             in->scene->name, in->scene->hash, in->ref->width, in->ref->height, GR_VERSION,
+             in->n_techniques + in->n_failed, in->n_techniques + in->n_failed == 1 ? "" : "s", failed);
     const double wall = meta_num(in->ref_meta, "godrays:wall_s");
     snprintf(c->lines[1], sizeof c->lines[1],
              "reference: %s s render%s, %s spp, rel. std. error of the image mean %s %%",
@@ -790,15 +796,100 @@ static void summary_lines(ctx *c)
         snprintf(tc->lines[0], sizeof tc->lines[0], "%s: GPU %s ms (timed passes), wall %s ms per render, %s fragments",
                  tc->t->name, fmt(tc->gpu_ms, t[0], sizeof t[0]), fmt(tc->wall_ms, t[1], sizeof t[1]),
                  fmt(meta_num(tc->t->meta, "godrays:fragments"), t[2], sizeof t[2]));
+        const gr_lb_row *row = gr_lb_technique_row(&c->lb, k);
         snprintf(tc->lines[1], sizeof tc->lines[1],
-                 "best scale a = %s; luminance after fit: RMSE %s (%s of the mean), bias %s, SSIM %s, RMSE at sigma 16 px %s",
-                 fmt(fs->scale, t[0], sizeof t[0]), fmt(y->rmse, t[1], sizeof t[1]), fmt(rel_rmse_y(fs), t[2], sizeof t[2]),
-                 fmt(y->bias, t[3], sizeof t[3]), fs->have_ssim ? fmt(fs->ssim_y, t[4], sizeof t[4]) : "n/a",
-                 fs->have_blur ? fmt(y->rmse_blur[GR_METRICS_NSCALES - 1], t[5], sizeof t[5]) : "n/a");
+                 "verdict %s (equivalent blur %s)%s; best scale a = %s; luminance after fit: RMSE %s (%s of the mean), "
+                 "bias %s, SSIM %s, structure score %s",
+                 fmt(verdict_of(fs), t[6], sizeof t[6]), gr_lb_eq_blur_text(in, row, t[7], sizeof t[7]),
+                 row && row->no_better ? ", " GR_LB_NO_BETTER : "", fmt(fs->scale, t[0], sizeof t[0]),
+                 fmt(y->rmse, t[1], sizeof t[1]), fmt(rel_rmse_y(fs), t[2], sizeof t[2]), fmt(y->bias, t[3], sizeof t[3]),
+                 fs->have_ssim ? fmt(fs->ssim_y, t[4], sizeof t[4]) : "n/a",
+                 fmt(gr_metric_value(fs, GR_METRIC_STRUCTURE), t[5], sizeof t[5]));
         snprintf(tc->lines[2], sizeof tc->lines[2],
                  "scored pixels %lld of %lld; not scored: %lld (reference rel. std. error > %s)", m->n_scored,
                  m->n_pixels, m->n_stderr_excluded, fmt(m->stderr_bound, t[0], sizeof t[0]));
     }
+}
+
+/* A leaderboard row's numbers (report/leaderboard.h) as a JSON object. */
+static cJSON *row_json(const ctx *c, const gr_lb_row *r)
+{
+    static const char *const kinds[3] = {"technique", "baseline", "failed"};
+    char t[48];
+    cJSON *o = cJSON_CreateObject();
+    int ok = o != NULL;
+    jstr(o, "kind", kinds[r->kind], &ok);
+    jstr(o, "name", r->name, &ok);
+    jstr(o, r->kind == GR_LB_FAILED ? "reason" : r->kind == GR_LB_BASELINE ? "label" : "description", r->text, &ok);
+    if (r->kind == GR_LB_TECHNIQUE) jnum(o, "rank", r->rank, &ok);
+    if (r->kind != GR_LB_FAILED) {
+        jnum(o, "verdict", r->verdict, &ok);
+        jnum(o, "rel_rmse_fit", r->error_fit, &ok);
+        jnum(o, "structure", r->structure, &ok);
+        jnum(o, "flip", r->flip, &ok);
+        jnum(o, "bandpass_corr", r->corr, &ok);
+        jnum(o, "streak_contrast_ratio", r->contrast_ratio, &ok);
+        jnum(o, "scale", r->scale, &ok);
+        jnum(o, "equivalent_blur_px", r->eq_blur_px, &ok);
+        jstr(o, "equivalent_blur", gr_lb_eq_blur_text(c->in, r, t, sizeof t), &ok);
+    }
+    if (r->kind == GR_LB_TECHNIQUE) jstr(o, "flag", r->no_better ? GR_LB_NO_BETTER : NULL, &ok);
+    if (!ok) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
+}
+
+/* The leaderboard's rows, the baselines (their ladder included) and the failures. */
+static void leaderboard_json(const ctx *c, cJSON *root, int *ok)
+{
+    const gr_report_input *in = c->in;
+    jstr(root, "leaderboard_rule",
+         "the verdict after the best scale fit, lower first: (relative RMSE of luminance Y + structure score) / 2 "
+         "(" GR_VERDICT_OBJECTIVE ", tune's default objective; docs/metrics.md)", ok);
+    cJSON *rows = *ok ? cJSON_CreateArray() : NULL;
+    for (int i = 0; rows && i < c->lb.n; i++) {
+        cJSON *x = row_json(c, &c->lb.rows[i]);
+        if (!x || !cJSON_AddItemToArray(rows, x)) {
+            cJSON_Delete(x);
+            cJSON_Delete(rows);
+            rows = NULL;
+        }
+    }
+    jadd(root, "leaderboard_rows", rows, ok);
+    jnum(root, "techniques_no_better_than_constant", c->lb.n_flagged, ok);
+    cJSON *fl = *ok ? cJSON_CreateArray() : NULL;
+    for (int f = 0; fl && f < in->n_failed; f++) {
+        cJSON *x = cJSON_CreateObject();
+        int xo = x != NULL;
+        jstr(x, "name", in->failed[f].name, &xo);
+        jstr(x, "description", in->failed[f].description, &xo);
+        jstr(x, "reason", in->failed[f].reason, &xo);
+        if (!xo || !cJSON_AddItemToArray(fl, x)) {
+            cJSON_Delete(x);
+            cJSON_Delete(fl);
+            fl = NULL;
+        }
+    }
+    jadd(root, "failed", fl, ok);
+    const gr_baselines *b = in->baselines;
+    if (!b) return;
+    cJSON *bj = cJSON_CreateObject();
+    jadd(root, "baselines", bj, ok);
+    for (int i = 0; *ok && i < GR_BASELINE_COUNT; i++) {
+        cJSON *one = cJSON_CreateObject();
+        jadd(bj, gr_baseline_key(i), one, ok);
+        jstr(one, "label", gr_baseline_label(i), ok);
+        jadd(one, "compare", gr_metrics_to_json(&b->m[i]), ok);
+    }
+    cJSON *ld = cJSON_CreateObject();
+    jadd(bj, "blur_ladder", ld, ok);
+    jstr(ld, "what", "the truth blurred by a Gaussian of each sigma, scored like a technique: its verdict, and the "
+                     "running maximum that turns a verdict into an equivalent blur (log-linear between rungs)", ok);
+    jadd(ld, "sigma_px", jarr(b->sigma_px, b->n_ladder), ok);
+    jadd(ld, "verdict", jarr(b->verdict, b->n_ladder), ok);
+    jadd(ld, "envelope", jarr(b->envelope, b->n_ladder), ok);
 }
 
 /* One technique's entry of metrics.json. */
@@ -818,6 +909,11 @@ static cJSON *technique_json(const ctx *c, int k, int rank)
     jnum(o, "gpu_ms", tc->gpu_ms, &ok);
     jnum(o, "wall_ms", tc->wall_ms, &ok);
     jnum(o, "fit_scale", tc->a, &ok);
+    const gr_lb_row *row = gr_lb_technique_row(&c->lb, k);
+    if (row) { /* the verdict, its components, the equivalent blur and the flag */
+        jadd(o, "verdict", row_json(c, row), &ok);
+        jstr(o, "flag", row->no_better ? GR_LB_NO_BETTER : NULL, &ok);
+    }
     /* the headline errors (luminance), raw and after the fit */
     cJSON *e = cJSON_CreateObject();
     jadd(o, "errors_y", e, &ok);
@@ -940,7 +1036,7 @@ static gr_status build_json(ctx *c, char **text, gr_error *err)
         }
     }
     jadd(root, "leaderboard", lb, &ok);
-    jstr(root, "leaderboard_rule", "relative RMSE of luminance Y after the best scale fit, lower first", &ok);
+    leaderboard_json(c, root, &ok);
     cJSON *ts = ok ? cJSON_CreateArray() : NULL;
     for (int k = 0; ts && k < in->n_techniques; k++) {
         int rank = 0;
@@ -1079,51 +1175,108 @@ static void html_tuning_pages(gr_strbuf *b, const ctx *c)
                   "The commands run from the folder <code>godrays run</code> was started in; docs/tuning.md.</p>\n");
 }
 
-/* The leaderboard table: one row per technique, best first. */
-static void html_leaderboard(gr_strbuf *b, const ctx *c)
+/* The leaderboard's header: the verdict and its components, the equivalent blur, the other
+ * registry leaderboard metrics (raw and after the fit), the timings. */
+static int html_leaderboard_head(gr_strbuf *b)
 {
-    const gr_report_input *in = c->in;
-    char t[48];
+    static const char *const cols[] = {"verdict", "error after fit<br>(rel. RMSE Y)", "structure<br>score",
+                                       "FLIP", "band-pass<br>corr.", "streak<br>contrast ratio", "scale a",
+                                       "equivalent<br>blur"};
+    int n = 3;
     gr_sb_puts(b, "<h2 id=\"leaderboard\">Leaderboard</h2>\n<table class=\"lb\"><tr><th>rank</th><th class=\"l\">"
                   "technique</th><th class=\"l\">image (x a)</th>");
-    for (int i = 0; i < gr_metric_count(); i++) { /* the registry's leaderboard metrics, raw and after the fit */
-        if (!gr_metric_at(i)->leaderboard) continue;
-        for (int f = 0; f < 2; f++) {
+    for (size_t i = 0; i < sizeof cols / sizeof cols[0]; i++, n++) gr_sb_printf(b, "<th>%s</th>", cols[i]);
+    for (int i = 0; i < gr_metric_count(); i++) {
+        if (!gr_metric_at(i)->leaderboard || gr_lb_verdict_column(i)) continue;
+        for (int f = 0; f < 2; f++, n++) {
             gr_sb_puts(b, "<th>");
             gr_sb_html(b, gr_metric_at(i)->label);
             gr_sb_puts(b, f ? "<br>after fit</th>" : "</th>");
         }
     }
-    gr_sb_puts(b, "<th>scale a</th><th>GPU ms<br>(passes)</th><th>wall ms<br>(render)</th><th>s in<br>this run</th></tr>\n");
-    for (int r = 0; r < in->n_techniques; r++) {
-        const tctx *tc = &c->t[c->order[r]];
-        const gr_metrics *m = tc->t->metrics;
-        const gr_metrics_set *fs = fit_set(m);
-        gr_sb_printf(b, "<tr><td>%d</td><td class=\"l\"><a href=\"#t-", r + 1);
-        gr_sb_html(b, tc->t->name);
-        gr_sb_puts(b, "\"><b>");
-        gr_sb_html(b, tc->t->name);
-        gr_sb_puts(b, "</b></a><br><span class=\"sub\">");
-        gr_sb_html(b, tc->t->description ? tc->t->description : "");
-        gr_sb_puts(b, "</span></td><td class=\"l\"><img src=\"");
-        gr_sb_htmlf(b, "%s.png", tc->stem);
-        gr_sb_puts(b, "\" class=\"thumb\" alt=\"");
-        gr_sb_html(b, tc->t->name);
-        gr_sb_printf(b, "\" width=\"%d\" height=\"%d\"></td>", tc->disp_fit->width, tc->disp_fit->height);
-        for (int i = 0; i < gr_metric_count(); i++) {
-            if (!gr_metric_at(i)->leaderboard) continue;
-            gr_sb_printf(b, "<td>%s</td>", fmt(gr_metric_value(&m->raw, i), t, sizeof t));
-            gr_sb_printf(b, "<td>%s</td>", fmt(gr_metric_value(fs, i), t, sizeof t));
+    gr_sb_puts(b, "<th>GPU ms<br>(passes)</th><th>wall ms<br>(render)</th><th>s in<br>this run</th></tr>\n");
+    return n + 3;
+}
+
+/* One row of the leaderboard (report/leaderboard.h). */
+static void html_leaderboard_row(gr_strbuf *b, const ctx *c, const gr_lb_row *r, int n_cols)
+{
+    char t[48];
+    static const char *const cls[3] = {"", " class=\"baseline\"", " class=\"failed\""};
+    gr_sb_printf(b, "<tr%s><td>", cls[r->kind]);
+    if (r->kind == GR_LB_TECHNIQUE) gr_sb_printf(b, "%d", r->rank);
+    else gr_sb_puts(b, r->kind == GR_LB_BASELINE ? "baseline" : "<b>failed</b>");
+    gr_sb_puts(b, "</td><td class=\"l\">");
+    if (r->kind == GR_LB_BASELINE) {
+        gr_sb_puts(b, "<i>baseline</i>: ");
+        gr_sb_html(b, r->text);
+        gr_sb_puts(b, "</td><td class=\"l\"></td>");
+    } else {
+        const tctx *tc = r->kind == GR_LB_TECHNIQUE ? &c->t[r->index] : NULL;
+        const char *desc = tc ? tc->t->description : c->in->failed[r->index].description;
+        if (tc) {
+            gr_sb_puts(b, "<a href=\"#t-");
+            gr_sb_html(b, r->name);
+            gr_sb_puts(b, "\">");
         }
-        const double v[4] = {tc->a, tc->gpu_ms, tc->wall_ms, tc->t->seconds >= 0 ? tc->t->seconds : NAN};
-        for (int i = 0; i < 4; i++) gr_sb_printf(b, "<td>%s</td>", fmt(v[i], t, sizeof t));
-        gr_sb_puts(b, "</tr>\n");
+        gr_sb_puts(b, "<b>");
+        gr_sb_html(b, r->name);
+        gr_sb_puts(b, tc ? "</b></a>" : "</b>");
+        if (tc && r->no_better) gr_sb_puts(b, "<br><span class=\"flag\">" GR_LB_NO_BETTER "</span>");
+        gr_sb_puts(b, "<br><span class=\"sub\">");
+        gr_sb_html(b, desc ? desc : "");
+        gr_sb_puts(b, "</span></td><td class=\"l\">");
+        if (tc) {
+            gr_sb_puts(b, "<img src=\"");
+            gr_sb_htmlf(b, "%s.png", tc->stem);
+            gr_sb_puts(b, "\" class=\"thumb\" alt=\"");
+            gr_sb_html(b, r->name);
+            gr_sb_printf(b, "\" width=\"%d\" height=\"%d\">", tc->disp_fit->width, tc->disp_fit->height);
+        }
+        gr_sb_puts(b, "</td>");
     }
-    gr_sb_puts(b, "</table>\n<p class=\"sub\">Ranked by the relative RMSE of luminance after the best scale fit "
-                  "(RMSE / mean reference Y; each technique's intensity is an arbitrary factor, so shapes are "
-                  "compared at the best-fitting level a = &lt;t, r&gt; / &lt;t, t&gt;). GPU ms: the sum of the "
-                  "technique's GL pass timers (GL_TIME_ELAPSED; on llvmpipe they measure the CPU rasterizer); "
-                  "wall ms: its render call, readback included. Details per technique below.</p>\n");
+    if (r->kind == GR_LB_FAILED) {
+        gr_sb_printf(b, "<td class=\"l\" colspan=\"%d\">FAILED: ", n_cols - 3);
+        gr_sb_html(b, r->text);
+        gr_sb_puts(b, "</td></tr>\n");
+        return;
+    }
+    const double v[7] = {r->verdict, r->error_fit, r->structure, r->flip, r->corr, r->contrast_ratio, r->scale};
+    for (int i = 0; i < 7; i++) gr_sb_printf(b, i ? "<td>%s</td>" : "<td><b>%s</b></td>", fmt(v[i], t, sizeof t));
+    gr_sb_printf(b, "<td>%s</td>", gr_lb_eq_blur_text(c->in, r, t, sizeof t));
+    for (int i = 0; i < gr_metric_count(); i++) {
+        if (!gr_metric_at(i)->leaderboard || gr_lb_verdict_column(i)) continue;
+        gr_sb_printf(b, "<td>%s</td>", fmt(gr_metric_value(&r->m->raw, i), t, sizeof t));
+        gr_sb_printf(b, "<td>%s</td>", fmt(gr_metric_value(fit_set(r->m), i), t, sizeof t));
+    }
+    if (r->kind == GR_LB_TECHNIQUE) {
+        const tctx *tc = &c->t[r->index];
+        const double w[3] = {tc->gpu_ms, tc->wall_ms, tc->t->seconds >= 0 ? tc->t->seconds : NAN};
+        for (int i = 0; i < 3; i++) gr_sb_printf(b, "<td>%s</td>", fmt(w[i], t, sizeof t));
+    } else {
+        gr_sb_puts(b, "<td></td><td></td><td></td>");
+    }
+    gr_sb_puts(b, "</tr>\n");
+}
+
+/* The leaderboard table: techniques and baselines by verdict, then the failed techniques. */
+static void html_leaderboard(gr_strbuf *b, const ctx *c)
+{
+    const int n_cols = html_leaderboard_head(b);
+    for (int i = 0; i < c->lb.n; i++) html_leaderboard_row(b, c, &c->lb.rows[i], n_cols);
+    gr_sb_puts(b, "</table>\n<p class=\"sub\">Ranked by the <b>verdict</b> (lower is better; 0 = the truth): the mean "
+                  "of the error after the best scale fit (RMSE of luminance over the truth's mean Y; each technique's "
+                  "intensity is an arbitrary factor, so shapes are compared at the best-fitting level a = &lt;t, r&gt; "
+                  "/ &lt;t, t&gt;) and the structure score (0 = the truth's beams, about 0.7 = none), the objective "
+                  "<code>godrays tune</code> minimizes by default. FLIP, the band-pass correlation (1 = beams in the "
+                  "truth's places) and the streak contrast ratio (1 = as streaky as the truth) explain it. "
+                  "<i>Baselines</i> are scored the same way: a black frame, the constant image at the truth's mean and "
+                  "the truth blurred by a 4 px Gaussian. The <b>equivalent blur</b> is the Gaussian sigma at which the "
+                  "blurred truth gets the same verdict: a technique at \"6 px\" looks as good as the truth blurred by "
+                  "6 px. A technique whose verdict is not below the constant image's is flagged <span class=\"flag\">"
+                  GR_LB_NO_BETTER "</span>. GPU ms: the sum of the technique's GL pass timers (GL_TIME_ELAPSED; on "
+                  "llvmpipe they measure the CPU rasterizer); wall ms: its render call, readback included. "
+                  "docs/metrics.md \"The verdict\"; details per technique below.</p>\n");
 }
 
 static void html_technique(ctx *c, gr_strbuf *b, int k)
@@ -1289,10 +1442,13 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     }
     gr_sb_puts(b, "</div>\n");
     /* Warnings a reader must not miss. */
-    const gr_metrics *m0 = in->techniques[0].metrics;
-    if (!m0->have_stderr || in->ref_cache_note || meta_num(in->ref_meta, "godrays:partial") > 0) {
+    const int no_stderr = gr_image_channel(in->ref, "stderr.R") < 0;
+    if (no_stderr || in->ref_cache_note || meta_num(in->ref_meta, "godrays:partial") > 0 || in->n_failed > 0) {
         gr_sb_puts(b, "<div class=\"box warn\">\n");
-        if (!m0->have_stderr) gr_sb_html(b, " The reference carries no standard-error channels: no significance test.");
+        if (in->n_failed > 0)
+            gr_sb_htmlf(b, " %d technique%s FAILED (no image to score): see the leaderboard's failed rows.",
+                        in->n_failed, in->n_failed == 1 ? "" : "s");
+        if (no_stderr) gr_sb_html(b, " The reference carries no standard-error channels: no significance test.");
         if (meta_num(in->ref_meta, "godrays:partial") > 0)
             gr_sb_html(b, " The reference is a PARTIAL (interrupted) render.");
         if (in->ref_cache_note) {
@@ -1310,7 +1466,7 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
         gr_sb_html(b, in->sequence_href);
         gr_sb_puts(b, "</a>. This page compares the first frame.</p>\n");
     }
-    {
+    if (in->n_techniques > 0) {
         gr_viewer_item vi[GR_REPORT_MAX_TECHNIQUES];
         for (int r = 0; r < in->n_techniques; r++) { /* leaderboard order: 1 = the best */
             const tctx *tc = &c->t[c->order[r]];
@@ -1320,8 +1476,11 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
         gr_status vst = gr_viewer_write(c->dir, in->ref, vi, in->n_techniques, c->exposure, b, err);
         if (vst != GR_OK) return vst;
     }
-    gr_sb_puts(b, "<p class=\"sub\">Every technique beside the reference with the key numbers: "
-                  "<a href=\"summary.png\">summary.png</a>; every number: <a href=\"metrics.json\">metrics.json</a>.</p>\n");
+    if (in->n_techniques > 0)
+        gr_sb_puts(b, "<p class=\"sub\">Every technique beside the reference with the key numbers: "
+                      "<a href=\"summary.png\">summary.png</a>; every number: <a href=\"metrics.json\">metrics.json</a>.</p>\n");
+    else
+        gr_sb_puts(b, "<p class=\"sub\">Every number: <a href=\"metrics.json\">metrics.json</a>.</p>\n");
     if (c->charts > 0) {
         gr_sb_puts(b, "<div class=\"grid\">\n");
         html_figure(b, "radial_profile.png", NULL, "radial profile, luminance, every technique",
@@ -1356,7 +1515,7 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     kv_num(b, "comparison (metrics) time, all techniques", in->compare_seconds >= 0 ? in->compare_seconds : NAN, 1.0, "s");
     gr_sb_puts(b, "</table>\n");
 
-    html_tuning_pages(b, c);
+    if (in->n_techniques > 0) html_tuning_pages(b, c);
 
     /* Scene and settings */
     gr_sb_puts(b, "<h2>Scene and settings</h2>\n");
@@ -1389,8 +1548,14 @@ static gr_status check_input(const gr_report_input *in, gr_error *err)
 {
     if (!in || !in->scene || !in->ref || !in->ref->pixels)
         return gr_fail(err, GR_E_INPUT, "report: missing scene or reference image");
-    if (in->n_techniques < 1 || in->n_techniques > GR_REPORT_MAX_TECHNIQUES || !in->techniques)
-        return gr_fail(err, GR_E_INPUT, "report: %d techniques (1..%d)", in->n_techniques, GR_REPORT_MAX_TECHNIQUES);
+    if (in->n_techniques < 0 || in->n_techniques > GR_REPORT_MAX_TECHNIQUES || (in->n_techniques > 0 && !in->techniques) ||
+        in->n_failed < 0 || in->n_failed > GR_REPORT_MAX_TECHNIQUES || (in->n_failed > 0 && !in->failed) ||
+        in->n_techniques + in->n_failed < 1)
+        return gr_fail(err, GR_E_INPUT, "report: %d techniques and %d failed (1..%d)", in->n_techniques, in->n_failed,
+                       GR_REPORT_MAX_TECHNIQUES);
+    for (int f = 0; f < in->n_failed; f++)
+        if (!in->failed[f].name || !in->failed[f].name[0] || !in->failed[f].reason)
+            return gr_fail(err, GR_E_INPUT, "report: failed technique %d: missing name or reason", f);
     for (int k = 0; k < in->n_techniques; k++) {
         const gr_report_technique *t = &in->techniques[k];
         if (!t->name || !t->name[0] || !t->test || !t->test->pixels || !t->metrics)
@@ -1493,6 +1658,11 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
     }
     if ((st = compute_profiles(in, as, &c->pr, err)) != GR_OK) goto done;
     c->have_profiles = 1;
+    {
+        double flips[GR_REPORT_MAX_TECHNIQUES];
+        for (int k = 0; k < nt; k++) flips[k] = c->t[k].flip.mean;
+        gr_leaderboard_build(in, flips, &c->lb);
+    }
     summary_lines(c);
 
     /* Files: images first, the pages that link them last. */
@@ -1529,16 +1699,17 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
         if ((st = gr_report_contact_sheet(panels, titles, lines, nl, 360, 800, &rows[r], &lab, err)) != GR_OK) goto done;
         c->labelled = c->labelled && lab;
     }
-    sheet = stack_rows(rows, nt);
-    if (!sheet) {
+    sheet = nt > 0 ? stack_rows(rows, nt) : NULL;
+    if (nt > 0 && !sheet) {
         st = gr_fail(err, GR_E_NOMEM, "report: out of memory for summary.png");
         goto done;
     }
     if ((st = join(path, sizeof path, dir, "summary.png", err)) != GR_OK) goto done;
-    if ((st = gr_oiio_write(path, sheet, err)) != GR_OK) goto done;
+    if (sheet && (st = gr_oiio_write(path, sheet, err)) != GR_OK) goto done;
     /* A chart PLplot could not draw is reported in the page, not fatal: the rest of the report
      * stands on its own. Running out of memory or disk is. */
-    st = draw_charts(dir, in, as, &c->pr, c->noise_y, &c->charts, c->chart_note, sizeof c->chart_note, err);
+    st = nt > 0 ? draw_charts(dir, in, as, &c->pr, c->noise_y, &c->charts, c->chart_note, sizeof c->chart_note, err)
+                : GR_OK; /* every technique failed: the leaderboard alone */
     if (st == GR_E_RUNTIME) {
         snprintf(c->chart_note, sizeof c->chart_note, "charts incomplete (%d drawn): %.400s", c->charts, err->msg);
         st = GR_OK;
@@ -1555,6 +1726,7 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
         for (int k = 0; k < nt; k++) {
             res->fit_scale[k] = c->t[k].a;
             res->order[k] = c->order[k];
+            res->flip[k] = c->t[k].flip.mean;
         }
         res->charts = c->charts;
         res->labelled = c->labelled;

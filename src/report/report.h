@@ -1,7 +1,8 @@
 /* The report of `godrays run`: a self-contained folder DIR comparing every real-time technique
  * of the run against one ground truth:
- *   index.html          the LEADERBOARD (one row per technique: thumbnail, errors with and
- *                       without the scale fit, GPU time of its passes, wall time), then per
+ *   index.html          the LEADERBOARD (report/leaderboard.h: one row per technique and per
+ *                       baseline, ranked by the verdict, with its components, the equivalent
+ *                       blur, GPU and wall time; a row per failed technique), then per
  *                       technique its images beside the reference with false-colour
  *                       differences and colorbars, metrics tables (raw and after the best
  *                       scale fit), charts, timings and counters; the scene and every setting;
@@ -22,6 +23,7 @@
 #define GR_REPORT_H
 
 #include "common/status.h"
+#include "compare/baseline.h"
 #include "compare/metrics.h"
 #include "image/image.h"
 #include "scene/scene.h"
@@ -39,12 +41,24 @@ typedef struct gr_report_technique {
     const char *exr;                /* name (inside DIR) of its EXR copy written beside; NULL: none */
 } gr_report_technique;
 
+/* A technique that has no image to score: it failed to build, to render, or rendered black or
+ * NaN. A row of its own on the leaderboard, with the reason. */
+typedef struct gr_report_failure {
+    const char *name;               /* the technique's name */
+    const char *description;        /* one line (NULL: none) */
+    const char *reason;             /* one line: why it failed */
+} gr_report_failure;
+
 typedef struct gr_report_input {
     const gr_scene *scene;
     const gr_image *ref;            /* ground truth: R, G, B [, stderr.R/G/B] */
     const gr_metadata *ref_meta;    /* its godrays:* attributes (NULL: none) */
-    int n_techniques;               /* 1..GR_REPORT_MAX_TECHNIQUES */
+    int n_techniques;               /* 0..GR_REPORT_MAX_TECHNIQUES (0 only with a failure) */
     const gr_report_technique *techniques;
+    int n_failed;                   /* techniques that failed, rows of their own (0..MAX) */
+    const gr_report_failure *failed;
+    const gr_baselines *baselines;  /* scored like the techniques (compare/baseline.h); NULL: no
+                                       baseline rows, no equivalent blur */
     /* provenance and timings; NULL strings and negative times are "unknown" */
     const char *command_line;
     int ref_cached;                 /* 1: the ground truth was read from the cache */
@@ -64,6 +78,7 @@ typedef struct gr_report_result {
     double exposure;                /* preview exposure: reference 99th percentile -> 0.8 */
     double fit_scale[GR_REPORT_MAX_TECHNIQUES]; /* per technique: a used for T.png and its differences */
     int order[GR_REPORT_MAX_TECHNIQUES]; /* leaderboard: technique indices, best first */
+    double flip[GR_REPORT_MAX_TECHNIQUES]; /* per technique: mean HDR-FLIP of a x test (its map) */
     int charts;                     /* charts drawn (0 without PLplot) */
     int labelled;                   /* 1 if summary.png carries text (a font was found) */
     double seconds;                 /* time spent writing the report */
@@ -72,8 +87,9 @@ typedef struct gr_report_result {
 /* Writes the report into dir (created if missing). Every file goes through a temporary name,
  * so a failure leaves no half-written file. GR_E_INPUT for missing inputs, no technique,
  * images of different sizes or a repeated technique name; GR_E_IO; GR_E_NOMEM. res may be
- * NULL. The leaderboard ranks by the relative RMSE of luminance after the scale fit
- * (lower first; ties: the input order). */
+ * NULL. The leaderboard ranks by the verdict after the scale fit (compare/registry.h; lower
+ * first; ties: the input order), among the baselines; failed techniques are rows at its end
+ * (report/leaderboard.h). */
 gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_result *res, gr_error *err);
 
 /* Creates dir and its missing parents (GR_E_IO naming the part that failed). */
@@ -89,8 +105,8 @@ gr_status gr_report_contact_sheet(const gr_image *const panels[3], const char *c
                                   const char *const *lines, int n_lines, int min_panel_w, int max_panel_w,
                                   gr_image **out, int *labelled, gr_error *err);
 
-/* The leaderboard order of techniques[0..n): indices sorted by relative RMSE of Y after the
- * scale fit (RMSE / |mean reference Y|), lower first, non-finite last, ties in input order. */
+/* The leaderboard order of techniques[0..n): indices sorted by the verdict after the scale fit
+ * (compare/registry.h GR_METRIC_VERDICT), lower first, non-finite last, ties in input order. */
 void gr_report_rank(const gr_report_technique *techniques, int n, int *order);
 
 /* Exposure mapping the q-th quantile (0..1) of max(R, G, B) of img (times scale) to `target`

@@ -84,20 +84,7 @@ double gr_tune_value(const gr_tune_problem *p, const gr_metrics_set *set)
         if (p->normalize && d && d->unit == GR_METRIC_RADIANCE && mean_y > 0) v /= mean_y;
         return v;
     }
-    /* each class made dimensionless (those in image units relative to the mean reference Y;
-     * relmse, 1 - SSIM, FLIP and the structure score already are), then weighted
-     * (docs/tuning.md); the registry's order is the order of the sum */
-    double sum = 0.0, wsum = 0.0;
-    for (int k = 0; k < gr_metric_count(); k++) {
-        if (!(p->weights[k] > 0.0)) continue;
-        const gr_metric_desc *d = gr_metric_at(k);
-        if (d->needs_scene && isnan(gr_metric_value(set, k))) continue; /* no vanishing point (no_vp) */
-        double v = gr_tune_metric_value(set, k);
-        if (d->unit == GR_METRIC_RADIANCE && mean_y > 0) v /= mean_y;
-        sum += p->weights[k] * v, wsum += p->weights[k];
-    }
-    const double v = wsum > 0 ? sum / wsum : 1e300;
-    return isfinite(v) ? v : 1e300;
+    return gr_metric_weighted(set, p->weights); /* compare/registry.h: the verdict's combination */
 }
 
 /* The metrics options of case i for the problem's metric(s): only the parts (cost classes)

@@ -38,10 +38,11 @@ double gr_tune_metric_value(const gr_metrics_set *set, gr_tune_metric m);
  * metrics 0; each >= 0, finite, at least one > 0). GR_E_USAGE naming flag and the bad part. */
 gr_status gr_tune_weights_parse(const char *flag, const char *s, double w[GR_METRIC_MAX], gr_error *err);
 
-/* `godrays tune`'s default objective (docs/tuning.md "The default objective"): the relative
- * RMSE of Y after the scale fit (the radiance error, dominated by the low frequencies: the
- * glow) and the beam-structure score, equal weights. */
-#define GR_TUNE_DEFAULT_OBJECTIVE "rmse=1,structure=1"
+/* `godrays tune`'s default objective (docs/tuning.md "The default objective"): the verdict
+ * (compare/registry.h), the relative RMSE of Y after the scale fit (the radiance error,
+ * dominated by the low frequencies: the glow) and the beam-structure score, equal weights;
+ * the score the leaderboard ranks by. */
+#define GR_TUNE_DEFAULT_OBJECTIVE GR_VERDICT_OBJECTIVE
 
 /* A camera view for tuning beyond the scene's own: same position and fov, other direction. */
 typedef struct gr_tune_view {

@@ -138,7 +138,7 @@ gr_status gr_pareto_write_plot(const char *path, const gr_pareto_point *pts, int
         s[ns++] = b;
     }
     gr_plot_spec spec = {.width = 900, .height = 560, .title = title, .xlabel = "time per frame (s)",
-                         .ylabel = "rel. RMSE of Y vs HQ ground truth", .log_x = 1, .log_y = 1,
+                         .ylabel = "verdict vs HQ ground truth", .log_x = 1, .log_y = 1,
                          .series = s, .n_series = ns, .legend_headroom = 0.0};
     gr_status st = gr_plot_write(path, &spec, err);
     free(buf);

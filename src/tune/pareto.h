@@ -21,7 +21,7 @@ typedef struct gr_pareto_point {
     double cost_s;           /* what the fronts and the plot rank by: time_s, except for the
                                 techniques on a hardware GPU, where it is gpu_s (their wall time
                                 there is mostly the harness's synchronous float readback) */
-    double error;            /* relative RMSE of Y against the high-quality reference */
+    double error;            /* the verdict (compare/registry.h) against the high-quality reference */
     int on_front;            /* set by gr_pareto_mark_fronts */
 } gr_pareto_point;
 

@@ -21,7 +21,8 @@ fast="--size 32x18 --set reference.surface_res=32 --set reference.bias_probe=fal
 fail=0
 bad() { echo "FAIL: $*"; fail=1; }
 ok() { echo "ok: $*"; }
-run() { timeout 120 "$bin" run "$scene" $fast -o out "$@" >out.txt 2>err.txt; }
+# exit 3 is a complete report with a failed technique (at 32 x 18 the radial blurs render black)
+run() { timeout 120 "$bin" run "$scene" $fast -o out "$@" >out.txt 2>err.txt; r=$?; [ $r -eq 3 ] && r=0; return $r; }
 
 run || { echo "FAIL: first run: $(cat err.txt)"; exit 1; }
 entry=$(ls cache/reference-*.exr 2>/dev/null | head -1)

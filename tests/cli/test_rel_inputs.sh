@@ -108,7 +108,8 @@ timeout 120 "$bin" run evil.json --size 32x18 --set reference.surface_res=32 --s
     --set reference.spp=4 -o evil_out >out.txt 2>err.txt
 rc=$?
 esc=$(cat out.txt err.txt | tr -d '\n' | od -An -c | grep -c '033')
-if [ "$rc" -eq 0 ] && [ "$esc" -eq 0 ] &&
+# exit 3: the report is complete, a technique failed (at 32 x 18 the radial blurs render black)
+if { [ "$rc" -eq 0 ] || [ "$rc" -eq 3 ]; } && [ "$esc" -eq 0 ] &&
    python3 -c "import json,sys; json.loads(open('evil_out/metrics.json','rb').read().decode('utf-8','strict'))" &&
    python3 -c "open('evil_out/index.html','rb').read().decode('utf-8','strict')"; then
     ok "scene name with ESC and non-UTF-8 bytes: terminal clean, metrics.json and index.html valid UTF-8"

@@ -6,7 +6,10 @@
 #  - every <img> decoded (an instrumented copy of the page in the same folder checks each
 #    image's naturalWidth after the load event and writes the result into the DOM, which
 #    --dump-dom prints), as many images as the page has <img> tags, all local files;
-#  - no reference to anything outside the folder (http:, https:, //, absolute paths).
+#  - no reference to anything outside the folder (http:, https:, //, absolute paths);
+#  - the leaderboard as the browser lays it out (its innerText, written into the DOM by the
+#    same script): the verdict and its components, the equivalent blur, the three baselines
+#    and a failed row for a user technique whose shader does not compile (the run exits 3).
 # A screenshot of the page is kept as the test's artifact: $GODRAYS_TEST_OUT/report_browser/
 # index.png. The report comes from a small, low-quality render (a few seconds).
 # Chromium is installed by scripts/setup.sh; without it the test is skipped with a message,
@@ -32,7 +35,10 @@ mkdir -p "$out"
 cd "$out" || exit 1
 GODRAYS_CACHE="$out/cache" "$bin" run "$src/data/scenes/default.json" -o report --size 160x90 \
     --set reference.surface_res=64 --set reference.sun_samples=2 --set reference.batches=2 \
-    --set reference.steps=16 -q >run.txt 2>&1
+    --set reference.steps=16 --technique-dir "$src/tests/techniques/gl_errors/compile_error" \
+    --techniques err_compile_error,froxel,shafts -q >run.txt 2>&1
+rc=$?
+ck "godrays run exits 3 (a technique failed) and made the report" [ "$rc" -eq 3 ]
 ck "godrays run made the report" [ -s report/index.html ]
 [ -s report/index.html ] || { cat run.txt; exit 1; }
 
@@ -69,7 +75,8 @@ window.addEventListener("load",function(){var im=document.images,bad=[];for(var 
 {if(!im[i].complete||im[i].naturalWidth===0)bad.push(im[i].getAttribute("src"));}
 var p=document.createElement("pre");p.id="grcheck";p.textContent="GRCHECK images="+im.length+" broken="+
 bad.length+" errors="+window.__grErr.length+" ["+bad.concat(window.__grErr).join(" ")+"] END";
-document.body.appendChild(p);});</script>'
+document.body.appendChild(p);var lb=document.querySelector("table.lb"),q=document.createElement("pre");
+q.id="grlb";q.textContent="GRLB "+(lb?lb.innerText.replace(/\s+/g," "):"none")+" LBEND";document.body.appendChild(q);});</script>'
 printf '%s\n' "$hook" >hook.html
 sed '/<head>/r hook.html' report/index.html >report/check.html
 ck "the check script is in the copy" grep -q '__grErr' report/check.html
@@ -80,6 +87,15 @@ result=$(grep -o 'GRCHECK[^<]*END' dom.html)
 echo "browser: $result"
 ck "the check script ran" [ -n "$result" ]
 ck "every image loaded ($n_img expected)" sh -c "echo '$result' | grep -q 'GRCHECK images=$n_img broken=0 errors=0 '"
+lbtext=$(grep -o 'id="grlb">GRLB[^<]*LBEND' dom.html)
+echo "leaderboard as laid out: $lbtext"
+for w in "verdict" "error after fit" "structure score" "FLIP" "band-pass corr." "streak contrast ratio" "scale a" \
+    "equivalent blur" "baseline: black frame" "baseline: constant: the truth's mean" \
+    "baseline: truth blurred, sigma 4 px" "failed err_compile_error" "FAILED: " "does not compile"; do
+    ck "the laid-out leaderboard shows '$w'" sh -c 'printf "%s" "$1" | grep -qF -- "$2"' _ "$lbtext" "$w"
+done
+ck "the laid-out leaderboard shows an equivalent blur in px for froxel" sh -c \
+    'printf "%s" "$1" | grep -Eq "froxel .* [0-9.]+ px "' _ "$lbtext"
 grep ':CONSOLE' dom.err >console2.txt
 ck "no console messages in the instrumented copy" [ ! -s console2.txt ]
 rm -f report/check.html

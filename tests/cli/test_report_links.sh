@@ -23,7 +23,10 @@ rep="rep x"
 small="--size 32x18 --set reference.surface_res=16 --set reference.sun_samples=1 --set reference.batches=2 --set reference.steps=4"
 # shellcheck disable=SC2086
 "$bin" run "$scene" -o "$rep" $small -q >run1.txt 2>&1
-ck "first run exits 0" [ $? -eq 0 ]
+rc=$?
+# 0, or 3 when a technique failed: at 32 x 18 both radial blurs render black (failed rows);
+# the report is complete either way (docs/report.md)
+ck "first run exits 0 or 3 ($rc)" [ $rc -eq 0 -o $rc -eq 3 ]
 ck "first run wrote index.html" [ -s "$rep/index.html" ]
 
 # the command in the page for COMMAND, HTML entities decoded
@@ -66,7 +69,8 @@ ck "lone sweep page has no link back" sh -c "! grep -q 'href=\"../index.html\"' 
 # the run again: it now links the two pages that exist
 # shellcheck disable=SC2086
 "$bin" run "$scene" -o "$rep" $small -q >run2.txt 2>&1
-ck "second run exits 0" [ $? -eq 0 ]
+rc=$?
+ck "second run exits 0 or 3 ($rc)" [ $rc -eq 0 -o $rc -eq 3 ]
 for c in sweep tune; do
     ck "second index links $c/index.html" grep -qF "<a href=\"$c/index.html\">" "$rep/index.html"
     ck "second index gives no $c command" [ -z "$(command_in_page $c)" ]
