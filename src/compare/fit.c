@@ -12,7 +12,7 @@ const char *gr_fit_mode_name(gr_fit_mode m)
     return (int)m >= 0 && (int)m < 3 ? names[m] : NULL;
 }
 
-int gr_fit_mode_is_word(const char *s)
+static int is_word(const char *s)
 {
     for (int k = 0; s && k < 3; k++)
         if (!strcmp(s, names[k])) return 1;
@@ -28,6 +28,18 @@ gr_status gr_fit_mode_parse(const char *flag, const char *s, gr_fit_mode *m, gr_
     }
     return gr_fail(err, GR_E_USAGE, "%s '%s': use scale (one factor for R, G, B), rgb (one per channel) or none",
                    flag, s ? s : "");
+}
+
+int gr_fit_mode_option(int argc, char *const *argv, int *i, gr_fit_mode *m, gr_error *err)
+{
+    const char *a = argv[*i];
+    if (!strcmp(a, "--fit-scale")) *m = GR_FIT_SCALE;
+    else if (!strcmp(a, "--no-fit")) *m = GR_FIT_NONE;
+    else if (!strncmp(a, "--fit=", 6)) return gr_fit_mode_parse("--fit", a + 6, m, err) == GR_OK ? 1 : -1;
+    else if (strcmp(a, "--fit")) return 0;
+    else if (*i + 1 < argc && is_word(argv[*i + 1])) return gr_fit_mode_parse("--fit", argv[++*i], m, err) == GR_OK ? 1 : -1;
+    else *m = GR_FIT_SCALE;
+    return 1;
 }
 
 int gr_fit_scales(const gr_image *ref, const gr_image *test, const unsigned char *scored, const int rr[3],

@@ -18,9 +18,12 @@ const char *gr_fit_mode_name(gr_fit_mode m);
 /* "none", "scale" or "rgb" into *m; GR_E_USAGE naming flag and the three words otherwise. */
 gr_status gr_fit_mode_parse(const char *flag, const char *s, gr_fit_mode *m, gr_error *err);
 
-/* Whether s is one of the three words (a command line's `--fit` may be followed by one, or stand
- * alone for `--fit scale`). */
-int gr_fit_mode_is_word(const char *s);
+/* A fit option at argv[*i], as every command that fits reads it: `--fit MODE` (MODE: none, scale
+ * or rgb; consumed), a bare `--fit` (scale: what it meant before there were modes), `--fit=MODE`,
+ * and the older spellings `--fit-scale` (scale) and `--no-fit` (none). Returns 1 when it was one
+ * (*m set, *i on its last word), 0 when argv[*i] is not a fit option, -1 for `--fit=` with
+ * another word (GR_E_USAGE in err). */
+int gr_fit_mode_option(int argc, char *const *argv, int *i, gr_fit_mode *m, gr_error *err);
 
 /* The least-squares factors over the scored pixels (scored: width * height, 1 = scored; NULL:
  * all) between ref's channels rr[0..2] and test's channels tr[0..2] (the same index three times
