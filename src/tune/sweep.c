@@ -104,7 +104,7 @@ gr_status gr_sweep_write_csv(const char *path, const gr_tune_problem *p, const g
     if (!f) return err->status;
     fprintf(f, "%s", p->params[0].key);
     if (res->n_axes > 1) fprintf(f, ",%s", p->params[1].key);
-    fprintf(f, ",%s%s,scale", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
+    fprintf(f, ",%s%s,scale", gr_tune_metric_name(p->metric), p->fit == GR_FIT_RGB ? "_fit_rgb" : p->fit ? "_fit" : "");
     for (int c = 0; c < res->n_cases; c++) {
         if (case_labels && case_labels[c]) fprintf(f, ",%s", case_labels[c]);
         else fprintf(f, ",case%d", c);
