@@ -273,7 +273,8 @@ static int sweep_with(gr_args *args)
     gr_strbuf sum;
     gr_sb_init(&sum);
     gr_sb_printf(&sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
-           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric),
+           p->fit == GR_FIT_RGB ? " after the per-channel fit" : p->fit ? " after the best scale fit" : "",
            p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "minimum %.6g at %s = %.6g", r.err[r.best], p->params[0].key, xbest[0]);
     if (n_params > 1) gr_sb_printf(&sum, ", %s = %.6g", p->params[1].key, xbest[1]);
