@@ -508,7 +508,8 @@ static gr_status rgb_fitted(compare_state *s, gr_error *err)
     return GR_OK;
 }
 
-/* The capture checks (compare/capture.h), each warning on stderr now and in the JSON later. */
+/* The capture checks (compare/capture.h): their warnings go into the JSON, and on stderr once
+ * everything has succeeded (print_warnings: a refused command says only why). */
 static gr_status capture_checks(const compare_opts *o, compare_state *s, gr_error *err)
 {
     gr_status st = need_scored(o, s, err);
@@ -520,13 +521,16 @@ static gr_status capture_checks(const compare_opts *o, compare_state *s, gr_erro
         *f[k] = (gr_capture_file){.bits = s->info[k].bits, .integer = s->info[k].integer,
                                   .decoded = s->info[k].decoded, .n_top_code = s->info[k].n_top_code};
     if (s->m.have_fit && s->m.fit_defined && s->m.fit_mode == GR_FIT_RGB) in.fit_rgb = s->m.fit.scale_rgb;
-    if ((st = gr_capture_check(&in, &s->capture, err)) != GR_OK) return st;
+    return gr_capture_check(&in, &s->capture, err);
+}
+
+static void print_warnings(const compare_opts *o, const compare_state *s)
+{
     for (int k = 0; k < s->capture.n; k++) {
         const int ref = !strcmp(s->capture.w[k].code, "clipped_reference");
         fprintf(stderr, "godrays compare: warning: %s %s: %s\n", ref ? "reference" : "test", o->paths[ref ? 0 : 1],
                 s->capture.w[k].message);
     }
-    return GR_OK;
 }
 
 /* Every number computed: the metrics (with the registry's), FLIP and the structure details. */
@@ -715,9 +719,13 @@ int cmd_compare(int argc, char **argv)
     if (st == GR_OK && !(s->text = cJSON_Print(s->root))) st = gr_fail(&err, GR_E_NOMEM, "out of memory printing the JSON");
     if (st == GR_OK && o.outdir) st = write_outputs(&o, s, &err);
     rc = 0;
-    if (st != GR_OK) rc = gr_cli_report(o.cmd, &err);
-    else if (o.json) printf("%s\n", s->text);
-    else print_text(&o, s);
+    if (st != GR_OK) {
+        rc = gr_cli_report(o.cmd, &err);
+    } else {
+        print_warnings(&o, s);
+        if (o.json) printf("%s\n", s->text);
+        else print_text(&o, s);
+    }
     state_free(s);
     free(s);
     return rc;
