@@ -16,6 +16,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "compare/capture.h"
 #include "compare/diffmap.h"
 #include "compare/flip.h"
 #include "compare/structure.h"
@@ -49,7 +50,11 @@ static void usage(FILE *f)
             "                       inferno) and DIR/diff_signed.png (dY, blue-red), with colorbars\n"
             "  --mask M             image of the same size; pixels whose first channel is 0 are\n"
             "                       not scored\n"
-            "  --fit-scale          also fit a = <t, r> / <t, t> and report the metrics of a * TEST\n"
+            "  --fit MODE           also report the metrics after a least-squares fit of TEST: scale\n"
+            "                       (one factor a = <t, r> / <t, t> for R, G, B; a bare --fit and\n"
+            "                       --fit-scale mean this), rgb (one factor per channel, a_c = <t_c, r_c> /\n"
+            "                       <t_c, t_c>: a tint is fitted too; the three are reported) or none\n"
+            "                       (default)\n"
             "  --stderr-bound B     do not score pixels whose reference luminance relative stderr\n"
             "                       exceeds B (default %g; inf: score all)\n"
             "  --no-linearize       read 8-bit files as code / 255 (default: sRGB-decode them)\n"
@@ -76,6 +81,11 @@ static void usage(FILE *f)
             "                       $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  -h, --help           this help\n"
             "\n"
+            "Warnings (stderr, and \"warnings\" in the JSON; the comparison goes on): TEST matches REF\n"
+            "better flipped upside down or mirrored; an 8-bit input with more than 0.5 %% of its pixels\n"
+            "at code 255; an 8- or 16-bit TEST whose values look linear although decoded as sRGB, or\n"
+            "the reverse; a best scale fit outside [0.1, 10] (docs/metrics.md, \"Capture warnings\").\n"
+            "\n"
             "Exit codes: 0 ok, 1 runtime failure, 2 bad usage, unreadable input or size mismatch.\n",
             GR_METRICS_STDERR_BOUND);
 }
@@ -94,10 +104,12 @@ static gr_status write_text(const char *path, const char *text, gr_error *err)
     return st;
 }
 
-/* Reads one input; any failure is bad input (exit 2) naming the role and the file. */
-static gr_status read_input(const char *role, const char *path, int linearize, gr_image **img, gr_error *err)
+/* Reads one input (and what the file says of its pixels, info: may be NULL); any failure is
+ * bad input (exit 2) naming the role and the file. */
+static gr_status read_input(const char *role, const char *path, int linearize, gr_image **img, gr_oiio_info *info,
+                            gr_error *err)
 {
-    gr_status st = gr_oiio_read(path, linearize, img, err);
+    gr_status st = gr_oiio_read_info(path, linearize, img, info, err);
     if (st == GR_OK) return GR_OK;
     if (st != GR_E_NOMEM) err->status = GR_E_INPUT;
     gr_error_prefix(err, "%s", role);
@@ -171,13 +183,17 @@ typedef struct compare_opts {
     int have_vp;
     double vp[2];
     int flip_mode;                /* -1: from REF's file extension */
+    gr_fit_mode fit;              /* --fit (opt.fit_scale follows it) */
     gr_metrics_options opt;
     gr_flip_options fopt;
 } compare_opts;
 
 /* What the comparison read, computed and owns (freed by state_free). */
 typedef struct compare_state {
-    gr_image *ref, *test, *mask, *diff[3], *scaled;
+    gr_image *ref, *test, *mask, *diff[3];
+    gr_image *scaled;             /* TEST as fitted, for FLIP (and the pictures, per channel) */
+    gr_oiio_info info[2];         /* what REF's and TEST's files say of their pixels */
+    gr_capture_report capture;    /* the capture checks (compare/capture.h) */
     unsigned char *scored;
     float *flipmap, *angles;
     gr_structure_options so;
@@ -309,7 +325,10 @@ static int parse_arg(gr_args *args, compare_opts *o)
         if (!rc) rc = parse_value_option(o, a, v);
         return rc ? rc : -1;
     }
-    if (!strcmp(a, "--fit-scale")) o->opt.fit_scale = 1;
+    gr_error ferr;
+    const int fr = gr_fit_mode_option(args->argc, args->argv, &args->i, &o->fit, &ferr);
+    if (fr < 0) return gr_cli_usage_error(o->cmd, "%s", ferr.msg);
+    if (fr > 0) o->opt.fit_scale = (int)o->fit;
     else if (!strcmp(a, "--json")) o->json = 1;
     else if (!strcmp(a, "--no-linearize")) o->linearize = 0;
     else if (a[0] == '-' && a[1] != '\0') return gr_cli_usage_error(o->cmd, "unknown option '%s'", a);
@@ -346,9 +365,9 @@ static int parse_args(gr_args *args, compare_opts *o)
  * reference. */
 static gr_status read_inputs(const compare_opts *o, compare_state *s, gr_error *err)
 {
-    gr_status st = read_input("reference", o->paths[0], o->linearize, &s->ref, err);
-    if (st == GR_OK) st = read_input("test", o->paths[1], o->linearize, &s->test, err);
-    if (st == GR_OK && o->mask_path) st = read_input("mask", o->mask_path, 0, &s->mask, err);
+    gr_status st = read_input("reference", o->paths[0], o->linearize, &s->ref, &s->info[0], err);
+    if (st == GR_OK) st = read_input("test", o->paths[1], o->linearize, &s->test, &s->info[1], err);
+    if (st == GR_OK && o->mask_path) st = read_input("mask", o->mask_path, 0, &s->mask, NULL, err);
     if (st != GR_OK) return st;
     const gr_image *ref = s->ref, *test = s->test, *mask = s->mask;
     if (ref->width != test->width || ref->height != test->height)
@@ -450,14 +469,13 @@ static gr_status compute_flip(compare_opts *o, compare_state *s, gr_error *err)
     gr_status st = need_scored(o, s, err);
     if (st != GR_OK) return st;
     o->fopt.scored = s->scored;
-    const gr_image *ft = test;
-    if (s->scale != 1.0) {
+    if (!s->scaled && s->scale != 1.0) {
         s->scaled = gr_image_create(test->width, test->height, test->nchannels, NULL);
         if (!s->scaled) return gr_fail(err, GR_E_NOMEM, "out of memory for FLIP");
         memcpy(s->scaled->names, test->names, sizeof test->names);
         for (size_t i = 0; i < n * (size_t)test->nchannels; i++) s->scaled->pixels[i] = (float)(s->scale * test->pixels[i]);
-        ft = s->scaled;
     }
+    const gr_image *ft = s->scaled ? s->scaled : test;
     const double t1 = now_s();
     gr_error ferr = {GR_OK, ""};
     double e0, e1;
@@ -475,6 +493,46 @@ static gr_status compute_flip(compare_opts *o, compare_state *s, gr_error *err)
     return st;
 }
 
+/* The per-channel fit: TEST's R, G, B times a_R, a_G, a_B into s->scaled (what FLIP and the
+ * difference pictures compare then, with factor 1). */
+static gr_status rgb_fitted(compare_state *s, gr_error *err)
+{
+    static const char *const rgb[3] = {"R", "G", "B"};
+    const gr_image *t = s->test;
+    const size_t n = (size_t)t->width * (size_t)t->height;
+    if (!(s->scaled = gr_image_create(t->width, t->height, 3, rgb))) return gr_fail(err, GR_E_NOMEM, "out of memory");
+    for (size_t p = 0; p < n; p++)
+        for (int c = 0; c < 3; c++)
+            s->scaled->pixels[3 * p + (size_t)c] =
+                (float)(s->m.fit.scale_rgb[c] * t->pixels[p * (size_t)t->nchannels + (size_t)s->m.test_rgb[c]]);
+    return GR_OK;
+}
+
+/* The capture checks (compare/capture.h): their warnings go into the JSON, and on stderr once
+ * everything has succeeded (print_warnings: a refused command says only why). */
+static gr_status capture_checks(const compare_opts *o, compare_state *s, gr_error *err)
+{
+    gr_status st = need_scored(o, s, err);
+    if (st != GR_OK) return st;
+    gr_capture_input in = {.ref = s->ref, .test = s->test, .ref_rgb = s->m.ref_rgb, .test_rgb = s->m.test_rgb,
+                           .scored = s->scored};
+    gr_capture_file *f[2] = {&in.ref_file, &in.test_file};
+    for (int k = 0; k < 2; k++)
+        *f[k] = (gr_capture_file){.bits = s->info[k].bits, .integer = s->info[k].integer,
+                                  .decoded = s->info[k].decoded, .n_top_code = s->info[k].n_top_code};
+    if (s->m.have_fit && s->m.fit_defined && s->m.fit_mode == GR_FIT_RGB) in.fit_rgb = s->m.fit.scale_rgb;
+    return gr_capture_check(&in, &s->capture, err);
+}
+
+static void print_warnings(const compare_opts *o, const compare_state *s)
+{
+    for (int k = 0; k < s->capture.n; k++) {
+        const int ref = !strcmp(s->capture.w[k].code, "clipped_reference");
+        fprintf(stderr, "godrays compare: warning: %s %s: %s\n", ref ? "reference" : "test", o->paths[ref ? 0 : 1],
+                s->capture.w[k].message);
+    }
+}
+
 /* Every number computed: the metrics (with the registry's), FLIP and the structure details. */
 static gr_status compute_all(compare_opts *o, compare_state *s, gr_error *err)
 {
@@ -488,6 +546,9 @@ static gr_status compute_all(compare_opts *o, compare_state *s, gr_error *err)
     s->t_metrics = now_s() - t0;
     if (st != GR_OK) return st;
     s->scale = s->m.have_fit && s->m.fit_defined ? s->m.fit.scale : 1.0;
+    if (s->m.have_fit && s->m.fit_defined && s->m.fit_mode == GR_FIT_RGB && (st = rgb_fitted(s, err)) != GR_OK)
+        return st;
+    if ((st = capture_checks(o, s, err)) != GR_OK) return st;
     if (o->do_flip && (st = compute_flip(o, s, err)) != GR_OK) return st;
     if (o->do_struct) {
         if ((st = need_scored(o, s, err)) != GR_OK) return st;
@@ -499,6 +560,42 @@ static gr_status compute_all(compare_opts *o, compare_state *s, gr_error *err)
     return st;
 }
 
+/* A number, or null when not finite (not checked). */
+static int add_num_or_null(cJSON *o, const char *k, double v)
+{
+    return (isfinite(v) ? cJSON_AddNumberToObject(o, k, v) : cJSON_AddNullToObject(o, k)) != NULL;
+}
+
+/* "warnings" (each: code, the file it is about, message) and "capture_checks" (the numbers
+ * behind them) of the capture checks. */
+static int add_capture_json(const compare_opts *o, const compare_state *s, cJSON *root)
+{
+    const gr_capture_report *c = &s->capture;
+    cJSON *ws = cJSON_AddArrayToObject(root, "warnings");
+    int ok = ws != NULL;
+    for (int k = 0; ok && k < c->n; k++) {
+        cJSON *w = cJSON_CreateObject();
+        ok = w && cJSON_AddItemToArray(ws, w);
+        const int ref = !strcmp(c->w[k].code, "clipped_reference");
+        ok = ok && cJSON_AddStringToObject(w, "code", c->w[k].code) &&
+             cJSON_AddStringToObject(w, "file", o->paths[ref ? 0 : 1]) &&
+             cJSON_AddStringToObject(w, "message", c->w[k].message);
+    }
+    cJSON *cj = ok ? cJSON_AddObjectToObject(root, "capture_checks") : NULL;
+    return cj && add_num_or_null(cj, "rel_rmse_y_fit_as_given", c->err_given) &&
+           add_num_or_null(cj, "rel_rmse_y_fit_flipped_vertically", c->err_vflip) &&
+           add_num_or_null(cj, "rel_rmse_y_fit_flipped_horizontally", c->err_hflip) &&
+           add_num_or_null(cj, "scale", c->scale) && add_num_or_null(cj, "reference_top_code_fraction", c->top_fraction[0]) &&
+           add_num_or_null(cj, "test_top_code_fraction", c->top_fraction[1]) &&
+           add_num_or_null(cj, "test_log_slope_as_read", c->slope_given) &&
+           add_num_or_null(cj, "test_log_slope_read_other_way", c->slope_other) &&
+           add_num_or_null(cj, "test_rel_rmse_y_fit_as_read", c->err_as_read) &&
+           add_num_or_null(cj, "test_rel_rmse_y_fit_read_other_way", c->err_other) &&
+           cJSON_AddBoolToObject(cj, "test_decoded_from_srgb", s->info[1].decoded) &&
+           cJSON_AddStringToObject(cj, "test_declared_colorspace", s->info[1].colorspace) &&
+           add_num_or_null(cj, "test_bits", s->info[1].bits);
+}
+
 /* The JSON document (without the difference images' entries). */
 static gr_status build_json(const compare_opts *o, compare_state *s, gr_error *err)
 {
@@ -507,7 +604,7 @@ static gr_status build_json(const compare_opts *o, compare_state *s, gr_error *e
     if (rj && !cJSON_AddItemToObject(root, "reference", rj)) cJSON_Delete(rj), rj = NULL;
     cJSON *tj = rj ? image_json(o->paths[1], s->test, s->m.test_rgb) : NULL;
     if (tj && !cJSON_AddItemToObject(root, "test", tj)) cJSON_Delete(tj), tj = NULL;
-    if (!tj || !cJSON_AddBoolToObject(root, "linearized_8bit", o->linearize) ||
+    if (!tj || !add_capture_json(o, s, root) || !cJSON_AddBoolToObject(root, "linearized_8bit", o->linearize) ||
         !cJSON_AddNumberToObject(root, "metrics_time_s", s->t_metrics) ||
         (o->mask_path && !cJSON_AddStringToObject(root, "mask", o->mask_path)))
         return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
@@ -535,10 +632,11 @@ static gr_status make_diff_images(const compare_opts *o, compare_state *s, gr_er
     cJSON *dj = cJSON_AddObjectToObject(s->root, "difference_images");
     if (!dj) return gr_fail(err, GR_E_NOMEM, "out of memory building the JSON");
     for (int k = 0; k < 2; k++) {
-        gr_diffmap_options dopt = {.kind = k ? GR_DIFFMAP_SIGNED : GR_DIFFMAP_ABS, .scale = s->scale,
+        const int per_channel = s->m.have_fit && s->m.fit_defined && s->m.fit_mode == GR_FIT_RGB;
+        gr_diffmap_options dopt = {.kind = k ? GR_DIFFMAP_SIGNED : GR_DIFFMAP_ABS, .scale = per_channel ? 1.0 : s->scale,
                                    .mask = s->mask, .stderr_bound = o->opt.stderr_bound};
         gr_diffmap_info info;
-        gr_status st = gr_diffmap_create(s->ref, s->test, &dopt, &s->diff[k], &info, err);
+        gr_status st = gr_diffmap_create(s->ref, per_channel ? s->scaled : s->test, &dopt, &s->diff[k], &info, err);
         if (st != GR_OK) return st;
         cJSON *one = cJSON_AddObjectToObject(dj, diff_names[k]);
         if (!one || !cJSON_AddStringToObject(one, "quantity", k ? "scale * Y(test) - Y(ref)" : "|scale * Y(test) - Y(ref)|") ||
@@ -621,9 +719,13 @@ int cmd_compare(int argc, char **argv)
     if (st == GR_OK && !(s->text = cJSON_Print(s->root))) st = gr_fail(&err, GR_E_NOMEM, "out of memory printing the JSON");
     if (st == GR_OK && o.outdir) st = write_outputs(&o, s, &err);
     rc = 0;
-    if (st != GR_OK) rc = gr_cli_report(o.cmd, &err);
-    else if (o.json) printf("%s\n", s->text);
-    else print_text(&o, s);
+    if (st != GR_OK) {
+        rc = gr_cli_report(o.cmd, &err);
+    } else {
+        print_warnings(&o, s);
+        if (o.json) printf("%s\n", s->text);
+        else print_text(&o, s);
+    }
     state_free(s);
     free(s);
     return rc;

@@ -65,6 +65,9 @@ static void usage(FILE *f)
             "                       an animated GIF per technique); index.html compares the first frame\n"
             "  --times T1,T2,...    a sequence at these water times (s)\n"
             "  --fps F              frames per second of --frames (default 30)\n"
+            "  --fit MODE           the fit before the errors after the fit: scale (default: one\n"
+            "                       least-squares factor), rgb (one per channel: a tint is fitted too)\n"
+            "                       or none (docs/metrics.md, \"Scale fits\")\n"
             "  --no-cache           render the ground truth even if a cached one exists, and do not\n"
             "                       store it\n"
             "  --max-memory SIZE    refuse (exit 2) a ground truth estimated to need more (e.g. 8G;\n"
@@ -257,6 +260,7 @@ static void print_summary(const char *dir, const gr_report_input *in, const gr_l
 typedef struct run_opts {
     const char *outdir, *tech_list, *frames_spec, *times_spec, *fps_spec;
     int quiet, use_cache, help;
+    gr_fit_mode fit;                /* --fit: the leaderboard's scaling (default: one scale) */
     const gr_technique_class *cls[GR_REPORT_MAX_TECHNIQUES];
     int nt;                         /* techniques */
     double fps, times[GR_SEQUENCE_MAX_FRAMES];
@@ -297,6 +301,7 @@ typedef struct run_state {
 static int parse_args(gr_args *args, run_opts *o)
 {
     int rc = 0, taken = 0;
+    gr_error ferr;
     for (; args->i < args->argc && !rc; args->i++) {
         const char *a = args->argv[args->i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -315,6 +320,8 @@ static int parse_args(gr_args *args, run_opts *o)
             rc = gr_args_value(args, &o->times_spec);
         } else if (!strcmp(a, "--fps")) {
             rc = gr_args_value(args, &o->fps_spec);
+        } else if ((taken = gr_fit_mode_option(args->argc, args->argv, &args->i, &o->fit, &ferr)) != 0) {
+            rc = taken < 0 ? gr_cli_usage_error("run", "%s", ferr.msg) : 0;
         } else if ((rc = gr_args_take_common(args, &o->outdir, NULL, &taken)) == 0 && !taken) {
             rc = gr_args_take_scene(args);
         }
@@ -478,7 +485,7 @@ static gr_status compute_metrics(const run_opts *o, run_state *rs, gr_error *err
     if (!rs->angles) return gr_fail(err, GR_E_NOMEM, "out of memory for the structure metrics");
     const int with_structure = gr_profile_structure_options(scene, rs->angles, &so);
     gr_metrics_options mopt = {0};
-    mopt.fit_scale = 1; /* a technique's intensity is an arbitrary factor (seed 000) */
+    mopt.fit_scale = (int)o->fit; /* a technique's intensity is an arbitrary factor (seed 000) */
     if (with_structure) mopt.structure = &so;
     if (dof && dof->type != GR_META_STRING && dof->num >= 1.0) mopt.stderr_dof = (int)dof->num;
     for (int k = 0; k < o->nt; k++) {
@@ -661,6 +668,7 @@ static int run_with(gr_args *args)
     run_opts o;
     memset(&o, 0, sizeof o);
     o.use_cache = 1;
+    o.fit = GR_FIT_SCALE;
     int rc = parse_args(args, &o);
     if (rc || o.help) return rc;
     if ((rc = gr_args_need_scene(args)) != 0) return rc;

@@ -75,6 +75,7 @@ static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, cons
     cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
     cJSON_AddStringToObject(root, "channel", "Y");
     cJSON_AddBoolToObject(root, "fit_scale", p->fit);
+    cJSON_AddStringToObject(root, "fit", gr_fit_mode_name((gr_fit_mode)p->fit));
     cJSON_AddBoolToObject(root, "normalized", p->normalize);
     cJSON_AddNumberToObject(root, "width", s->base->camera.width);
     cJSON_AddNumberToObject(root, "height", s->base->camera.height);
@@ -248,7 +249,11 @@ static int sweep_with(gr_args *args)
     const double sw_render_s = p->render_s, sw_metrics_s = p->metrics_s;
     int bx = r.best % r.nx, by = r.best / r.nx;
     double xbest[2] = {r.xs[bx], r.ys[by]};
-    snippet = gr_tune_snippet(p, xbest, p->fit ? r.scale[r.best] : 0.0);
+    double fold[3] = {r.scale[r.best], r.scale[r.best], r.scale[r.best]}, fbest;
+    /* --rgb-per-channel: the best point's per-channel factors (one more evaluation) */
+    if (p->rgb_per_channel && gr_tune_evaluate(p, xbest, &fbest, NULL, NULL, &err) != GR_OK) goto fail;
+    if (p->rgb_per_channel) gr_tune_mean_scale_rgb(p, fold);
+    snippet = gr_tune_snippet(p, xbest, p->fit ? fold : NULL);
     json = sweep_json(&s, p, &r, snippet);
     if (!snippet || !json) {
         gr_fail(&err, GR_E_NOMEM, "out of memory building the JSON");
@@ -268,7 +273,8 @@ static int sweep_with(gr_args *args)
     gr_strbuf sum;
     gr_sb_init(&sum);
     gr_sb_printf(&sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
-           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+           s.base->name, s.base->camera.width, s.base->camera.height, s.n_cases, gr_tune_metric_name(p->metric),
+           p->fit == GR_FIT_RGB ? " after the per-channel fit" : p->fit ? " after the best scale fit" : "",
            p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(&sum, "minimum %.6g at %s = %.6g", r.err[r.best], p->params[0].key, xbest[0]);
     if (n_params > 1) gr_sb_printf(&sum, ", %s = %.6g", p->params[1].key, xbest[1]);

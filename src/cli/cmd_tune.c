@@ -371,7 +371,7 @@ static gr_status search(const tune_opts *t, const gr_tune_session *s, gr_tune_pr
     if (st != GR_OK) return st;
     fprintf(trace.f, "eval");
     for (int k = 0; k < n; k++) fprintf(trace.f, ",%s", r->params[k].key);
-    fprintf(trace.f, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
+    fprintf(trace.f, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit == GR_FIT_RGB ? "_fit_rgb" : p->fit ? "_fit" : "");
     st = gr_tune_evaluate(p, r->xb, &r->fb, r->before, r->sc_b, err);
     traced tr = {.p = p, .trace = trace.f, .progress = !t->c.quiet && isatty(2), .budget = t->c.quiet ? NULL : &r->budget};
     char plan[512];
@@ -387,9 +387,11 @@ static gr_status search(const tune_opts *t, const gr_tune_session *s, gr_tune_pr
     gr_outfile_abort(&trace);
     if (st == GR_OK) st = gr_tune_evaluate(p, r->res.x, &r->fa, r->after, r->sc_a, err);
     if (st != GR_OK) return st;
-    double scale_mean = 0.0;
-    for (int i = 0; i < s->n_cases; i++) scale_mean += r->sc_a[i] / s->n_cases;
-    if (!(r->snippet = gr_tune_snippet(p, r->res.x, p->fit ? scale_mean : 0.0)))
+    double fold[3] = {0.0, 0.0, 0.0}; /* the fitted factors folded into the gain: mean over the cases */
+    for (int i = 0; i < s->n_cases; i++) fold[0] += r->sc_a[i] / s->n_cases;
+    fold[1] = fold[2] = fold[0];
+    if (p->rgb_per_channel) gr_tune_mean_scale_rgb(p, fold);
+    if (!(r->snippet = gr_tune_snippet(p, r->res.x, p->fit ? fold : NULL)))
         return gr_fail(err, GR_E_NOMEM, "out of memory");
     /* Agreement of the starts: the spread (fraction of each box side) of the results of the
      * starts that reached the best value within 2 %. */
@@ -462,6 +464,8 @@ static char *tune_json(const tune_opts *t, const gr_tune_session *s, const gr_tu
     cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
     cJSON_AddStringToObject(root, "channel", "Y");
     cJSON_AddBoolToObject(root, "fit_scale", p->fit);
+    cJSON_AddStringToObject(root, "fit", gr_fit_mode_name((gr_fit_mode)p->fit));
+    cJSON_AddBoolToObject(root, "rgb_per_channel", p->rgb_per_channel);
     cJSON_AddBoolToObject(root, "normalized", p->normalize);
     cJSON_AddNumberToObject(root, "width", s->base->camera.width);
     cJSON_AddNumberToObject(root, "height", s->base->camera.height);
@@ -498,7 +502,8 @@ static void tune_summary(const tune_opts *t, const gr_tune_session *s, const gr_
     const int n = r->n_params;
     gr_sb_printf(sum, "technique %s, scene '%s' (%d x %d), %d case(s), metric %s of Y%s%s\n", p->cls->name,
                  s->base->name, s->base->camera.width, s->base->camera.height, s->n_cases,
-                 gr_tune_metric_name(p->metric), p->fit ? " after the best scale fit" : "",
+                 gr_tune_metric_name(p->metric),
+                 p->fit == GR_FIT_RGB ? " after the per-channel fit" : p->fit ? " after the best scale fit" : "",
                  p->normalize ? ", / mean reference Y per case" : "");
     gr_sb_printf(sum, "%-28s %12s %12s %14s\n", "parameter", "before", "after", "box");
     for (int k = 0; k < n; k++)

@@ -243,6 +243,7 @@ static gr_status compute_set(const ctx *cx, const int rr[3], const int tr[3], do
 {
     memset(set, 0, sizeof *set);
     set->scale = scale;
+    set->scale_rgb[0] = set->scale_rgb[1] = set->scale_rgb[2] = scale;
     acc a[GR_MCH_COUNT];
     memset(a, 0, sizeof a);
     const gr_image *ref = cx->ref, *test = cx->test;
@@ -300,17 +301,19 @@ double gr_structure_score(const gr_structure_compare *c)
     return isfinite(v) ? v : 1.0;
 }
 
-/* The structure comparison (scale-invariant: computed once, copied into each set). */
-static gr_status structure_fill(const ctx *cx, gr_metrics *out, gr_error *err)
+/* The structure comparison of test against the reference into sets[0..n) (invariant to one
+ * scale: computed once for the raw and the single-scale fitted set; the per-channel fit changes
+ * the luminance's mix, so its set gets its own). */
+static gr_status structure_fill(const ctx *cx, const gr_image *test, gr_metrics_set *const *sets, int n,
+                                gr_error *err)
 {
     gr_structure_options so = *cx->opt->structure;
     so.scored = cx->scored;
     gr_structure_compare *c = malloc(sizeof *c);
     if (!c) return gr_fail(err, GR_E_NOMEM, "metrics: out of memory");
-    gr_status st = gr_structure_compare_images(cx->ref, cx->test, &so, c, err);
+    gr_status st = gr_structure_compare_images(cx->ref, test, &so, c, err);
     if (st == GR_OK) {
-        gr_metrics_set *sets[2] = {&out->raw, &out->fit};
-        for (int k = 0; k < (out->have_fit ? 2 : 1); k++) {
+        for (int k = 0; k < n; k++) {
             sets[k]->have_structure = 1;
             sets[k]->structure_corr = c->bandpass_corr;
             sets[k]->structure_contrast_err = c->contrast_log_err;
@@ -320,6 +323,36 @@ static gr_status structure_fill(const ctx *cx, gr_metrics *out, gr_error *err)
         }
     }
     free(c);
+    return st;
+}
+
+/* The fitted set (options.fit_scale): one factor on the test, or one per channel. The per-
+ * channel fit is computed on a copy of the test scaled per channel (R, G, B), with scale 1, so
+ * that every part (SSIM, blurs, FLIP, the registry's own functions) sees the test as fitted;
+ * *scaled is that copy (the caller destroys it), NULL for one factor. */
+static gr_status fit_set(const ctx *cx, const int rr[3], const int tr[3], gr_metrics *out, gr_image **scaled,
+                         gr_error *err)
+{
+    const gr_fit_mode mode = cx->opt->fit_scale == GR_FIT_RGB ? GR_FIT_RGB : GR_FIT_SCALE;
+    double a[3];
+    out->have_fit = 1;
+    out->fit_mode = (int)mode;
+    out->fit_defined = gr_fit_scales(cx->ref, cx->test, cx->scored, rr, tr, mode, a) > 0;
+    if (mode == GR_FIT_SCALE) return compute_set(cx, rr, tr, a[0], &out->fit, err);
+    static const char *const rgb_names[3] = {"R", "G", "B"};
+    static const int rgb_idx[3] = {0, 1, 2};
+    const gr_image *test = cx->test;
+    gr_image *t = *scaled = gr_image_create(test->width, test->height, 3, rgb_names);
+    if (!t) return gr_fail(err, GR_E_NOMEM, "metrics: cannot allocate the per-channel fitted test");
+    for (size_t p = 0; p < cx->n; p++)
+        for (int c = 0; c < 3; c++)
+            t->pixels[3 * p + (size_t)c] = (float)(a[c] * (double)test->pixels[p * (size_t)test->nchannels + (size_t)tr[c]]);
+    ctx c2 = *cx;
+    c2.test = t;
+    gr_status st = compute_set(&c2, rr, rgb_idx, 1.0, &out->fit, err);
+    const double mean_t[3] = {out->raw.ch[0].test_mean, out->raw.ch[1].test_mean, out->raw.ch[2].test_mean};
+    out->fit.scale = gr_fit_luminance_scale(a, mean_t);
+    memcpy(out->fit.scale_rgb, a, sizeof a);
     return st;
 }
 
@@ -481,23 +514,14 @@ gr_status gr_metrics_compute(const gr_image *ref, const gr_image *test, const gr
     out->ssim_c1 = cx.ssim_c1, out->ssim_c2 = cx.ssim_c2;
 
     st = compute_set(&cx, rr, tr, 1.0, &out->raw, err);
-    if (st == GR_OK && opt->fit_scale) {
-        /* Best scale a = <t, r> / <t, t> (least squares over the scored RGB samples). */
-        double tr_dot = 0.0, tt_dot = 0.0;
-        for (size_t p = 0; p < cx.n; p++) {
-            if (!scored[p]) continue;
-            const float *rp = ref->pixels + p * (size_t)ref->nchannels;
-            const float *tp = test->pixels + p * (size_t)test->nchannels;
-            for (int c = 0; c < 3; c++) {
-                tr_dot += (double)tp[tr[c]] * (double)rp[rr[c]];
-                tt_dot += (double)tp[tr[c]] * (double)tp[tr[c]];
-            }
-        }
-        out->have_fit = 1;
-        out->fit_defined = tt_dot > 0.0;
-        st = compute_set(&cx, rr, tr, tt_dot > 0.0 ? tr_dot / tt_dot : 1.0, &out->fit, err);
+    gr_image *scaled = NULL; /* the per-channel fitted test */
+    if (st == GR_OK && opt->fit_scale) st = fit_set(&cx, rr, tr, out, &scaled, err);
+    if (st == GR_OK && opt->structure) {
+        gr_metrics_set *sets[2] = {&out->raw, &out->fit};
+        st = structure_fill(&cx, test, sets, out->have_fit && !scaled ? 2 : 1, err);
+        if (st == GR_OK && scaled) st = structure_fill(&cx, scaled, sets + 1, 1, err);
     }
-    if (st == GR_OK && opt->structure) st = structure_fill(&cx, out, err);
+    gr_image_destroy(scaled);
     free(scored);
     return st;
 }

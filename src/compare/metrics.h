@@ -10,6 +10,7 @@
 
 #include "common/status.h"
 #include "compare/channels.h"
+#include "compare/fit.h"
 #include "compare/flip.h"
 #include "compare/results.h"
 #include "compare/structure.h"
@@ -32,7 +33,10 @@ extern const double gr_metrics_blur_sigmas[GR_METRICS_NSCALES];
 typedef struct gr_metrics_options {
     const gr_image *mask;         /* same size; its first channel nonzero = scored; NULL: all */
     double stderr_bound;          /* 0: GR_METRICS_STDERR_BOUND; INFINITY: no exclusion */
-    int fit_scale;                /* also compute the best scale fit and the metrics after it */
+    int fit_scale;                /* a gr_fit_mode (compare/fit.h): 0 none; 1 (GR_FIT_SCALE) also the
+                                     best single scale fit and the metrics after it; 2 (GR_FIT_RGB)
+                                     one factor per channel, the metrics on the per-channel-scaled
+                                     test (docs/metrics.md, "Scale fits") */
     int skip_ssim;                /* leave SSIM out (cheap sweeps) */
     int skip_blur;                /* leave the multi-scale RMSE out */
     int stderr_dof;               /* degrees of freedom of REF's stderr (batches - 1; the reference

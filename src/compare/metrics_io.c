@@ -51,7 +51,9 @@ static cJSON *set_json(const gr_metrics *m, const gr_metrics_set *s)
 {
     cJSON *o = cJSON_CreateObject();
     if (!o) return NULL;
-    int ok = add_num(o, "scale", s->scale) &&
+    cJSON *srgb = cJSON_AddObjectToObject(o, "scale_rgb");
+    int ok = srgb && add_num(srgb, "R", s->scale_rgb[0]) && add_num(srgb, "G", s->scale_rgb[1]) &&
+             add_num(srgb, "B", s->scale_rgb[2]) && add_num(o, "scale", s->scale) &&
              (s->have_ssim ? add_num(o, "ssim_y", s->ssim_y) : cJSON_AddNullToObject(o, "ssim_y") != NULL);
     cJSON *chs = ok ? cJSON_AddObjectToObject(o, "channels") : NULL;
     ok = ok && chs;
@@ -162,7 +164,9 @@ cJSON *gr_metrics_to_json(const gr_metrics *m)
     if (!ok) cJSON_Delete(raw);
     if (ok && m->have_fit) {
         cJSON *fit = set_json(m, &m->fit);
+        const char *mode = gr_fit_mode_name((gr_fit_mode)m->fit_mode);
         ok = fit && cJSON_AddBoolToObject(fit, "fit_defined", m->fit_defined) &&
+             cJSON_AddStringToObject(fit, "fit_mode", mode ? mode : "scale") &&
              cJSON_AddItemToObject(o, "fitted", fit);
         if (!ok) cJSON_Delete(fit);
     }
@@ -249,7 +253,11 @@ void gr_metrics_print_table(FILE *f, const gr_metrics *m)
             GR_LUM_G, GR_LUM_B);
     print_set(f, m, &m->raw);
     if (m->have_fit) {
-        if (m->fit_defined)
+        const double *a = m->fit.scale_rgb;
+        if (m->fit_defined && m->fit_mode == GR_FIT_RGB)
+            fprintf(f, "\nbest per-channel fit: test R x %.6g, G x %.6g, B x %.6g (least squares per channel over "
+                    "scored samples; on luminance x %.6g); after fitting:\n", a[0], a[1], a[2], m->fit.scale);
+        else if (m->fit_defined)
             fprintf(f, "\nbest scale fit: test x %.6g (least squares over scored RGB samples); after fitting:\n",
                     m->fit.scale);
         else fprintf(f, "\nbest scale fit undefined (the test image is zero over the scored pixels): scale 1\n");
@@ -268,7 +276,7 @@ void gr_metrics_print_summary(FILE *f, const gr_metrics *m, unsigned costs)
         if (!(costs & (1u << d->cost)) || (isnan(x[0]) && isnan(x[1]))) continue;
         if (!shown++) {
             fprintf(f, "metrics (docs/metrics.md)           %11s", "as given");
-            if (fit) fprintf(f, " %11s", "x scale");
+            if (fit) fprintf(f, " %11s", m->fit_mode == GR_FIT_RGB ? "x a_R,G,B" : "x scale");
             fprintf(f, "\n");
         }
         char lab[64], v[2][32];

@@ -13,7 +13,7 @@
 
 /* A new JSON object with every field of m and the conventions used (luminance weights, rel
  * MSE epsilon rule, PSNR peaks, SSIM constants, blur sigmas, stderr z and bound). Each set
- * ("metrics": as given, "fitted") carries "registry": every registered metric by key
+ * ("metrics": as given, "fitted" with its "fit_mode") carries "scale", "scale_rgb" and "registry": every registered metric by key
  * (compare/registry.h), each described under conventions.registry. +inf PSNR and metrics not computed are written as
  * null (JSON has no infinity). NULL if out of memory. */
 cJSON *gr_metrics_to_json(const gr_metrics *m);

@@ -35,7 +35,11 @@ typedef struct gr_channel_metrics {
 
 /* One complete set of metrics for one test scaling. */
 typedef struct gr_metrics_set {
-    double scale;                 /* factor applied to TEST before comparing (1 unless fitted) */
+    double scale;                 /* factor applied to TEST before comparing (1 unless fitted); for
+                                     the per-channel fit its luminance equivalent
+                                     (gr_fit_luminance_scale): what a single factor stands for */
+    double scale_rgb[3];          /* the factors applied to TEST's R, G, B (all = scale unless the
+                                     fit is per channel) */
     gr_channel_metrics ch[GR_MCH_COUNT];
     double ssim_y;                /* mean SSIM of luminance over scored pixels (1 if none) */
     int have_ssim, have_blur;     /* 0 when skipped through the options */
@@ -70,8 +74,11 @@ typedef struct gr_metrics {
     double ssim_c1, ssim_c2;      /* (K1 L)^2, (K2 L)^2 */
     gr_metrics_set raw;           /* TEST as given */
     int have_fit;                 /* options.fit_scale was set */
-    int fit_defined;              /* <t, t> > 0 over the scored samples (else scale 1) */
-    gr_metrics_set fit;           /* TEST times a = <t, r> / <t, t> (RGB pooled) */
+    int fit_mode;                 /* its gr_fit_mode (compare/fit.h): 0 none, 1 scale, 2 rgb */
+    int fit_defined;              /* <t, t> > 0 over the scored samples (else scale 1); per channel:
+                                     for at least one channel (a black channel keeps factor 1) */
+    gr_metrics_set fit;           /* TEST times a = <t, r> / <t, t> (RGB pooled), or each channel c
+                                     times a_c = <t_c, r_c> / <t_c, t_c> (fit_mode rgb) */
 } gr_metrics;
 
 

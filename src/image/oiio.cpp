@@ -272,6 +272,31 @@ extern "C" const char *gr_oiio_version(void)
 
 extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **out, gr_error *err)
 {
+    return gr_oiio_read_info(path, linearize, out, nullptr, err);
+}
+
+// Pixels with a channel other than alpha at 1, the top code of an integer file read as
+// code / max (before any decoding).
+static long long count_top_code(const gr_image *img, int alpha)
+{
+    const size_t n = static_cast<size_t>(img->width) * static_cast<size_t>(img->height);
+    const size_t nc = static_cast<size_t>(img->nchannels);
+    long long top = 0;
+    for (size_t p = 0; p < n; p++) {
+        for (size_t c = 0; c < nc; c++) {
+            if (static_cast<int>(c) != alpha && img->pixels[p * nc + c] >= 1.0f) {
+                top++;
+                break;
+            }
+        }
+    }
+    return top;
+}
+
+extern "C" gr_status gr_oiio_read_info(const char *path, int linearize, gr_image **out, gr_oiio_info *info,
+                                       gr_error *err)
+{
+    if (info) std::memset(info, 0, sizeof *info);
     if (out) *out = nullptr;
     if (!path || !path[0] || !out) return gr_fail(err, GR_E_USAGE, "image read: no input path or output");
     gr_image *img = nullptr;
@@ -377,7 +402,15 @@ extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **ou
         // never alpha (stored linear) or files that declare themselves linear.
         const bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
         const std::string cs = spec.get_string_attribute("oiio:ColorSpace");
-        if (linearize && integer && !OIIO::Strutil::iequals(cs, "Linear")) {
+        const bool decode = linearize && integer && !OIIO::Strutil::iequals(cs, "Linear");
+        if (info) {
+            info->bits = static_cast<int>(spec.format.size() * 8);
+            info->integer = integer;
+            info->decoded = decode;
+            std::snprintf(info->colorspace, sizeof info->colorspace, "%s", cs.c_str());
+            if (integer) info->n_top_code = count_top_code(img, spec.alpha_channel);
+        }
+        if (decode) {
             const size_t n = static_cast<size_t>(img->width) * static_cast<size_t>(img->height);
             for (size_t p = 0; p < n; p++)
                 for (int c = 0; c < nc; c++)

@@ -15,6 +15,19 @@ const char *gr_oiio_version(void);
  * channel names as the file gives them (8-bit files are decoded to linear only if
  * linearize is nonzero; otherwise values are code/255). */
 gr_status gr_oiio_read(const char *path, int linearize, gr_image **out, gr_error *err);
+
+/* What a file says of its pixels beyond their values (compare's capture checks: docs/metrics.md,
+ * "Capture warnings"). */
+typedef struct gr_oiio_info {
+    int bits;                /* bits per sample of the file's pixel type (8, 16, 32, ...) */
+    int integer;             /* unsigned integer samples: display-encoded codes */
+    int decoded;             /* the codes were sRGB-decoded to linear on reading */
+    char colorspace[64];     /* oiio:ColorSpace as OpenImageIO reports it ("sRGB", "Linear", ...) */
+    long long n_top_code;    /* integer files: pixels with a channel other than alpha at the top code */
+} gr_oiio_info;
+
+/* gr_oiio_read, and *info (may be NULL) filled. */
+gr_status gr_oiio_read_info(const char *path, int linearize, gr_image **out, gr_oiio_info *info, gr_error *err);
 /* Writes a display-encoded 8-bit preview (PNG, by extension): the channels rgb[0..2] of img
  * times `exposure`, clamped to [0, 1], then sRGB-encoded (OpenImageIO writes floats to 8-bit
  * files without encoding). Written to a temporary name and renamed into place. */

@@ -13,8 +13,14 @@ static const char help_rest[] =
     "                       the first of `godrays techniques`); its settings are NAME.KEY\n"
     "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
     "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
-    "  --fit / --no-fit     score the technique after the best scale fit a = <t,r>/<t,t>\n"
-    "                       (default: on, unless its gain setting, e.g. intensity, is a parameter)\n"
+    "  --fit MODE           score the technique after a least-squares fit of its image: scale\n"
+    "                       (one factor a = <t,r>/<t,t>; a bare --fit), rgb (one per channel) or\n"
+    "                       none (= --no-fit); default: scale, unless its gain setting (e.g.\n"
+    "                       intensity) is a parameter: none\n"
+    "  --rgb-per-channel    tune the technique's colour too: score after the per-channel fit\n"
+    "                       (--fit rgb) and fold the three fitted factors into its RGB gain\n"
+    "                       setting (e.g. intensity) in the snippet; exit 2 for a technique whose\n"
+    "                       gain is one number (docs/tuning.md)\n"
     "  --normalize          divide a metric in image units (rmse, msrmse) by each case's mean\n"
     "                       reference Y, so that every frame and view weighs the same in the mean\n"
     "  --set KEY=VALUE      override a scene value before validation (repeatable), e.g.\n"
@@ -99,10 +105,14 @@ int gr_tune_cli_option(gr_tune_cli *c, int argc, char **argv, int *i, gr_error *
         c->so.use_cache = 0;
         return 1;
     }
-    if (!strcmp(a, "--fit") || !strcmp(a, "--no-fit")) {
-        c->fit = !strcmp(a, "--fit");
+    if (!strcmp(a, "--rgb-per-channel")) {
+        c->rgb_per_channel = 1;
         return 1;
     }
+    gr_fit_mode fit;
+    const int fr = gr_fit_mode_option(argc, argv, i, &fit, err);
+    if (fr > 0) c->fit = (int)fit;
+    if (fr) return fr;
     if (!needs_value(a)) return 0;
     if (*i + 1 >= argc) {
         gr_fail(err, GR_E_USAGE, "%s needs a value", a);
@@ -173,10 +183,21 @@ gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_pa
             return gr_fail(err, GR_E_USAGE, "%s: not a setting of technique %s (its settings are %s.KEY)", params[k].key,
                            cls->name, cls->name);
     c->so.technique = cls;
+    if (c->rgb_per_channel) {
+        const gr_param *gain = cls->gain_key ? gr_param_find(cls->params, cls->gain_key) : NULL;
+        if (!gain || gain->type != GR_PT_RGB)
+            return gr_fail(err, GR_E_USAGE, "--rgb-per-channel: technique %s has no per-channel colour setting (%s%s%s); "
+                           "--fit rgb scores it after a per-channel fit without tuning its colour", cls->name,
+                           gain ? "its gain " : "no gain setting", gain ? gain->name : "", gain ? " is one number" : "");
+        if (c->fit >= 0 && c->fit != GR_FIT_RGB)
+            return gr_fail(err, GR_E_USAGE, "--rgb-per-channel folds the per-channel fit into %s.%s: it needs --fit rgb, "
+                           "not --fit %s", cls->name, gain->name, gr_fit_mode_name((gr_fit_mode)c->fit));
+        c->fit = GR_FIT_RGB;
+    }
     if (c->fit < 0) {
-        c->fit = 1;
+        c->fit = GR_FIT_SCALE;
         for (int k = 0; k < n_params; k++)
-            if (cls->gain_key && !strcmp(params[k].p->name, cls->gain_key)) c->fit = 0;
+            if (cls->gain_key && !strcmp(params[k].p->name, cls->gain_key)) c->fit = GR_FIT_NONE;
     }
     gr_status st = gr_tune_session_open(&c->so, s, err);
     if (st != GR_OK) return st;
@@ -186,6 +207,7 @@ gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_pa
     p->metric = c->metric;
     memcpy(p->weights, c->weights, sizeof p->weights);
     p->fit = c->fit;
+    p->rgb_per_channel = c->rgb_per_channel;
     p->normalize = c->normalize;
     return gr_tune_problem_init(p, err);
 }

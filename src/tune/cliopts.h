@@ -14,7 +14,10 @@ typedef struct gr_tune_cli {
     gr_tune_session_options so;   /* sets, n_sets, gl_platform, scene_path: the caller's */
     gr_tune_metric metric;
     double weights[GR_METRIC_MAX]; /* --objective (metric GR_TM_WEIGHTED) */
-    int fit;                      /* -1: auto (on unless the gain_key setting is a parameter) */
+    int fit;                      /* a gr_fit_mode (compare/fit.h); -1: auto (scale, unless the
+                                     gain_key setting is a parameter: none; rgb with
+                                     rgb_per_channel) */
+    int rgb_per_channel;          /* --rgb-per-channel: fold the per-channel fit into the gain */
     int normalize;                /* --normalize */
     int quiet;
     int yes;                      /* --yes: more renders than GR_TUNE_BUDGET_RENDERS (tune/budget.h) */
@@ -36,7 +39,9 @@ gr_status gr_tune_cli_finish(gr_tune_cli *c, gr_error *err);
 
 /* After gr_tune_cli_finish and the caller's own checks: the technique (--technique, else the
  * one params name, else the first registered; GR_E_USAGE if a parameter belongs to another),
- * the fit default (on, unless its gain_key is among params), gr_tune_session_open with c->so (s is the caller's; close
+ * the fit default (scale, unless its gain_key is among params; rgb with --rgb-per-channel, which
+ * is GR_E_USAGE naming the technique when its gain_key is not an RGB setting, or with another
+ * --fit), gr_tune_session_open with c->so (s is the caller's; close
  * it even after a failure), and p set up from the session, params, metric, fit and
  * normalization, and initialized (gr_tune_problem_free it). */
 gr_status gr_tune_cli_open(gr_tune_cli *c, const gr_tune_param *params, int n_params, gr_tune_session *s,

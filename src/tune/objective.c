@@ -271,6 +271,7 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
         sum += v;
         if (per_case) per_case[i] = v;
         if (scale) scale[i] = p->fit ? m.fit.scale : 1.0;
+        for (int c = 0; c < 3; c++) p->scale_rgb[i][c] = p->fit ? m.fit.scale_rgb[c] : 1.0;
     }
     *mean = sum / (double)p->n_cases;
     return GR_OK;
@@ -310,7 +311,15 @@ static int add_rgb(cJSON *o, const char *name, const double *rgb)
     return a && cJSON_AddItemToObject(o, name, a);
 }
 
-char *gr_tune_snippet(const gr_tune_problem *p, const double *x, double scale)
+void gr_tune_mean_scale_rgb(const gr_tune_problem *p, double out[3])
+{
+    for (int c = 0; c < 3; c++) {
+        out[c] = 0.0;
+        for (int i = 0; i < p->n_cases; i++) out[c] += p->scale_rgb[i][c] / p->n_cases;
+    }
+}
+
+char *gr_tune_snippet(const gr_tune_problem *p, const double *x, const double *scale)
 {
     gr_section_store s;
     gr_error e;
@@ -319,9 +328,11 @@ char *gr_tune_snippet(const gr_tune_problem *p, const double *x, double scale)
     cJSON *sh = root ? cJSON_AddObjectToObject(root, p->cls->name) : NULL;
     const gr_param *gain = p->cls->gain_key ? gr_param_find(p->cls->params, p->cls->gain_key) : NULL;
     int ok = sh != NULL, has_gain = 0;
+    const int per_channel = p->rgb_per_channel && scale && gain && gain->type == GR_PT_RGB;
     for (int k = 0; ok && k < p->n_params; k++) {
         const gr_tune_param *tp = &p->params[k];
         if (tp->p == gain) has_gain = 1;
+        if (tp->p == gain && per_channel) continue; /* written below, with the fit folded in */
         if (tp->kind == GR_TK_RGB_SCALE) {
             const double *rgb = (const double *)(const void *)(s.bytes + tp->p->offset);
             ok = add_rgb(sh, tp->p->name, rgb);
@@ -330,13 +341,14 @@ char *gr_tune_snippet(const gr_tune_problem *p, const double *x, double scale)
             ok = cJSON_AddNumberToObject(sh, tp->p->name, tp->kind == GR_TK_INT ? v : round_sig(v, 5)) != NULL;
         }
     }
-    if (ok && gain && !has_gain && scale > 0 && scale != 1.0) {
+    const double a = scale ? scale[0] : 0.0;
+    if (ok && (per_channel || (gain && !has_gain && a > 0 && a != 1.0))) {
         if (gain->type == GR_PT_RGB) {
             double in[3];
-            for (int c = 0; c < 3; c++) in[c] = gr_param_get_number(gain, s.bytes, c) * scale;
+            for (int c = 0; c < 3; c++) in[c] = gr_param_get_number(gain, s.bytes, c) * (per_channel ? scale[c] : a);
             ok = add_rgb(sh, gain->name, in);
         } else {
-            ok = cJSON_AddNumberToObject(sh, gain->name, round_sig(gr_param_get_number(gain, s.bytes, 0) * scale, 5)) != NULL;
+            ok = cJSON_AddNumberToObject(sh, gain->name, round_sig(gr_param_get_number(gain, s.bytes, 0) * a, 5)) != NULL;
         }
     }
     char *text = ok ? cJSON_Print(root) : NULL;

@@ -66,7 +66,12 @@ typedef struct gr_tune_problem {
     int n_params;
     gr_tune_param params[GR_TUNE_MAX_PARAMS];
     gr_tune_metric metric;
-    int fit;                            /* score the test after the best scale fit */
+    int fit;                            /* a gr_fit_mode (compare/fit.h): score the test after the
+                                           best scale fit (scale), one per channel (rgb), or not */
+    int rgb_per_channel;                /* fold the per-channel factors into the gain_key (an RGB
+                                           setting) in the snippet (gr_tune_snippet) */
+    double scale_rgb[GR_TUNE_MAX_CASES][3]; /* per case, the per-channel factors of the last
+                                           gr_tune_evaluate (1 without fit) */
     int normalize;                      /* a metric in image units (rmse, msrmse) divided by the
                                            case's mean reference Y, so that every frame and view
                                            weighs the same */
@@ -117,9 +122,15 @@ gr_status gr_tune_render_case(gr_tune_problem *p, int i, const void *s, gr_image
 
 /* The settings at x as a snippet ready to paste into the scene: {"NAME": {KEY: value, ...}}
  * with every parameter (RGB settings as [r, g, b] = base x scale) rounded to 5 significant
- * digits; with scale > 0 and != 1 (the fitted scale) also the class's gain_key = base x scale,
- * unless it is a parameter or the class has none. malloc'd text (caller frees); NULL on failure. */
-char *gr_tune_snippet(const gr_tune_problem *p, const double *x, double scale);
+ * digits; with scale given (the fitted factors, may be NULL: none) also the class's gain_key:
+ * with p->rgb_per_channel its [r, g, b] x (scale[0], scale[1], scale[2]) (the per-channel fit
+ * folded into the colour; a gain that is also a parameter gets it on top of its tuned value),
+ * else, unless the gain is a parameter or the class has none, gain x scale[0] when scale[0] > 0
+ * and != 1. malloc'd text (caller frees); NULL on failure. */
+char *gr_tune_snippet(const gr_tune_problem *p, const double *x, const double *scale);
+
+/* The mean over the cases of p->scale_rgb (the last evaluation's per-channel factors). */
+void gr_tune_mean_scale_rgb(const gr_tune_problem *p, double out[3]);
 
 /* The objective for gr_opt_minimize: user = gr_tune_problem. */
 gr_status gr_tune_objective(void *user, const double *x, double *f, gr_error *err);

@@ -104,7 +104,7 @@ gr_status gr_sweep_write_csv(const char *path, const gr_tune_problem *p, const g
     if (!f) return err->status;
     fprintf(f, "%s", p->params[0].key);
     if (res->n_axes > 1) fprintf(f, ",%s", p->params[1].key);
-    fprintf(f, ",%s%s,scale", gr_tune_metric_name(p->metric), p->fit ? "_fit" : "");
+    fprintf(f, ",%s%s,scale", gr_tune_metric_name(p->metric), p->fit == GR_FIT_RGB ? "_fit_rgb" : p->fit ? "_fit" : "");
     for (int c = 0; c < res->n_cases; c++) {
         if (case_labels && case_labels[c]) fprintf(f, ",%s", case_labels[c]);
         else fprintf(f, ",case%d", c);
@@ -255,7 +255,7 @@ gr_status gr_sweep_write_plot(const char *path, const gr_tune_problem *p, const 
 {
     *drawn = 0;
     char title[512], ylabel[128];
-    snprintf(ylabel, sizeof ylabel, "%s of Y%s", gr_tune_metric_name(p->metric), p->fit ? " after scale fit" : "");
+    snprintf(ylabel, sizeof ylabel, "%s of Y%s", gr_tune_metric_name(p->metric), p->fit == GR_FIT_RGB ? " after per-channel fit" : p->fit ? " after scale fit" : "");
     if (res->n_axes == 2) {
         int bx = res->best % res->nx, by = res->best / res->nx;
         snprintf(title, sizeof title, "%s; min %.4g at %s=%.4g, %s=%.4g", ylabel, res->err[res->best],
