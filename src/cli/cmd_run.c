@@ -387,7 +387,7 @@ static gr_status technique_failed(const run_opts *o, run_state *rs, int k, const
     rs->failed[k] = 1;
     rs->n_failed++;
     snprintf(rs->reason[k], sizeof rs->reason[k], "%s", e->msg);
-    if (!o->quiet) fprintf(stderr, "godrays run: %s FAILED: %s\n", o->cls[k]->name, e->msg);
+    fprintf(stderr, "godrays run: warning: %s FAILED: %s\n", o->cls[k]->name, e->msg); /* even with -q */
     return GR_OK;
 }
 
@@ -436,6 +436,13 @@ static gr_status render_techniques(const run_opts *o, run_state *rs, gr_error *e
         gr_error e = {GR_OK, ""};
         if (render_one(o, rs, gl, k, &e) != GR_OK) {
             if ((st = technique_failed(o, rs, k, &e)) != GR_OK) *err = e;
+            /* a render over its time limit abandons its context (realtime/technique.h): the
+             * techniques after it get a new one */
+            if (st == GR_OK && gr_gl_abandoned(gl)) {
+                gr_gl_destroy(gl);
+                gl = NULL;
+                st = gr_gl_create(NULL, &gl, err);
+            }
             continue;
         }
         ts->seconds = now_s() - t;
