@@ -228,7 +228,7 @@ static void print_leaderboard(const gr_report_input *in, const gr_leaderboard *l
         const gr_meta_item *g = gr_meta_get(meta, "godrays:gpu_ms"), *w = gr_meta_get(meta, "godrays:wall_ms");
         printf(" %10.3f %10.3f", g && g->type != GR_META_STRING && g->num >= 0 ? g->num : NAN,
                w && w->type != GR_META_STRING ? w->num : NAN);
-        printf("%s\n", row->no_better ? "  <- " GR_LB_NO_BETTER : "");
+        printf("%s%s\n", row->no_better ? "  <- " : "", row->no_better ? gr_lb_flag(row) : "");
     }
 }
 
@@ -245,7 +245,8 @@ static void print_summary(const char *dir, const gr_report_input *in, const gr_l
     print_details(in, lb);
     print_leaderboard(in, lb);
     if (lb->n_flagged > 0)
-        printf("%d technique%s no better than a constant image at the truth's mean (verdict not below its)\n",
+        printf("%d technique%s no better than a constant image at the truth's mean (verdict, or error after the fit, "
+               "not below its)\n",
                lb->n_flagged, lb->n_flagged == 1 ? " is" : "s are");
     if (in->n_failed > 0)
         printf("%d technique%s FAILED (rows above; exit code 3)\n", in->n_failed, in->n_failed == 1 ? "" : "s");

@@ -35,6 +35,7 @@ void gr_leaderboard_build(const gr_report_input *in, const double *flip, gr_lead
     gr_report_rank(in->techniques, nt, order);
     const gr_baselines *b = in->baselines;
     const double v_const = b ? gr_metric_value(fit_of(&b->m[GR_BASELINE_CONSTANT]), GR_METRIC_VERDICT) : NAN;
+    const double e_const = b ? gr_metric_value(fit_of(&b->m[GR_BASELINE_CONSTANT]), GR_METRIC_REL_RMSE) : NAN;
     /* merge the ranked techniques with the baselines sorted by verdict (a tie: the technique first) */
     int bo[GR_BASELINE_COUNT], nb = b ? GR_BASELINE_COUNT : 0;
     for (int i = 0; i < nb; i++) {
@@ -54,8 +55,9 @@ void gr_leaderboard_build(const gr_report_input *in, const double *flip, gr_lead
             r->name = in->techniques[k].name;
             r->text = in->techniques[k].description;
             fill(r, in->techniques[k].metrics, flip ? flip[k] : NAN);
-            /* no better than knowing only the truth's mean: a NaN verdict is not better either */
-            r->no_better = b && !(r->verdict < v_const);
+            /* no better than knowing only the truth's mean: by the verdict, or by its radiance
+             * error alone (a NaN is not better either) */
+            r->no_better = !b ? 0 : !(r->verdict < v_const) ? 1 : !(r->error_fit < e_const) ? 2 : 0;
             lb->n_flagged += r->no_better;
         } else {
             r->kind = GR_LB_BASELINE, r->index = bo[ib++];
@@ -73,6 +75,11 @@ void gr_leaderboard_build(const gr_report_input *in, const double *flip, gr_lead
         r->verdict = r->error_fit = r->structure = r->flip = r->corr = r->contrast_ratio = r->scale = NAN;
         r->eq_blur_px = NAN;
     }
+}
+
+const char *gr_lb_flag(const gr_lb_row *r)
+{
+    return !r || !r->no_better ? NULL : r->no_better == 1 ? GR_LB_NO_BETTER : GR_LB_NO_BETTER_ERROR;
 }
 
 const char *gr_lb_eq_blur_text(const gr_report_input *in, const gr_lb_row *r, char *buf, size_t n)

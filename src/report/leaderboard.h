@@ -13,8 +13,11 @@
 
 #define GR_LB_MAX_ROWS (2 * GR_REPORT_MAX_TECHNIQUES + GR_BASELINE_COUNT)
 
-/* The flag in words (terminal, index.html, metrics.json "flag"). */
+/* The flag in words (terminal, index.html, metrics.json "flag"): the verdict no better than
+ * the constant image's, or its first component alone (the radiance error after the fit; the
+ * structure score can rank a technique whose light is no closer than a constant above it). */
 #define GR_LB_NO_BETTER "no better than a constant image"
+#define GR_LB_NO_BETTER_ERROR "no better than a constant image in error after the fit"
 
 typedef enum gr_lb_kind { GR_LB_TECHNIQUE = 0, GR_LB_BASELINE, GR_LB_FAILED } gr_lb_kind;
 
@@ -29,8 +32,12 @@ typedef struct gr_lb_row {
     double verdict, error_fit, structure, flip, corr, contrast_ratio, scale;
     double eq_blur_px;         /* the equivalent blur (scored rows; NaN without baselines) */
     int eq_where;              /* -1: below the ladder, +1: above, 0: inside */
-    int no_better;             /* a technique whose verdict is >= the constant image's */
+    int no_better;             /* a technique no better than the constant image: 1 by the verdict,
+                                  2 by the error after the fit alone (0: better by both) */
 } gr_lb_row;
+
+/* The flag's words for a row (NULL: no flag). */
+const char *gr_lb_flag(const gr_lb_row *r);
 
 typedef struct gr_leaderboard {
     int n;                     /* rows: by verdict (techniques and baselines), then the failed */

@@ -798,10 +798,10 @@ static void summary_lines(ctx *c)
                  fmt(meta_num(tc->t->meta, "godrays:fragments"), t[2], sizeof t[2]));
         const gr_lb_row *row = gr_lb_technique_row(&c->lb, k);
         snprintf(tc->lines[1], sizeof tc->lines[1],
-                 "verdict %s (equivalent blur %s)%s; best scale a = %s; luminance after fit: RMSE %s (%s of the mean), "
+                 "verdict %s (equivalent blur %s)%s%s; best scale a = %s; luminance after fit: RMSE %s (%s of the mean), "
                  "bias %s, SSIM %s, structure score %s",
                  fmt(verdict_of(fs), t[6], sizeof t[6]), gr_lb_eq_blur_text(in, row, t[7], sizeof t[7]),
-                 row && row->no_better ? ", " GR_LB_NO_BETTER : "", fmt(fs->scale, t[0], sizeof t[0]),
+                 row && row->no_better ? ", " : "", row && row->no_better ? gr_lb_flag(row) : "", fmt(fs->scale, t[0], sizeof t[0]),
                  fmt(y->rmse, t[1], sizeof t[1]), fmt(rel_rmse_y(fs), t[2], sizeof t[2]), fmt(y->bias, t[3], sizeof t[3]),
                  fs->have_ssim ? fmt(fs->ssim_y, t[4], sizeof t[4]) : "n/a",
                  fmt(gr_metric_value(fs, GR_METRIC_STRUCTURE), t[5], sizeof t[5]));
@@ -833,7 +833,7 @@ static cJSON *row_json(const ctx *c, const gr_lb_row *r)
         jnum(o, "equivalent_blur_px", r->eq_blur_px, &ok);
         jstr(o, "equivalent_blur", gr_lb_eq_blur_text(c->in, r, t, sizeof t), &ok);
     }
-    if (r->kind == GR_LB_TECHNIQUE) jstr(o, "flag", r->no_better ? GR_LB_NO_BETTER : NULL, &ok);
+    if (r->kind == GR_LB_TECHNIQUE) jstr(o, "flag", gr_lb_flag(r), &ok);
     if (!ok) {
         cJSON_Delete(o);
         return NULL;
@@ -912,7 +912,7 @@ static cJSON *technique_json(const ctx *c, int k, int rank)
     const gr_lb_row *row = gr_lb_technique_row(&c->lb, k);
     if (row) { /* the verdict, its components, the equivalent blur and the flag */
         jadd(o, "verdict", row_json(c, row), &ok);
-        jstr(o, "flag", row->no_better ? GR_LB_NO_BETTER : NULL, &ok);
+        jstr(o, "flag", gr_lb_flag(row), &ok);
     }
     /* the headline errors (luminance), raw and after the fit */
     cJSON *e = cJSON_CreateObject();
@@ -1222,7 +1222,11 @@ static void html_leaderboard_row(gr_strbuf *b, const ctx *c, const gr_lb_row *r,
         gr_sb_puts(b, "<b>");
         gr_sb_html(b, r->name);
         gr_sb_puts(b, tc ? "</b></a>" : "</b>");
-        if (tc && r->no_better) gr_sb_puts(b, "<br><span class=\"flag\">" GR_LB_NO_BETTER "</span>");
+        if (tc && r->no_better) {
+            gr_sb_puts(b, "<br><span class=\"flag\">");
+            gr_sb_html(b, gr_lb_flag(r));
+            gr_sb_puts(b, "</span>");
+        }
         gr_sb_puts(b, "<br><span class=\"sub\">");
         gr_sb_html(b, desc ? desc : "");
         gr_sb_puts(b, "</span></td><td class=\"l\">");
@@ -1274,7 +1278,9 @@ static void html_leaderboard(gr_strbuf *b, const ctx *c)
                   "the truth blurred by a 4 px Gaussian. The <b>equivalent blur</b> is the Gaussian sigma at which the "
                   "blurred truth gets the same verdict: a technique at \"6 px\" looks as good as the truth blurred by "
                   "6 px. A technique whose verdict is not below the constant image's is flagged <span class=\"flag\">"
-                  GR_LB_NO_BETTER "</span>. GPU ms: the sum of the technique's GL pass timers (GL_TIME_ELAPSED; on "
+                  GR_LB_NO_BETTER "</span>, and one whose error after the fit alone is not below the constant's "
+                  "<span class=\"flag\">" GR_LB_NO_BETTER_ERROR "</span> (its structure score ranks it, its light "
+                  "is no closer). GPU ms: the sum of the technique's GL pass timers (GL_TIME_ELAPSED; on "
                   "llvmpipe they measure the CPU rasterizer); wall ms: its render call, readback included. "
                   "docs/metrics.md \"The verdict\"; details per technique below.</p>\n");
 }
