@@ -58,7 +58,7 @@ void gr_leaderboard_build(const gr_report_input *in, const double *flip, gr_lead
             /* no better than knowing only the truth's mean: by the verdict, or by its radiance
              * error alone (a NaN is not better either) */
             r->no_better = !b ? 0 : !(r->verdict < v_const) ? 1 : !(r->error_fit < e_const) ? 2 : 0;
-            lb->n_flagged += r->no_better;
+            lb->n_flagged += r->no_better != 0;
         } else {
             r->kind = GR_LB_BASELINE, r->index = bo[ib++];
             r->name = gr_baseline_key(r->index);
