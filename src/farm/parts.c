@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "common/memlimit.h"
+#include "common/outfile.h"
 #include "reference/cache.h"
 #include "reference/truth.h"
 
@@ -335,6 +336,8 @@ static gr_status part_read(const char *path, part *p, gr_error *err)
 {
     memset(p, 0, sizeof *p);
     p->path = path;
+    gr_status reg = gr_check_regular_input(path, err); /* a FIFO would block the open (issue 31) */
+    if (reg != GR_OK) return reg;
     FILE *f = fopen(path, "rb");
     if (!f) return gr_fail(err, GR_E_INPUT, "%s: cannot open: %s", path, strerror(errno));
     char line[64];

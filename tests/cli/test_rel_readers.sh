@@ -12,6 +12,7 @@
 #  5. `export --frames 0:199:1` under GODRAYS_MAX_MEMORY=1G: exit 2 at once with the estimate
 #     (main took 1.4 GB); `export --gltf x.glb --frames 0:999:1`: exit 2 at once (main ran
 #     160 s to 6.3 GB before saying that a .glb cannot hold 4 GiB);
+#  4. a FIFO given to `merge` as a part file: exit 2 at once (main blocked forever opening it);
 #  11. `merge PART -o x.png`: exit 2 (main wrote EXR bytes into x.png); `render --size
 #     16384x16384`: exit 2 naming the GL limit where this GL cannot hold the target (main:
 #     "framebuffer incomplete (0x8cd6)", exit 1), or a render where it can.
@@ -74,4 +75,15 @@ elif [ "$rc" -eq 2 ] && grep -qF "camera.width/height: a 16384x16384 render targ
 elif [ "$rc" -eq 0 ]; then echo "ok: 16384 x 16384 rendered (this GL holds it)"
 else bad "16384 x 16384: exit $rc, stderr: $(cat err.txt)"; fi
 rm -f big.exr big.png
+# ---- 4: a FIFO as a part file (timeout: main blocked forever in its open) ----
+mkfifo part.fifo
+t0=$(date +%s)
+timeout 20 "$bin" merge part.fifo -o fifo_merged.exr >out.txt 2>err.txt
+rc=$?
+if [ "$rc" -eq 2 ] && grep -q "part.fifo: a FIFO, not a regular file" err.txt; then
+    echo "ok: FIFO part refused in $(($(date +%s) - t0)) s: $(cat err.txt)"
+else
+    bad "FIFO part file: exit $rc (124: hung): $(cat err.txt)"
+fi
+
 exit $fail
