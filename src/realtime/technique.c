@@ -346,12 +346,29 @@ gr_status gr_technique_create(const gr_technique_class *cls, gr_gl *gl, const gr
     return GR_OK;
 }
 
+/* An abandoned instance's state stays with its abandoned context, which a driver may still be
+ * working for (its buffers, its programs): it is parked here, reachable until the process
+ * ends, rather than freed under the driver or lost (a leak the sanitizer build reports). */
+#define GR_PARKED_MAX 64
+static void *parked[GR_PARKED_MAX];
+static int n_parked;
+static pthread_mutex_t parked_lock = PTHREAD_MUTEX_INITIALIZER;
+
+static void park(void *state)
+{
+    pthread_mutex_lock(&parked_lock);
+    if (n_parked < GR_PARKED_MAX) parked[n_parked++] = state; /* beyond 64 timeouts: let it go */
+    pthread_mutex_unlock(&parked_lock);
+}
+
 void gr_technique_destroy(gr_technique *t)
 {
     if (!t) return;
-    if (!t->abandoned) { /* an abandoned instance's state stays with its abandoned context */
+    if (!t->abandoned) {
         if (t->gl) gr_gl_make_current(t->gl, NULL);
         t->cls->destroy(t->state);
+    } else {
+        park(t->state);
     }
     free(t);
 }
