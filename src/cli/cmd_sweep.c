@@ -67,18 +67,8 @@ static cJSON *num_array(const double *v, int n)
 static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, const gr_sweep_result *r,
                         const char *snippet)
 {
-    cJSON *root = cJSON_CreateObject();
+    cJSON *root = gr_tune_json_root(s, p);
     if (!root) return NULL;
-    cJSON_AddStringToObject(root, "scene", s->base->name);
-    cJSON_AddStringToObject(root, "technique", p->cls->name);
-    cJSON_AddStringToObject(root, "scene_file", s->base->source_path);
-    cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
-    cJSON_AddStringToObject(root, "channel", "Y");
-    cJSON_AddBoolToObject(root, "fit_scale", p->fit);
-    cJSON_AddStringToObject(root, "fit", gr_fit_mode_name((gr_fit_mode)p->fit));
-    cJSON_AddBoolToObject(root, "normalized", p->normalize);
-    cJSON_AddNumberToObject(root, "width", s->base->camera.width);
-    cJSON_AddNumberToObject(root, "height", s->base->camera.height);
     cJSON *axes = cJSON_AddArrayToObject(root, "axes");
     for (int k = 0; axes && k < p->n_params; k++) {
         cJSON *a = cJSON_CreateObject();
@@ -94,12 +84,8 @@ static char *sweep_json(const gr_tune_session *s, const gr_tune_problem *p, cons
     }
     cJSON *cases = cJSON_AddArrayToObject(root, "cases");
     for (int i = 0; cases && i < s->n_cases; i++) {
-        cJSON *c = cJSON_CreateObject();
+        cJSON *c = gr_tune_json_case(s, i);
         if (!c) break;
-        cJSON_AddStringToObject(c, "label", s->labels[i]);
-        cJSON_AddNumberToObject(c, "time_s", s->cases[i].water.time_s);
-        cJSON_AddNumberToObject(c, "yaw_deg", s->cases[i].camera.yaw_deg);
-        cJSON_AddNumberToObject(c, "pitch_deg", s->cases[i].camera.pitch_deg);
         cJSON_AddBoolToObject(c, "ground_truth_cached", s->truth[i].cached);
         cJSON_AddNumberToObject(c, "ground_truth_seconds", s->truth[i].seconds);
         cJSON_AddItemToArray(cases, c);

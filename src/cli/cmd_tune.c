@@ -437,12 +437,8 @@ static void json_arrays(cJSON *root, const gr_tune_session *s, const tune_run *r
     }
     cJSON *cs = cJSON_AddArrayToObject(root, "cases");
     for (int i = 0; cs && i < s->n_cases; i++) {
-        cJSON *o = cJSON_CreateObject();
+        cJSON *o = gr_tune_json_case(s, i);
         if (!o) break;
-        cJSON_AddStringToObject(o, "label", s->labels[i]);
-        cJSON_AddNumberToObject(o, "time_s", s->cases[i].water.time_s);
-        cJSON_AddNumberToObject(o, "yaw_deg", s->cases[i].camera.yaw_deg);
-        cJSON_AddNumberToObject(o, "pitch_deg", s->cases[i].camera.pitch_deg);
         cJSON_AddNumberToObject(o, "before", r->before[i]);
         cJSON_AddNumberToObject(o, "after", r->after[i]);
         cJSON_AddNumberToObject(o, "scale_before", r->sc_b[i]);
@@ -456,19 +452,8 @@ static void json_arrays(cJSON *root, const gr_tune_session *s, const tune_run *r
 static char *tune_json(const tune_opts *t, const gr_tune_session *s, const gr_tune_problem *p, const tune_run *r)
 {
     const gr_opt_result *res = &r->res;
-    cJSON *root = cJSON_CreateObject();
+    cJSON *root = gr_tune_json_root(s, p);
     if (!root) return NULL;
-    cJSON_AddStringToObject(root, "scene", s->base->name);
-    cJSON_AddStringToObject(root, "technique", p->cls->name);
-    cJSON_AddStringToObject(root, "scene_file", s->base->source_path);
-    cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
-    cJSON_AddStringToObject(root, "channel", "Y");
-    cJSON_AddBoolToObject(root, "fit_scale", p->fit);
-    cJSON_AddStringToObject(root, "fit", gr_fit_mode_name((gr_fit_mode)p->fit));
-    cJSON_AddBoolToObject(root, "rgb_per_channel", p->rgb_per_channel);
-    cJSON_AddBoolToObject(root, "normalized", p->normalize);
-    cJSON_AddNumberToObject(root, "width", s->base->camera.width);
-    cJSON_AddNumberToObject(root, "height", s->base->camera.height);
     json_arrays(root, s, r);
     cJSON_AddNumberToObject(root, "before", r->fb);
     cJSON_AddNumberToObject(root, "after", r->fa);

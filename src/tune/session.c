@@ -1,6 +1,9 @@
 /* Cases, ground truths and renderer shared by sweep and tune (session.h). */
 #include "tune/session.h"
 #include "common/outfile.h"
+#include "compare/fit.h"
+
+#include <cjson/cJSON.h>
 
 #include <errno.h>
 #include <math.h>
@@ -158,4 +161,33 @@ void gr_tune_session_problem(const gr_tune_session *s, gr_tune_problem *p)
     }
     p->cls = s->cls;
     memcpy(p->base.bytes, gr_technique_scene_settings(s->cls, s->base), s->cls->settings_size);
+}
+
+cJSON *gr_tune_json_root(const gr_tune_session *s, const gr_tune_problem *p)
+{
+    cJSON *root = cJSON_CreateObject();
+    if (!root) return NULL;
+    cJSON_AddStringToObject(root, "scene", s->base->name);
+    cJSON_AddStringToObject(root, "technique", p->cls->name);
+    cJSON_AddStringToObject(root, "scene_file", s->base->source_path);
+    cJSON_AddStringToObject(root, "metric", gr_tune_metric_name(p->metric));
+    cJSON_AddStringToObject(root, "channel", "Y");
+    cJSON_AddBoolToObject(root, "fit_scale", p->fit);
+    cJSON_AddStringToObject(root, "fit", gr_fit_mode_name((gr_fit_mode)p->fit));
+    cJSON_AddBoolToObject(root, "rgb_per_channel", p->rgb_per_channel);
+    cJSON_AddBoolToObject(root, "normalized", p->normalize);
+    cJSON_AddNumberToObject(root, "width", s->base->camera.width);
+    cJSON_AddNumberToObject(root, "height", s->base->camera.height);
+    return root;
+}
+
+cJSON *gr_tune_json_case(const gr_tune_session *s, int i)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o) return NULL;
+    cJSON_AddStringToObject(o, "label", s->labels[i]);
+    cJSON_AddNumberToObject(o, "time_s", s->cases[i].water.time_s);
+    cJSON_AddNumberToObject(o, "yaw_deg", s->cases[i].camera.yaw_deg);
+    cJSON_AddNumberToObject(o, "pitch_deg", s->cases[i].camera.pitch_deg);
+    return o;
 }

@@ -66,6 +66,13 @@ gr_status gr_tune_parse_view(const char *flag, const char *spec, gr_tune_view *v
  * the folder of `godrays run`, in which sweep, tune and pareto make theirs). */
 void gr_tune_default_dir(const char *scene_name, const char *sub, char *buf, size_t n);
 
+/* tune.json's and sweep.json's common part: a new object with the scene, technique, metric,
+ * fit and size (NULL: out of memory). */
+struct cJSON *gr_tune_json_root(const gr_tune_session *s, const gr_tune_problem *p);
+/* A new entry of their "cases" arrays: case i's label, water time and view (NULL: out of
+ * memory); the command adds its own numbers. */
+struct cJSON *gr_tune_json_case(const gr_tune_session *s, int i);
+
 /* Writes text to path through a temporary file renamed into place. */
 gr_status gr_tune_write_text(const char *path, const char *text, gr_error *err);
 
