@@ -14,6 +14,7 @@
 
 #include "cli/cli.h"
 #include "common/paths.h"
+#include "tune/preset.h"
 #include "tune/session.h"
 
 void gr_args_create(gr_args *a, const char *cmd, int argc, char **argv)
@@ -178,6 +179,41 @@ int gr_args_take_gl_platform(gr_args *a, gr_gl_platform *platform)
     return 0;
 }
 
+/* The preset of --preset (tune/preset.h), once its technique is registered: its settings as
+ * overrides at the place of --preset among the others (a later --set wins), each named
+ * "--preset FILE" in messages. Exit 2 naming the file and JSON path for a bad preset. */
+static int apply_preset(gr_args *a)
+{
+    if (!a->preset_path || a->preset_technique[0]) return 0;
+    gr_preset p;
+    gr_error err = {GR_OK, ""};
+    if (gr_preset_load(a->preset_path, &p, &err) != GR_OK) return gr_cli_report(a->cmd, &err);
+    int rc = 0;
+    for (int k = 0; k < p.n_sets && !rc; k++) {
+        const size_t n = strlen(a->preset_path) + 12;
+        char *origin = malloc(n);
+        if ((rc = push_set(a, p.sets[k])) != 0 || !origin) {
+            free(origin);
+            rc = rc ? rc : out_of_memory(a);
+            p.sets[k] = NULL;
+            break;
+        }
+        p.sets[k] = NULL; /* taken over */
+        snprintf(origin, n, "--preset %s", a->preset_path);
+        a->origins[a->n_sets - 1] = origin;
+        /* moved to the place of --preset */
+        const int at = a->preset_pos + k;
+        char *ss = a->sets[a->n_sets - 1], *oo = a->origins[a->n_sets - 1];
+        memmove(&a->sets[at + 1], &a->sets[at], (size_t)(a->n_sets - 1 - at) * sizeof *a->sets);
+        memmove(&a->origins[at + 1], &a->origins[at], (size_t)(a->n_sets - 1 - at) * sizeof *a->origins);
+        a->sets[at] = ss;
+        a->origins[at] = oo;
+    }
+    for (int k = 0; k < p.n_sets; k++) free(p.sets[k]);
+    if (!rc) snprintf(a->preset_technique, sizeof a->preset_technique, "%s", p.technique);
+    return rc;
+}
+
 int gr_args_take_common(gr_args *a, const char **dir, gr_gl_platform *platform, int *taken)
 {
     const char *f = a->argv[a->i];
@@ -189,6 +225,7 @@ int gr_args_take_common(gr_args *a, const char **dir, gr_gl_platform *platform, 
     if (!strcmp(f, "--technique-dir")) return gr_args_take_technique_dir(a);
     if (!strcmp(f, "--max-memory")) return gr_args_take_max_memory(a);
     if (!strcmp(f, "--time-limit")) return gr_args_take_time_limit(a);
+    if (!strcmp(f, "--preset")) return gr_args_take_preset(a);
     *taken = 0;
     return 0;
 }
@@ -228,13 +265,24 @@ int gr_args_take_time_limit(gr_args *a)
     return 0;
 }
 
-int gr_args_add_technique_dirs(const gr_args *a)
+int gr_args_add_technique_dirs(gr_args *a)
 {
     gr_error err = {GR_OK, ""};
     gr_technique_count(); /* the built-in techniques first: theirs are the first sections */
     for (int i = 0; i < a->n_tech_dirs; i++)
         if (gr_technique_add_dir(a->tech_dirs[i], &err) != GR_OK) return gr_cli_report(a->cmd, &err);
-    return 0;
+    return apply_preset(a);
+}
+
+int gr_args_take_preset(gr_args *a)
+{
+    const char *v = NULL;
+    int rc = gr_args_value(a, &v);
+    if (rc) return rc;
+    if (a->preset_path) return gr_cli_usage_error(a->cmd, "--preset %s: one preset only (%s was given)", v, a->preset_path);
+    a->preset_path = v;
+    a->preset_pos = a->n_sets;
+    return gr_args_add_input(a, "--preset", v);
 }
 
 int gr_args_find_technique(const gr_args *a, const char *what, const char *name, const gr_technique_class **cls)

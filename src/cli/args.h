@@ -34,6 +34,9 @@ typedef struct gr_args {
     char *out_roles[GR_ARGS_MAX_OUTPUTS]; /* the outputs checked so far: "--gltf" (owned) */
     char *out_paths[GR_ARGS_MAX_OUTPUTS]; /* and their paths (owned) */
     int n_outs;
+    const char *preset_path;    /* --preset FILE (NULL: none) */
+    int preset_pos;             /* where its overrides go among the others */
+    char preset_technique[GR_TECH_NAME_MAX]; /* its technique, once applied ("" before) */
 } gr_args;
 
 /* Empty overrides, reading argv from argument 1. */
@@ -61,7 +64,7 @@ int gr_args_take_setting(gr_args *a, const char *key);
 int gr_args_take_gl_platform(gr_args *a, gr_gl_platform *platform);
 /* argv[i] as one of the options of the commands that write a folder from a scene (run,
  * sweep, tune, pareto): -o/--output DIR (into *dir, see gr_args_dir), --set, --size,
- * --technique-dir, --max-memory, --time-limit, and --gl-platform when platform is not NULL.
+ * --technique-dir, --max-memory, --time-limit, --preset, and --gl-platform when platform is not NULL.
  * *taken = 0 (and 0 returned) when it is none. */
 int gr_args_take_common(gr_args *a, const char **dir, gr_gl_platform *platform, int *taken);
 /* --max-memory SIZE: the limit of every memory estimate of the command (common/memlimit). */
@@ -70,10 +73,15 @@ int gr_args_take_max_memory(gr_args *a);
 int gr_args_take_technique_dir(gr_args *a);
 /* --time-limit SECONDS: every technique render's time limit (gr_technique_set_time_limit). */
 int gr_args_take_time_limit(gr_args *a);
-/* Registers the user technique of every --technique-dir (gr_technique_add_dir), in order;
- * call it once, after the argument loop and BEFORE loading the scene (a user technique's
- * section is unknown to the loader until then). A bad folder or manifest: its message. */
-int gr_args_add_technique_dirs(const gr_args *a);
+/* Registers the user technique of every --technique-dir (gr_technique_add_dir), in order,
+ * then applies --preset (its technique may be a user one); call it once, after the argument
+ * loop and BEFORE loading the scene (a user technique's section is unknown to the loader until
+ * then). A bad folder, manifest or preset: its message. */
+int gr_args_add_technique_dirs(gr_args *a);
+/* --preset FILE (tune/preset.h): remembered; its settings become overrides at this place
+ * among the --set ones when gr_args_add_technique_dirs applies it (taken by
+ * gr_args_take_common too). A second --preset is a usage error. */
+int gr_args_take_preset(gr_args *a);
 /* The technique called name (for the argument `what`, e.g. "--technique"); a usage error
  * listing the known ones otherwise. */
 int gr_args_find_technique(const gr_args *a, const char *what, const char *name, const gr_technique_class **cls);

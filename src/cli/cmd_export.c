@@ -35,6 +35,7 @@ static void usage(FILE *f)
             "                    point P of seed eq. 5.5.5 (above the eye along the refracted sun)\n"
             "  --time T          water time in s (same as --set water.time_s=T)\n"
             "  --set PATH=VALUE  override a scene value (as in godrays validate)\n"
+            "  --preset FILE     apply a preset's settings as overrides (docs/tuning.md \"Presets\")\n"
             "  --size WxH        frame size (camera.width, camera.height)\n"
             "  -h, --help        this help\n"
             "\n"
@@ -67,6 +68,8 @@ static int export_with(gr_args *args)
             if ((rc = gr_args_take_set(args)) != 0) return rc;
         } else if (!strcmp(a, "--size")) {
             if ((rc = gr_args_take_size(args)) != 0) return rc;
+        } else if (!strcmp(a, "--preset")) {
+            if ((rc = gr_args_take_preset(args)) != 0) return rc;
         } else if (!strcmp(a, "--time")) {
             if ((rc = gr_args_take_setting(args, "water.time_s")) != 0) return rc;
         } else if (!strcmp(a, "--gltf") || !strcmp(a, "--constants") || !strcmp(a, "--glsl") ||
@@ -116,6 +119,7 @@ static int export_with(gr_args *args)
     if (glsl && (rc = gr_args_check_output_file(args, "--glsl", glsl)) != 0) return rc;
 
     gr_scene *scene = NULL;
+    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc; /* the built-ins, then --preset */
     if ((rc = gr_args_load_scene(args, &scene)) != 0) return rc;
     gr_error err = {GR_OK, ""};
     gr_shader_constants *c = NULL;

@@ -14,6 +14,7 @@
 #include "compare/metrics.h"
 #include "compare/registry.h"
 #include "realtime/technique.h"
+#include "realtime/timing.h"
 #include "report/profile.h"
 #include "report/report.h"
 #include "tune/page.h"
@@ -49,6 +50,7 @@ static void usage(FILE *f)
             "  --size WxH         image size (default 320x180: the high-quality ground truth costs\n"
             "                     about 4x a default-quality one)\n"
             "  --set KEY=VALUE    override a scene value (repeatable)\n"
+            "  --preset FILE      apply a preset's settings as overrides (docs/tuning.md \"Presets\")\n"
             "  --techniques A,B   the techniques to place (default: every registered one)\n"
             "  --technique NAME   one technique only (same as --techniques NAME)\n"
             "  --technique-dir DIR  add the user technique in DIR (repeatable)\n"
@@ -64,12 +66,6 @@ static void usage(FILE *f)
             "  -h, --help         this help\n"
             "\n"
             "Exit codes: 0 ok, 1 runtime failure, 2 bad usage or bad scene.\n");
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 /* The error axis: the verdict (compare/registry.h), the score `godrays run` ranks by. */
@@ -250,41 +246,28 @@ static gr_status reference_points(const pareto_opts *o, const gr_scene *scene, g
     return GR_OK;
 }
 
-/* One setting of a technique's ladder: a warm-up render (buffers rebuilt for new sizes,
- * shader JIT), then o->repeat timed renders (median wall and GPU time) and the error after
- * the best scale fit against truth. times, gpus: o->repeat scratch values each. */
+/* One setting of a technique's ladder: warm timing (realtime/timing.h: a warm-up render,
+ * then the median of o->repeat renders in one context) and the error after the best scale
+ * fit against truth. */
 static gr_status ladder_point(pareto_opts *o, const gr_technique_class *cls, gr_technique *r,
                               const gr_scene *scene, const char *lvs, const gr_image *truth,
-                              const gr_structure_options *so, gr_image *img, double *times, double *gpus,
-                              gr_pareto_point *p, gr_error *err)
+                              const gr_structure_options *so, gr_image *img, gr_pareto_point *p, gr_error *err)
 {
     gr_section_store s;
     memcpy(s.bytes, gr_technique_scene_settings(cls, scene), cls->settings_size);
-    gr_technique_stats stats;
+    gr_timing tm;
     gr_status st = gr_technique_apply_text(cls, s.bytes, lvs, err);
-    if (st == GR_OK) st = gr_technique_render(r, scene, s.bytes, img, &stats, err);
-    for (long q = 0; st == GR_OK && q < o->repeat; q++) {
-        st = gr_technique_render(r, scene, s.bytes, img, &stats, err);
-        /* once, after the first level's warm-up and first timed render */
-        char line[512];
-        if (!o->quiet && gr_tune_budget_eta(&o->budget, 2, line, sizeof line)) fprintf(stderr, "%s\n", line);
-        times[q] = stats.wall_ms * 1e-3;
-        double g = 0;
-        int ok = stats.n_passes > 0;
-        for (int pp = 0; pp < stats.n_passes; pp++) {
-            if (stats.gpu_ns[pp] < 0) ok = 0;
-            else g += (double)stats.gpu_ns[pp] * 1e-9;
-        }
-        gpus[q] = ok ? g : -1;
-    }
+    if (st == GR_OK) st = gr_timing_measure(r, scene, s.bytes, img, 1, (int)o->repeat, &tm, err);
+    /* once, after the first level's warm-up and timed renders */
+    char line[512];
+    if (st == GR_OK && !o->quiet && gr_tune_budget_eta(&o->budget, 1 + o->repeat, line, sizeof line))
+        fprintf(stderr, "%s\n", line);
     gr_metrics m;
     if (st == GR_OK) {
         const gr_metrics_options fo = verdict_options(so, 1);
         st = gr_metrics_compute(truth, img, &fo, &m, err);
     }
     if (st != GR_OK) return st;
-    qsort(times, (size_t)o->repeat, sizeof *times, cmp_double);
-    qsort(gpus, (size_t)o->repeat, sizeof *gpus, cmp_double);
     snprintf(p->family_name, sizeof p->family_name, "%s", cls->name);
     snprintf(p->label, sizeof p->label, "%s %s", cls->name, lvs[0] ? lvs : "(scene's settings)");
     for (char *c = p->label; *c; c++)
@@ -292,8 +275,8 @@ static gr_status ladder_point(pareto_opts *o, const gr_technique_class *cls, gr_
     snprintf(p->settings, sizeof p->settings, "%s", lvs);
     for (char *c = p->settings; *c; c++)
         if (*c == ',') *c = ';';
-    p->time_s = times[o->repeat / 2];
-    p->gpu_s = gpus[o->repeat / 2];
+    p->time_s = tm.wall_ms * 1e-3;
+    p->gpu_s = tm.gpu_ms >= 0 ? tm.gpu_ms * 1e-3 : -1;
     p->error = verdict(&m.fit);
     return GR_OK;
 }
@@ -305,9 +288,8 @@ static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *
                                   gr_pareto_point *pts, int *n, int *gpu_any, gr_error *err)
 {
     gr_image *img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
-    double *times = malloc((size_t)o->repeat * sizeof *times), *gpus = malloc((size_t)o->repeat * sizeof *gpus);
     gr_technique *r = NULL;
-    gr_status st = img && times && gpus ? GR_OK : gr_fail(err, GR_E_NOMEM, "out of memory");
+    gr_status st = img ? GR_OK : gr_fail(err, GR_E_NOMEM, "out of memory");
     char line[512];
     gr_tune_budget_plan_line(&o->budget, line, sizeof line);
     if (!o->quiet) fprintf(stderr, "%s\n", line);
@@ -323,7 +305,7 @@ static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *
             if (o->quick && cls->n_ladder > 0 && !cls->ladder[l].quick) continue;
             if (*n >= MAX_POINTS) break;
             gr_pareto_point *p = &pts[*n];
-            if ((st = ladder_point(o, cls, r, scene, lvs, truth, so, img, times, gpus, p, err)) != GR_OK) break;
+            if ((st = ladder_point(o, cls, r, scene, lvs, truth, so, img, p, err)) != GR_OK) break;
             (*n)++;
             p->family = 1 + k;
             if (p->gpu_s >= 0) *gpu_any = 1;
@@ -331,8 +313,6 @@ static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *
         }
     }
     gr_technique_destroy(r);
-    free(times);
-    free(gpus);
     gr_image_destroy(img);
     return st;
 }

@@ -15,6 +15,7 @@
 #include "image/exr.h"
 #include "image/oiio.h"
 #include "realtime/technique.h"
+#include "realtime/timing.h"
 #include "scene/scene.h"
 
 static void usage(FILE *f)
@@ -32,14 +33,17 @@ static void usage(FILE *f)
             "                       medium.g=0.9 (repeatable)\n"
             "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"
             "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
+            "  --preset FILE        apply a preset (docs/tuning.md \"Presets\"): its technique's settings as\n"
+            "                       overrides; TECHNIQUE may then be left out\n"
             "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --shader-dir DIR     GLSL files in DIR replace the technique's embedded ones of the same name\n"
             "  --time T             water time t (s) of eq. 5.5.7 (default: the scene's water.time_s)\n"
             "  --frames A:B:S       render frames A, A+S, ... up to B at time T + frame / fps; the\n"
             "                       frame number goes into the file names (OUT.0007.exr)\n"
             "  --fps F              frames per second for --frames (default 30)\n"
-            "  --repeat R           render each frame R times in one context; timings printed are\n"
-            "                       the median of the renders (default 1)\n"
+            "  --repeat R           render each frame R times in one context after a warm-up render;\n"
+            "                       timings printed are the median of the R renders, with their\n"
+            "                       spread and GL_RENDERER (default 1: one render, no warm-up)\n"
             "  --exposure E         preview exposure (default: auto, the 99.5th percentile maps to 1)\n"
             "  --no-preview         do not write the PNG preview\n"
             "  --save-target FILE   also write the technique's intermediate render target (RGBA float\n"
@@ -178,6 +182,8 @@ static int parse_args(gr_args *args, render_opts *o)
             rc = gr_args_take_technique_dir(args);
         } else if (!strcmp(a, "--time-limit")) {
             rc = gr_args_take_time_limit(args);
+        } else if (!strcmp(a, "--preset")) {
+            rc = gr_args_take_preset(args);
         } else if (a[0] == '-' && a[1] != '\0') {
             rc = take_value_option(args, o, a); /* every other option takes a value */
         } else if (!o->tech_name) {
@@ -187,7 +193,13 @@ static int parse_args(gr_args *args, render_opts *o)
         }
     }
     if (rc) return rc;
-    if (!o->tech_name) return gr_cli_usage_error("render", "no technique given (`godrays techniques` lists them)");
+    if (args->preset_path && o->tech_name && !args->scene_path && (strchr(o->tech_name, '/') || strchr(o->tech_name, '.'))) {
+        /* `render --preset P SCENE`: the technique is the preset's */
+        args->scene_path = o->tech_name;
+        o->tech_name = NULL;
+        if ((rc = gr_args_add_input(args, "the scene", args->scene_path)) != 0) return rc;
+    }
+    if (!o->tech_name && !args->preset_path) return gr_cli_usage_error("render", "no technique given (`godrays techniques` lists them)");
     if (!args->scene_path && (strchr(o->tech_name, '/') || strchr(o->tech_name, '.')))
         return gr_cli_usage_error("render", "%s: expected TECHNIQUE SCENE, the technique first (`godrays techniques` lists them)",
                                   o->tech_name);
@@ -200,7 +212,7 @@ static int parse_args(gr_args *args, render_opts *o)
 
 /* The line printed per frame: the pass timings, the wall time and the technique's summary. */
 static void print_frame(const char *path, const gr_technique *r, const gr_technique_class *cls, const gr_scene *scene,
-                        const gr_technique_stats *stats)
+                        const gr_technique_stats *stats, const gr_timing *tm)
 {
     gr_strbuf line;
     char extra[512];
@@ -213,6 +225,9 @@ static void print_frame(const char *path, const gr_technique *r, const gr_techni
             gr_sb_printf(&line, "%s %s n/a", p ? "," : "", stats->pass_names[p]);
     }
     gr_sb_printf(&line, "; wall %.3f ms", stats->wall_ms);
+    if (tm)
+        gr_sb_printf(&line, " (median of %d after %d warm-up; %.3f-%.3f; %s)", tm->n, tm->warmup, tm->wall_min_ms,
+                     tm->wall_max_ms, tm->renderer);
     if (stats->fragments >= 0) gr_sb_printf(&line, "; fragments %lld", stats->fragments);
     gr_technique_summary(r, stats, extra, sizeof extra);
     if (extra[0]) gr_sb_printf(&line, "; %s", extra);
@@ -257,7 +272,6 @@ static gr_status render_frames(const render_opts *o, const gr_technique_class *c
     gr_gl *gl = NULL;
     gr_technique *r = NULL;
     gr_image *img = NULL;
-    gr_technique_stats *runs = NULL;
     const double t_base = o->have_time ? o->time_s : scene->water.time_s;
     gr_gl_options glo;
     memset(&glo, 0, sizeof glo);
@@ -273,23 +287,21 @@ static gr_status render_frames(const render_opts *o, const gr_technique_class *c
     if (st == GR_OK) st = gr_technique_create(cls, gl, &opts, &r, err);
     if (st == GR_OK) {
         img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
-        runs = calloc((size_t)o->repeat, sizeof *runs);
-        if (!img || !runs)
+        if (!img)
             st = gr_fail(err, GR_E_NOMEM, "out of memory for a %dx%d image", scene->camera.width, scene->camera.height);
     }
     for (long fr = o->f0; st == GR_OK && fr <= o->f1; fr += o->fstep) {
         char path[4096];
         scene->water.time_s = o->have_frames ? t_base + (double)fr / o->fps : t_base;
-        for (long k = 0; st == GR_OK && k < o->repeat; k++) st = gr_technique_render(r, scene, NULL, img, &runs[k], err);
-        if (st != GR_OK) break;
-        gr_technique_stats stats;
-        gr_technique_stats_median(runs, (int)o->repeat, &stats);
+        /* with --repeat, one warm-up render first (realtime/timing.h) */
+        gr_timing tm;
+        if ((st = gr_timing_measure(r, scene, NULL, img, o->repeat > 1, (int)o->repeat, &tm, err)) != GR_OK) break;
+        const gr_technique_stats stats = tm.median;
         if (o->have_frames) frame_path(o->out_path, fr, path, sizeof path);
         else snprintf(path, sizeof path, "%s", o->out_path);
         st = write_frame(o, r, scene, fr, img, &stats, path, err);
-        if (st == GR_OK && !o->quiet) print_frame(path, r, cls, scene, &stats);
+        if (st == GR_OK && !o->quiet) print_frame(path, r, cls, scene, &stats, o->repeat > 1 ? &tm : NULL);
     }
-    free(runs);
     gr_image_destroy(img);
     gr_technique_destroy(r);
     gr_gl_destroy(gl);
@@ -307,7 +319,11 @@ static int render_with(gr_args *args)
     /* user techniques before the scene, whose sections they add */
     const gr_technique_class *cls = NULL;
     if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
+    if (!o.tech_name) o.tech_name = args->preset_technique;
     if ((rc = gr_args_find_technique(args, "TECHNIQUE", o.tech_name, &cls)) != 0) return rc;
+    if (args->preset_path && strcmp(cls->name, args->preset_technique))
+        return gr_cli_usage_error("render", "--preset %s: a preset of technique %s, not %s", args->preset_path,
+                                  args->preset_technique, cls->name);
     char default_out[GR_TECH_NAME_MAX + 8];
     snprintf(default_out, sizeof default_out, "%s.exr", cls->name);
     if (!o.out_path) o.out_path = default_out;

@@ -18,6 +18,7 @@
 #include "compare/structure.h"
 #include "image/exr.h"
 #include "realtime/technique.h"
+#include "realtime/timing.h"
 #include "reference/truth.h"
 #include "report/leaderboard.h"
 #include "report/profile.h"
@@ -55,6 +56,7 @@ static void usage(FILE *f)
             "  --techniques A,B     the techniques to compare (default: every registered one)\n"
             "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
             "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
+            "  --preset FILE        apply a preset's settings as overrides (docs/tuning.md \"Presets\")\n"
             "  --set KEY=VALUE      override a scene value before validation, e.g. TECHNIQUE.KEY=V,\n"
             "                       reference.spp=4, medium.g=0.9 (repeatable)\n"
             "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"
@@ -65,6 +67,8 @@ static void usage(FILE *f)
             "                       an animated GIF per technique); index.html compares the first frame\n"
             "  --times T1,T2,...    a sequence at these water times (s)\n"
             "  --fps F              frames per second of --frames (default 30)\n"
+            "  --repeat N           time each technique as the median of N renders after a warm-up\n"
+            "                       render, the spread (min-max) in metrics.json (default 1)\n"
             "  --fit MODE           the fit before the errors after the fit: scale (default: one\n"
             "                       least-squares factor), rgb (one per channel: a tint is fitted too)\n"
             "                       or none (docs/metrics.md, \"Scale fits\")\n"
@@ -100,9 +104,10 @@ static void command_line(int argc, char **argv, gr_strbuf *b)
     }
 }
 
-/* One render of technique cls in context gl, as `godrays render` does. */
-static gr_status render_technique(const gr_technique_class *cls, gr_gl *gl, const gr_scene *scene, gr_image **img,
-                                  gr_metadata *meta, gr_error *err)
+/* Technique cls in context gl, as `godrays render --repeat` does: with repeat > 1 a warm-up
+ * render, then the median of repeat renders (realtime/timing.h), its spread in the metadata. */
+static gr_status render_technique(const gr_technique_class *cls, gr_gl *gl, const gr_scene *scene, int repeat,
+                                  gr_image **img, gr_metadata *meta, gr_error *err)
 {
     gr_technique *r = NULL;
     gr_status st = gr_technique_create(cls, gl, NULL, &r, err);
@@ -112,9 +117,14 @@ static gr_status render_technique(const gr_technique_class *cls, gr_gl *gl, cons
         gr_technique_destroy(r);
         return gr_fail(err, GR_E_NOMEM, "out of memory for a %d x %d image", scene->camera.width, scene->camera.height);
     }
-    gr_technique_stats stats;
-    st = gr_technique_render(r, scene, NULL, *img, &stats, err);
-    if (st == GR_OK) st = gr_technique_metadata(r, scene, NULL, &stats, meta, err);
+    gr_timing tm;
+    st = gr_timing_measure(r, scene, NULL, *img, repeat > 1, repeat, &tm, err);
+    if (st == GR_OK) st = gr_technique_metadata(r, scene, NULL, &tm.median, meta, err);
+    if (st == GR_OK && repeat > 1 &&
+        (gr_meta_set_int(meta, "godrays:timing_repeats", repeat) != GR_OK ||
+         gr_meta_set_double(meta, "godrays:wall_min_ms", tm.wall_min_ms) != GR_OK ||
+         gr_meta_set_double(meta, "godrays:wall_max_ms", tm.wall_max_ms) != GR_OK))
+        st = gr_fail(err, GR_E_NOMEM, "out of memory");
     gr_technique_destroy(r);
     return st;
 }
@@ -261,6 +271,7 @@ static void print_summary(const char *dir, const gr_report_input *in, const gr_l
 typedef struct run_opts {
     const char *outdir, *tech_list, *frames_spec, *times_spec, *fps_spec;
     int quiet, use_cache, help;
+    int repeat;                     /* --repeat: renders timed per technique (median; 1: one render) */
     gr_fit_mode fit;                /* --fit: the leaderboard's scaling (default: one scale) */
     const gr_technique_class *cls[GR_REPORT_MAX_TECHNIQUES];
     int nt;                         /* techniques */
@@ -321,6 +332,15 @@ static int parse_args(gr_args *args, run_opts *o)
             rc = gr_args_value(args, &o->times_spec);
         } else if (!strcmp(a, "--fps")) {
             rc = gr_args_value(args, &o->fps_spec);
+        } else if (!strcmp(a, "--repeat")) {
+            const char *v = NULL;
+            char *end = NULL;
+            if ((rc = gr_args_value(args, &v)) != 0) break;
+            errno = 0;
+            const long r = strtol(v, &end, 10);
+            if (errno || end == v || *end || r < 1 || r > 1000)
+                rc = gr_cli_usage_error("run", "--repeat %s: expected an integer in [1, 1000]", v);
+            o->repeat = (int)r;
         } else if ((taken = gr_fit_mode_option(args->argc, args->argv, &args->i, &o->fit, &ferr)) != 0) {
             rc = taken < 0 ? gr_cli_usage_error("run", "%s", ferr.msg) : 0;
         } else if ((rc = gr_args_take_common(args, &o->outdir, NULL, &taken)) == 0 && !taken) {
@@ -406,13 +426,13 @@ static gr_status render_one(const run_opts *o, run_state *rs, gr_gl *gl, int k, 
 {
     const gr_technique_class *cls = o->cls[k];
     const int nf = o->nf;
-    gr_status st = render_technique(cls, gl, rs->scene0, &rs->test[k], &rs->smeta[k], err);
+    gr_status st = render_technique(cls, gl, rs->scene0, o->repeat, &rs->test[k], &rs->smeta[k], err);
     if (st == GR_OK) st = check_not_black(rs->test[k], err);
     if (st != GR_OK) return st; /* its row names it */
     for (int i = 1; i < nf && st == GR_OK; i++) {
         gr_metadata scratch;
         gr_meta_init(&scratch);
-        st = render_technique(cls, gl, &rs->cases[i], &rs->seq_test[k * nf + i], &scratch, err);
+        st = render_technique(cls, gl, &rs->cases[i], 1, &rs->seq_test[k * nf + i], &scratch, err);
         gr_meta_free(&scratch);
         if (st != GR_OK) gr_error_prefix(err, "%s: frame %d (t = %g s)", cls->name, i, o->times[i]);
     }
@@ -676,6 +696,7 @@ static int run_with(gr_args *args)
     run_opts o;
     memset(&o, 0, sizeof o);
     o.use_cache = 1;
+    o.repeat = 1;
     o.fit = GR_FIT_SCALE;
     int rc = parse_args(args, &o);
     if (rc || o.help) return rc;

@@ -23,6 +23,7 @@ static const char help_rest[] =
     "                       gain is one number (docs/tuning.md)\n"
     "  --normalize          divide a metric in image units (rmse, msrmse) by each case's mean\n"
     "                       reference Y, so that every frame and view weighs the same in the mean\n"
+    "  --preset FILE        apply a preset's settings as overrides (docs/tuning.md \"Presets\")\n"
     "  --set KEY=VALUE      override a scene value before validation (repeatable), e.g.\n"
     "                       reference.spp=2 or NAME.KEY=V\n"
     "  --size WxH           image size (camera.width/height)\n"
