@@ -1,0 +1,288 @@
+/* Tuning over a view suite (suitetune.h). */
+#include "tune/suitetune.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "report/profile.h"
+#include "tune/cliopts.h"
+#include "tune/optimize.h"
+#include "tune/paramspec.h"
+#include "tune/pareto.h"
+
+/* The settings a level starts from: case 0's section with the ladder applied, and every
+ * scene-derived setting that is not in keep[] (the tuned ones) set back to NaN, so that each
+ * case's render resolves it from its own scene (gr_technique_render). */
+static gr_status level_base(const gr_technique_class *cls, const gr_scene *scene0, int level,
+                            const gr_tune_param *keep, int n_keep, gr_section_store *out, gr_error *err)
+{
+    memcpy(out->bytes, gr_technique_scene_settings(cls, scene0), cls->settings_size);
+    if (level >= 0) {
+        gr_status st = gr_technique_apply_text(cls, out->bytes, cls->ladder[level].settings, err);
+        if (st != GR_OK) return st;
+    }
+    for (size_t i = 0; i < cls->params->count; i++) {
+        const gr_param *p = &cls->params->params[i];
+        int kept = 0;
+        for (int k = 0; k < n_keep; k++) kept |= keep[k].p == p;
+        if (!p->scene_source || kept) continue;
+        double *v = (double *)(void *)(out->bytes + p->offset);
+        if (p->type == GR_PT_DOUBLE) v[0] = NAN;
+        else if (p->type == GR_PT_RGB) v[0] = v[1] = v[2] = NAN;
+    }
+    return GR_OK;
+}
+
+/* A problem over the cases of one split, scored by the default objective (the verdict) after
+ * the scale fit, from base (kept unresolved: see level_base). */
+static gr_status make_problem(gr_technique *r, const gr_st_case *cases, int n_cases, gr_split split,
+                              const gr_section_store *base, const gr_tune_param *params, int n_params,
+                              gr_tune_problem *p, gr_error *err)
+{
+    memset(p, 0, sizeof *p);
+    p->renderer = r;
+    p->cls = gr_technique_class_of(r);
+    for (int i = 0; i < n_cases; i++) {
+        if (cases[i].split != split) continue;
+        if (p->n_cases >= GR_TUNE_MAX_CASES)
+            return gr_fail(err, GR_E_INPUT, "suite tuning: more than %d %s cases", GR_TUNE_MAX_CASES,
+                           split == GR_SPLIT_TRAIN ? "train" : "test");
+        p->scenes[p->n_cases] = cases[i].scene;
+        p->refs[p->n_cases++] = cases[i].truth;
+    }
+    if (p->n_cases == 0)
+        return gr_fail(err, GR_E_INPUT, "suite tuning: no %s case", split == GR_SPLIT_TRAIN ? "train" : "test");
+    p->base = *base;
+    p->n_params = n_params;
+    if (n_params > 0) memcpy(p->params, params, (size_t)n_params * sizeof *params);
+    p->metric = GR_TM_WEIGHTED;
+    gr_status st = gr_tune_weights_parse("objective", GR_TUNE_DEFAULT_OBJECTIVE, p->weights, err);
+    p->fit = GR_FIT_SCALE;
+    if (st == GR_OK) st = gr_tune_problem_init(p, err);
+    if (st == GR_OK) p->base = *base; /* init resolved it from case 0: each case resolves its own */
+    return st;
+}
+
+gr_status gr_st_score(gr_technique *r, const gr_st_case *cases, int n_cases, gr_split split, const void *s,
+                      double *mean, gr_error *err)
+{
+    gr_tune_problem p;
+    gr_section_store base;
+    memcpy(base.bytes, s, gr_technique_class_of(r)->settings_size);
+    gr_status st = make_problem(r, cases, n_cases, split, &base, NULL, 0, &p, err);
+    if (st == GR_OK) st = gr_tune_evaluate(&p, NULL, mean, NULL, NULL, err);
+    gr_tune_problem_free(&p);
+    return st;
+}
+
+/* The parameters: o->params or the class's tune_keys. */
+static gr_status level_params(const gr_technique_class *cls, const gr_st_options *o, gr_tune_param *params, int *n,
+                              gr_error *err)
+{
+    char buf[1024];
+    const char *spec = o && o->params ? o->params : NULL;
+    if (!spec) {
+        if (gr_tune_default_params(cls, buf, sizeof buf))
+            return gr_fail(err, GR_E_INPUT, "technique %s has no settings to tune", cls->name);
+        spec = buf;
+    }
+    return gr_tune_param_parse_list("--params", spec, params, GR_TUNE_MAX_PARAMS, n, err);
+}
+
+static void point_init(gr_st_point *pt, const gr_technique_class *cls, int level, int tuned, const gr_tune_problem *p)
+{
+    memset(pt, 0, sizeof *pt);
+    pt->cls = cls;
+    pt->level = level;
+    pt->tuned = tuned;
+    snprintf(pt->ladder, sizeof pt->ladder, "%s", level >= 0 ? cls->ladder[level].settings : "");
+    pt->n_params = tuned ? p->n_params : 0;
+    for (int k = 0; k < pt->n_params; k++) snprintf(pt->keys[k], sizeof pt->keys[k], "%s", p->params[k].p->name);
+    pt->train_error = pt->test_error = NAN;
+}
+
+gr_status gr_st_tune_level(gr_technique *r, const gr_st_case *cases, int n_cases, int level, const gr_st_options *o,
+                           gr_st_point *untuned, gr_st_point *tuned, gr_error *err)
+{
+    const gr_technique_class *cls = gr_technique_class_of(r);
+    gr_tune_param params[GR_TUNE_MAX_PARAMS];
+    int np = 0;
+    gr_section_store base;
+    gr_tune_problem train, test;
+    memset(&train, 0, sizeof train);
+    memset(&test, 0, sizeof test);
+    if (n_cases < 1) return gr_fail(err, GR_E_INPUT, "suite tuning: no cases");
+    if (level >= cls->n_ladder) return gr_fail(err, GR_E_INPUT, "technique %s: no ladder level %d", cls->name, level);
+    gr_status st = level_params(cls, o, params, &np, err);
+    if (st == GR_OK) st = level_base(cls, cases[0].scene, level, params, np, &base, err);
+    if (st == GR_OK) st = make_problem(r, cases, n_cases, GR_SPLIT_TRAIN, &base, params, np, &train, err);
+    if (st == GR_OK) st = make_problem(r, cases, n_cases, GR_SPLIT_TEST, &base, params, np, &test, err);
+    /* the untuned point: x0 = the base's own values (RGB: scale 1), the search's first start */
+    double x0[GR_TUNE_MAX_PARAMS], lo[GR_TUNE_MAX_PARAMS], hi[GR_TUNE_MAX_PARAMS];
+    for (int k = 0; k < np; k++) {
+        const gr_tune_param *tp = &params[k];
+        x0[k] = tp->kind == GR_TK_RGB_SCALE ? 1.0 : gr_param_get_number(tp->p, train.base.bytes, 0);
+        lo[k] = tp->lo;
+        hi[k] = tp->hi;
+        x0[k] = x0[k] < lo[k] ? lo[k] : x0[k] > hi[k] ? hi[k] : x0[k];
+    }
+    gr_st_point u;
+    point_init(&u, cls, level, 0, &train);
+    if (st == GR_OK) st = gr_tune_settings_at(&train, x0, u.settings.bytes, err);
+    if (st == GR_OK) st = gr_tune_evaluate(&train, x0, &u.train_error, NULL, NULL, err);
+    if (st == GR_OK) st = gr_tune_evaluate(&test, x0, &u.test_error, NULL, NULL, err);
+    if (st == GR_OK && untuned) *untuned = u;
+    if (st == GR_OK && tuned) {
+        gr_opt_options oo;
+        gr_tune_search_defaults(&oo, np, x0);
+        oo.n_starts = o && o->n_starts > 0 ? o->n_starts : 2;
+        oo.screen = 2 * oo.n_starts;
+        oo.coarse = o && o->coarse > 0 ? o->coarse : 8 * np;
+        if (o && o->max_evals > 0) {
+            oo.max_evals = oo.polish = o->max_evals;
+            if (oo.screen_evals > o->max_evals) oo.screen_evals = o->max_evals;
+        }
+        oo.seed = o ? o->seed : 0;
+        gr_opt_result res;
+        gr_st_point *t = tuned;
+        point_init(t, cls, level, 1, &train);
+        st = gr_opt_minimize(np, lo, hi, gr_tune_objective, &train, &oo, &res, err);
+        if (st == GR_OK) {
+            memcpy(t->x, res.x, (size_t)np * sizeof *t->x);
+            t->evals = res.evals;
+            st = gr_tune_settings_at(&train, res.x, t->settings.bytes, err);
+        }
+        /* the train error evaluated again at the best point (the search's own value is the same
+         * number; re-evaluated so that train and test are computed alike) */
+        if (st == GR_OK) st = gr_tune_evaluate(&train, res.x, &t->train_error, NULL, NULL, err);
+        if (st == GR_OK) st = gr_tune_evaluate(&test, res.x, &t->test_error, NULL, NULL, err);
+    }
+    gr_tune_problem_free(&train);
+    gr_tune_problem_free(&test);
+    if (st != GR_OK) gr_error_prefix(err, "%s %s", cls->name, level >= 0 ? cls->ladder[level].settings : "(scene's settings)");
+    return st;
+}
+
+gr_status gr_st_level_settings(const gr_technique_class *cls, const gr_scene *scene0, int level, const gr_st_options *o,
+                               const double *x, void *out, gr_error *err)
+{
+    gr_tune_param params[GR_TUNE_MAX_PARAMS];
+    int np = 0;
+    gr_section_store base, resolved;
+    gr_status st = level_params(cls, o, params, &np, err);
+    if (st == GR_OK) st = level_base(cls, scene0, level, params, np, &base, err);
+    if (st != GR_OK) return st;
+    memcpy(out, base.bytes, cls->settings_size);
+    gr_technique_resolve(cls, scene0, base.bytes, resolved.bytes); /* as make_problem's init: case 0's */
+    for (int k = 0; k < np && st == GR_OK; k++) st = gr_tune_param_apply(&params[k], resolved.bytes, x[k], out, err);
+    return st;
+}
+
+gr_status gr_st_time_point(gr_technique *r, const gr_scene *scene, int repeat, gr_st_point *pt, gr_error *err)
+{
+    gr_image *img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
+    if (!img) return gr_fail(err, GR_E_NOMEM, "out of memory for a %dx%d frame", scene->camera.width, scene->camera.height);
+    gr_status st = gr_timing_measure(r, scene, pt->settings.bytes, img, 1, repeat, &pt->timing, err);
+    pt->timed = st == GR_OK;
+    gr_image_destroy(img);
+    return st;
+}
+
+void gr_st_mark_fronts(gr_st_point *pts, int n)
+{
+    gr_pareto_point *pp = calloc((size_t)(n > 0 ? n : 1), sizeof *pp);
+    if (!pp) return;
+    for (int i = 0; i < n; i++) {
+        pp[i].family = 2 * gr_technique_index(pts[i].cls) + pts[i].tuned;
+        pp[i].cost_s = pts[i].timed ? pts[i].timing.cost_ms : NAN;
+        pp[i].error = pts[i].test_error;
+    }
+    gr_pareto_mark_fronts(pp, n);
+    for (int i = 0; i < n; i++) pts[i].on_front = pp[i].on_front;
+    free(pp);
+}
+
+void gr_st_pick(const gr_st_point *pts, int n, const double *budgets_ms, int n_budgets, int *pick)
+{
+    for (int b = 0; b < n_budgets; b++) {
+        pick[b] = -1;
+        for (int i = 0; i < n; i++) {
+            if (!pts[i].timed || !(pts[i].timing.cost_ms <= budgets_ms[b]) || !isfinite(pts[i].train_error)) continue;
+            const int j = pick[b];
+            if (j < 0 || pts[i].train_error < pts[j].train_error ||
+                (pts[i].train_error == pts[j].train_error && pts[i].timing.cost_ms < pts[j].timing.cost_ms))
+                pick[b] = i;
+        }
+    }
+}
+
+gr_status gr_st_baselines(const gr_st_case *cases, int n_cases, gr_split split, gr_baselines *out, gr_error *err)
+{
+    memset(out, 0, sizeof *out);
+    gr_baselines *one = malloc(sizeof *one);
+    int m = 0;
+    gr_status st = one ? GR_OK : gr_fail(err, GR_E_NOMEM, "out of memory");
+    for (int i = 0; i < n_cases && st == GR_OK; i++) {
+        if (cases[i].split != split) continue;
+        const gr_camera *c = &cases[i].scene->camera;
+        float *angles = malloc((size_t)c->width * (size_t)c->height * sizeof *angles);
+        if (!angles) {
+            st = gr_fail(err, GR_E_NOMEM, "out of memory");
+            break;
+        }
+        gr_structure_options so;
+        gr_metrics_options mo = {0};
+        mo.skip_ssim = mo.skip_blur = mo.skip_extra = 1;
+        mo.fit_scale = 1;
+        mo.structure = gr_profile_structure_options(cases[i].scene, angles, &so) ? &so : NULL;
+        st = gr_baselines_compute(cases[i].truth, &mo, one, err);
+        free(angles);
+        if (st != GR_OK) break;
+        if (m == 0) *out = *one;
+        else
+            for (int k = 0; k < one->n_ladder; k++) out->verdict[k] += one->verdict[k];
+        m++;
+    }
+    if (st == GR_OK && m == 0) st = gr_fail(err, GR_E_INPUT, "suite: no case in the split");
+    if (st == GR_OK) {
+        for (int k = 0; k < out->n_ladder; k++) {
+            out->verdict[k] /= m;
+            out->envelope[k] = k == 0 || out->verdict[k] > out->envelope[k - 1] ? out->verdict[k] : out->envelope[k - 1];
+        }
+    }
+    free(one);
+    return st;
+}
+
+void gr_st_point_label(const gr_st_point *pt, char *buf, size_t n)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+    len += (size_t)snprintf(buf, n, "%s", pt->ladder[0] ? pt->ladder : "scene's settings");
+    for (int k = 0; k < pt->n_params && len < n; k++) {
+        const gr_param *p = gr_param_find(pt->cls->params, pt->keys[k]);
+        len += (size_t)snprintf(buf + len, n - len, "%s%s=%s%.4g", k ? " " : "; ", pt->keys[k],
+                                p && p->type == GR_PT_RGB ? "x" : "", pt->x[k]);
+    }
+}
+
+gr_status gr_st_parse_budgets(const char *flag, const char *s, double *budgets, int max, int *n, gr_error *err)
+{
+    *n = 0;
+    const char *c = s;
+    while (*c) {
+        char *end = NULL;
+        errno = 0;
+        const double v = strtod(c, &end);
+        if (errno || end == c || !(v > 0) || !isfinite(v) || (*end && *end != ','))
+            return gr_fail(err, GR_E_USAGE, "%s %s: expected milliseconds > 0 separated by commas, e.g. 0.5,1,2,4", flag, s);
+        if (*n >= max) return gr_fail(err, GR_E_USAGE, "%s %s: at most %d budgets", flag, s, max);
+        budgets[(*n)++] = v;
+        c = *end ? end + 1 : end;
+    }
+    if (*n == 0) return gr_fail(err, GR_E_USAGE, "%s: no budget given", flag);
+    return GR_OK;
+}

@@ -1,0 +1,93 @@
+/* Tuning over a view suite (`godrays pareto --suite SUITE --tune`, docs/tuning.md "Tuned
+ * fronts and budgets"): for one technique and one point of its cost ladder
+ * (gr_technique_class.ladder), its look settings (its tune_keys) are tuned on the suite's
+ * train cases with the default objective (the verdict, tune/objective.h) by the global search
+ * of tune/optimize.h, then scored on its test cases; each point is timed warm at a timing size
+ * (realtime/timing.h); a budget table picks, for each frame budget, the point with the lowest
+ * TRAIN error among those that fit (the test error is never used to choose: it is what the
+ * table reports, so the choice does not peek at the views it is judged on).
+ *
+ * Settings derived from the scene (a descriptor's scene_source: the camera position, the
+ * medium's extinction) and not tuned are left unresolved, so that each case resolves them from
+ * its own scene; a tuned RGB setting (extinction) is tuned as a scale on case 0's value, and
+ * the preset states the absolute value found. Deterministic for a seed. */
+#ifndef GR_TUNE_SUITETUNE_H
+#define GR_TUNE_SUITETUNE_H
+
+#include "common/status.h"
+#include "compare/baseline.h"
+#include "image/image.h"
+#include "realtime/technique.h"
+#include "realtime/timing.h"
+#include "scene/scene.h"
+#include "suite/suite.h"
+#include "tune/objective.h"
+
+/* One case: a scene (camera size = the error size, the same for all) and its ground truth. */
+typedef struct gr_st_case {
+    const gr_scene *scene;
+    const gr_image *truth;
+    gr_split split;
+} gr_st_case;
+
+typedef struct gr_st_options {
+    const char *params;       /* "NAME.KEY,..." to tune (NULL: the class's tune_keys) */
+    int max_evals;            /* per local search (0: the search's default, 60 + 40 n) */
+    int n_starts;             /* 0: 2 */
+    int coarse;               /* first-stage sample points (0: 8 per parameter) */
+    unsigned long long seed;
+} gr_st_options;
+
+typedef struct gr_st_point {
+    const gr_technique_class *cls;
+    int level;                    /* index into cls->ladder; -1: the scene's settings */
+    char ladder[192];             /* the level's settings text ("" for the scene's) */
+    int tuned;                    /* 0: the ladder point as it is; 1: its look tuned */
+    gr_section_store settings;    /* every setting as rendered (unresolved scene-derived ones NaN) */
+    int n_params;
+    char keys[GR_TUNE_MAX_PARAMS][64];
+    double x[GR_TUNE_MAX_PARAMS]; /* the tuned parameters' values (RGB: the scale) */
+    double train_error, test_error; /* mean verdict after the scale fit over the split's cases */
+    int evals;
+    gr_timing timing;             /* at the timing size (timed = 1) */
+    int timed;
+    int on_front;                 /* on the front of (cost, test error) of its technique and kind */
+} gr_st_point;
+
+/* Scores settings s on the cases of one split: *mean verdict after the scale fit; renders into
+ * a scratch frame. GR_E_INPUT when the split has no case. */
+gr_status gr_st_score(gr_technique *r, const gr_st_case *cases, int n_cases, gr_split split, const void *s,
+                      double *mean, gr_error *err);
+
+/* The ladder level (-1: none) of r's class: the untuned point (its settings as the level sets
+ * them, scored on train and test) and the tuned one (tuned on train, scored on test). Either
+ * output may be NULL (the untuned point is always scored: the search starts there). */
+gr_status gr_st_tune_level(gr_technique *r, const gr_st_case *cases, int n_cases, int level, const gr_st_options *o,
+                           gr_st_point *untuned, gr_st_point *tuned, gr_error *err);
+
+/* The settings of r's class at ladder level (-1: none) with the tuned parameters (o->params, or
+ * the tune_keys) at x, as gr_st_tune_level renders them (the identifiability check's truths). */
+gr_status gr_st_level_settings(const gr_technique_class *cls, const gr_scene *scene0, int level, const gr_st_options *o,
+                               const double *x, void *out, gr_error *err);
+
+/* Times pt's settings warm (1 warm-up, repeat renders) on scene (a case at the timing size). */
+gr_status gr_st_time_point(gr_technique *r, const gr_scene *scene, int repeat, gr_st_point *pt, gr_error *err);
+
+/* The points of each (technique, tuned) family on the front of (timing cost, test error). */
+void gr_st_mark_fronts(gr_st_point *pts, int n);
+
+/* For each budget (ms), the index of the timed point whose cost fits and whose TRAIN error is
+ * lowest (ties: the cheaper one); -1 when none fits. */
+void gr_st_pick(const gr_st_point *pts, int n, const double *budgets_ms, int n_budgets, int *pick);
+
+/* The blur ladder of the split's cases, its verdicts averaged over them (for
+ * gr_equivalent_blur of a mean verdict over the same cases). */
+gr_status gr_st_baselines(const gr_st_case *cases, int n_cases, gr_split split, gr_baselines *out, gr_error *err);
+
+/* "K=0.91 extinction=x1.2 g=0.77" (the tuned values) or the ladder text, into buf. */
+void gr_st_point_label(const gr_st_point *pt, char *buf, size_t n);
+
+/* "0.5,1,2,4" -> budgets (ms, each > 0 and finite, at most max). GR_E_USAGE naming flag. */
+gr_status gr_st_parse_budgets(const char *flag, const char *s, double *budgets, int max, int *n, gr_error *err);
+
+#endif

@@ -1,0 +1,114 @@
+/* Suite tuning (tune/suitetune.h), on cases built in memory (issue 27's checks).
+ *  - Identifiability: the "truths" of every case are the shafts' own renders at known look
+ *    settings (K and the extinction scale) at a ladder point; the tuned point must recover them
+ *    within 2 % at every ladder point checked (the oracle is the known setting).
+ *  - Generalization is measured: truths rendered with a K that differs per case (0.8 .. 1.2:
+ *    no one setting fits all views); tuning on one case alone fits it (train error ~ 0) and
+ *    does worse on the test cases than on its train case, and tuning on the suite's train
+ *    cases has the lower test error.
+ *  - The budget pick chooses by train error among the points that fit, never by test error.
+ * Every ladder point of the shafts (12, rgba8 and rgba16f targets; label slow); reduced
+ * (GODRAYS_TEST_REDUCED): one ladder point and a shorter search, 96 x 54. */
+#include <math.h>
+#include <stdio.h>
+
+#include "check.h"
+#include "tune/suitetune.h"
+#include "tune_test.h"
+
+#define W 96
+#define H 54
+enum { NCASE = 5 };
+
+/* The default scene turned to (yaw, pitch) at water time t: one view of the suite. */
+static gr_scene *view(double yaw, double pitch, double t)
+{
+    gr_scene *base = tune_test_default_scene(W, H, NULL, 0), *s = malloc(sizeof *s);
+    gr_error err;
+    CHECK(s != NULL);
+    gr_tune_view v = {yaw, pitch};
+    CHECK_OK(gr_tune_make_case(base, t, yaw == 0 && pitch == 0 ? NULL : &v, s, &err), err);
+    free(base);
+    return s;
+}
+
+static void identify(gr_technique *r, gr_scene **sc, gr_image **truth, int level, int reduced)
+{
+    gr_error err;
+    const gr_st_options o = {.params = "shafts.K,shafts.extinction", .max_evals = reduced ? 40 : 60,
+                             .n_starts = reduced ? 1 : 2, .seed = 1};
+    const double xt[2] = {0.9, 1.3};
+    gr_st_case cases[NCASE];
+    for (int i = 0; i < NCASE; i++) {
+        gr_section_store s;
+        CHECK_OK(gr_st_level_settings(&gr_shafts_class, sc[0], level, &o, xt, s.bytes, &err), err);
+        CHECK_OK(gr_technique_render(r, sc[i], s.bytes, truth[i], NULL, &err), err);
+        cases[i] = (gr_st_case){sc[i], truth[i], i < 3 ? GR_SPLIT_TRAIN : GR_SPLIT_TEST};
+    }
+    gr_st_point u, t;
+    CHECK_OK(gr_st_tune_level(r, cases, NCASE, level, &o, &u, &t, &err), err);
+    printf("level %d (%s): K %.4f (true 0.9), extinction x%.4f (true 1.3); train %.3g test %.3g (untuned %.3g / %.3g); "
+           "%d evals\n", level, t.ladder, t.x[0], t.x[1], t.train_error, t.test_error, u.train_error, u.test_error, t.evals);
+    CHECK_REL(t.x[0], xt[0], 0.02);
+    CHECK_REL(t.x[1], xt[1], 0.02);
+    CHECK(t.test_error < u.test_error);
+}
+
+static void generalization(gr_technique *r, gr_scene **sc, gr_image **truth)
+{
+    gr_error err;
+    const gr_st_options o = {.params = "shafts.K", .max_evals = 24, .n_starts = 1, .coarse = 6, .seed = 3};
+    /* per case, the K its truth was rendered with: train 0.8, 1.0, 1.2; test 0.95, 1.05 */
+    const double k_case[NCASE] = {0.8, 1.0, 1.2, 0.95, 1.05};
+    const int level = 9; /* N=11, half-size rgba16f target */
+    gr_st_case cases[NCASE], one[NCASE];
+    for (int i = 0; i < NCASE; i++) {
+        gr_section_store s;
+        CHECK_OK(gr_st_level_settings(&gr_shafts_class, sc[0], level, &o, &k_case[i], s.bytes, &err), err);
+        CHECK_OK(gr_technique_render(r, sc[i], s.bytes, truth[i], NULL, &err), err);
+        cases[i] = (gr_st_case){sc[i], truth[i], i < 3 ? GR_SPLIT_TRAIN : GR_SPLIT_TEST};
+        one[i] = cases[i];
+        if (i == 1 || i == 2) one[i].split = 2; /* neither split: tuned on case 0 alone */
+    }
+    gr_st_point suite, single;
+    CHECK_OK(gr_st_tune_level(r, cases, NCASE, level, &o, NULL, &suite, &err), err);
+    CHECK_OK(gr_st_tune_level(r, one, NCASE, level, &o, NULL, &single, &err), err);
+    printf("one case: K %.4f train %.4g test %.4g (gap %.3g); suite: K %.4f train %.4g test %.4g (gap %.3g)\n",
+           single.x[0], single.train_error, single.test_error, single.test_error - single.train_error, suite.x[0],
+           suite.train_error, suite.test_error, suite.test_error - suite.train_error);
+    CHECK(single.test_error > single.train_error); /* overfits its one view */
+    CHECK(suite.test_error < single.test_error);   /* the suite generalizes better */
+
+    /* the pick: by train error among the points within budget */
+    gr_st_point pts[3] = {single, suite, suite};
+    pts[0].timed = pts[1].timed = pts[2].timed = 1;
+    pts[0].timing.cost_ms = 1, pts[1].timing.cost_ms = 3, pts[2].timing.cost_ms = 2;
+    pts[2].train_error = suite.train_error, pts[2].test_error = 0; /* a perfect test error must not sway it */
+    pts[1].train_error = fmin(single.train_error, suite.train_error) * 0.5;
+    const double budgets[3] = {0.5, 2.5, 10};
+    int pick[3];
+    gr_st_pick(pts, 3, budgets, 3, pick);
+    CHECK(pick[0] == -1);
+    CHECK(pick[1] == (single.train_error < suite.train_error ? 0 : 2));
+    CHECK(pick[2] == 1);
+}
+
+int main(void)
+{
+    gr_technique *r = tune_test_renderer();
+    gr_scene *sc[NCASE] = {view(0, 0, 0), view(25, 0, 0.5), view(-20, -5, 1.0), view(12, 4, 0.25), view(-8, 0, 1.5)};
+    gr_image *truth[NCASE];
+    for (int i = 0; i < NCASE; i++) truth[i] = gr_image_create(W, H, 3, NULL);
+    const int reduced = tune_test_reduced();
+    const int n_lv = gr_shafts_class.n_ladder;
+    for (int l = 0; l < n_lv; l++)
+        if (!reduced || l == 9) identify(r, sc, truth, l, reduced);
+    generalization(r, sc, truth);
+    for (int i = 0; i < NCASE; i++) {
+        gr_image_destroy(truth[i]);
+        free(sc[i]);
+    }
+    tune_test_renderer_destroy(r);
+    printf("suite_tune: all checks passed\n");
+    return 0;
+}
