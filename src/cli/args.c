@@ -347,6 +347,27 @@ int gr_args_need_scene(const gr_args *a)
     return a->scene_path ? 0 : gr_cli_usage_error(a->cmd, "no scene file given");
 }
 
+/* "--set KEY=V: ..." for an override that a flag made: name the flag as typed */
+static void name_flag(const gr_args *a, gr_error *err)
+{
+    for (int k = 0; k < a->n_sets; k++) {
+        char typed[GR_ERROR_MSG_MAX];
+        const int n = snprintf(typed, sizeof typed, "--set %s", a->sets[k]);
+        const char *at = n < 0 || n >= (int)sizeof typed ? NULL : strstr(err->msg, typed);
+        /* at the start (a scene's error) or after "SUITE: cases[i] (NAME): " (a suite's) */
+        if (!a->origins[k] || !at || (at != err->msg && strncmp(at - 2, ": ", 2))) continue;
+        char rest[GR_ERROR_MSG_MAX];
+        snprintf(rest, sizeof rest, "%s", at + n);
+        const int head = (int)(at - err->msg);
+        gr_strbuf b;
+        gr_sb_init(&b);
+        gr_sb_printf(&b, "%.*s%s%s", head, err->msg, a->origins[k], rest);
+        if (gr_sb_str(&b)) snprintf(err->msg, sizeof err->msg, "%.*s", (int)sizeof err->msg - 1, gr_sb_str(&b));
+        gr_sb_free(&b);
+        break;
+    }
+}
+
 int gr_args_load_scene(const gr_args *a, gr_scene **scene)
 {
     gr_error err = {GR_OK, ""};
@@ -358,16 +379,19 @@ int gr_args_load_scene(const gr_args *a, gr_scene **scene)
     if (gr_scene_load_file(a->scene_path, gr_args_sets(a), a->n_sets, *scene, &err) != GR_OK) {
         free(*scene);
         *scene = NULL;
-        /* "--set KEY=V: ..." for an override that a flag made: name the flag as typed */
-        for (int k = 0; k < a->n_sets; k++) {
-            char typed[GR_ERROR_MSG_MAX];
-            const int n = snprintf(typed, sizeof typed, "--set %s", a->sets[k]);
-            if (!a->origins[k] || n < 0 || n >= (int)sizeof typed || strncmp(err.msg, typed, (size_t)n)) continue;
-            char rest[GR_ERROR_MSG_MAX];
-            snprintf(rest, sizeof rest, "%s", err.msg + n);
-            snprintf(err.msg, sizeof err.msg, "%s%s", a->origins[k], rest);
-            break;
-        }
+        name_flag(a, &err);
+        return gr_cli_report(a->cmd, &err);
+    }
+    return 0;
+}
+
+int gr_args_load_suite(gr_args *a, const char *path, gr_suite **suite)
+{
+    gr_error err = {GR_OK, ""};
+    int rc = gr_args_add_input(a, "the suite", path);
+    if (rc) return rc;
+    if (gr_suite_load_with(path, gr_args_sets(a), a->n_sets, suite, &err) != GR_OK) {
+        name_flag(a, &err);
         return gr_cli_report(a->cmd, &err);
     }
     return 0;

@@ -14,6 +14,7 @@
 #include "realtime/technique.h"
 #include "report/html.h"
 #include "scene/scene.h"
+#include "suite/suite.h"
 
 #define GR_ARGS_MAX_OUTPUTS 16 /* files one command writes beside each other (export: 4) */
 
@@ -97,6 +98,10 @@ int gr_args_need_scene(const gr_args *a);
 /* Loads the scene with the overrides into a new *scene (free() it); the loader's message and
  * exit code otherwise (2 for a bad scene, 1 for an unreadable file). */
 int gr_args_load_scene(const gr_args *a, gr_scene **scene);
+/* Loads the suite at path (registered as the input "the suite") with the overrides, which
+ * apply to every case after its own (suite/suite.h), into a new *suite (gr_suite_destroy it);
+ * the loader's one line and exit code otherwise (2 for a bad suite, 1 for an unreadable file). */
+int gr_args_load_suite(gr_args *a, const char *path, gr_suite **suite);
 /* Appends the scene and the options that change it (--set, --size) as typed, shell-quoted
  * and separated by spaces: the scene words of commands that an output suggests running next. */
 void gr_args_scene_words(const gr_args *a, gr_strbuf *b);

@@ -34,4 +34,14 @@ void gr_suite_destroy(gr_suite *suite);
 /* Number of cases of a split. */
 int gr_suite_count(const gr_suite *suite, gr_split split);
 
+/* gr_suite_load with the caller's scene overrides ("json.path=value", e.g. the command line's
+ * --set and --size) applied to every case after the suite's own (its size, then the case's);
+ * an error in one of them keeps its "--set OV" wording, under the suite file and the case. */
+gr_status gr_suite_load_with(const char *path, const char *const *overrides, int n_overrides, gr_suite **out,
+                             gr_error *err);
+/* The index of the case called name (-1: none). */
+int gr_suite_find(const gr_suite *suite, const char *name);
+/* "train" or "test". */
+const char *gr_split_name(gr_split split);
+
 #endif
