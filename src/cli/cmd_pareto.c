@@ -21,6 +21,8 @@
 #include "tune/budget.h"
 #include "reference/truth.h"
 #include "tune/pareto.h"
+#include "tune/suitetune.h"
+#include "cli/pareto_suite.h"
 #include "tune/session.h"
 
 #define MAX_POINTS 256
@@ -29,6 +31,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: godrays pareto SCENE [-o DIR] [options]\n"
+            "       godrays pareto --suite SUITE [--tune] [--budgets MS,MS,..] [--timing-size WxH] [options]\n"
             "\n"
             "Speed against error. Renders a high-quality ground truth (2x the scene's passes\n"
             "(sun_samples), 2x its march steps, 1.5x its surface resolution, another seed; cached),\n"
@@ -58,6 +61,18 @@ static void usage(FILE *f)
             "  --quick            fewer points (q0, q1, the quick levels of each ladder), for tests\n"
             "  --repeat R         renders per setting; time = median (default 5)\n"
             "  --no-cache         render the high-quality ground truth even if cached\n"
+            "  --suite SUITE      over a view suite instead of one scene (docs/tuning.md \"Tuned fronts and\n"
+            "                     budgets\"): each technique's ladder points scored against the cases'\n"
+            "                     ground truths (cached) on the train and the test cases; writes\n"
+            "                     DIR/fronts.csv, fronts.png (time against TEST error), index.html\n"
+            "  --tune             with --suite: each ladder point's look settings (its tune_keys) also\n"
+            "                     tuned on the train cases (verdict, global search), scored on the test ones\n"
+            "  --budgets LIST     with --suite: frame budgets in ms (e.g. 0.5,1,2,4): the budget table\n"
+            "                     (DIR/budgets.csv) and one preset per budget (DIR/presets/)\n"
+            "  --timing-size WxH  with --suite: the size each point is timed at (default 1920x1080;\n"
+            "                     errors are at the suite's size or --size)\n"
+            "  --seed S           with --tune: the search's seed (default 0; same seed, same result)\n"
+            "  --max-evals N      with --tune: evaluations per local search (default 60 + 40 per setting)\n"
             "  --yes              start more than 20000 technique renders (docs/tuning.md \"Budgets\")\n"
             "  --max-memory SIZE  refuse (exit 2) a ground truth estimated to need more (e.g. 8G;\n"
             "                     default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
@@ -134,10 +149,49 @@ typedef struct pareto_opts {
     int quiet, quick, use_cache, help, yes;
     gr_tune_budget budget; /* the count before the ground truths, the estimate after a render (tune/budget.h) */
     long repeat;
+    int have_repeat;
+    gr_ps_opts ps;                 /* --suite and its options (cli/pareto_suite.h) */
     gr_gl_platform platform;
     const gr_technique_class *techs[GR_TECH_MAX];
     int n_techs;
 } pareto_opts;
+
+/* --suite, --tune, --budgets, --timing-size, --seed, --max-evals: 1 when argv[i] is one of
+ * them (*rc: the exit code of its value). */
+static int take_suite_option(gr_args *args, pareto_opts *o, int *rc)
+{
+    const char *a = args->argv[args->i], *v = NULL;
+    gr_error e = {GR_OK, ""};
+    if (!strcmp(a, "--tune")) {
+        o->ps.tune = 1;
+        return 1;
+    }
+    if (strcmp(a, "--suite") && strcmp(a, "--budgets") && strcmp(a, "--timing-size") && strcmp(a, "--seed") &&
+        strcmp(a, "--max-evals"))
+        return 0;
+    if ((*rc = gr_args_value(args, &v)) != 0) return 1;
+    char *end = NULL, x = 0;
+    errno = 0;
+    if (!strcmp(a, "--suite")) {
+        o->ps.suite_path = v;
+    } else if (!strcmp(a, "--budgets")) {
+        if (gr_st_parse_budgets(a, v, o->ps.budgets_ms, GR_PS_MAX_BUDGETS, &o->ps.n_budgets, &e) != GR_OK)
+            *rc = gr_cli_usage_error("pareto", "%s", e.msg);
+    } else if (!strcmp(a, "--timing-size")) {
+        if (sscanf(v, "%dx%d%c", &o->ps.timing_w, &o->ps.timing_h, &x) != 2 || o->ps.timing_w < 1 || o->ps.timing_h < 1 ||
+            o->ps.timing_w > 16384 || o->ps.timing_h > 16384)
+            *rc = gr_cli_usage_error("pareto", "--timing-size %s: expected WxH, e.g. 1920x1080", v);
+    } else if (!strcmp(a, "--seed")) {
+        o->ps.seed = strtoull(v, &end, 10);
+        if (errno || end == v || *end || v[0] == '-') *rc = gr_cli_usage_error("pareto", "--seed %s: expected an integer >= 0", v);
+    } else {
+        const long m = strtol(v, &end, 10);
+        if (errno || end == v || *end || m < 4 || m > 100000)
+            *rc = gr_cli_usage_error("pareto", "--max-evals %s: expected an integer in [4, 100000]", v);
+        o->ps.max_evals = (int)m;
+    }
+    return 1;
+}
 
 /* The argument loop and the technique list; returns the exit code (o->help: help printed). */
 static int parse_args(gr_args *args, pareto_opts *o)
@@ -176,11 +230,18 @@ static int parse_args(gr_args *args, pareto_opts *o)
             o->repeat = strtol(v, &end, 10);
             if (errno || end == v || *end || o->repeat < 1 || o->repeat > 1000)
                 rc = gr_cli_usage_error(cmd, "--repeat %s: expected an integer in [1, 1000]", v);
+            o->have_repeat = 1;
+        } else if (take_suite_option(args, o, &rc)) {
+            if (rc) break;
         } else if ((rc = gr_args_take_common(args, &o->outopt, &o->platform, &taken)) == 0 && !taken) {
             rc = gr_args_take_scene(args);
         }
     }
-    if (rc || (rc = gr_args_need_scene(args)) != 0) return rc;
+    if (rc || (!o->ps.suite_path && (rc = gr_args_need_scene(args)) != 0)) return rc;
+    if (o->ps.suite_path && args->scene_path)
+        return gr_cli_usage_error(cmd, "--suite %s and the scene %s: give one of them", o->ps.suite_path, args->scene_path);
+    if (!o->ps.suite_path && (o->ps.tune || o->ps.n_budgets))
+        return gr_cli_usage_error(cmd, "--tune and --budgets need --suite SUITE");
     if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
     gr_error lerr = {GR_OK, ""};
     if (gr_technique_parse_list(o->tech_flag, o->tech_list, o->techs, GR_TECH_MAX, &o->n_techs, &lerr) != GR_OK)
@@ -188,6 +249,7 @@ static int parse_args(gr_args *args, pareto_opts *o)
     if (gr_tune_budget_init(&o->budget, "godrays pareto", "renders",
                             gr_tune_budget_ladders(o->techs, o->n_techs, o->quick, o->repeat), 1, o->yes, &lerr) != GR_OK)
         return gr_cli_report(cmd, &lerr);
+    if (o->ps.suite_path) return 0; /* the suite's size unless --size */
     /* the default size after every override, so that it wins over --set camera.width/height */
     if (!args->have_size && (rc = gr_args_add_set(args, "camera.width=320")) != 0) return rc;
     if (!args->have_size && (rc = gr_args_add_set(args, "camera.height=180")) != 0) return rc;
@@ -412,6 +474,15 @@ static int pareto_with(gr_args *args)
     gr_scene *scene = NULL;
     char dirbuf[4096];
     const char *outdir = NULL;
+    if (o.ps.suite_path) {
+        o.ps.outopt = o.outopt;
+        o.ps.quick = o.quick, o.ps.quiet = o.quiet, o.ps.use_cache = o.use_cache, o.ps.platform = o.platform;
+        o.ps.repeat = o.have_repeat ? (int)o.repeat : 3;
+        if (o.ps.timing_w <= 0) o.ps.timing_w = 1920, o.ps.timing_h = 1080;
+        o.ps.techs = o.techs;
+        o.ps.n_techs = o.n_techs;
+        return gr_pareto_suite(args, &o.ps);
+    }
     if ((rc = gr_args_load_scene(args, &scene)) != 0) return rc;
     for (int k = 0; k < o.n_techs && !rc; k++)
         if (gr_technique_check(o.techs[k], gr_technique_scene_settings(o.techs[k], scene), &err) != GR_OK)

@@ -1,0 +1,305 @@
+/* pareto --suite (pareto_suite.h). */
+#include "cli/pareto_suite.h"
+#include "cli/cli.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "common/outfile.h"
+#include "compare/baseline.h"
+#include "reference/truth.h"
+#include "report/html.h"
+#include "report/report.h"
+#include "suite/suite.h"
+#include "tune/page.h"
+#include "tune/pareto.h"
+#include "tune/preset.h"
+#include "tune/suitetune.h"
+
+#define PS_MAX_POINTS 512
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* What the run holds; ps_free frees it. */
+typedef struct ps_run {
+    gr_suite *suite;
+    gr_image **truths;
+    gr_st_case *cases;
+    gr_scene *timing_scene;   /* the first train case at the timing size */
+    gr_gl *gl;
+    gr_st_point *pts;
+    int n;
+    double truth_s, tune_s, time_s;
+    gr_baselines *bl;         /* the blur ladder over the test cases (equivalent blur) */
+} ps_run;
+
+static void ps_free(ps_run *r)
+{
+    for (int i = 0; r->suite && r->truths && i < r->suite->n_cases; i++) gr_image_destroy(r->truths[i]);
+    free(r->truths);
+    free(r->cases);
+    free(r->timing_scene);
+    free(r->pts);
+    free(r->bl);
+    gr_gl_destroy(r->gl);
+    gr_suite_destroy(r->suite);
+}
+
+/* Every case's ground truth through the provider (cached); the timing scene. */
+static gr_status truths(const gr_ps_opts *o, ps_run *r, gr_error *err)
+{
+    const int n = r->suite->n_cases;
+    r->truths = calloc((size_t)n, sizeof *r->truths);
+    r->cases = calloc((size_t)n, sizeof *r->cases);
+    r->timing_scene = malloc(sizeof *r->timing_scene);
+    if (!r->truths || !r->cases || !r->timing_scene) return gr_fail(err, GR_E_NOMEM, "out of memory");
+    gr_truth_options to;
+    gr_truth_options_default(&to);
+    to.use_cache = o->use_cache;
+    to.ref.progress = !o->quiet;
+    const double t0 = now_s();
+    int first_train = -1;
+    for (int i = 0; i < n; i++) {
+        gr_suite_case *c = &r->suite->cases[i];
+        gr_truth_info ti;
+        if (!o->quiet) fprintf(stderr, "godrays pareto: ground truth of case %s (%s)...\n", c->name, gr_split_name(c->split));
+        gr_status st = gr_truth_image(&c->scene, &to, &r->truths[i], &ti, err);
+        if (st != GR_OK) return gr_error_prefix(err, "%s: case %s", r->suite->path, c->name);
+        r->cases[i] = (gr_st_case){&c->scene, r->truths[i], c->split};
+        if (first_train < 0 && c->split == GR_SPLIT_TRAIN) first_train = i;
+    }
+    r->truth_s = now_s() - t0;
+    if (first_train < 0 || gr_suite_count(r->suite, GR_SPLIT_TEST) == 0)
+        return gr_fail(err, GR_E_INPUT, "%s: --tune needs train and test cases (%d train, %d test)", r->suite->path,
+                       gr_suite_count(r->suite, GR_SPLIT_TRAIN), gr_suite_count(r->suite, GR_SPLIT_TEST));
+    memcpy(r->timing_scene, &r->suite->cases[first_train].scene, sizeof *r->timing_scene);
+    r->timing_scene->camera.width = o->timing_w;
+    r->timing_scene->camera.height = o->timing_h;
+    return gr_scene_refresh(r->timing_scene, err);
+}
+
+/* One technique: each ladder point untuned (and tuned with --tune), each timed. */
+static gr_status technique(const gr_ps_opts *o, ps_run *r, const gr_technique_class *cls, gr_error *err)
+{
+    gr_technique *t = NULL;
+    gr_status st = gr_technique_create(cls, r->gl, NULL, &t, err);
+    const gr_st_options so = {.max_evals = o->max_evals, .seed = o->seed};
+    const int n_lv = cls->n_ladder > 0 ? cls->n_ladder : 1;
+    for (int l = 0; l < n_lv && st == GR_OK; l++) {
+        if (o->quick && cls->n_ladder > 0 && !cls->ladder[l].quick) continue;
+        if (r->n + 2 > PS_MAX_POINTS) break;
+        gr_st_point *u = &r->pts[r->n], *tu = o->tune ? &r->pts[r->n + 1] : NULL;
+        double t0 = now_s();
+        st = gr_st_tune_level(t, r->cases, r->suite->n_cases, cls->n_ladder > 0 ? l : -1, &so, u, tu, err);
+        r->tune_s += now_s() - t0;
+        t0 = now_s();
+        if (st == GR_OK) st = gr_st_time_point(t, r->timing_scene, o->repeat, u, err);
+        if (st == GR_OK && tu) st = gr_st_time_point(t, r->timing_scene, o->repeat, tu, err);
+        r->time_s += now_s() - t0;
+        if (st != GR_OK) break;
+        r->n += tu ? 2 : 1;
+        if (!o->quiet)
+            fprintf(stderr, "godrays pareto: %s %s: %.2f ms, test error %.4g untuned%s", cls->name,
+                    u->ladder[0] ? u->ladder : "(scene's)", u->timing.cost_ms, u->test_error, tu ? "" : "\n");
+        if (!o->quiet && tu) fprintf(stderr, ", %.4g tuned (train %.4g)\n", tu->test_error, tu->train_error);
+    }
+    gr_technique_destroy(t);
+    return st;
+}
+
+/* The header every table and chart of times carries: the renderer and what its times mean. */
+static void time_header(const ps_run *r, const gr_ps_opts *o, char *buf, size_t n)
+{
+    const gr_timing *tm = r->n > 0 ? &r->pts[0].timing : NULL;
+    const char *glr = tm ? tm->renderer : gr_gl_renderer(r->gl);
+    if (gr_timing_is_cpu_renderer(glr))
+        snprintf(buf, n, "times on %s at %dx%d: CPU-rasterizer wall times (median of %d after a warm-up), which do NOT "
+                 "stand for a GPU's", glr, o->timing_w, o->timing_h, o->repeat);
+    else
+        snprintf(buf, n, "times on %s at %dx%d: GPU time of the GL passes (timer queries; median of %d after a warm-up)",
+                 glr, o->timing_w, o->timing_h, o->repeat);
+}
+
+/* fronts.csv: every point. */
+static gr_status write_fronts_csv(const char *dir, const ps_run *r, gr_error *err)
+{
+    char path[4300], label[512];
+    gr_strbuf b;
+    gr_sb_init(&b);
+    gr_sb_puts(&b, "technique,tuned,ladder,label,cost_ms,wall_ms,gpu_ms,wall_min_ms,wall_max_ms,train_error,test_error,"
+                   "on_front,renderer\n");
+    for (int i = 0; i < r->n; i++) {
+        const gr_st_point *p = &r->pts[i];
+        gr_st_point_label(p, label, sizeof label);
+        for (char *c = label; *c; c++)
+            if (*c == ',') *c = ';';
+        char lad[200];
+        snprintf(lad, sizeof lad, "%s", p->ladder);
+        for (char *c = lad; *c; c++)
+            if (*c == ',') *c = ';';
+        gr_sb_printf(&b, "%s,%d,%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%s\n", p->cls->name, p->tuned, lad, label,
+                     p->timing.cost_ms, p->timing.wall_ms, p->timing.gpu_ms, p->timing.wall_min_ms, p->timing.wall_max_ms,
+                     p->train_error, p->test_error, p->on_front, p->timing.renderer);
+    }
+    snprintf(path, sizeof path, "%s/fronts.csv", dir);
+    gr_status st = gr_outfile_write(path, gr_sb_str(&b), -1, err);
+    gr_sb_free(&b);
+    return st;
+}
+
+/* The chart: time against TEST error, tuned and untuned families of every technique. */
+static gr_status write_plot(const char *dir, const ps_run *r, const char *header, int *drawn, gr_error *err)
+{
+    gr_pareto_point *pp = calloc((size_t)(r->n > 0 ? r->n : 1), sizeof *pp);
+    if (!pp) return gr_fail(err, GR_E_NOMEM, "out of memory");
+    for (int i = 0; i < r->n; i++) {
+        const gr_st_point *p = &r->pts[i];
+        pp[i].family = 1 + 2 * gr_technique_index(p->cls) + p->tuned;
+        snprintf(pp[i].family_name, sizeof pp[i].family_name, "%s %s", p->cls->name, p->tuned ? "tuned" : "untuned");
+        pp[i].cost_s = pp[i].time_s = 1e-3 * p->timing.cost_ms;
+        pp[i].error = p->test_error;
+        pp[i].on_front = p->on_front;
+    }
+    char path[4300], title[600];
+    snprintf(path, sizeof path, "%s/fronts.png", dir);
+    snprintf(title, sizeof title, "test error vs time (%s)", header);
+    gr_status st = gr_pareto_write_plot(path, pp, r->n, title, "", drawn, err);
+    free(pp);
+    return st;
+}
+
+/* The budget table (printed, budgets.csv) and one preset per row (presets/budget_Bms.json). */
+static gr_status budget_table(const gr_ps_opts *o, const ps_run *r, const char *dir, const char *header,
+                              gr_strbuf *sum, gr_error *err)
+{
+    int pick[GR_PS_MAX_BUDGETS];
+    gr_st_pick(r->pts, r->n, o->budgets_ms, o->n_budgets, pick);
+    char path[4400];
+    snprintf(path, sizeof path, "%s/presets", dir);
+    gr_status st = gr_report_make_dir(path, err);
+    gr_strbuf csv;
+    gr_sb_init(&csv);
+    gr_sb_puts(&csv, "budget_ms,technique,settings,time_ms,train_error,test_error,generalization_gap,eq_blur_px,preset\n");
+    gr_sb_printf(sum, "\nbudget table (%s);\nchosen by TRAIN error among the points within the budget, scored on the %d "
+                 "test cases:\n", header, gr_suite_count(r->suite, GR_SPLIT_TEST));
+    gr_sb_printf(sum, "%9s  %-12s %9s %9s %9s %8s %10s  %s\n", "budget ms", "technique", "time ms", "train", "test", "gap",
+                 "eq. blur", "settings");
+    for (int b = 0; b < o->n_budgets && st == GR_OK; b++) {
+        if (pick[b] < 0) {
+            gr_sb_printf(sum, "%9g  (no point within the budget)\n", o->budgets_ms[b]);
+            gr_sb_printf(&csv, "%g,,,,,,,,\n", o->budgets_ms[b]);
+            continue;
+        }
+        const gr_st_point *p = &r->pts[pick[b]];
+        char label[512], eq[32], file[64];
+        gr_st_point_label(p, label, sizeof label);
+        gr_equivalent_blur_text(r->bl, p->test_error, eq, sizeof eq);
+        snprintf(file, sizeof file, "budget_%gms.json", o->budgets_ms[b]);
+        gr_preset_info info;
+        gr_preset_info_clear(&info);
+        snprintf(info.renderer, sizeof info.renderer, "%s", p->timing.renderer);
+        info.timing_width = o->timing_w, info.timing_height = o->timing_h;
+        info.time_ms = p->timing.cost_ms;
+        info.cpu_rasterizer = !p->timing.hardware;
+        info.budget_ms = o->budgets_ms[b];
+        info.test_error = p->test_error, info.train_error = p->train_error;
+        info.eq_blur_px = gr_equivalent_blur(r->bl, p->test_error, NULL);
+        snprintf(info.suite, sizeof info.suite, "%s", r->suite->path);
+        info.error_width = r->suite->cases[0].scene.camera.width;
+        info.error_height = r->suite->cases[0].scene.camera.height;
+        snprintf(path, sizeof path, "%s/presets/%s", dir, file);
+        st = gr_preset_write(path, p->cls, p->settings.bytes, &info, err);
+        gr_sb_printf(sum, "%9g  %-12s %9.3f %9.4g %9.4g %8.3g %10s  %s%s  -> presets/%s\n", o->budgets_ms[b], p->cls->name,
+                     p->timing.cost_ms, p->train_error, p->test_error, p->test_error - p->train_error, eq,
+                     p->tuned ? "tuned: " : "untuned: ", label, file);
+        for (char *c = label; *c; c++)
+            if (*c == ',') *c = ';';
+        gr_sb_printf(&csv, "%g,%s,%s,%.6g,%.6g,%.6g,%.6g,%.4g,presets/%s\n", o->budgets_ms[b], p->cls->name, label,
+                     p->timing.cost_ms, p->train_error, p->test_error, p->test_error - p->train_error,
+                     info.eq_blur_px, file);
+    }
+    snprintf(path, sizeof path, "%s/budgets.csv", dir);
+    if (st == GR_OK) st = gr_outfile_write(path, gr_sb_str(&csv), -1, err);
+    gr_sb_free(&csv);
+    return st;
+}
+
+static gr_status outputs(const gr_ps_opts *o, ps_run *r, const char *dir, double wall_s, gr_error *err)
+{
+    char header[512], label[512];
+    time_header(r, o, header, sizeof header);
+    gr_st_mark_fronts(r->pts, r->n);
+    gr_status st = gr_report_make_dir(dir, err);
+    int drawn = 0;
+    if (st == GR_OK) st = write_fronts_csv(dir, r, err);
+    if (st == GR_OK) st = write_plot(dir, r, header, &drawn, err);
+    gr_strbuf sum;
+    gr_sb_init(&sum);
+    gr_sb_printf(&sum, "suite %s: %d cases (%d train, %d test) at %dx%d; %s\n", r->suite->path, r->suite->n_cases,
+                 gr_suite_count(r->suite, GR_SPLIT_TRAIN), gr_suite_count(r->suite, GR_SPLIT_TEST),
+                 r->suite->cases[0].scene.camera.width, r->suite->cases[0].scene.camera.height, header);
+    gr_sb_printf(&sum, "%-12s %-7s %10s %9s %9s %5s  %s\n", "technique", "", "time ms", "train", "test", "front", "settings");
+    for (int i = 0; i < r->n; i++) {
+        const gr_st_point *p = &r->pts[i];
+        gr_st_point_label(p, label, sizeof label);
+        gr_sb_printf(&sum, "%-12s %-7s %10.3f %9.4g %9.4g %5s  %s\n", p->cls->name, p->tuned ? "tuned" : "untuned",
+                     p->timing.cost_ms, p->train_error, p->test_error, p->on_front ? "*" : "", label);
+    }
+    if (st == GR_OK && o->n_budgets > 0) st = budget_table(o, r, dir, header, &sum, err);
+    gr_sb_printf(&sum, "\nseconds: ground truths %.1f, tuning and scoring %.1f, timing %.1f, all %.1f (seed %llu)\n",
+                 r->truth_s, r->tune_s, r->time_s, wall_s, o->seed);
+    gr_sb_printf(&sum, "written: %s/fronts.csv%s%s\n", dir, drawn ? ", fronts.png" : " (no chart: PLplot missing)",
+                 o->n_budgets > 0 ? ", budgets.csv, presets/" : "");
+    fputs(gr_sb_str(&sum), stdout);
+    gr_strbuf pg;
+    gr_sb_init(&pg);
+    gr_tune_page_begin(&pg, dir, "godrays pareto --suite: %s", r->suite->name);
+    if (drawn) gr_tune_page_figure(&pg, "fronts.png", header);
+    if (st == GR_OK) st = gr_tune_page_write(&pg, gr_sb_str(&sum), "fronts.csv", dir, err);
+    else gr_sb_free(&pg);
+    gr_sb_free(&sum);
+    return st;
+}
+
+int gr_pareto_suite(gr_args *args, const gr_ps_opts *o)
+{
+    const char *cmd = "pareto";
+    ps_run r;
+    memset(&r, 0, sizeof r);
+    gr_error err = {GR_OK, ""};
+    int rc = gr_args_load_suite(args, o->suite_path, &r.suite);
+    char dirbuf[4096];
+    const char *dir = NULL;
+    if (!rc) {
+        char sub[GR_SUITE_NAME_MAX + 16];
+        snprintf(sub, sizeof sub, "pareto-%s", r.suite->name);
+        rc = gr_args_output_dir(args, &r.suite->cases[0].scene, o->outopt, sub, dirbuf, sizeof dirbuf, &dir);
+    }
+    if (rc) {
+        ps_free(&r);
+        return rc;
+    }
+    const double t0 = now_s();
+    gr_gl_options glo;
+    memset(&glo, 0, sizeof glo);
+    glo.platform = o->platform;
+    r.pts = calloc(PS_MAX_POINTS, sizeof *r.pts);
+    r.bl = malloc(sizeof *r.bl);
+    gr_status st = r.pts && r.bl ? GR_OK : gr_fail(&err, GR_E_NOMEM, "out of memory");
+    if (st == GR_OK) st = gr_gl_create(&glo, &r.gl, &err); /* before the slow ground truths */
+    if (st == GR_OK) st = truths(o, &r, &err);
+    if (st == GR_OK) st = gr_st_baselines(r.cases, r.suite->n_cases, GR_SPLIT_TEST, r.bl, &err);
+    for (int k = 0; k < o->n_techs && st == GR_OK; k++) st = technique(o, &r, o->techs[k], &err);
+    if (st == GR_OK) st = outputs(o, &r, dir, now_s() - t0, &err);
+    if (st != GR_OK) rc = gr_cli_report(cmd, &err);
+    ps_free(&r);
+    return rc;
+}
