@@ -4,7 +4,7 @@
  * frame's cost), then the median of n timed renders of the same settings in one context, with
  * their spread (min, max, quartiles) and the renderer (GL_RENDERER) that timed them. Per-pass
  * GPU times come from the GL timer queries where they exist (a hardware GPU: the cost that
- * stands for the frame; on llvmpipe the wall time does). docs/benchmarks.md "Warm timing". */
+ * stands for the frame; on llvmpipe the wall time does). docs/tuning.md "Warm timing". */
 #ifndef GR_TIMING_H
 #define GR_TIMING_H
 
