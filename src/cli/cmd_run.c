@@ -34,6 +34,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: godrays run SCENE [-o DIR] [--techniques A,B] [--frames A:B:S | --times T,..] [options]\n"
+            "       godrays run --suite SUITE [-o DIR] [--techniques A,B] [--size WxH] [options]\n"
             "\n"
             "The main job: renders SCENE with every real-time technique (OpenGL; `godrays techniques`\n"
             "lists them) and as ground truth (Embree single scattering, with error bars), compares\n"
@@ -56,6 +57,12 @@ static void usage(FILE *f)
             "options:\n"
             "  -o, --output DIR     report folder (default: out/SCENE_NAME)\n"
             "  --techniques A,B     the techniques to compare (default: every registered one)\n"
+            "  --suite SUITE        every case of a view suite (docs/scene-format.md \"Suites\") instead of\n"
+            "                       one scene: each case's report in DIR/cases/CASE/, and in DIR the suite\n"
+            "                       leaderboard: per case the verdict of each technique, their mean over\n"
+            "                       the cases and the worst case (index.html with thumbnails, metrics.json,\n"
+            "                       the terminal); default DIR out/SUITE_NAME; --set/--size apply to every\n"
+            "                       case, after its own overrides (docs/report.md \"Suites\")\n"
             "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
             "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --set KEY=VALUE      override a scene value before validation, e.g. TECHNIQUE.KEY=V,\n"
