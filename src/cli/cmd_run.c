@@ -24,7 +24,10 @@
 #include "report/profile.h"
 #include "report/report.h"
 #include "report/sequence.h"
+#include "report/suite_board.h"
+#include "common/outfile.h"
 #include "scene/scene.h"
+#include "suite/suite.h"
 #include "tune/objective.h"
 #include "tune/session.h"
 
@@ -32,6 +35,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: godrays run SCENE [-o DIR] [--techniques A,B] [--frames A:B:S | --times T,..] [options]\n"
+            "       godrays run --suite SUITE [-o DIR] [--techniques A,B] [--size WxH] [options]\n"
             "\n"
             "The main job: renders SCENE with every real-time technique (OpenGL; `godrays techniques`\n"
             "lists them) and as ground truth (Embree single scattering, with error bars), compares\n"
@@ -54,6 +58,12 @@ static void usage(FILE *f)
             "options:\n"
             "  -o, --output DIR     report folder (default: out/SCENE_NAME)\n"
             "  --techniques A,B     the techniques to compare (default: every registered one)\n"
+            "  --suite SUITE        every case of a view suite (docs/scene-format.md \"Suites\") instead of\n"
+            "                       one scene: each case's report in DIR/cases/CASE/, and in DIR the suite\n"
+            "                       leaderboard: per case the verdict of each technique, their mean over\n"
+            "                       the cases and the worst case (index.html with thumbnails, metrics.json,\n"
+            "                       the terminal); default DIR out/SUITE_NAME; --set/--size apply to every\n"
+            "                       case, after its own overrides (docs/report.md \"Suites\")\n"
             "  --technique-dir DIR  add the user technique in DIR (its manifest.json; repeatable)\n"
             "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --preset FILE        apply a preset's settings as overrides (docs/tuning.md \"Presets\")\n"
@@ -270,6 +280,7 @@ static void print_summary(const char *dir, const gr_report_input *in, const gr_l
 /* What the command line asks for. */
 typedef struct run_opts {
     const char *outdir, *tech_list, *frames_spec, *times_spec, *fps_spec;
+    const char *suite;              /* --suite SUITE: every case of a view suite (run_suite) */
     int quiet, use_cache, help;
     int repeat;                     /* --repeat: renders timed per technique (median; 1: one render) */
     gr_fit_mode fit;                /* --fit: the leaderboard's scaling (default: one scale) */
@@ -341,6 +352,8 @@ static int parse_args(gr_args *args, run_opts *o)
             if (errno || end == v || *end || r < 1 || r > 1000)
                 rc = gr_cli_usage_error("run", "--repeat %s: expected an integer in [1, 1000]", v);
             o->repeat = (int)r;
+        } else if (!strcmp(a, "--suite")) {
+            rc = gr_args_value(args, &o->suite);
         } else if ((taken = gr_fit_mode_option(args->argc, args->argv, &args->i, &o->fit, &ferr)) != 0) {
             rc = taken < 0 ? gr_cli_usage_error("run", "%s", ferr.msg) : 0;
         } else if ((rc = gr_args_take_common(args, &o->outdir, NULL, &taken)) == 0 && !taken) {
@@ -651,32 +664,17 @@ static void run_free(const run_opts *o, run_state *rs)
     free(rs);
 }
 
-/* Everything after the command line: scene, techniques, ground truths, metrics, report. */
-static int run_scene(gr_args *args, run_opts *o, run_state *rs)
+/* One case's work (a scene's run, or one case of a suite): techniques, ground truth, metrics
+ * and the report into outdir, whose leaderboard rs->lb then holds; rs->scene0 is the scene.
+ * Returns an exit code (0: done, failed techniques included). */
+static int run_case(run_opts *o, run_state *rs, const char *outdir)
 {
     const char *cmd = "run";
     gr_error err = {GR_OK, ""};
-    int rc = 0;
-    char dirbuf[4096];
     if (!(rs->mets = calloc((size_t)o->nt, sizeof *rs->mets))) {
         gr_fail(&err, GR_E_NOMEM, "out of memory");
         return gr_cli_report(cmd, &err);
     }
-    if ((rc = gr_args_load_scene(args, &rs->scene)) != 0) return rc;
-    if (o->n_times > 0 && make_cases(o, rs, &err) != GR_OK) return gr_cli_report(cmd, &err);
-    rs->scene0 = rs->cases ? &rs->cases[0] : rs->scene;
-    /* Bad settings are bad input (exit 2) before any slow or GL work. */
-    for (int k = 0; k < o->nt; k++)
-        if (gr_technique_check(o->cls[k], gr_technique_scene_settings(o->cls[k], rs->scene), &err) != GR_OK)
-            return gr_cli_report(cmd, &err);
-    /* The ground truth takes minutes: a folder that cannot be made is refused before it. */
-    const char *outdir = NULL;
-    if ((rc = gr_args_output_dir(args, rs->scene, o->outdir, NULL, dirbuf, sizeof dirbuf, &outdir)) != 0) return rc;
-    command_line(args->argc, args->argv, &rs->cmdline);
-    gr_args_scene_words(args, &rs->words);
-    if (gr_sb_status(&rs->cmdline, "the command line", &err) != GR_OK ||
-        gr_sb_status(&rs->words, "the command line", &err) != GR_OK)
-        return gr_cli_report(cmd, &err);
     if (render_techniques(o, rs, &err) != GR_OK || get_references(o, rs, &err) != GR_OK)
         return gr_cli_report(cmd, &err);
     if (!o->quiet) fprintf(stderr, "godrays run: comparing...\n");
@@ -685,9 +683,225 @@ static int run_scene(gr_args *args, run_opts *o, run_state *rs)
     rs->t_cmp = now_s() - t;
     gr_report_result rres;
     if (write_report(o, rs, outdir, &rres, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    return 0;
+}
+
+/* Bad settings are bad input (exit 2) before any slow or GL work. */
+static int check_settings(const run_opts *o, const gr_scene *scene)
+{
+    gr_error err = {GR_OK, ""};
+    for (int k = 0; k < o->nt; k++)
+        if (gr_technique_check(o->cls[k], gr_technique_scene_settings(o->cls[k], scene), &err) != GR_OK)
+            return gr_cli_report("run", &err);
+    return 0;
+}
+
+/* Everything after the command line: scene, techniques, ground truths, metrics, report. */
+static int run_scene(gr_args *args, run_opts *o, run_state *rs)
+{
+    const char *cmd = "run";
+    gr_error err = {GR_OK, ""};
+    int rc = 0;
+    char dirbuf[4096];
+    if ((rc = gr_args_load_scene(args, &rs->scene)) != 0) return rc;
+    if (o->n_times > 0 && make_cases(o, rs, &err) != GR_OK) return gr_cli_report(cmd, &err);
+    rs->scene0 = rs->cases ? &rs->cases[0] : rs->scene;
+    if ((rc = check_settings(o, rs->scene)) != 0) return rc;
+    /* The ground truth takes minutes: a folder that cannot be made is refused before it. */
+    const char *outdir = NULL;
+    if ((rc = gr_args_output_dir(args, rs->scene, o->outdir, NULL, dirbuf, sizeof dirbuf, &outdir)) != 0) return rc;
+    command_line(args->argc, args->argv, &rs->cmdline);
+    gr_args_scene_words(args, &rs->words);
+    if (gr_sb_status(&rs->cmdline, "the command line", &err) != GR_OK ||
+        gr_sb_status(&rs->words, "the command line", &err) != GR_OK)
+        return gr_cli_report(cmd, &err);
+    if ((rc = run_case(o, rs, outdir)) != 0) return rc;
     print_summary(outdir, &rs->in, &rs->lb, &rs->ro, rs->t_ref);
     if (o->nf > 1 && rs->n_failed < o->nt) print_sequence(o, rs, outdir);
     return rs->n_failed > 0 ? 3 : 0; /* the report is complete; some technique failed (docs/report.md) */
+}
+
+/* A new, empty run state (NULL: out of memory); run_free frees it. */
+static run_state *run_state_new(void)
+{
+    run_state *rs = calloc(1, sizeof *rs);
+    if (!rs) return NULL;
+    for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) gr_meta_init(&rs->smeta[k]);
+    gr_meta_init(&rs->ro.meta);
+    gr_sb_init(&rs->cmdline);
+    gr_sb_init(&rs->words);
+    return rs;
+}
+
+/* ---- run --suite: every case of a view suite (suite/suite.h), then the suite leaderboard ---- */
+
+/* The suite's cells, [case * nt + technique] (report/suite_board.h). */
+typedef struct suite_cells {
+    double *verdict, *error_fit, *structure, *gpu_ms, *constant;
+    char **reasons;
+} suite_cells;
+
+static void cells_free(suite_cells *c, int n)
+{
+    for (int i = 0; c->reasons && i < n; i++) free(c->reasons[i]);
+    free(c->reasons);
+    free(c->verdict);
+    free(c->error_fit);
+    free(c->structure);
+    free(c->gpu_ms);
+    free(c->constant);
+}
+
+static gr_status cells_alloc(suite_cells *c, int nc, int nt, gr_error *err)
+{
+    const size_t n = (size_t)nc * (size_t)nt;
+    c->verdict = malloc(n * sizeof *c->verdict);
+    c->error_fit = malloc(n * sizeof *c->error_fit);
+    c->structure = malloc(n * sizeof *c->structure);
+    c->gpu_ms = malloc(n * sizeof *c->gpu_ms);
+    c->constant = malloc((size_t)nc * sizeof *c->constant);
+    c->reasons = calloc(n, sizeof *c->reasons);
+    if (!c->verdict || !c->error_fit || !c->structure || !c->gpu_ms || !c->constant || !c->reasons)
+        return gr_fail(err, GR_E_NOMEM, "out of memory");
+    for (size_t i = 0; i < n; i++) c->verdict[i] = c->error_fit[i] = c->structure[i] = c->gpu_ms[i] = NAN;
+    for (int i = 0; i < nc; i++) c->constant[i] = NAN;
+    return GR_OK;
+}
+
+/* Case c's leaderboard (rs->lb, the rows its report shows) into the cells. */
+static void collect_case(const run_opts *o, const run_state *rs, int c, suite_cells *cells)
+{
+    for (int r = 0; r < rs->lb.n; r++) {
+        const gr_lb_row *row = &rs->lb.rows[r];
+        if (row->kind == GR_LB_BASELINE) {
+            if (row->index == GR_BASELINE_CONSTANT) cells->constant[c] = row->verdict;
+            continue;
+        }
+        int k = 0;
+        while (k < o->nt && strcmp(o->cls[k]->name, row->name) != 0) k++;
+        if (k == o->nt) continue;
+        const int i = c * o->nt + k;
+        if (row->kind == GR_LB_FAILED) {
+            cells->reasons[i] = strdup(row->text ? row->text : "failed");
+            continue;
+        }
+        cells->verdict[i] = row->verdict;
+        cells->error_fit[i] = row->error_fit;
+        cells->structure[i] = row->structure;
+        const gr_meta_item *g = gr_meta_get(rs->in.techniques[row->index].meta, "godrays:gpu_ms");
+        cells->gpu_ms[i] = g && g->type != GR_META_STRING && g->num >= 0 ? g->num : NAN;
+    }
+}
+
+/* Case c into DIR/cases/NAME/: its scene as normalized JSON (scene.json, which the report's
+ * suggested commands name), then run_case. Returns an exit code. */
+static int suite_case(gr_args *args, run_opts *o, const gr_suite *s, int c, const char *outdir, suite_cells *cells)
+{
+    const gr_suite_case *sc = &s->cases[c];
+    char dir[4400], file[4500];
+    gr_error err = {GR_OK, ""};
+    snprintf(dir, sizeof dir, "%s/cases/%s", outdir, sc->name);
+    snprintf(file, sizeof file, "%s/scene.json", dir);
+    run_state *rs = run_state_new();
+    char *json = gr_scene_to_json(&sc->scene);
+    gr_status st = rs && json && (rs->scene = malloc(sizeof *rs->scene)) ? GR_OK : gr_fail(&err, GR_E_NOMEM, "out of memory");
+    if (st == GR_OK) {
+        *rs->scene = sc->scene;
+        rs->scene0 = rs->scene;
+        command_line(args->argc, args->argv, &rs->cmdline);
+        gr_sb_shell_word(&rs->words, file);
+        st = gr_report_make_dir(dir, &err);
+    }
+    if (st == GR_OK) st = gr_outfile_write(file, json, -1, &err);
+    free(json);
+    int rc = st != GR_OK ? gr_cli_report("run", &err) : 0;
+    if (!rc && !o->quiet)
+        fprintf(stderr, "godrays run: case %d of %d: %s (%s, %d x %d)\n", c + 1, s->n_cases, sc->name,
+                gr_split_name(sc->split), sc->scene.camera.width, sc->scene.camera.height);
+    if (!rc) rc = run_case(o, rs, dir);
+    if (!rc) collect_case(o, rs, c, cells);
+    if (rs) run_free(o, rs);
+    return rc;
+}
+
+/* The terminal's suite table: per case the verdict of every technique, then the aggregate. */
+static void print_suite(const run_opts *o, const gr_suite *s, const gr_suite_board_input *in, const char *outdir)
+{
+    const int nt = o->nt;
+    gr_suite_aggregate agg[GR_SUITE_BOARD_MAX_TECHNIQUES];
+    int order[GR_SUITE_BOARD_MAX_TECHNIQUES], w[GR_SUITE_BOARD_MAX_TECHNIQUES];
+    gr_suite_board_aggregate(in, agg, order);
+    printf("suite '%s': %d cases (%d train, %d test); verdict per case (lower is better):\n", s->name, s->n_cases,
+           gr_suite_count(s, GR_SPLIT_TRAIN), gr_suite_count(s, GR_SPLIT_TEST));
+    printf("  %-24s %-5s %10s", "case", "split", "(constant)");
+    for (int k = 0; k < nt; k++) {
+        w[k] = (int)strlen(o->cls[k]->name) > 11 ? (int)strlen(o->cls[k]->name) : 11;
+        printf(" %*s", w[k], o->cls[k]->name);
+    }
+    printf("\n");
+    for (int c = 0; c < s->n_cases; c++) {
+        printf("  %-24s %-5s %10.6g", s->cases[c].name, gr_split_name(s->cases[c].split), in->constant[c]);
+        for (int k = 0; k < nt; k++)
+            if (isfinite(in->verdict[c * nt + k])) printf(" %*.6g", w[k], in->verdict[c * nt + k]);
+            else printf(" %*s", w[k], "FAILED");
+        printf("\n");
+    }
+    static const char *const rows[] = {"mean", "worst", "mean train", "mean test"};
+    for (int r = 0; r < 4; r++) {
+        printf("  %-24s %-5s %10s", rows[r], "", "");
+        for (int k = 0; k < nt; k++)
+            printf(" %*.6g", w[k], r == 0 ? agg[k].mean : r == 1 ? agg[k].worst : r == 2 ? agg[k].mean_train : agg[k].mean_test);
+        printf("\n");
+    }
+    printf("ranking (mean verdict over the cases; worst case):\n");
+    for (int r = 0; r < nt; r++) {
+        const gr_suite_aggregate *a = &agg[order[r]];
+        printf("  %2d %-24s mean %.6g, worst %.6g (%s)", r + 1, o->cls[order[r]]->name, a->mean, a->worst,
+               a->worst_case >= 0 ? s->cases[a->worst_case].name : "-");
+        if (a->n_failed) printf(", FAILED in %d case%s", a->n_failed, a->n_failed == 1 ? "" : "s");
+        printf("\n");
+    }
+    printf("report: %s/index.html (also metrics.json; each case's report in %s/cases/CASE/)\n", outdir, outdir);
+}
+
+/* run --suite SUITE: each case as a run of its own into DIR/cases/CASE/, then the suite's
+ * leaderboard (report/suite_board.h) in DIR and on the terminal. Returns the exit code. */
+static int run_suite(gr_args *args, run_opts *o)
+{
+    gr_suite *s = NULL;
+    int rc = gr_args_load_suite(args, o->suite, &s);
+    if (rc) return rc;
+    for (int c = 0; c < s->n_cases && !rc; c++) rc = check_settings(o, &s->cases[c].scene);
+    char dirbuf[4096];
+    const char *outdir = o->outdir;
+    if (!rc && !outdir) {
+        gr_tune_default_dir(s->name, NULL, dirbuf, sizeof dirbuf);
+        outdir = dirbuf;
+    }
+    if (!rc) rc = gr_args_check_output_dir(args, o->outdir ? "-o" : "default output folder", outdir);
+    suite_cells cells = {0};
+    gr_error err = {GR_OK, ""};
+    if (!rc && cells_alloc(&cells, s->n_cases, o->nt, &err) != GR_OK) rc = gr_cli_report("run", &err);
+    const double t0 = now_s();
+    for (int c = 0; c < s->n_cases && !rc; c++) rc = suite_case(args, o, s, c, outdir, &cells);
+    gr_strbuf cl;
+    gr_sb_init(&cl);
+    command_line(args->argc, args->argv, &cl);
+    const char *names[GR_REPORT_MAX_TECHNIQUES];
+    for (int k = 0; k < o->nt; k++) names[k] = o->cls[k]->name;
+    gr_suite_board_input in = {.suite = s, .n_techniques = o->nt, .techniques = names, .verdict = cells.verdict,
+                               .error_fit = cells.error_fit, .structure = cells.structure, .gpu_ms = cells.gpu_ms,
+                               .reasons = (const char *const *)cells.reasons, .constant = cells.constant,
+                               .command_line = gr_sb_str(&cl), .seconds = now_s() - t0};
+    if (!rc && gr_suite_board_write(outdir, &in, &err) != GR_OK) rc = gr_cli_report("run", &err);
+    int failed = 0;
+    for (int i = 0; !rc && i < s->n_cases * o->nt; i++) failed += cells.reasons[i] != NULL;
+    if (!rc) print_suite(o, s, &in, outdir);
+    if (!rc && failed) printf("%d case x technique cell%s FAILED (exit code 3)\n", failed, failed == 1 ? "" : "s");
+    gr_sb_free(&cl);
+    cells_free(&cells, s->n_cases * o->nt);
+    gr_suite_destroy(s);
+    return rc ? rc : failed ? 3 : 0;
 }
 
 /* The command after gr_args_create; returns the exit code (gr_args_main frees args). */
@@ -700,19 +914,19 @@ static int run_with(gr_args *args)
     o.fit = GR_FIT_SCALE;
     int rc = parse_args(args, &o);
     if (rc || o.help) return rc;
-    if ((rc = gr_args_need_scene(args)) != 0) return rc;
+    if (o.suite && args->scene_path)
+        return gr_cli_usage_error("run", "--suite %s and the scene %s: give one of them", o.suite, args->scene_path);
+    if (!o.suite && (rc = gr_args_need_scene(args)) != 0) return rc;
     /* user techniques before the scene, whose sections they add */
     if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
     if ((rc = parse_choices(&o)) != 0) return rc;
-    run_state *rs = calloc(1, sizeof *rs);
+    if (o.suite && o.n_times > 0) return gr_cli_usage_error("run", "--suite with --frames/--times: not supported");
+    if (o.suite) return run_suite(args, &o);
+    run_state *rs = run_state_new();
     if (!rs) {
         gr_error err = {GR_E_NOMEM, "out of memory"};
         return gr_cli_report("run", &err);
     }
-    for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) gr_meta_init(&rs->smeta[k]);
-    gr_meta_init(&rs->ro.meta);
-    gr_sb_init(&rs->cmdline);
-    gr_sb_init(&rs->words);
     rc = run_scene(args, &o, rs);
     run_free(&o, rs);
     return rc;

@@ -322,7 +322,7 @@ static const unsigned char tech_rgb[9][3] = {{31, 119, 180}, {44, 160, 44},   {2
                                               {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
 
 /* The report's own file stems: a technique with one of these names gets "rt_" in front. */
-static void tech_stem(const char *name, char *buf, size_t n)
+void gr_report_tech_stem(const char *name, char *buf, size_t n)
 {
     static const char *const own[] = {"reference", "summary", "metrics", "index", "radial_profile"};
     for (size_t i = 0; i < sizeof own / sizeof own[0]; i++)
@@ -373,7 +373,7 @@ static gr_status draw_tech_charts(const char *dir, const gr_report_input *in, in
     gr_status st;
     const gr_report_technique *t = &in->techniques[k];
     const gr_metrics *m = t->metrics;
-    tech_stem(t->name, stem, sizeof stem);
+    gr_report_tech_stem(t->name, stem, sizeof stem);
     /* 1. Radial profile per channel. */
     static const unsigned char col[3][3] = {{215, 40, 40}, {30, 150, 50}, {40, 80, 220}};
     static const char *const cn[3] = {"R", "G", "B"};
@@ -1623,7 +1623,7 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
     for (int k = 0; k < nt; k++) {
         tctx *tc = &c->t[k];
         tc->t = &in->techniques[k];
-        tech_stem(tc->t->name, tc->stem, sizeof tc->stem);
+        gr_report_tech_stem(tc->t->name, tc->stem, sizeof tc->stem);
         const gr_metrics *m = tc->t->metrics;
         tc->a = as[k] = m->have_fit && m->fit_defined ? m->fit.scale : 1.0;
         tc->exposure_raw = gr_report_exposure(tc->t->test, 1.0, 0.99, 0.8);

@@ -92,6 +92,10 @@ typedef struct gr_report_result {
  * (report/leaderboard.h). */
 gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_result *res, gr_error *err);
 
+/* Technique name's file stem in the report: its name, or "rt_NAME" for one of the report's own
+ * names (reference, summary, metrics, index, radial_profile). */
+void gr_report_tech_stem(const char *name, char *buf, size_t n);
+
 /* Creates dir and its missing parents (GR_E_IO naming the part that failed). */
 gr_status gr_report_make_dir(const char *dir, gr_error *err);
 
