@@ -214,6 +214,10 @@ static void print_frame(const char *path, const gr_technique *r, const gr_techni
     }
     gr_sb_printf(&line, "; wall %.3f ms", stats->wall_ms);
     if (stats->fragments >= 0) gr_sb_printf(&line, "; fragments %lld", stats->fragments);
+    for (int p = 0; p < stats->n_passes; p++) { /* cost counters (docs/techniques.md; * = GL query) */
+        gr_pass_cost_text(&stats->cost[p], extra, sizeof extra);
+        if (extra[0]) gr_sb_printf(&line, "%s %s [%s]", p ? "," : "; cost:", stats->pass_names[p], extra);
+    }
     gr_technique_summary(r, stats, extra, sizeof extra);
     if (extra[0]) gr_sb_printf(&line, "; %s", extra);
     printf("%s\n", gr_sb_str(&line));

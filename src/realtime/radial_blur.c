@@ -507,6 +507,53 @@ static void stage_resolve(rb_state *r, const gr_radial_blur_settings *s, int W, 
     gr_gl_timer_end(&r->timer);
 }
 
+/* ---- cost counters (technique.h; docs/radial-blur.md, "Cost") -------------------------------- */
+
+/* Sets the analytic counters of pass p (keeping its queried primitives). */
+static void set_pass(gr_technique_stats *stats, int p, gr_pass_cost c)
+{
+    const gr_pass_cost q = stats->cost[p];
+    if (q.queried & (1u << GR_COST_PRIMITIVES)) {
+        c.v[GR_COST_PRIMITIVES] = q.v[GR_COST_PRIMITIVES];
+        c.queried |= 1u << GR_COST_PRIMITIVES;
+    }
+    stats->cost[p] = c;
+}
+
+/* eye depth: R32F at the light target's size; light: a full-screen pass into the light target
+ * (one eye-depth fetch with occluders); blur: samples + 1 taps a pixel at the frame's size into
+ * RGBA32F; quads: the same taps per (queried) fragment, 6 vertices a light, after a clear of
+ * the accumulator; resolve: one fetch a pixel. */
+static void count_cost(const rb_state *r, const gr_radial_blur_settings *s, int W, int H, gr_technique_stats *stats)
+{
+    const long long tw = r->light.w, th = r->light.h, taps = (long long)s->samples + 1;
+    gr_pass_cost c;
+    gr_pass_cost_clear(&c);
+    c.v[GR_COST_BYTES] = tw * th * 4;
+    c.v[GR_COST_TAPS] = 0;
+    c.v[GR_COST_INVOCATIONS] = 0;
+    set_pass(stats, PASS_DEPTH, c);
+    set_pass(stats, PASS_LIGHT, gr_pass_cost_screen(tw, th, s->occluders ? 1 : 0,
+                                                    s->target_format == GR_RB_RGBA8 ? 4 : 8));
+    if (!r->v->quads) {
+        set_pass(stats, PASS_BLUR, gr_pass_cost_screen(W, H, taps, 16));
+        stats->cost[PASS_BLUR].v[GR_COST_FRAGMENTS] = stats->fragments;
+        stats->cost[PASS_BLUR].queried |= 1u << GR_COST_FRAGMENTS;
+        return;
+    }
+    const long long frag = stats->fragments;
+    gr_pass_cost_clear(&c);
+    c.v[GR_COST_FRAGMENTS] = frag;
+    c.queried = 1u << GR_COST_FRAGMENTS;
+    c.v[GR_COST_TAPS] = frag * taps;
+    c.v[GR_COST_VERTICES] = 6LL * r->n_lights;
+    c.v[GR_COST_PRIMITIVES] = 2LL * r->n_lights;
+    c.v[GR_COST_BYTES] = (long long)W * H * 16 + frag * 16;
+    c.v[GR_COST_INVOCATIONS] = 0;
+    set_pass(stats, PASS_BLUR, c);
+    set_pass(stats, PASS_RESOLVE, gr_pass_cost_screen(W, H, 1, 16));
+}
+
 /* ---- render ---------------------------------------------------------------------------------- */
 
 
@@ -628,6 +675,7 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     if (stats) {
         gr_gl_timer_stats(stats, &r->timer, r->v->pass_names, r->v->n_passes, t0);
         stats->fragments = gr_gl_query_result(r->q_samples);
+        count_cost(r, s, W, H, stats);
         stats->wall_ms = gr_clock_ms() - t0;
     }
     r->rendered = 1;
