@@ -44,6 +44,8 @@ static const gr_param params[] = {
 static const gr_param_table table = {"froxel", params, sizeof params / sizeof params[0]};
 
 static const gr_technique_level ladder[] = {
+    /* under 1 ms class at 1080p (docs/volume-techniques.md "Cost"): 8 192 caustic triangles */
+    {"grid_x=40,grid_y=23,grid_z=16,texture_size=64,grid=32,caustic_depths=4", 1},
     {"grid_x=40,grid_y=23,grid_z=16,texture_size=128,grid=64,caustic_depths=4", 1},
     {"grid_x=80,grid_y=45,grid_z=32,texture_size=128,grid=96,caustic_depths=6", 0},
     {"grid_x=160", 1},

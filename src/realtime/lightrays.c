@@ -43,6 +43,9 @@ static const gr_param params[] = {
 static const gr_param_table table = {"light_rays", params, sizeof params / sizeof params[0]};
 
 static const gr_technique_level ladder[] = {
+    /* fewer, wider rays with the cheap footprint (docs/volume-techniques.md "Cost") */
+    {"rays=64,footprint=ribbon", 1},
+    {"rays=128,footprint=ribbon", 0},
     {"rays=128", 1},
     {"rays=256", 0},
     {"rays=512", 1},

@@ -35,6 +35,8 @@ static const gr_param params[] = {
 static const gr_param_table table = {"slicing", params, sizeof params / sizeof params[0]};
 
 static const gr_technique_level ladder[] = {
+    /* the cheap end (docs/volume-techniques.md "Cost"): 4 full-screen slices, 8 192 triangles */
+    {"slices=4,texture_size=64,grid=32,caustic_depths=4", 1},
     {"slices=8,texture_size=128,grid=64,caustic_depths=4", 1},
     {"slices=16,texture_size=128,grid=96,caustic_depths=6", 0},
     {"slices=32", 1},
