@@ -229,6 +229,10 @@ static void print_frame(const char *path, const gr_technique *r, const gr_techni
         gr_sb_printf(&line, " (median of %d after %d warm-up; %.3f-%.3f; %s)", tm->n, tm->warmup, tm->wall_min_ms,
                      tm->wall_max_ms, tm->renderer);
     if (stats->fragments >= 0) gr_sb_printf(&line, "; fragments %lld", stats->fragments);
+    for (int p = 0; p < stats->n_passes; p++) { /* cost counters (docs/techniques.md; * = GL query) */
+        gr_pass_cost_text(&stats->cost[p], extra, sizeof extra);
+        if (extra[0]) gr_sb_printf(&line, "%s %s [%s]", p ? "," : "; cost:", stats->pass_names[p], extra);
+    }
     gr_technique_summary(r, stats, extra, sizeof extra);
     if (extra[0]) gr_sb_printf(&line, "; %s", extra);
     printf("%s\n", gr_sb_str(&line));

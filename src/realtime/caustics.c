@@ -14,7 +14,10 @@
 
 struct gr_caustics {
     GLuint prog, vao, fbo, tex;
+    GLuint ibo, q_samples;   /* the grid's index buffer (for ibo_grid), the fragments' query */
+    int ibo_grid;
     int tex_size, tex_layers;
+    gr_pass_cost cost;       /* of the last build */
     GLint l_grid, l_L, l_nw, l_wa, l_wamp, l_sun, l_ior, l_fresnel, l_gL, l_plane, l_to_sun, l_texel;
     double origin[2];
     long long triangles;
@@ -55,6 +58,8 @@ gr_status gr_caustics_create(const char *shader_dir, gr_caustics **out, gr_error
     c->l_texel = glGetUniformLocation(p, "u_texel");
     glGenVertexArrays(1, &c->vao);
     glGenFramebuffers(1, &c->fbo);
+    glGenQueries(1, &c->q_samples);
+    gr_pass_cost_clear(&c->cost);
     *out = c;
     return gr_gl_check("caustics setup", err);
 }
@@ -66,6 +71,8 @@ void gr_caustics_destroy(gr_caustics *c)
     if (c->vao) glDeleteVertexArrays(1, &c->vao);
     if (c->fbo) glDeleteFramebuffers(1, &c->fbo);
     if (c->tex) glDeleteTextures(1, &c->tex);
+    if (c->ibo) glDeleteBuffers(1, &c->ibo);
+    if (c->q_samples) glDeleteQueries(1, &c->q_samples);
     free(c);
 }
 
@@ -76,6 +83,33 @@ void gr_caustics_origin(const gr_caustics *c, double origin[2])
     origin[0] = c->origin[0];
     origin[1] = c->origin[1];
 }
+
+/* The grid's triangles as indices of its (grid + 1)^2 vertices, cell by cell in the order the
+ * vertex shader's gl_VertexID / 6 used to give them (same triangles, same vertex order, so the
+ * same sums): (0,0) (1,0) (1,1), (0,0) (1,1) (0,1). */
+static gr_status ensure_indices(gr_caustics *c, int grid, gr_error *err)
+{
+    if (c->ibo && c->ibo_grid == grid) return GR_OK;
+    size_t n = (size_t)grid * (size_t)grid * 6;
+    GLuint *idx = malloc(n * sizeof *idx);
+    if (!idx) return gr_fail(err, GR_E_NOMEM, "caustics.grid = %d: out of memory for the index buffer", grid);
+    static const int corner[6][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
+    const GLuint row = (GLuint)grid + 1;
+    size_t k = 0;
+    for (int j = 0; j < grid; j++)
+        for (int i = 0; i < grid; i++)
+            for (int v = 0; v < 6; v++) idx[k++] = (GLuint)(i + corner[v][0]) + (GLuint)(j + corner[v][1]) * row;
+    if (!c->ibo) glGenBuffers(1, &c->ibo);
+    glBindVertexArray(c->vao);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, c->ibo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(n * sizeof *idx), idx, GL_STATIC_DRAW);
+    glBindVertexArray(0);
+    free(idx);
+    c->ibo_grid = grid;
+    return gr_gl_check("caustics.grid: index buffer", err);
+}
+
+void gr_caustics_cost(const gr_caustics *c, gr_pass_cost *out) { *out = c->cost; }
 
 gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_frame *f, const gr_caustics_params *p,
                             gr_error *err)
@@ -103,6 +137,8 @@ gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_fram
         gr_status st = gr_gl_check("caustics.texture_size: caustic texture", err);
         if (st != GR_OK) return st;
     }
+    gr_status ist = ensure_indices(c, p->grid, err);
+    if (ist != GR_OK) return ist;
     double L = p->patch_m;
     c->origin[0] = floor(f->eye[0] / L) * L;
     c->origin[1] = floor(f->eye[2] / L) * L;
@@ -131,12 +167,14 @@ gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_fram
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
     glClearColor(0, 0, 0, 0);
+    glBeginQuery(GL_SAMPLES_PASSED, c->q_samples);
     for (int d = 0; d < p->n_depths; d++) {
         glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, c->tex, 0, d);
         glClear(GL_COLOR_BUFFER_BIT);
         glUniform1f(c->l_plane, (float)-p->depths_m[d]);
-        glDrawArrays(GL_TRIANGLES, 0, p->grid * p->grid * 6);
+        glDrawElements(GL_TRIANGLES, p->grid * p->grid * 6, GL_UNSIGNED_INT, (const void *)0);
     }
+    glEndQuery(GL_SAMPLES_PASSED);
     c->triangles = 2LL * p->grid * p->grid * p->n_depths;
     glDisable(GL_BLEND);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -147,6 +185,19 @@ gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_fram
     glGenerateMipmap(GL_TEXTURE_2D_ARRAY);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_BASE_LEVEL, 1);
     glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+    /* Cost (technique.h): fragments queried; 6 indices a cell a plane; each plane's level 0
+     * cleared and blended per fragment (R32F), then every coarser level written from 4 taps
+     * of the finer one (glGenerateMipmap's box filter). */
+    const long long layers = p->n_depths, s0 = (long long)S2 * S2;
+    long long mip_texels = 0;
+    for (int l = 1; (S2 >> l) >= 1; l++) mip_texels += (long long)(S2 >> l) * (S2 >> l);
+    gr_pass_cost_clear(&c->cost);
+    c->cost.v[GR_COST_FRAGMENTS] = gr_gl_query_result(c->q_samples);
+    c->cost.queried = 1u << GR_COST_FRAGMENTS;
+    c->cost.v[GR_COST_VERTICES] = 6LL * p->grid * p->grid * layers;
+    c->cost.v[GR_COST_TAPS] = 4 * mip_texels * layers;
+    c->cost.v[GR_COST_BYTES] = (s0 + mip_texels) * 4 * layers + c->cost.v[GR_COST_FRAGMENTS] * 4;
+    c->cost.v[GR_COST_INVOCATIONS] = 0;
     return gr_gl_check("caustic texture build", err);
 }
 

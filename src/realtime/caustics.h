@@ -15,6 +15,7 @@
 #include "common/status.h"
 #include "image/image.h"
 #include "realtime/frame.h"
+#include "realtime/technique.h"
 #include "scene/scene.h"
 
 #define GR_CAUSTICS_MAX_DEPTHS 64
@@ -46,6 +47,11 @@ void gr_caustics_origin(const gr_caustics *c, double origin[2]);
 gr_status gr_caustics_read(gr_caustics *c, int layer, gr_image **out, gr_error *err);
 /* Triangles drawn in the last build (for the summary). */
 long long gr_caustics_triangles(const gr_caustics *c);
+
+/* The cost counters of the last build (technique.h): fragments (GL_SAMPLES_PASSED), indices
+ * drawn, texture taps and bytes of the mip chain, bytes cleared and blended; primitives are
+ * the caller's timer's. */
+void gr_caustics_cost(const gr_caustics *c, gr_pass_cost *out);
 
 /* Depths of a stack: n depths geometric between first_m and last_m (n = 1: first_m). */
 void gr_caustics_depths(int n, double first_m, double last_m, double *out);

@@ -44,6 +44,8 @@ static const gr_param params[] = {
 static const gr_param_table table = {"froxel", params, sizeof params / sizeof params[0]};
 
 static const gr_technique_level ladder[] = {
+    /* under 1 ms class at 1080p (docs/volume-techniques.md "Cost"): 8 192 caustic triangles */
+    {"grid_x=40,grid_y=23,grid_z=16,texture_size=64,grid=32,caustic_depths=4", 1},
     {"grid_x=40,grid_y=23,grid_z=16,texture_size=128,grid=64,caustic_depths=4", 1},
     {"grid_x=80,grid_y=45,grid_z=32,texture_size=128,grid=96,caustic_depths=6", 0},
     {"grid_x=160", 1},
@@ -155,6 +157,28 @@ static gr_status fx_check(const gr_technique_class *cls, const void *settings, g
 
 enum { P_SCATTER = GR_VOL_PASS_OWN, P_INTEGRATE, P_APPLY };
 
+/* The own passes' cost counters (technique.h): the dispatches' invocations (8 x 8 groups, the
+ * grid rounded up), a froxel's caustic taps (up to 2) and shadow tap, one RGBA32F image write
+ * per froxel in each compute pass, the integration's one image load per froxel; apply: a
+ * full-screen pass with the eye-depth tap and two volume taps a pixel. */
+static void count_cost(const gr_froxel_settings *s, int W, int H, int shadow, gr_technique_stats *stats)
+{
+    const long long gx = s->grid_x, gy = s->grid_y, nz = s->grid_z;
+    const long long ix = (gx + 7) / 8 * 8, iy = (gy + 7) / 8 * 8, vox = gx * gy * nz;
+    gr_pass_cost c;
+    gr_pass_cost_clear(&c);
+    c.v[GR_COST_FRAGMENTS] = c.v[GR_COST_VERTICES] = c.v[GR_COST_PRIMITIVES] = 0;
+    c.v[GR_COST_INVOCATIONS] = ix * iy * nz;
+    c.v[GR_COST_TAPS] = vox * (2 + shadow);
+    c.v[GR_COST_BYTES] = vox * 16;
+    gr_vol_cost_pass(stats, P_SCATTER, &c);
+    c.v[GR_COST_INVOCATIONS] = ix * iy;
+    c.v[GR_COST_TAPS] = vox;
+    gr_vol_cost_pass(stats, P_INTEGRATE, &c);
+    c = gr_pass_cost_screen(W, H, 3, 16);
+    gr_vol_cost_pass(stats, P_APPLY, &c);
+}
+
 static gr_status fx_render(void *state, const gr_scene *scene, const void *settings, gr_image *out,
                            gr_technique_stats *stats, gr_error *err)
 {
@@ -240,7 +264,9 @@ static gr_status fx_render(void *state, const gr_scene *scene, const void *setti
     glUseProgram(0);
     r->n_slices = nz;
     static const char *const names[6] = {"shadow", "eye_depth", "caustics", "scatter", "integrate", "apply"};
-    return gr_vol_finish("froxel", &r->base, &prep, out, names, 6, stats, err);
+    st = gr_vol_finish("froxel", &r->base, &prep, out, names, 6, stats, err);
+    if (stats) count_cost(s, W, H, prep.shadow_size > 0, stats);
+    return st;
 }
 
 static void fx_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)

@@ -43,6 +43,9 @@ static const gr_param params[] = {
 static const gr_param_table table = {"light_rays", params, sizeof params / sizeof params[0]};
 
 static const gr_technique_level ladder[] = {
+    /* fewer, wider rays with the cheap footprint (docs/volume-techniques.md "Cost") */
+    {"rays=64,footprint=ribbon", 1},
+    {"rays=128,footprint=ribbon", 0},
     {"rays=128", 1},
     {"rays=256", 0},
     {"rays=512", 1},
@@ -353,7 +356,28 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
     r->n_rays = N;
     r->window_m = 2.0 * win.half_m;
     static const char *const names[4] = {"shadow", "eye_depth", "surface", "lines"};
-    return gr_vol_finish("light_rays", &r->base, &prep, out, names, 4, stats, err);
+    st = gr_vol_finish("light_rays", &r->base, &prep, out, names, 4, stats, err);
+    if (stats) {
+        /* surface: cells^2 quads into two RGBA32F targets and a DEPTH32F buffer, N x N, cleared
+         * then written (each texel at least once); lines: N^2 points, the vertex stage fetching
+         * 2 texels each; a kept fragment (queried) takes the eye-depth tap and blends one
+         * RGBA32F texel after the clear (the shadow taps are the geometry stage's, per line) */
+        const long long nn = (long long)N * N, frag = stats->fragments;
+        gr_pass_cost c;
+        gr_pass_cost_clear(&c);
+        c.v[GR_COST_VERTICES] = 6LL * cells * cells;
+        c.v[GR_COST_TAPS] = 0;
+        c.v[GR_COST_BYTES] = nn * (16 + 16 + 4) * 2;
+        c.v[GR_COST_INVOCATIONS] = 0;
+        gr_vol_cost_pass(stats, P_SURFACE, &c);
+        c.v[GR_COST_FRAGMENTS] = frag;
+        c.queried = 1u << GR_COST_FRAGMENTS;
+        c.v[GR_COST_VERTICES] = nn;
+        c.v[GR_COST_TAPS] = 2 * nn + frag;
+        c.v[GR_COST_BYTES] = (long long)W * H * 16 + frag * 16;
+        gr_vol_cost_pass(stats, P_LINES, &c);
+    }
+    return st;
 }
 
 static void lr_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)

@@ -70,6 +70,8 @@ static const gr_param blur_params[] = {
     COMMON_PARAMS,
     {.name = "fade_margin", .type = GR_PT_DOUBLE, .offset = RB(fade_margin), .min = 0, .max = 100, .def = 0.5,
      .unit = "", .doc = "NDC beyond the screen edge over which the rays fade out (smoothstep)", .tune_lo = 0.1, .tune_hi = 3.0},
+    {.name = "blur_scale", .type = GR_PT_DOUBLE, .offset = RB(blur_scale), .min = 0, .max = 1, .flags = LO_X,
+     .def = 1, .unit = "", .doc = "blur target size / frame size, per axis (< 1: blurred there, upsampled bilinearly)"},
 };
 
 static const gr_param local_params[] = {
@@ -176,7 +178,10 @@ struct rb_state {
     const char *name; /* the class's */
     char *shader_dir;
     gr_scenegl *sg;
-    GLuint prog_light, prog_blur, prog_local, prog_resolve;
+    GLuint prog_light, prog_blur, prog_local, prog_resolve, prog_up;
+    GLint loc_up_src, loc_up_size;
+    gr_target small;   /* radial_blur at blur_scale < 1: the reduced blur target */
+    int upsampled;     /* the last render blurred at a reduced size */
     struct {
         GLint inv_vp_rot, depth, wave_groups, waves, ior, to_sun, a0, extinction, t_flat, threshold, occluders,
             eye_depth, dither8;
@@ -221,6 +226,7 @@ static void rb_destroy(void *state)
     if (r->prog_blur) glDeleteProgram(r->prog_blur);
     if (r->prog_local) glDeleteProgram(r->prog_local);
     if (r->prog_resolve) glDeleteProgram(r->prog_resolve);
+    if (r->prog_up) glDeleteProgram(r->prog_up);
     if (r->vao_empty) glDeleteVertexArrays(1, &r->vao_empty);
     if (r->vao_quads) glDeleteVertexArrays(1, &r->vao_quads);
     if (r->vbo_quads) glDeleteBuffers(1, &r->vbo_quads);
@@ -229,6 +235,7 @@ static void rb_destroy(void *state)
     gr_target_release(&r->light);
     gr_target_release(&r->out);
     gr_target_release(&r->acc);
+    gr_target_release(&r->small);
     gr_readback_free(&r->rb);
     free(r->shader_dir);
     free(r);
@@ -262,6 +269,13 @@ static gr_status rb_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     if ((st = gr_shader_program(dir, "radial_blur_screen.vert.glsl", "radial_blur.frag.glsl", NULL, 0, &r->prog_blur,
                                 NULL, err)) != GR_OK)
         goto fail;
+    if (!r->v->quads) {
+        if ((st = gr_shader_program(dir, "radial_blur_screen.vert.glsl", "radial_blur_upsample.frag.glsl", NULL, 0,
+                                    &r->prog_up, NULL, err)) != GR_OK)
+            goto fail;
+        r->loc_up_src = glGetUniformLocation(r->prog_up, "u_src");
+        r->loc_up_size = glGetUniformLocation(r->prog_up, "u_size");
+    }
     if (r->v->quads) {
         if ((st = gr_shader_program(dir, "radial_blur_local.vert.glsl", "radial_blur_local.frag.glsl", NULL, 0,
                                     &r->prog_local, NULL, err)) != GR_OK)
@@ -341,11 +355,11 @@ static void set_blur_uniforms(GLuint prog, GLint light, GLint size, GLint sample
     glUniform1i(dither, s->dither);
 }
 
-/* Runs the full-screen blur from r->light.tex into r->out.fbo (w x h). */
-static void blur_pass(rb_state *r, const gr_radial_blur_settings *s, const double sun_uv[2], const double scale[3],
-                      int w, int h)
+/* Runs the full-screen blur from r->light.tex into fbo (w x h). */
+static void blur_pass(rb_state *r, unsigned fbo, const gr_radial_blur_settings *s, const double sun_uv[2],
+                      const double scale[3], int w, int h)
 {
-    glBindFramebuffer(GL_FRAMEBUFFER, r->out.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, w, h);
     glDisable(GL_BLEND);
     set_blur_uniforms(r->prog_blur, r->lb.light, r->lb.size, r->lb.samples, r->lb.density, r->lb.decay, r->lb.weight,
@@ -440,9 +454,34 @@ static gr_status select_lights(rb_state *r, const gr_radial_blur_settings *s, gr
 static gr_status stage_blur(rb_state *r, const gr_radial_blur_settings *s, int W, int H, const double sun_uv[2],
                             const double scale[3], gr_error *err)
 {
-    (void)err;
+    r->upsampled = s->blur_scale < 1.0;
+    if (!r->upsampled) {
+        gr_gl_timer_begin(&r->timer, PASS_BLUR);
+        blur_pass(r, r->out.fbo, s, sun_uv, scale, W, H);
+        gr_gl_timer_end(&r->timer);
+        return GR_OK;
+    }
+    /* blur_scale < 1: the march on a reduced target (the taps fall by blur_scale^2), then a
+     * bilinear upsample (docs/radial-blur.md, "Cost") */
+    int bw = (int)lround(W * s->blur_scale), bh = (int)lround(H * s->blur_scale);
+    if (bw < 1) bw = 1;
+    if (bh < 1) bh = 1;
+    gr_status st = gr_target_ensure(&r->small, GL_RGBA32F, bw, bh, GR_TARGET_LINEAR,
+                                    "radial_blur.blur_scale: reduced blur target", err);
+    if (st != GR_OK) return st;
     gr_gl_timer_begin(&r->timer, PASS_BLUR);
-    blur_pass(r, s, sun_uv, scale, W, H);
+    blur_pass(r, r->small.fbo, s, sun_uv, scale, bw, bh);
+    gr_gl_timer_end(&r->timer);
+    gr_gl_timer_begin(&r->timer, PASS_RESOLVE);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out.fbo);
+    glViewport(0, 0, W, H);
+    glUseProgram(r->prog_up);
+    glUniform1i(r->loc_up_src, 0);
+    glUniform2f(r->loc_up_size, (float)W, (float)H);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r->small.tex);
+    glBindVertexArray(r->vao_empty);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
     gr_gl_timer_end(&r->timer);
     return GR_OK;
 }
@@ -505,6 +544,58 @@ static void stage_resolve(rb_state *r, const gr_radial_blur_settings *s, int W, 
     glBindVertexArray(r->vao_empty);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     gr_gl_timer_end(&r->timer);
+}
+
+/* ---- cost counters (technique.h; docs/radial-blur.md, "Cost") -------------------------------- */
+
+/* Sets the analytic counters of pass p (keeping its queried primitives). */
+static void set_pass(gr_technique_stats *stats, int p, gr_pass_cost c)
+{
+    const gr_pass_cost q = stats->cost[p];
+    if (q.queried & (1u << GR_COST_PRIMITIVES)) {
+        c.v[GR_COST_PRIMITIVES] = q.v[GR_COST_PRIMITIVES];
+        c.queried |= 1u << GR_COST_PRIMITIVES;
+    }
+    stats->cost[p] = c;
+}
+
+/* eye depth: R32F at the light target's size; light: a full-screen pass into the light target
+ * (one eye-depth fetch with occluders); blur: samples + 1 taps a pixel at the frame's size into
+ * RGBA32F; quads: the same taps per (queried) fragment, 6 vertices a light, after a clear of
+ * the accumulator; resolve: one fetch a pixel. */
+static void count_cost(const rb_state *r, const gr_radial_blur_settings *s, int W, int H, gr_technique_stats *stats)
+{
+    const long long tw = r->light.w, th = r->light.h, taps = (long long)s->samples + 1;
+    gr_pass_cost c;
+    gr_pass_cost_clear(&c);
+    c.v[GR_COST_BYTES] = tw * th * 4;
+    c.v[GR_COST_TAPS] = 0;
+    c.v[GR_COST_INVOCATIONS] = 0;
+    set_pass(stats, PASS_DEPTH, c);
+    set_pass(stats, PASS_LIGHT, gr_pass_cost_screen(tw, th, s->occluders ? 1 : 0,
+                                                    s->target_format == GR_RB_RGBA8 ? 4 : 8));
+    if (!r->v->quads) {
+        const long long bw = r->upsampled ? r->small.w : W, bh = r->upsampled ? r->small.h : H;
+        set_pass(stats, PASS_BLUR, gr_pass_cost_screen(bw, bh, taps, 16));
+        if (r->upsampled) { /* the samples query spans both passes: the blur's fragments analytic */
+            set_pass(stats, PASS_RESOLVE, gr_pass_cost_screen(W, H, 1, 16));
+            return;
+        }
+        stats->cost[PASS_BLUR].v[GR_COST_FRAGMENTS] = stats->fragments;
+        stats->cost[PASS_BLUR].queried |= 1u << GR_COST_FRAGMENTS;
+        return;
+    }
+    const long long frag = stats->fragments;
+    gr_pass_cost_clear(&c);
+    c.v[GR_COST_FRAGMENTS] = frag;
+    c.queried = 1u << GR_COST_FRAGMENTS;
+    c.v[GR_COST_TAPS] = frag * taps;
+    c.v[GR_COST_VERTICES] = 6LL * r->n_lights;
+    c.v[GR_COST_PRIMITIVES] = 2LL * r->n_lights;
+    c.v[GR_COST_BYTES] = (long long)W * H * 16 + frag * 16;
+    c.v[GR_COST_INVOCATIONS] = 0;
+    set_pass(stats, PASS_BLUR, c);
+    set_pass(stats, PASS_RESOLVE, gr_pass_cost_screen(W, H, 1, 16));
 }
 
 /* ---- render ---------------------------------------------------------------------------------- */
@@ -626,8 +717,9 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (st != GR_OK) return st;
     if (stats) {
-        gr_gl_timer_stats(stats, &r->timer, r->v->pass_names, r->v->n_passes, t0);
+        gr_gl_timer_stats(stats, &r->timer, r->v->pass_names, r->v->n_passes + (r->upsampled && !r->v->quads), t0);
         stats->fragments = gr_gl_query_result(r->q_samples);
+        count_cost(r, s, W, H, stats);
         stats->wall_ms = gr_clock_ms() - t0;
     }
     r->rendered = 1;
@@ -661,7 +753,7 @@ gr_status gr_radial_blur_blur_image(void *state, const gr_image *light, const do
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, light->width, light->height, GL_RGBA, GL_FLOAT, px);
     glBindTexture(GL_TEXTURE_2D, 0);
     free(px);
-    blur_pass(r, s, sun_uv, scale, out->width, out->height);
+    blur_pass(r, r->out.fbo, s, sun_uv, scale, out->width, out->height);
     st = read_out(r, out, "radial_blur (injected light)", err);
     glBindVertexArray(0);
     glUseProgram(0);
@@ -725,13 +817,29 @@ static void rb_summary(void *state, const gr_technique_stats *stats, char *buf, 
     if (r->v->quads && k > 0 && (size_t)k < n) snprintf(buf + k, n - (size_t)k, ", %d light(s)", r->n_lights);
 }
 
+/* `godrays pareto` (docs/radial-blur.md, "Cost"): fewer taps with the decay and weight rescaled
+ * so that the march keeps its length and gain (decay^(100/N), weight 100/N), at reduced blur
+ * and light resolutions; the last point is the seed's. */
+static const gr_technique_level blur_ladder[] = {
+    {"samples=16,decay=0.8168,weight=3.673,blur_scale=0.25,target_scale=0.25", 1},
+    {"samples=32,decay=0.9038,weight=1.8365,blur_scale=0.5,target_scale=0.25", 1},
+    {"samples=50,decay=0.9373,weight=1.1753,blur_scale=0.5", 0},
+    {"samples=100,blur_scale=0.5", 1},
+    {"samples=100", 1},
+};
+static const gr_technique_level local_ladder[] = {
+    {"samples=16,decay=0.8168,weight=3.673,lights=4,target_scale=0.25", 1},
+    {"samples=32,decay=0.9038,weight=1.8365,lights=8", 1},
+    {"samples=100", 1},
+};
+
 static const rb_variant variant_blur = {
     .quads = 0,
     .fade = 1,
     .screen = stage_blur,
     .resolve = NULL,
-    .n_passes = 3,
-    .pass_names = {"eye_depth", "light", "blur"},
+    .n_passes = 3, /* + "upsample" at blur_scale < 1 */
+    .pass_names = {"eye_depth", "light", "blur", "upsample"},
 };
 
 static const rb_variant variant_local = {
@@ -751,6 +859,8 @@ const gr_technique_class gr_radial_blur_class = {
     .origin = "built-in",
     .class_data = &variant_blur,
     .gain_key = "intensity",
+    .ladder = blur_ladder,
+    .n_ladder = (int)(sizeof blur_ladder / sizeof blur_ladder[0]),
     .create = rb_create,
     .destroy = rb_destroy,
     .render = rb_render,
@@ -767,6 +877,8 @@ const gr_technique_class gr_radial_blur_local_class = {
     .origin = "built-in",
     .class_data = &variant_local,
     .gain_key = "intensity",
+    .ladder = local_ladder,
+    .n_ladder = (int)(sizeof local_ladder / sizeof local_ladder[0]),
     .create = rb_create,
     .destroy = rb_destroy,
     .render = rb_render,

@@ -40,6 +40,7 @@ typedef struct gr_radial_blur_settings {
     double intensity[3];     /* factor on the derived scale to the ground truth's units (1) */
     int dither;              /* per-pixel jitter of the march (and of 8-bit storage) vs banding */
     double fade_margin;      /* NDC beyond the screen edge over which the rays fade out */
+    double blur_scale;       /* radial_blur: blur target size / frame size (1: the blur at full size) */
     /* radial_blur_local */
     int lights;              /* at most this many lights (quads) */
     double quad_size;        /* quad half-size as a fraction of the frame height */

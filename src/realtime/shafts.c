@@ -798,6 +798,44 @@ static void set_shaft_uniforms(GLuint prog, const shaft_locs *l, const frame_set
     glUniform1i(l->corner_refr, 3);
 }
 
+/* The passes' cost counters (technique.h) after a render: queried primitives (the timer's)
+ * and shaft fragments (GL_SAMPLES_PASSED), the rest from what was drawn (docs/realtime-shafts.md,
+ * "Cost"). */
+static void count_cost(gr_shafts *r, const frame_setup *f, long long n_idx, gr_shafts_stats *st)
+{
+    for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
+        gr_pass_cost_clear(&st->cost[p]);
+        long long prims = gr_gl_timer_primitives(&r->timer, p);
+        if (prims >= 0) {
+            st->cost[p].v[GR_COST_PRIMITIVES] = prims;
+            st->cost[p].queried |= 1u << GR_COST_PRIMITIVES;
+        }
+        st->cost[p].v[GR_COST_INVOCATIONS] = 0;
+    }
+    /* shadow: scenegl's depth map, DEPTH_COMPONENT32F, cleared then drawn (each texel once at least) */
+    const long long sm = (long long)f->s.shadow_map_size * f->s.shadow_map_size;
+    st->cost[GR_SHAFTS_PASS_SHADOW].v[GR_COST_BYTES] = sm * 4;
+    st->cost[GR_SHAFTS_PASS_SHADOW].v[GR_COST_TAPS] = 0;
+    /* shafts: every level with a weight draws the index buffer; a fragment takes the shadow
+     * tap, the eye-depth tap with depth_test, and blends one texel (read + write counted once) */
+    int levels = 0;
+    for (int k = 0; k < f->n_levels; k++) levels += f->lvl_weight[k] > 0.0;
+    const int bpp = f->fmt == TARGET_RGBA32F ? 16 : f->fmt == GR_TARGET_RGBA16F ? 8 : 4;
+    const long long frag = st->fragments, tpx = (long long)f->tw * f->th;
+    gr_pass_cost *c = &st->cost[GR_SHAFTS_PASS_SHAFTS];
+    c->v[GR_COST_FRAGMENTS] = frag;
+    c->queried |= 1u << GR_COST_FRAGMENTS;
+    c->v[GR_COST_VERTICES] = n_idx * levels;
+    c->v[GR_COST_TAPS] = frag * (1 + (f->s.depth_test ? 1 : 0) + (f->s.variant == GR_SHAFTS_FLUX ? 1 : 0));
+    c->v[GR_COST_BYTES] = tpx * bpp + frag * bpp; /* the clear, then each blended fragment */
+    /* final: a full-screen strip (4 vertices, 2 triangles), 4 bilinear taps, one RGBA32F write */
+    gr_pass_cost fin = gr_pass_cost_screen(f->W, f->H, 4, 16);
+    fin.v[GR_COST_VERTICES] = 4;
+    fin.v[GR_COST_PRIMITIVES] = st->cost[GR_SHAFTS_PASS_FINAL].v[GR_COST_PRIMITIVES];
+    fin.queried = st->cost[GR_SHAFTS_PASS_FINAL].queried;
+    st->cost[GR_SHAFTS_PASS_FINAL] = fin;
+}
+
 static gr_status render_frame(gr_shafts *r, const gr_scene *scene, const gr_shafts_settings *s, int checked,
                               gr_image *out, gr_shafts_stats *stats, gr_error *err)
 {
@@ -961,7 +999,6 @@ static gr_status render_frame(gr_shafts *r, const gr_scene *scene, const gr_shaf
     gr_gl_timer_begin(&r->timer, GR_SHAFTS_PASS_FINAL);
     glBindFramebuffer(GL_FRAMEBUFFER, r->frame.fbo);
     glViewport(0, 0, f->W, f->H);
-    glClear(GL_COLOR_BUFFER_BIT);
     glUseProgram(r->prog_final);
     glUniformMatrix4fv(r->loc_inv_vp, 1, GL_FALSE, f->inv_view_proj);
     glUniform2f(r->loc_texel, 1.0f / (float)f->tw, 1.0f / (float)f->th);
@@ -997,6 +1034,7 @@ static gr_status render_frame(gr_shafts *r, const gr_scene *scene, const gr_shaf
         stats->spacing_m = f->S;
         stats->center[0] = f->P.x; stats->center[1] = f->P.y; stats->center[2] = f->P.z;
         stats->refr_dir[0] = f->T.x; stats->refr_dir[1] = f->T.y; stats->refr_dir[2] = f->T.z;
+        count_cost(r, f, n_idx, stats);
     }
     if ((st = gr_gl_check("shafts render", err)) != GR_OK) goto unbind;
     r->rendered = 1;
@@ -1237,6 +1275,7 @@ static gr_status tech_render(void *state, const gr_scene *scene, const void *set
     for (int p = 0; p < GR_SHAFTS_NPASS; p++) {
         snprintf(stats->pass_names[p], sizeof stats->pass_names[p], "%s", gr_shafts_pass_names[p]);
         stats->gpu_ns[p] = t->last.gpu_ns[p];
+        stats->cost[p] = t->last.cost[p];
     }
     stats->wall_ms = t->last.cpu_ms;
     stats->fragments = t->last.fragments;

@@ -78,6 +78,7 @@ typedef struct gr_shafts_stats {
     double spacing_m;                  /* S, seed eq. 5.5.6 */
     double center[3];                  /* P, seed eq. 5.5.5a */
     double refr_dir[3];                /* T, seed eq. 5.5.5b */
+    gr_pass_cost cost[GR_SHAFTS_NPASS];/* per pass (technique.h; docs/realtime-shafts.md "Cost") */
 } gr_shafts_stats;
 
 /* One transformed shaft vertex read back by transform feedback (gr_shafts_capture). */

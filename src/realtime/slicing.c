@@ -35,6 +35,8 @@ static const gr_param params[] = {
 static const gr_param_table table = {"slicing", params, sizeof params / sizeof params[0]};
 
 static const gr_technique_level ladder[] = {
+    /* the cheap end (docs/volume-techniques.md "Cost"): 4 full-screen slices, 8 192 triangles */
+    {"slices=4,texture_size=64,grid=32,caustic_depths=4", 1},
     {"slices=8,texture_size=128,grid=64,caustic_depths=4", 1},
     {"slices=16,texture_size=128,grid=96,caustic_depths=6", 0},
     {"slices=32", 1},
@@ -146,7 +148,21 @@ static gr_status sl_render(void *state, const gr_scene *scene, const void *setti
     glUseProgram(0);
     r->n_slices = s->slices;
     static const char *const names[4] = {"shadow", "eye_depth", "caustics", "slices"};
-    return gr_vol_finish("slicing", &r->base, &prep, out, names, 4, stats, err);
+    st = gr_vol_finish("slicing", &r->base, &prep, out, names, 4, stats, err);
+    if (stats) {
+        /* every slice is a full-screen triangle: W H fragments each, all taking the eye-depth
+         * tap; those kept (queried) take up to 2 caustic taps (trilinear between 2 mip levels
+         * counted as 2) and the shadow tap, and blend one RGBA32F texel after the clear */
+        const long long px = (long long)W * H, kept = stats->fragments;
+        gr_pass_cost c = gr_pass_cost_screen(W, H, 1, 16);
+        c.v[GR_COST_FRAGMENTS] = px * s->slices;
+        c.v[GR_COST_TAPS] = px * s->slices + kept * (2 + (prep.shadow_size > 0));
+        c.v[GR_COST_VERTICES] = 3LL * s->slices;
+        c.v[GR_COST_PRIMITIVES] = s->slices;
+        c.v[GR_COST_BYTES] = px * 16 + kept * 16;
+        gr_vol_cost_pass(stats, P_SLICES, &c);
+    }
+    return st;
 }
 
 static void sl_summary(void *state, const gr_technique_stats *stats, char *buf, size_t n)

@@ -428,9 +428,70 @@ gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void
 void gr_technique_stats_clear(gr_technique_stats *s)
 {
     memset(s, 0, sizeof *s);
-    for (int p = 0; p < GR_TECH_MAX_PASSES; p++) s->gpu_ns[p] = -1;
+    for (int p = 0; p < GR_TECH_MAX_PASSES; p++) {
+        s->gpu_ns[p] = -1;
+        gr_pass_cost_clear(&s->cost[p]);
+    }
     s->wall_ms = -1;
     s->fragments = -1;
+}
+
+/* ---- cost counters --------------------------------------------------------------------- */
+
+static const char *const cost_names[GR_COST_N] = {"fragments", "taps", "vertices", "primitives", "bytes",
+                                                  "invocations"};
+
+const char *gr_cost_name(int k) { return k >= 0 && k < GR_COST_N ? cost_names[k] : "?"; }
+
+void gr_pass_cost_clear(gr_pass_cost *c)
+{
+    for (int k = 0; k < GR_COST_N; k++) c->v[k] = -1;
+    c->queried = 0;
+}
+
+gr_pass_cost gr_pass_cost_screen(long long w, long long h, long long taps_per_px, long long bytes_per_px)
+{
+    gr_pass_cost c;
+    c.v[GR_COST_FRAGMENTS] = w * h;
+    c.v[GR_COST_TAPS] = w * h * taps_per_px;
+    c.v[GR_COST_VERTICES] = 3;
+    c.v[GR_COST_PRIMITIVES] = 1;
+    c.v[GR_COST_BYTES] = w * h * bytes_per_px;
+    c.v[GR_COST_INVOCATIONS] = 0;
+    c.queried = 0;
+    return c;
+}
+
+void gr_technique_cost_set(gr_technique_stats *s, int p, int k, long long v, int queried)
+{
+    if (p < 0 || p >= GR_TECH_MAX_PASSES || k < 0 || k >= GR_COST_N) return;
+    s->cost[p].v[k] = v;
+    if (queried) s->cost[p].queried |= 1u << k;
+    else s->cost[p].queried &= ~(1u << k);
+}
+
+void gr_technique_cost_total(const gr_technique_stats *s, gr_pass_cost *out)
+{
+    gr_pass_cost_clear(out);
+    for (int p = 0; p < s->n_passes && p < GR_TECH_MAX_PASSES; p++)
+        for (int k = 0; k < GR_COST_N; k++)
+            if (s->cost[p].v[k] >= 0) {
+                out->v[k] = (out->v[k] < 0 ? 0 : out->v[k]) + s->cost[p].v[k];
+                out->queried |= s->cost[p].queried & (1u << k);
+            }
+}
+
+void gr_pass_cost_text(const gr_pass_cost *c, char *buf, size_t n)
+{
+    size_t used = 0;
+    if (n) buf[0] = '\0';
+    for (int k = 0; k < GR_COST_N && used < n; k++) {
+        if (c->v[k] < 0) continue;
+        int w = snprintf(buf + used, n - used, "%s%s %lld%s", used ? ", " : "", cost_names[k], c->v[k],
+                         (c->queried & (1u << k)) ? "*" : "");
+        if (w < 0) break;
+        used += (size_t)w;
+    }
 }
 
 double gr_technique_stats_gpu_ms(const gr_technique_stats *s)
@@ -492,6 +553,35 @@ gr_status gr_technique_read_target(gr_technique *t, gr_image **out, gr_error *er
 }
 
 /* ---- metadata ------------------------------------------------------------------------- */
+
+/* "godrays:cost.PASS.COUNTER" for every counted figure, "godrays:cost.COUNTER" summed over the
+ * passes, "godrays:cost_queried" = "PASS.COUNTER ..." for those read from GL queries. */
+static gr_status cost_metadata(const gr_technique_stats *stats, gr_metadata *meta)
+{
+    char key[96], queried[512] = "";
+    gr_status st = GR_OK;
+    size_t used = 0;
+    for (int p = 0; p < stats->n_passes && p < GR_TECH_MAX_PASSES && st == GR_OK; p++)
+        for (int k = 0; k < GR_COST_N && st == GR_OK; k++) {
+            if (stats->cost[p].v[k] < 0) continue;
+            snprintf(key, sizeof key, "godrays:cost.%s.%s", stats->pass_names[p], cost_names[k]);
+            st = gr_meta_set_int(meta, key, stats->cost[p].v[k]);
+            if ((stats->cost[p].queried & (1u << k)) && used < sizeof queried) {
+                int w = snprintf(queried + used, sizeof queried - used, "%s%s.%s", used ? " " : "",
+                                 stats->pass_names[p], cost_names[k]);
+                if (w > 0) used += (size_t)w;
+            }
+        }
+    gr_pass_cost tot;
+    gr_technique_cost_total(stats, &tot);
+    for (int k = 0; k < GR_COST_N && st == GR_OK; k++) {
+        if (tot.v[k] < 0) continue;
+        snprintf(key, sizeof key, "godrays:cost.%s", cost_names[k]);
+        st = gr_meta_set_int(meta, key, tot.v[k]);
+    }
+    if (st == GR_OK && used > 0) st = gr_meta_set_string(meta, "godrays:cost_queried", queried);
+    return st;
+}
 
 gr_status gr_technique_metadata(const gr_technique *t, const gr_scene *scene, const void *settings,
                                 const gr_technique_stats *stats, gr_metadata *meta, gr_error *err)
@@ -556,6 +646,7 @@ gr_status gr_technique_metadata(const gr_technique *t, const gr_scene *scene, co
         CK(gr_meta_set_double(meta, "godrays:gpu_ms", gr_technique_stats_gpu_ms(stats)));
         CK(gr_meta_set_double(meta, "godrays:wall_ms", stats->wall_ms));
         CK(gr_meta_set_int(meta, "godrays:fragments", stats->fragments));
+        CK(cost_metadata(stats, meta));
     }
 #undef CK
     if (cls->metadata) return cls->metadata(t->state, scene, rs.bytes, stats, meta, err);

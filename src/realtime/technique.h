@@ -28,6 +28,26 @@
 #define GR_TECH_SETTINGS_MAX GR_SCENE_SECTION_BYTES /* bytes of one settings struct (1024), at most */
 #define GR_TECH_MAX GR_SCENE_MAX_SECTIONS           /* techniques in one registry (32, built-in + user) */
 
+/* What one pass did: the cost model a machine without a GPU can measure (docs/techniques.md,
+ * "Cost counters"). Each counter is either counted from what the pass draws or dispatches
+ * (analytic: a full-screen pass shades width x height fragments) or read from a GL query
+ * (bit k of `queried`): fragments from GL_SAMPLES_PASSED (fragments that reach the target:
+ * one discarded in the shader is not counted), primitives from GL_PRIMITIVES_GENERATED (what
+ * the vertex or geometry stage emitted, before clipping). -1: not counted. */
+enum {
+    GR_COST_FRAGMENTS = 0,  /* fragments shaded */
+    GR_COST_TAPS = 1,       /* texture taps (texture()/texelFetch()/imageLoad() calls executed) */
+    GR_COST_VERTICES = 2,   /* vertices submitted to draws (indices for an indexed draw) */
+    GR_COST_PRIMITIVES = 3, /* primitives emitted by the last vertex-processing stage */
+    GR_COST_BYTES = 4,      /* bytes written to render targets and images (blending: each write) */
+    GR_COST_INVOCATIONS = 5,/* compute-shader invocations */
+    GR_COST_N = 6
+};
+typedef struct gr_pass_cost {
+    long long v[GR_COST_N];
+    unsigned queried;       /* bit k: counter k came from a GL query, else analytic */
+} gr_pass_cost;
+
 /* What one render cost. Filled by the technique; -1 where a figure is unavailable. */
 typedef struct gr_technique_stats {
     int n_passes;
@@ -35,7 +55,25 @@ typedef struct gr_technique_stats {
     long long gpu_ns[GR_TECH_MAX_PASSES];    /* GL_TIME_ELAPSED of each pass; -1 if no timer */
     double wall_ms;                          /* wall time of the render call, readback included */
     long long fragments;                     /* fragments shaded in the main pass(es); -1 unknown */
+    gr_pass_cost cost[GR_TECH_MAX_PASSES];   /* per pass; every counter -1 until counted */
 } gr_technique_stats;
+
+/* ---- cost counters ---------------------------------------------------------------------- */
+
+/* "fragments", "taps", "vertices", "primitives", "bytes", "invocations" (k < GR_COST_N). */
+const char *gr_cost_name(int k);
+/* Every counter -1, none queried. */
+void gr_pass_cost_clear(gr_pass_cost *c);
+/* A full-screen pass (one triangle, 3 vertices) over a w x h target: w h fragments, each
+ * taking taps_per_px texture taps and writing bytes_per_px bytes; no compute. */
+gr_pass_cost gr_pass_cost_screen(long long w, long long h, long long taps_per_px, long long bytes_per_px);
+/* Sets counter k of pass p of stats to v, marking it queried or not (ignores p out of range). */
+void gr_technique_cost_set(gr_technique_stats *s, int p, int k, long long v, int queried);
+/* The sum over the passes of each counter (-1 where no pass counted it). */
+void gr_technique_cost_total(const gr_technique_stats *s, gr_pass_cost *out);
+/* "fragments 2073600, taps 8294400, ..." of a pass cost (counters not counted left out; a
+ * queried one marked with '*'), "" when nothing was counted. */
+void gr_pass_cost_text(const gr_pass_cost *c, char *buf, size_t n);
 
 /* Options of an instance; zero = defaults. */
 typedef struct gr_technique_options {
@@ -186,7 +224,8 @@ const gr_technique_class *gr_technique_class_of(const gr_technique *t);
 gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out,
                               gr_technique_stats *stats, gr_error *err);
 /* "godrays:technique", every setting (resolved, by name), GL strings, per-pass GPU ns, wall ms,
- * fragments, then the class's own keys. */
+ * fragments, the cost counters ("godrays:cost.PASS.COUNTER" per pass, "godrays:cost.COUNTER"
+ * summed, "godrays:cost_queried" naming the queried ones), then the class's own keys. */
 gr_status gr_technique_metadata(const gr_technique *t, const gr_scene *scene, const void *settings,
                                 const gr_technique_stats *stats, gr_metadata *meta, gr_error *err);
 /* Sum of the passes' GPU times in ms; -1 if none was timed. */

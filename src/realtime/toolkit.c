@@ -91,6 +91,7 @@ void gr_gl_timer_init(gr_gl_timer *t)
 {
     memset(t, 0, sizeof *t);
     glGenQueries(GR_GL_TIMER_PASSES, t->queries);
+    glGenQueries(GR_GL_TIMER_PASSES, t->prims);
     t->have_timer = 1; /* GL_TIME_ELAPSED is core since 3.3 */
 }
 
@@ -104,13 +105,22 @@ void gr_gl_timer_begin(gr_gl_timer *t, int pass)
 {
     if (pass < 0 || pass >= GR_GL_TIMER_PASSES || !t->have_timer) return;
     glBeginQuery(GL_TIME_ELAPSED, t->queries[pass]);
+    glBeginQuery(GL_PRIMITIVES_GENERATED, t->prims[pass]);
     if (pass + 1 > t->n) t->n = pass + 1;
     t->used |= 1u << pass;
 }
 
 void gr_gl_timer_end(gr_gl_timer *t)
 {
-    if (t->have_timer) glEndQuery(GL_TIME_ELAPSED);
+    if (!t->have_timer) return;
+    glEndQuery(GL_PRIMITIVES_GENERATED);
+    glEndQuery(GL_TIME_ELAPSED);
+}
+
+long long gr_gl_timer_primitives(gr_gl_timer *t, int pass)
+{
+    if (!t->have_timer || pass < 0 || pass >= t->n || !(t->used & (1u << pass))) return -1;
+    return gr_gl_query_result(t->prims[pass]);
 }
 
 long long gr_gl_query_result(unsigned query)
@@ -135,6 +145,7 @@ long long gr_gl_timer_ns_within(gr_gl_timer *t, int pass, double wall_ns)
 void gr_gl_timer_free(gr_gl_timer *t)
 {
     if (t->queries[0]) glDeleteQueries(GR_GL_TIMER_PASSES, t->queries);
+    if (t->prims[0]) glDeleteQueries(GR_GL_TIMER_PASSES, t->prims);
     memset(t, 0, sizeof *t);
 }
 
@@ -147,6 +158,11 @@ void gr_gl_timer_stats(gr_technique_stats *stats, gr_gl_timer *t, const char *co
     for (int p = 0; p < n; p++) {
         snprintf(stats->pass_names[p], sizeof stats->pass_names[p], "%s", names[p]);
         stats->gpu_ns[p] = gr_gl_timer_ns_within(t, p, wall_ns);
+    }
+    for (int p = 0; p < GR_TECH_MAX_PASSES; p++) gr_pass_cost_clear(&stats->cost[p]);
+    for (int p = 0; p < n; p++) {
+        long long prims = gr_gl_timer_primitives(t, p);
+        if (prims >= 0) gr_technique_cost_set(stats, p, GR_COST_PRIMITIVES, prims, 1);
     }
     stats->fragments = -1;
     stats->wall_ms = gr_clock_ms() - t0_ms;

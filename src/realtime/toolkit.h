@@ -45,9 +45,12 @@ void gr_target_accumulate(const gr_target *t);
 
 #define GR_GL_TIMER_PASSES 8
 
-/* GPU pass timing: begin/end around a pass; results collected after the frame. */
+/* GPU pass timing: begin/end around a pass; results collected after the frame. Each pass
+ * also counts its primitives (GL_PRIMITIVES_GENERATED, core since 3.0): the stats' queried
+ * primitive counter (technique.h, "cost counters"). */
 typedef struct gr_gl_timer {
     unsigned queries[GR_GL_TIMER_PASSES];
+    unsigned prims[GR_GL_TIMER_PASSES]; /* GL_PRIMITIVES_GENERATED per pass */
     int n, have_timer;
     unsigned used;      /* bit p: pass p was timed in this frame */
 } gr_gl_timer;
@@ -67,9 +70,12 @@ void gr_gl_timer_free(gr_gl_timer *t);            /* accepts one never initializ
 /* The result of a query object (GL_SAMPLES_PASSED, ...); waits for it. */
 long long gr_gl_query_result(unsigned query);
 
+/* Primitives pass `pass` generated (GL_PRIMITIVES_GENERATED); -1 if it was not timed. */
+long long gr_gl_timer_primitives(gr_gl_timer *t, int pass);
 /* Fills stats after a render that started at t0_ms (gr_clock_ms): n passes named names[p]
  * with t's times (gr_gl_timer_ns_within the wall time so far), fragments -1 (the caller sets
- * it), wall_ms the time since t0_ms. */
+ * it), each pass's cost counters -1 but its queried primitives (the caller counts the rest),
+ * wall_ms the time since t0_ms. */
 void gr_gl_timer_stats(gr_technique_stats *stats, gr_gl_timer *t, const char *const *names, int n, double t0_ms);
 
 #endif

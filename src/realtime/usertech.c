@@ -637,7 +637,8 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
         snprintf(names[slot++], 24, "eye_depth");
     }
 
-    int cleared[GR_UT_MAX_TARGETS] = {0};
+    int cleared[GR_UT_MAX_TARGETS] = {0}, cleared_by[GR_UT_MAX_PASSES] = {0};
+    const int first_pass_slot = slot;
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glDisable(GL_SCISSOR_TEST);
@@ -658,6 +659,7 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
             else glClearColor(0, 0, 0, 0);
             glClear(GL_COLOR_BUFFER_BIT);
             cleared[t] = 1;
+            cleared_by[p] = 1;
         }
         if (ps->blend == GR_UT_BLEND_NONE) {
             glDisable(GL_BLEND);
@@ -737,6 +739,24 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
         gr_gl_timer_stats(stats, &s->timer, pass_names, slot, t0);
         stats->fragments = 0;
         for (int p = 0; p < m->n_passes; p++) stats->fragments += s->samples[p];
+        /* cost counters (technique.h): the harness inputs' bytes (DEPTH32F shadow map, R32F eye
+         * depth); per pass the queried fragments, the vertices drawn, the bytes of its clear
+         * and of one texel per fragment; taps are the user's shader's (not counted) */
+        for (int k = 0; k < first_pass_slot; k++) {
+            long long side = strcmp(names[k], "shadow_map") == 0 ? s->shadow_size : 0;
+            gr_technique_cost_set(stats, k, GR_COST_BYTES, side > 0 ? side * side * 4 : (long long)W * H * 4, 0);
+            gr_technique_cost_set(stats, k, GR_COST_TAPS, 0, 0);
+            gr_technique_cost_set(stats, k, GR_COST_INVOCATIONS, 0, 0);
+        }
+        static const int bpp[] = {4, 8, 16};
+        for (int p = 0; p < m->n_passes; p++) {
+            const int k = first_pass_slot + p, t = m->passes[p].target, b = bpp[m->targets[t].format];
+            gr_technique_cost_set(stats, k, GR_COST_FRAGMENTS, s->samples[p], 1);
+            gr_technique_cost_set(stats, k, GR_COST_VERTICES, nv[p] * ni[p], 0);
+            gr_technique_cost_set(stats, k, GR_COST_BYTES,
+                                  (cleared_by[p] ? (long long)tw[t] * th[t] * b : 0) + s->samples[p] * b, 0);
+            gr_technique_cost_set(stats, k, GR_COST_INVOCATIONS, 0, 0);
+        }
         stats->wall_ms = gr_clock_ms() - t0;
     }
     st = GR_OK;

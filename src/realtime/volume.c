@@ -204,6 +204,7 @@ gr_status gr_vol_prepare(const char *name, gr_vol_base *b, const gr_scene *scene
         st = gr_scenegl_shadow_map(sg, scene, f, s->shadow_map_size, f->eye, s->shadow_extent_m, &in->shadow_tex,
                                    in->light_vp, err);
         gr_gl_timer_end(timer);
+        p->shadow_size = s->shadow_map_size;
         if (st != GR_OK) return st;
     } else {
         for (int i = 0; i < 16; i++) in->light_vp[i] = i % 5 == 0;
@@ -241,9 +242,40 @@ gr_status gr_vol_finish(const char *name, gr_vol_base *b, const gr_vol_prep *p, 
     if (stats) {
         gr_gl_timer_stats(stats, &b->timer, names, n, p->t0_ms);
         if (b->q_samples) stats->fragments = gr_gl_query_result(b->q_samples);
+        gr_vol_cost_prelude(b, p, stats);
         stats->wall_ms = gr_clock_ms() - p->t0_ms;
     }
     return gr_image_check_finite(out, name, err);
+}
+
+void gr_vol_cost_pass(gr_technique_stats *stats, int p, const gr_pass_cost *c)
+{
+    if (p < 0 || p >= stats->n_passes) return;
+    gr_pass_cost m = *c;
+    const gr_pass_cost *q = &stats->cost[p];
+    if ((q->queried & (1u << GR_COST_PRIMITIVES)) && !(m.queried & (1u << GR_COST_PRIMITIVES))) {
+        m.v[GR_COST_PRIMITIVES] = q->v[GR_COST_PRIMITIVES];
+        m.queried |= 1u << GR_COST_PRIMITIVES;
+    }
+    stats->cost[p] = m;
+}
+
+void gr_vol_cost_prelude(const gr_vol_base *b, const gr_vol_prep *p, gr_technique_stats *stats)
+{
+    gr_pass_cost c;
+    gr_pass_cost_clear(&c);
+    c.v[GR_COST_TAPS] = 0;
+    c.v[GR_COST_INVOCATIONS] = 0;
+    if (p->shadow_size > 0) {
+        c.v[GR_COST_BYTES] = (long long)p->shadow_size * p->shadow_size * 4;
+        gr_vol_cost_pass(stats, GR_VOL_PASS_SHADOW, &c);
+    }
+    c.v[GR_COST_BYTES] = (long long)p->frame.width * p->frame.height * 4;
+    gr_vol_cost_pass(stats, GR_VOL_PASS_DEPTH, &c);
+    if (b->caus) {
+        gr_caustics_cost(b->caus, &c);
+        gr_vol_cost_pass(stats, GR_VOL_PASS_CAUSTICS, &c);
+    }
 }
 
 gr_status gr_vol_check(const char *name, const gr_vol_settings *s, gr_error *err)

@@ -111,6 +111,7 @@ typedef struct gr_vol_prep {
     unsigned depth_tex;          /* gr_scenegl_eye_depth at the frame's size */
     double t_max;                /* gr_vol_t_max */
     double t0_ms;                /* when the render started (for the wall time) */
+    int shadow_size;             /* the shadow map's side; 0: none drawn (no occluders) */
 } gr_vol_prep;
 
 /* The waves for volume_surface.glsl (u_wa, u_wamp; GR_MAX_WAVES each): per wave (dir.x,
@@ -150,10 +151,17 @@ void gr_vol_base_release(gr_vol_base *b);
 gr_status gr_vol_prepare(const char *name, gr_vol_base *b, const gr_scene *scene, const gr_vol_settings *s,
                          const gr_image *out, gr_vol_prep *p, gr_error *err);
 /* The end of a volume technique's render: b->out read back into out's R, G, B; stats (may be
- * NULL) filled with the n passes of b's timer named by names, the samples of b's query and
- * the wall time since p->t0_ms; then out checked for NaN and Inf (GR_E_RUNTIME). */
+ * NULL) filled with the n passes of b's timer named by names, the samples of b's query, the
+ * prelude passes' cost counters (gr_vol_cost_prelude) and the wall time since p->t0_ms; then
+ * out checked for NaN and Inf (GR_E_RUNTIME). The technique counts its own passes after. */
 gr_status gr_vol_finish(const char *name, gr_vol_base *b, const gr_vol_prep *p, gr_image *out,
                         const char *const *names, int n, gr_technique_stats *stats, gr_error *err);
+
+/* The cost counters (technique.h) of the prelude's passes: shadow map (DEPTH32F, the side
+ * squared), eye depth (R32F at the frame's size), the caustic stack's (gr_caustics_cost). */
+void gr_vol_cost_prelude(const gr_vol_base *b, const gr_vol_prep *p, gr_technique_stats *stats);
+/* Counter k of pass p set analytically, keeping the pass's queried primitives. */
+void gr_vol_cost_pass(gr_technique_stats *stats, int p, const gr_pass_cost *c);
 
 /* Checks of the shared block across its settings (`name` is the technique's section):
  * caustic_last_m >= caustic_first_m. The table's ranges are checked by technique.c. */

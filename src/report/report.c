@@ -892,6 +892,85 @@ static void leaderboard_json(const ctx *c, cJSON *root, int *ok)
     jadd(ld, "envelope", jarr(b->envelope, b->n_ladder), ok);
 }
 
+/* ---- cost counters (written by realtime/technique.c as EXR metadata) ------------------------ */
+
+/* Calls fn(pass, user) for each pass named in "godrays:passes", then fn(NULL, user) (the sum). */
+static void cost_each_pass(const gr_metadata *m, void (*fn)(const gr_metadata *, const char *, void *), void *user)
+{
+    const char *p = meta_str(m, "godrays:passes");
+    char pname[64];
+    while (p && *p) {
+        size_t n = strcspn(p, " ");
+        snprintf(pname, sizeof pname, "%.*s", (int)(n < sizeof pname - 1 ? n : sizeof pname - 1), p);
+        fn(m, pname, user);
+        p += n;
+        while (*p == ' ') p++;
+    }
+    fn(m, NULL, user);
+}
+
+/* The counter's name when item is one of pass's ("godrays:cost.PASS.NAME"; pass NULL: the sums,
+ * "godrays:cost.NAME"), else NULL. */
+static const char *cost_key(const gr_meta_item *it, const char *pass)
+{
+    static const char pre[] = "godrays:cost.";
+    if (it->type == GR_META_STRING || strncmp(it->key, pre, sizeof pre - 1) != 0) return NULL;
+    const char *rest = it->key + sizeof pre - 1;
+    if (!pass) return strchr(rest, '.') ? NULL : rest;
+    size_t n = strlen(pass);
+    return strncmp(rest, pass, n) == 0 && rest[n] == '.' ? rest + n + 1 : NULL;
+}
+
+static void cost_json_pass(const gr_metadata *m, const char *pass, void *user)
+{
+    cJSON *o = cJSON_CreateObject();
+    int ok = o != NULL, any = 0;
+    for (int i = 0; m && i < m->count; i++) {
+        const char *name = cost_key(&m->items[i], pass);
+        if (!name) continue;
+        jnum(o, name, m->items[i].num, &ok);
+        any = 1;
+    }
+    if (!any) {
+        cJSON_Delete(o);
+        return;
+    }
+    jadd(user, pass ? pass : "total", o, &ok);
+}
+
+/* {"PASS": {"fragments": ..., ...}, ..., "total": {...}, "queried": "PASS.COUNTER ..."}; NULL
+ * when nothing was counted. */
+static cJSON *cost_json(const gr_metadata *m)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o) return NULL;
+    cost_each_pass(m, cost_json_pass, o);
+    if (!cJSON_GetArraySize(o)) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    int ok = 1;
+    jstr(o, "queried", meta_str(m, "godrays:cost_queried"), &ok);
+    return o;
+}
+
+static void cost_text_pass(const gr_metadata *m, const char *pass, void *user)
+{
+    gr_strbuf *b = user;
+    int first = 1;
+    for (int i = 0; m && i < m->count; i++) {
+        const char *name = cost_key(&m->items[i], pass);
+        if (!name) continue;
+        if (first) gr_sb_printf(b, "%s: ", pass ? pass : "all passes");
+        gr_sb_printf(b, "%s%s %.0f", first ? "" : ", ", name, m->items[i].num);
+        first = 0;
+    }
+    if (!first) gr_sb_puts(b, "\n");
+}
+
+/* One line per pass ("PASS: fragments N, taps N, ...") and the sum: the leaderboard's tooltip. */
+static void cost_text(const gr_metadata *m, gr_strbuf *b) { cost_each_pass(m, cost_text_pass, b); }
+
 /* One technique's entry of metrics.json. */
 static cJSON *technique_json(const ctx *c, int k, int rank)
 {
@@ -908,6 +987,8 @@ static cJSON *technique_json(const ctx *c, int k, int rank)
     jnum(o, "seconds_this_run", t->seconds >= 0 ? t->seconds : NAN, &ok);
     jnum(o, "gpu_ms", tc->gpu_ms, &ok);
     jnum(o, "wall_ms", tc->wall_ms, &ok);
+    cJSON *cost = cost_json(t->meta);
+    if (cost) jadd(o, "cost", cost, &ok); /* per-pass cost counters (docs/techniques.md) */
     jnum(o, "fit_scale", tc->a, &ok);
     const gr_lb_row *row = gr_lb_technique_row(&c->lb, k);
     if (row) { /* the verdict, its components, the equivalent blur and the flag */
@@ -1256,7 +1337,14 @@ static void html_leaderboard_row(gr_strbuf *b, const ctx *c, const gr_lb_row *r,
     if (r->kind == GR_LB_TECHNIQUE) {
         const tctx *tc = &c->t[r->index];
         const double w[3] = {tc->gpu_ms, tc->wall_ms, tc->t->seconds >= 0 ? tc->t->seconds : NAN};
-        for (int i = 0; i < 3; i++) gr_sb_printf(b, "<td>%s</td>", fmt(w[i], t, sizeof t));
+        gr_strbuf tip; /* the cost counters per pass as the GPU time's tooltip */
+        gr_sb_init(&tip);
+        cost_text(tc->t->meta, &tip);
+        gr_sb_puts(b, "<td title=\"");
+        gr_sb_html(b, gr_sb_str(&tip));
+        gr_sb_printf(b, "\">%s</td>", fmt(w[0], t, sizeof t));
+        gr_sb_free(&tip);
+        for (int i = 1; i < 3; i++) gr_sb_printf(b, "<td>%s</td>", fmt(w[i], t, sizeof t));
     } else {
         gr_sb_puts(b, "<td></td><td></td><td></td>");
     }

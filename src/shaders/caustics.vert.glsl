@@ -1,5 +1,6 @@
 // Caustic texture (seed 002), vertex stage: one vertex of the water grid over the patch, from
-// gl_VertexID (6 per cell, two triangles). Displaced by seed 000 eq. 5.5.7, unit normal from
+// gl_VertexID = the grid vertex i + j (grid + 1) (an indexed draw: 6 indices per cell, two
+// triangles, so the post-transform cache shades a shared vertex once instead of six times). Displaced by seed 000 eq. 5.5.7, unit normal from
 // the analytic tangents (eq. 5.5.8), the sun refracted (eq. 5.5.1, air 1.0 / water n) and the
 // exact Fresnel transmittance (docs/optics.md). Positions are patch-local (metres from the
 // patch corner, y from the rest height).
@@ -15,9 +16,7 @@ out float v_ft;
 
 void main()
 {
-    const ivec2 corner[6] = ivec2[6](ivec2(0, 0), ivec2(1, 0), ivec2(1, 1), ivec2(0, 0), ivec2(1, 1), ivec2(0, 1));
-    int cell = gl_VertexID / 6, k = gl_VertexID % 6;
-    ivec2 ij = ivec2(cell % u_grid, cell / u_grid) + corner[k];
+    ivec2 ij = ivec2(gl_VertexID % (u_grid + 1), gl_VertexID / (u_grid + 1));
     float h = u_L / float(u_grid);
     vec2 x0 = vec2(ij) * h;
     vec3 p = vec3(x0.x, 0.0, x0.y);
