@@ -18,6 +18,9 @@
  *     phase);
  *  C. the default 8-pixel tiles: a wider spread than B (the phase is evaluated once per froxel,
  *     8 x 8 pixels, and interpolated: the residual that tile_size controls).
+ * GODRAYS_TEST_REDUCED=1 (CI; the test is labelled slow): A and B only (Blender's start and
+ * shader compilation dominate, so a smaller frame saves little and at 64 x 36 the 2-pixel
+ * froxels span twice the angle: B's band then reaches 0.70-1.26).
  * Blender absent: the test says so and passes (`godrays techniques` shows eevee unavailable;
  * test_eevee_unavailable.sh checks that path). */
 #include <math.h>
@@ -151,6 +154,8 @@ int main(void)
         printf("eevee unavailable here (%s): nothing to check\n", why);
         return 0;
     }
+    const char *red = getenv("GODRAYS_TEST_REDUCED");
+    const int reduced = red && red[0] && strcmp(red, "0") != 0;
     gr_scene *s = malloc(sizeof *s);
     const char *sets[2] = {"camera.width=96", "camera.height=54"};
     if (!s) return 1;
@@ -168,6 +173,11 @@ int main(void)
     for (int ch = 0; ch < 3; ch++) CHECK_NEAR(b.mean_ratio[ch], 1.0, 0.12);
     CHECK(b.p05 >= 0.75 && b.p95 <= 1.25);
     /* C: default tiles */
+    if (reduced) {
+        gr_technique_destroy(t);
+        free(s);
+        CHECK_DONE();
+    }
     stats c = run_case(t, s, "C default tiles", "end_m=20,difference=false", 1, &off);
     CHECK(c.p95 - c.p05 > b.p95 - b.p05);
     CHECK(c.rel_rmse > b.rel_rmse);
