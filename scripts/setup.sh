@@ -26,6 +26,9 @@ GODRAYS_PACKAGES=(
   # Blender round trip of the glTF export (tests/cli/test_export_blender.sh); its glTF
   # importer needs NumPy, only a Recommends of blender
   blender python3-numpy
+  # an X server for Blender's Eevee (the eevee technique, docs/engines.md section 5): xvfb-run
+  # needs xauth, only a Recommends of xvfb
+  xvfb xauth
   # a single-node Slurm cluster for the farm test (tests/farm/test_slurm.sh, docs/farm.md)
   slurm-wlm munge
   # libFuzzer targets (tests/fuzz, scripts/fuzz.sh): clang and its fuzzer runtime

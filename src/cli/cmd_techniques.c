@@ -109,6 +109,11 @@ static int print_json(void)
         cJSON_AddStringToObject(t, "name", c->name);
         cJSON_AddStringToObject(t, "description", c->description ? c->description : "");
         cJSON_AddStringToObject(t, "origin", c->origin ? c->origin : "built-in");
+        char why[512];
+        int avail = gr_technique_available(c, why, sizeof why);
+        cJSON_AddBoolToObject(t, "available", avail);
+        if (!avail) cJSON_AddStringToObject(t, "unavailable_reason", why);
+        cJSON_AddBoolToObject(t, "by_name_only", c->by_name_only != 0);
         if (c->gain_key) cJSON_AddStringToObject(t, "gain_key", c->gain_key);
         else cJSON_AddNullToObject(t, "gain_key");
         cJSON *ld = cJSON_AddArrayToObject(t, "ladder"); /* pareto's speed/quality levels */
@@ -147,6 +152,9 @@ static void print_text(void)
         const gr_technique_class *c = gr_technique_at(i);
         printf("%s%s  (%s)\n  %s\n", i ? "\n" : "", c->name, c->origin ? c->origin : "built-in",
                c->description ? c->description : "");
+        char why[512];
+        if (!gr_technique_available(c, why, sizeof why)) printf("  unavailable here: %s\n", why);
+        if (c->by_name_only) printf("  not in the default list of run/pareto: runs when named\n");
         int kw = 24; /* the key column fits the longest NAME.KEY */
         for (size_t k = 0; k < c->params->count; k++) {
             int w = (int)(strlen(c->name) + 1 + strlen(c->params->params[k].name));

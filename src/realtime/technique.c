@@ -16,6 +16,7 @@
 #include "realtime/slicing.h"
 #include "realtime/froxel.h"
 #include "realtime/lightrays.h"
+#include "realtime/eevee.h"
 
 static const gr_technique_class *const builtins[] = {
     &gr_shafts_class,
@@ -24,6 +25,7 @@ static const gr_technique_class *const builtins[] = {
     &gr_slicing_class,
     &gr_froxel_class,
     &gr_light_rays_class,
+    &gr_eevee_class,
 };
 
 /* ---- registry ------------------------------------------------------------------------- */
@@ -142,8 +144,10 @@ gr_status gr_technique_parse_list(const char *flag, const char *list, const gr_t
 {
     ensure_builtins();
     *n = 0;
+    char why[512];
     if (!list || !list[0]) {
-        for (int i = 0; i < n_classes && *n < max; i++) out[(*n)++] = classes[i];
+        for (int i = 0; i < n_classes && *n < max; i++)
+            if (!classes[i]->by_name_only && gr_technique_available(classes[i], why, sizeof why)) out[(*n)++] = classes[i];
         return GR_OK;
     }
     const char *p = list;
@@ -161,12 +165,20 @@ gr_status gr_technique_parse_list(const char *flag, const char *list, const gr_t
         }
         for (int i = 0; i < *n; i++)
             if (out[i] == c) return gr_fail(err, GR_E_USAGE, "%s %s: technique '%s' given twice", flag, list, name);
+        if (!gr_technique_available(c, why, sizeof why))
+            return gr_fail(err, GR_E_USAGE, "%s %s: technique '%s' is unavailable here: %s", flag, list, name, why);
         if (*n >= max) return gr_fail(err, GR_E_USAGE, "%s %s: more than %d techniques", flag, list, max);
         out[(*n)++] = c;
         if (!e) break;
         p = e + 1;
     }
     return GR_OK;
+}
+
+int gr_technique_available(const gr_technique_class *cls, char *why, size_t n)
+{
+    if (n) why[0] = '\0';
+    return !cls->available || cls->available(cls, why, n);
 }
 
 /* ---- settings ------------------------------------------------------------------------- */

@@ -107,6 +107,13 @@ struct gr_technique_class {
     /* The settings `godrays tune` tunes when --params is not given, "KEY,KEY,..." (NULL: every
      * setting with a tuning box except gain_key). */
     const char *tune_keys;
+    /* 1: left out of gr_technique_parse_list's default list (every technique): a slow technique
+     * that runs only when named (eevee: Blender as a child process). */
+    int by_name_only;
+    /* May be NULL (always available). Else 1, or 0 with the reason in why (naming the missing
+     * program): an unavailable class is listed by `godrays techniques` with its reason, left
+     * out of the default list and refused when named (GR_E_USAGE, exit 2). */
+    int (*available)(const gr_technique_class *cls, char *why, size_t n);
 
     /* Checks across settings beyond each one's range (e.g. N >= 2 and a target that fits).
      * May be NULL. Errors name "NAME.KEY" and the reason (GR_E_INPUT). Called only by
@@ -162,10 +169,14 @@ gr_status gr_technique_register(const gr_technique_class *cls, gr_error *err);
 /* Loads the user technique in dir (its manifest.json, docs/techniques.md) and registers it
  * under the manifest's name. A bad manifest is GR_E_INPUT naming the file and JSON path. */
 gr_status gr_technique_add_dir(const char *dir, gr_error *err);
-/* "shafts,radial_blur,..." -> classes; GR_E_USAGE naming flag and the unknown name.
- * NULL or "" -> every registered technique. Returns the count in *n. */
+/* "shafts,radial_blur,..." -> classes; GR_E_USAGE naming flag and the unknown name, or the
+ * unavailable technique and why. NULL or "" -> every registered technique that is available
+ * and not by_name_only. Returns the count in *n. */
 gr_status gr_technique_parse_list(const char *flag, const char *list, const gr_technique_class **out,
                                   int max, int *n, gr_error *err);
+
+/* 1 if cls can run here (its available callback, or none); else 0 with the reason in why. */
+int gr_technique_available(const gr_technique_class *cls, char *why, size_t n);
 
 /* The scene's settings of a technique (as loaded and overridden; the loader already resolved
  * scene-derived defaults by each descriptor's scene_source, a NaN set later stays NaN until
