@@ -6,6 +6,8 @@
 #include <string.h>
 
 #include "core/optics.h"
+#include "reference/phase.h"
+#include "reference/pool.h"
 
 /* ---- the sun-disc kernel ----
  * In the kernel's own coordinates c (x = p + d M c) the disc of directions is the unit
@@ -520,19 +522,37 @@ static void grid_range(const gr_beams *b, const float *bx, int lo[3], int hi[3])
     }
 }
 
-/* Runs fn on n jobs (each `size` bytes apart), job 0 on the calling thread and the others on
- * their own threads (serially if a thread cannot be started: the same result). */
-#define GRID_MAX_THREADS 64
-static void run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n)
+typedef struct job_call {
+    void *(*fn)(void *);
+    void *arg;
+    double t0, t1;
+} job_call;
+
+static void *job_main(void *arg)
+{
+    job_call *c = arg;
+    c->t0 = gr_ref_mono_s();
+    c->fn(c->arg);
+    c->t1 = gr_ref_mono_s();
+    return NULL;
+}
+
+double gr_beams_run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n)
 {
     pthread_t th[GRID_MAX_THREADS];
+    job_call call[GRID_MAX_THREADS];
     int started[GRID_MAX_THREADS] = {0};
-    for (int i = 1; i < n; i++) started[i] = pthread_create(&th[i], NULL, fn, (char *)jobs + (size_t)i * size) == 0;
-    fn(jobs);
+    if (n > GRID_MAX_THREADS) n = GRID_MAX_THREADS;
+    for (int i = 0; i < n; i++) call[i] = (job_call){fn, (char *)jobs + (size_t)i * size, 0.0, 0.0};
+    for (int i = 1; i < n; i++) started[i] = pthread_create(&th[i], NULL, job_main, &call[i]) == 0;
+    job_main(&call[0]);
     for (int i = 1; i < n; i++) {
         if (started[i]) pthread_join(th[i], NULL);
-        else fn((char *)jobs + (size_t)i * size);
+        else job_main(&call[i]);
     }
+    double a[GRID_MAX_THREADS], b[GRID_MAX_THREADS];
+    for (int i = 0; i < n; i++) { a[i] = call[i].t0; b[i] = call[i].t1; }
+    return gr_ref_overlap_s(a, b, n);
 }
 
 typedef struct grid_job {
@@ -625,7 +645,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
             jobs[i].w1 = (int)((long)b->gn[2] * (i + 1) / nt);
             jobs[i].fill = 0;
         }
-        run_jobs(grid_work, jobs, sizeof jobs[0], nt);
+        b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
         size_t total = 0; /* in size_t: an attempt far over the budget must not wrap the lists' uint32 */
         for (size_t c = 0; c < ncells && (double)total <= budget; c++) {
             total += b->cell_first[c + 1];
@@ -641,7 +661,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     /* fill, each cell by one worker in primitive order (deterministic): cell_first[c] runs
      * ahead as the cursor while filling, restored below */
     for (int i = 0; i < nt; i++) jobs[i].fill = 1;
-    run_jobs(grid_work, jobs, sizeof jobs[0], nt);
+    b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
     for (size_t c = ncells; c > 0; c--) b->cell_first[c] = b->cell_first[c - 1];
     b->cell_first[0] = 0;
     /* the 16-bit boxes; the float ones are no longer needed */
@@ -684,6 +704,6 @@ gr_status gr_beams_index(gr_beams *b, uint32_t np, int threads, gr_error *err)
         jobs[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nt);
         jobs[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nt);
     }
-    run_jobs(box_work, jobs, sizeof jobs[0], nt);
+    b->stats.par_s += gr_beams_run_jobs(box_work, jobs, sizeof jobs[0], nt);
     return build_grid(b, np, threads, err);
 }

@@ -279,9 +279,45 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     return st;
 }
 
+/* The render's phases (reference/phase.h), the statistics' own included: into the result and
+ * the metadata (godrays:phase.NAME.wall_s, .cpu_s, .serial_s; godrays:serial_s, serial_fraction).
+ * Nothing when not measured (assembled parts). */
+static gr_status record_phases(gr_ref_renderer *r, gr_ref_result *out)
+{
+    if (!r->phases.on) return GR_OK;
+    gr_ref_phases_switch(&r->phases, REF_PH_OTHER);
+    gr_metadata *m = &out->meta;
+    gr_status st = GR_OK;
+    double wall = 0.0, serial = 0.0, cpu = 0.0;
+    char key[64];
+    out->phases = 1;
+    for (int i = 0; i < REF_PH_COUNT; i++) {
+        double w = r->phases.wall_s[i], s = fmax(0.0, w - r->phases.par_s[i]);
+        out->phase_wall_s[i] = w;
+        out->phase_cpu_s[i] = r->phases.cpu_s[i];
+        out->phase_serial_s[i] = s;
+        wall += w;
+        serial += s;
+        cpu += r->phases.cpu_s[i];
+        snprintf(key, sizeof key, "godrays:phase.%s.wall_s", gr_ref_phase_names[i]);
+        if (st == GR_OK) st = gr_meta_set_double(m, key, w);
+        snprintf(key, sizeof key, "godrays:phase.%s.cpu_s", gr_ref_phase_names[i]);
+        if (st == GR_OK) st = gr_meta_set_double(m, key, r->phases.cpu_s[i]);
+        snprintf(key, sizeof key, "godrays:phase.%s.serial_s", gr_ref_phase_names[i]);
+        if (st == GR_OK) st = gr_meta_set_double(m, key, s);
+    }
+    out->serial_frac = wall > 0.0 ? serial / wall : 0.0;
+    if (st == GR_OK) st = gr_meta_set_double(m, "godrays:phases_wall_s", wall);
+    if (st == GR_OK) st = gr_meta_set_double(m, "godrays:phases_cpu_s", cpu);
+    if (st == GR_OK) st = gr_meta_set_double(m, "godrays:serial_s", serial);
+    if (st == GR_OK) st = gr_meta_set_double(m, "godrays:serial_fraction", out->serial_frac);
+    return st;
+}
+
 gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_march_totals *tot, double wall_s,
                         gr_ref_result *out, gr_error *err)
 {
+    gr_ref_phases_switch(&r->phases, REF_PH_STATS);
     size_t np = (size_t)acc->W * acc->H;
     int P = r->passes_per_round;
     ref_errors e;
@@ -321,5 +357,5 @@ gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_marc
     gr_meta_set_double(&out->meta, "godrays:shadow_rays_per_s", out->shadow_rays_per_s);
     /* the most beams at one march point (the list grows; -1: not carried through parts) */
     gr_meta_set_int(&out->meta, "godrays:beam_max_hits", tot->max_hits);
-    return GR_OK;
+    return record_phases(r, out) == GR_OK ? GR_OK : gr_fail(err, GR_E_NOMEM, "reference: out of memory for metadata");
 }
