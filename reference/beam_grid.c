@@ -594,17 +594,84 @@ static void *box_work(void *arg)
     return NULL;
 }
 
+/* The boxes' bounds and summed extents over BOUND_CHUNKS fixed chunks of the primitives (the
+ * same chunks and the same order of summation for any number of threads: the same grid) */
+enum { BOUND_CHUNKS = 64 };
+typedef struct bound_job {
+    const gr_beams *b;
+    uint32_t np;
+    int c0, c1;                              /* chunks */
+    double lo[BOUND_CHUNKS][3], hi[BOUND_CHUNKS][3], ext[BOUND_CHUNKS][3];
+} bound_job;
+
+static void *bound_work(void *arg)
+{
+    bound_job *j = arg;
+    for (int ck = j->c0; ck < j->c1; ck++) {
+        uint32_t k0 = (uint32_t)((uint64_t)j->np * (uint64_t)ck / BOUND_CHUNKS);
+        uint32_t k1 = (uint32_t)((uint64_t)j->np * (uint64_t)(ck + 1) / BOUND_CHUNKS);
+        double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
+        for (uint32_t k = k0; k < k1; k++) {
+            const float *bx = j->b->box + 6 * (size_t)k;
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fmin(lo[a], bx[a]);
+                hi[a] = fmax(hi[a], bx[3 + a]);
+                ext[a] += (double)bx[3 + a] - bx[a];
+            }
+        }
+        for (int a = 0; a < 3; a++) { j->lo[ck][a] = lo[a]; j->hi[ck][a] = hi[a]; j->ext[ck][a] = ext[a]; }
+    }
+    return NULL;
+}
+
+/* The 16-bit boxes of primitives [k0, k1) (the job's range) */
+typedef struct quant_job {
+    gr_beams *b;
+    uint32_t k0, k1;
+    double qunit[3];
+} quant_job;
+
+static void *quant_work(void *arg)
+{
+    quant_job *j = arg;
+    gr_beams *b = j->b;
+    for (uint32_t k = j->k0; k < j->k1; k++) {
+        const float *bx = b->box + 6 * (size_t)k;
+        uint16_t *q = b->qbox[k].q;
+        b->qbox[k].tri = b->prim_tri[k];
+        for (int a = 0; a < 3; a++) {
+            double l = floor(((double)bx[a] - (double)b->q0[a]) / j->qunit[a]) - 1.0;
+            double h = ceil(((double)bx[3 + a] - (double)b->q0[a]) / j->qunit[a]) + 1.0;
+            q[a] = (uint16_t)(l < 0.0 ? 0.0 : l > 65535.0 ? 65535.0 : l);
+            q[3 + a] = (uint16_t)(h < 0.0 ? 0.0 : h > 65535.0 ? 65535.0 : h);
+        }
+    }
+    return NULL;
+}
+
 static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err)
 {
     if (np == 0) return GR_OK;
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
-    for (uint32_t k = 0; k < np; k++) {
-        const float *bx = b->box + 6 * (size_t)k;
-        for (int a = 0; a < 3; a++) {
-            lo[a] = fmin(lo[a], bx[a]);
-            hi[a] = fmax(hi[a], bx[3 + a]);
-            ext[a] += (double)bx[3 + a] - bx[a];
+    {
+        int nb = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+        bound_job *bj = malloc((size_t)nb * sizeof *bj);
+        if (!bj) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid");
+        for (int i = 0; i < nb; i++) {
+            bj[i].b = b;
+            bj[i].np = np;
+            bj[i].c0 = BOUND_CHUNKS * i / nb;
+            bj[i].c1 = BOUND_CHUNKS * (i + 1) / nb;
         }
+        b->stats.par_s += gr_beams_run_jobs(bound_work, bj, sizeof bj[0], nb);
+        for (int i = 0; i < nb; i++)
+            for (int ck = bj[i].c0; ck < bj[i].c1; ck++)
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = fmin(lo[a], bj[i].lo[ck][a]);
+                    hi[a] = fmax(hi[a], bj[i].hi[ck][a]);
+                    ext[a] += bj[i].ext[ck][a];
+                }
+        free(bj);
     }
     double cell[3];
     for (int a = 0; a < 3; a++) {
@@ -674,16 +741,16 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         b->q0[a] = (float)lo[a];
         b->qinv[a] = (float)(1.0 / qunit[a]);
     }
-    for (uint32_t k = 0; k < np; k++) {
-        const float *bx = b->box + 6 * (size_t)k;
-        uint16_t *q = b->qbox[k].q;
-        b->qbox[k].tri = b->prim_tri[k];
-        for (int a = 0; a < 3; a++) {
-            double l = floor(((double)bx[a] - (double)b->q0[a]) / qunit[a]) - 1.0;
-            double h = ceil(((double)bx[3 + a] - (double)b->q0[a]) / qunit[a]) + 1.0;
-            q[a] = (uint16_t)(l < 0.0 ? 0.0 : l > 65535.0 ? 65535.0 : l);
-            q[3 + a] = (uint16_t)(h < 0.0 ? 0.0 : h > 65535.0 ? 65535.0 : h);
+    {
+        quant_job qj[GRID_MAX_THREADS];
+        int nq = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+        for (int i = 0; i < nq; i++) {
+            qj[i].b = b;
+            qj[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nq);
+            qj[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nq);
+            for (int a = 0; a < 3; a++) qj[i].qunit[a] = qunit[a];
         }
+        b->stats.par_s += gr_beams_run_jobs(quant_work, qj, sizeof qj[0], nq);
     }
     free(b->box);
     b->box = NULL;

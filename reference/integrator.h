@@ -67,6 +67,8 @@ typedef struct gr_ref_result {
     double rel_se_mean;     /* relative standard error of the image mean (mean of RGB) */
     double rel_se_p95;      /* relative standard error of the 95th-percentile pixel value */
     double frac_se_1pct;    /* fraction of pixels whose standard error <= 1% of max(pixel, mean) */
+    double block8_rel_se_max; /* 8x8 blocks: the largest standard error of a block mean over max(block
+                               mean, image mean), worst channel (-1: none) */
     double preview_exposure;/* exposure that maps the 99th percentile to 0.8 in the preview */
     double queries_per_s;   /* beam lookups (or closed-form evaluations) per second, all threads */
     double shadow_rays_per_s;
