@@ -6,6 +6,8 @@
 #include <string.h>
 
 #include "core/optics.h"
+#include "reference/phase.h"
+#include "reference/pool.h"
 
 /* ---- the sun-disc kernel ----
  * In the kernel's own coordinates c (x = p + d M c) the disc of directions is the unit
@@ -520,19 +522,37 @@ static void grid_range(const gr_beams *b, const float *bx, int lo[3], int hi[3])
     }
 }
 
-/* Runs fn on n jobs (each `size` bytes apart), job 0 on the calling thread and the others on
- * their own threads (serially if a thread cannot be started: the same result). */
-#define GRID_MAX_THREADS 64
-static void run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n)
+typedef struct job_call {
+    void *(*fn)(void *);
+    void *arg;
+    double t0, t1;
+} job_call;
+
+static void *job_main(void *arg)
+{
+    job_call *c = arg;
+    c->t0 = gr_ref_mono_s();
+    c->fn(c->arg);
+    c->t1 = gr_ref_mono_s();
+    return NULL;
+}
+
+double gr_beams_run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n)
 {
     pthread_t th[GRID_MAX_THREADS];
+    job_call call[GRID_MAX_THREADS];
     int started[GRID_MAX_THREADS] = {0};
-    for (int i = 1; i < n; i++) started[i] = pthread_create(&th[i], NULL, fn, (char *)jobs + (size_t)i * size) == 0;
-    fn(jobs);
+    if (n > GRID_MAX_THREADS) n = GRID_MAX_THREADS;
+    for (int i = 0; i < n; i++) call[i] = (job_call){fn, (char *)jobs + (size_t)i * size, 0.0, 0.0};
+    for (int i = 1; i < n; i++) started[i] = pthread_create(&th[i], NULL, job_main, &call[i]) == 0;
+    job_main(&call[0]);
     for (int i = 1; i < n; i++) {
         if (started[i]) pthread_join(th[i], NULL);
-        else fn((char *)jobs + (size_t)i * size);
+        else job_main(&call[i]);
     }
+    double a[GRID_MAX_THREADS], b[GRID_MAX_THREADS];
+    for (int i = 0; i < n; i++) { a[i] = call[i].t0; b[i] = call[i].t1; }
+    return gr_ref_overlap_s(a, b, n);
 }
 
 typedef struct grid_job {
@@ -574,17 +594,84 @@ static void *box_work(void *arg)
     return NULL;
 }
 
+/* The boxes' bounds and summed extents over BOUND_CHUNKS fixed chunks of the primitives (the
+ * same chunks and the same order of summation for any number of threads: the same grid) */
+enum { BOUND_CHUNKS = 64 };
+typedef struct bound_job {
+    const gr_beams *b;
+    uint32_t np;
+    int c0, c1;                              /* chunks */
+    double lo[BOUND_CHUNKS][3], hi[BOUND_CHUNKS][3], ext[BOUND_CHUNKS][3];
+} bound_job;
+
+static void *bound_work(void *arg)
+{
+    bound_job *j = arg;
+    for (int ck = j->c0; ck < j->c1; ck++) {
+        uint32_t k0 = (uint32_t)((uint64_t)j->np * (uint64_t)ck / BOUND_CHUNKS);
+        uint32_t k1 = (uint32_t)((uint64_t)j->np * (uint64_t)(ck + 1) / BOUND_CHUNKS);
+        double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
+        for (uint32_t k = k0; k < k1; k++) {
+            const float *bx = j->b->box + 6 * (size_t)k;
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fmin(lo[a], bx[a]);
+                hi[a] = fmax(hi[a], bx[3 + a]);
+                ext[a] += (double)bx[3 + a] - bx[a];
+            }
+        }
+        for (int a = 0; a < 3; a++) { j->lo[ck][a] = lo[a]; j->hi[ck][a] = hi[a]; j->ext[ck][a] = ext[a]; }
+    }
+    return NULL;
+}
+
+/* The 16-bit boxes of primitives [k0, k1) (the job's range) */
+typedef struct quant_job {
+    gr_beams *b;
+    uint32_t k0, k1;
+    double qunit[3];
+} quant_job;
+
+static void *quant_work(void *arg)
+{
+    quant_job *j = arg;
+    gr_beams *b = j->b;
+    for (uint32_t k = j->k0; k < j->k1; k++) {
+        const float *bx = b->box + 6 * (size_t)k;
+        uint16_t *q = b->qbox[k].q;
+        b->qbox[k].tri = b->prim_tri[k];
+        for (int a = 0; a < 3; a++) {
+            double l = floor(((double)bx[a] - (double)b->q0[a]) / j->qunit[a]) - 1.0;
+            double h = ceil(((double)bx[3 + a] - (double)b->q0[a]) / j->qunit[a]) + 1.0;
+            q[a] = (uint16_t)(l < 0.0 ? 0.0 : l > 65535.0 ? 65535.0 : l);
+            q[3 + a] = (uint16_t)(h < 0.0 ? 0.0 : h > 65535.0 ? 65535.0 : h);
+        }
+    }
+    return NULL;
+}
+
 static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err)
 {
     if (np == 0) return GR_OK;
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
-    for (uint32_t k = 0; k < np; k++) {
-        const float *bx = b->box + 6 * (size_t)k;
-        for (int a = 0; a < 3; a++) {
-            lo[a] = fmin(lo[a], bx[a]);
-            hi[a] = fmax(hi[a], bx[3 + a]);
-            ext[a] += (double)bx[3 + a] - bx[a];
+    {
+        int nb = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+        bound_job *bj = malloc((size_t)nb * sizeof *bj);
+        if (!bj) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid");
+        for (int i = 0; i < nb; i++) {
+            bj[i].b = b;
+            bj[i].np = np;
+            bj[i].c0 = BOUND_CHUNKS * i / nb;
+            bj[i].c1 = BOUND_CHUNKS * (i + 1) / nb;
         }
+        b->stats.par_s += gr_beams_run_jobs(bound_work, bj, sizeof bj[0], nb);
+        for (int i = 0; i < nb; i++)
+            for (int ck = bj[i].c0; ck < bj[i].c1; ck++)
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = fmin(lo[a], bj[i].lo[ck][a]);
+                    hi[a] = fmax(hi[a], bj[i].hi[ck][a]);
+                    ext[a] += bj[i].ext[ck][a];
+                }
+        free(bj);
     }
     double cell[3];
     for (int a = 0; a < 3; a++) {
@@ -625,7 +712,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
             jobs[i].w1 = (int)((long)b->gn[2] * (i + 1) / nt);
             jobs[i].fill = 0;
         }
-        run_jobs(grid_work, jobs, sizeof jobs[0], nt);
+        b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
         size_t total = 0; /* in size_t: an attempt far over the budget must not wrap the lists' uint32 */
         for (size_t c = 0; c < ncells && (double)total <= budget; c++) {
             total += b->cell_first[c + 1];
@@ -641,7 +728,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     /* fill, each cell by one worker in primitive order (deterministic): cell_first[c] runs
      * ahead as the cursor while filling, restored below */
     for (int i = 0; i < nt; i++) jobs[i].fill = 1;
-    run_jobs(grid_work, jobs, sizeof jobs[0], nt);
+    b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
     for (size_t c = ncells; c > 0; c--) b->cell_first[c] = b->cell_first[c - 1];
     b->cell_first[0] = 0;
     /* the 16-bit boxes; the float ones are no longer needed */
@@ -654,16 +741,16 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         b->q0[a] = (float)lo[a];
         b->qinv[a] = (float)(1.0 / qunit[a]);
     }
-    for (uint32_t k = 0; k < np; k++) {
-        const float *bx = b->box + 6 * (size_t)k;
-        uint16_t *q = b->qbox[k].q;
-        b->qbox[k].tri = b->prim_tri[k];
-        for (int a = 0; a < 3; a++) {
-            double l = floor(((double)bx[a] - (double)b->q0[a]) / qunit[a]) - 1.0;
-            double h = ceil(((double)bx[3 + a] - (double)b->q0[a]) / qunit[a]) + 1.0;
-            q[a] = (uint16_t)(l < 0.0 ? 0.0 : l > 65535.0 ? 65535.0 : l);
-            q[3 + a] = (uint16_t)(h < 0.0 ? 0.0 : h > 65535.0 ? 65535.0 : h);
+    {
+        quant_job qj[GRID_MAX_THREADS];
+        int nq = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+        for (int i = 0; i < nq; i++) {
+            qj[i].b = b;
+            qj[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nq);
+            qj[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nq);
+            for (int a = 0; a < 3; a++) qj[i].qunit[a] = qunit[a];
         }
+        b->stats.par_s += gr_beams_run_jobs(quant_work, qj, sizeof qj[0], nq);
     }
     free(b->box);
     b->box = NULL;
@@ -684,6 +771,6 @@ gr_status gr_beams_index(gr_beams *b, uint32_t np, int threads, gr_error *err)
         jobs[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nt);
         jobs[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nt);
     }
-    run_jobs(box_work, jobs, sizeof jobs[0], nt);
+    b->stats.par_s += gr_beams_run_jobs(box_work, jobs, sizeof jobs[0], nt);
     return build_grid(b, np, threads, err);
 }

@@ -96,4 +96,11 @@ static inline void slab_range(const gr_beams *b, uint32_t t, uint32_t k, uint32_
  * them). GR_E_NOMEM naming the grid. */
 gr_status gr_beams_index(gr_beams *b, uint32_t np, int threads, gr_error *err);
 
+/* Runs fn on n jobs (each `size` bytes apart; at most GRID_MAX_THREADS), job 0 on the calling
+ * thread and the others on their own threads (serially if a thread cannot be started: the
+ * same result). Returns the time during which at least two jobs ran (the serial part's
+ * complement, reference/phase.h). */
+#define GRID_MAX_THREADS 64
+double gr_beams_run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n);
+
 #endif

@@ -6,6 +6,7 @@
 
 #include "core/gerstner.h"
 #include "core/optics.h"
+#include "reference/phase.h"
 
 static double now_s(void)
 {
@@ -206,6 +207,139 @@ static uint32_t slab_count(double depth, double drift, double cell, double scale
     return (uint32_t)n;
 }
 
+/* A range of a beam build's vertices or triangles (gr_beams_run_jobs; disjoint outputs). */
+typedef struct build_job {
+    const gr_beam_params *p;
+    gr_beams *b;
+    const topo *tp;
+    gr_dvec3 *pos;
+    float *jv, *drift;
+    const uint8_t *lev;
+    double start_u, start_w, h;
+    int disc;
+    size_t k0, k1;    /* the range */
+    size_t lit;       /* triangles: the lit ones counted */
+    int stopped;      /* 1: Ctrl-C seen */
+} build_job;
+
+/* Vertices [k0, k1): displaced (seed eq. 5.5.7), normal (5.5.8), refraction, Fresnel, the
+ * disc's slope Jacobian. */
+static void *vertex_work(void *arg)
+{
+    build_job *j = arg;
+    const gr_beam_params *p = j->p;
+    gr_beams *b = j->b;
+    const topo *tp = j->tp;
+    gr_dvec3 I = p->sun_dir;
+    double eta = 1.0 / p->ior; /* air (n = 1) to water, seed eq. 5.5.1 with eta = n1 / n2 */
+    for (size_t k = j->k0; k < j->k1; k++) {
+        if ((k & 4095) == 0 && p->interrupt && *p->interrupt) { /* Ctrl-C: a cheap read per 4096 vertices */
+            j->stopped = 1;
+            return NULL;
+        }
+        double x0, z0;
+        if (k < tp->nv0) {
+            int i = (int)(k % (size_t)(b->nu + 1)), jj = (int)(k / (size_t)(b->nu + 1));
+            x0 = p->origin.x + j->start_u + i * j->h;
+            z0 = p->origin.z + j->start_w + jj * j->h;
+        } else {
+            x0 = p->origin.x + j->start_u + tp->rx[2 * (k - tp->nv0)];
+            z0 = p->origin.z + j->start_w + tp->rx[2 * (k - tp->nv0) + 1];
+        }
+        gr_dvec3 P = gr_gerstner_position(p->water, x0, z0, p->water->time_s);
+        gr_dvec3 n;
+        gr_gerstner_frame(p->water, x0, z0, p->water->time_s, NULL, NULL, &n);
+        j->pos[k] = gr_d3_sub(P, p->origin);
+        beam_vertex *v = &b->v[k];
+        double cos_i = -gr_d3_dot(I, n);
+        gr_dvec3 T = cos_i > 0.0 ? gr_refract_d(I, n, eta) : gr_d3(0, 0, 0);
+        v->py = (float)j->pos[k].y;
+        v->pu = (float)(j->pos[k].x - p->shear_x * j->pos[k].y);
+        v->pw = (float)(j->pos[k].z - p->shear_z * j->pos[k].y);
+        v->tx = (float)T.x; v->ty = (float)T.y; v->tz = (float)T.z;
+        /* a refracted ray that does not head down (grazing sun on a steep back slope)
+         * leaves the water again at once: such vertices carry no beam (docs/reference.md) */
+        if (!(T.y < -1e-4)) {
+            v->ft = -1.0f;
+            v->au = v->aw = 0.0f;
+            v->ity = -1.0f;
+            continue;
+        }
+        v->ft = p->fresnel ? (float)(1.0 - gr_fresnel_exact(cos_i, 1.0, p->ior)) : 1.0f;
+        if (j->disc) {
+            double J[4];
+            slope_jacobian(I, n, eta, p->disc_e1, p->disc_e2, J);
+            for (int c = 0; c < 4; c++) j->jv[4 * k + (size_t)c] = (float)J[c];
+        }
+        v->au = (float)(T.x / T.y - p->shear_x);
+        v->aw = (float)(T.z / T.y - p->shear_z);
+        v->ity = (float)(1.0 / T.y);
+    }
+    return NULL;
+}
+
+/* Triangles [k0, k1): flux, the cross-section's coefficients, the disc kernel, the drift. */
+static void *triangle_work(void *arg)
+{
+    build_job *j = arg;
+    const gr_beam_params *p = j->p;
+    gr_beams *b = j->b;
+    const gr_dvec3 *pos = j->pos;
+    const float *jv = j->jv;
+    float *drift = j->drift;
+    const uint8_t *lev = j->lev;
+    gr_dvec3 I = p->sun_dir;
+    int disc = j->disc;
+    j->lit = 0;
+    for (size_t t = j->k0; t < j->k1; t++) {
+        if ((t & 65535) == 0 && p->interrupt && *p->interrupt) { /* Ctrl-C, every 65536 triangles */
+            j->stopped = 1;
+            return NULL;
+        }
+        beam_tri *bt = &b->tri[t];
+        uint32_t idx[3];
+        tri_vertices(b, (uint32_t)t, idx);
+        const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
+        bt->ytop = fmaxf(v0->py, fmaxf(v1->py, v2->py));
+        bt->ybar = bt->ytop;
+        drift[t] = 0.0f;
+        if (v0->ft < 0.0f || v1->ft < 0.0f || v2->ft < 0.0f) continue;
+        /* the grid's triangles wind so that their area vector points down */
+        gr_dvec3 a = gr_d3_scale(gr_d3_cross(gr_d3_sub(pos[idx[1]], pos[idx[0]]), gr_d3_sub(pos[idx[2]], pos[idx[0]])), 0.5);
+        double flux = gr_d3_dot(I, a); /* sun flux through the displaced triangle per unit E_sun */
+        if (!(flux > 0.0)) continue;   /* faces away from the sun: shadowed by its own wave */
+        /* F_t averaged over the vertices: O(h^2) like the rest of the tessellation */
+        bt->phi = (float)(flux * (v0->ft + v1->ft + v2->ft) / 3.0);
+        const beam_vertex *vs[3] = {v0, v1, v2};
+        /* the cross-section's coefficients for the lookups (beam_tri's c), in double */
+        double xs[3], zs[3];
+        for (int c = 0; c < 3; c++) {
+            xs[c] = (double)vs[c]->pu + (double)vs[c]->au * ((double)bt->ytop - vs[c]->py);
+            zs[c] = (double)vs[c]->pw + (double)vs[c]->aw * ((double)bt->ytop - vs[c]->py);
+            bt->c[4 * c] = (float)(c ? xs[c] - xs[0] : xs[0]);
+            bt->c[4 * c + 1] = (float)(c ? zs[c] - zs[0] : zs[0]);
+            bt->c[4 * c + 2] = (float)(c ? (double)vs[c]->au - v0->au : v0->au);
+            bt->c[4 * c + 3] = (float)(c ? (double)vs[c]->aw - v0->aw : v0->aw);
+        }
+        if (disc) {
+            /* the beam's kernel: the disc radius times its vertices' mean Jacobian (first
+             * order: the cross-section moves rigidly with the sun direction) */
+            for (int c = 0; c < 4; c++)
+                bt->kern[c] = (float)(p->disc_radius * (jv[4 * (size_t)idx[0] + (size_t)c] + jv[4 * (size_t)idx[1] + (size_t)c] +
+                                                        jv[4 * (size_t)idx[2] + (size_t)c]) / 3.0);
+            bt->ybar = (v0->py + v1->py + v2->py) / 3.0f;
+            const float *M = bt->kern;
+            bt->kr = 1.0001f * sqrtf(M[0] * M[0] + M[1] * M[1] + M[2] * M[2] + M[3] * M[3]);
+        }
+        float d = 0.0f;
+        for (int c = 0; c < 3; c++) d = fmaxf(d, hypotf(vs[c]->au, vs[c]->aw));
+        /* in cells of the grid: a fine triangle's slabs are F times thinner (its box as tight) */
+        drift[t] = lev[t] == 1 ? d * (float)j->tp->F : d;
+        j->lit++;
+    }
+    return NULL;
+}
+
 gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err)
 {
     *out = NULL;
@@ -347,100 +481,36 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         free(pos); free(drift); free(jv); free(lev); free(tp.rx); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu surface vertices (reference.surface_res)", nv);
     }
-    gr_dvec3 I = p->sun_dir;
-    double eta = 1.0 / p->ior; /* air (n = 1) to water, seed eq. 5.5.1 with eta = n1 / n2 */
-    for (size_t k = 0; k < nv; k++) {
-        if ((k & 4095) == 0 && p->interrupt && *p->interrupt) { /* Ctrl-C: a cheap read per 4096 vertices */
-            free(pos); free(drift); free(jv); free(lev); free(tp.rx); gr_beams_destroy(b);
-            return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
-        }
-        {
-            double x0, z0;
-            if (k < tp.nv0) {
-                int i = (int)(k % (size_t)(b->nu + 1)), j = (int)(k / (size_t)(b->nu + 1));
-                x0 = p->origin.x + start_u + i * h;
-                z0 = p->origin.z + start_w + j * h;
-            } else {
-                x0 = p->origin.x + start_u + tp.rx[2 * (k - tp.nv0)];
-                z0 = p->origin.z + start_w + tp.rx[2 * (k - tp.nv0) + 1];
-            }
-            gr_dvec3 P = gr_gerstner_position(p->water, x0, z0, p->water->time_s);
-            gr_dvec3 n;
-            gr_gerstner_frame(p->water, x0, z0, p->water->time_s, NULL, NULL, &n);
-            pos[k] = gr_d3_sub(P, p->origin);
-            beam_vertex *v = &b->v[k];
-            double cos_i = -gr_d3_dot(I, n);
-            gr_dvec3 T = cos_i > 0.0 ? gr_refract_d(I, n, eta) : gr_d3(0, 0, 0);
-            v->py = (float)pos[k].y;
-            v->pu = (float)(pos[k].x - p->shear_x * pos[k].y);
-            v->pw = (float)(pos[k].z - p->shear_z * pos[k].y);
-            v->tx = (float)T.x; v->ty = (float)T.y; v->tz = (float)T.z;
-            /* a refracted ray that does not head down (grazing sun on a steep back slope)
-             * leaves the water again at once: such vertices carry no beam (docs/reference.md) */
-            if (!(T.y < -1e-4)) {
-                v->ft = -1.0f;
-                v->au = v->aw = 0.0f;
-                v->ity = -1.0f;
-                continue;
-            }
-            v->ft = p->fresnel ? (float)(1.0 - gr_fresnel_exact(cos_i, 1.0, p->ior)) : 1.0f;
-            if (disc) {
-                double J[4];
-                slope_jacobian(I, n, eta, p->disc_e1, p->disc_e2, J);
-                for (int c = 0; c < 4; c++) jv[4 * k + (size_t)c] = (float)J[c];
-            }
-            v->au = (float)(T.x / T.y - p->shear_x);
-            v->aw = (float)(T.z / T.y - p->shear_z);
-            v->ity = (float)(1.0 / T.y);
-        }
+    /* vertices, then triangles, on the build's threads (disjoint outputs: the same bytes for
+     * any number of threads) */
+    build_job bj[GRID_MAX_THREADS];
+    int nbj = p->threads < 1 ? 1 : p->threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : p->threads;
+    for (int i = 0; i < nbj; i++) {
+        bj[i] = (build_job){p, b, &tp, pos, jv, drift, lev, start_u, start_w, h, disc, 0, 0, 0, 0};
+        bj[i].k0 = nv * (size_t)i / (size_t)nbj;
+        bj[i].k1 = nv * (size_t)(i + 1) / (size_t)nbj;
+    }
+    b->stats.par_s += gr_beams_run_jobs(vertex_work, bj, sizeof bj[0], nbj);
+    int stopped = 0;
+    for (int i = 0; i < nbj; i++) stopped |= bj[i].stopped;
+    if (stopped) { /* Ctrl-C */
+        free(pos); free(drift); free(jv); free(lev); free(tp.rx); gr_beams_destroy(b);
+        return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
     }
     free(tp.rx);
     size_t lit = 0;
-    for (size_t t = 0; t < ntri; t++) {
-        if ((t & 65535) == 0 && p->interrupt && *p->interrupt) { /* Ctrl-C, every 65536 triangles */
-            free(pos); free(drift); free(jv); free(lev); gr_beams_destroy(b);
-            return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
-        }
-        beam_tri *bt = &b->tri[t];
-        uint32_t idx[3];
-        tri_vertices(b, (uint32_t)t, idx);
-        const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
-        bt->ytop = fmaxf(v0->py, fmaxf(v1->py, v2->py));
-        bt->ybar = bt->ytop;
-        drift[t] = 0.0f;
-        if (v0->ft < 0.0f || v1->ft < 0.0f || v2->ft < 0.0f) continue;
-        /* the grid's triangles wind so that their area vector points down */
-        gr_dvec3 a = gr_d3_scale(gr_d3_cross(gr_d3_sub(pos[idx[1]], pos[idx[0]]), gr_d3_sub(pos[idx[2]], pos[idx[0]])), 0.5);
-        double flux = gr_d3_dot(I, a); /* sun flux through the displaced triangle per unit E_sun */
-        if (!(flux > 0.0)) continue;   /* faces away from the sun: shadowed by its own wave */
-        /* F_t averaged over the vertices: O(h^2) like the rest of the tessellation */
-        bt->phi = (float)(flux * (v0->ft + v1->ft + v2->ft) / 3.0);
-        const beam_vertex *vs[3] = {v0, v1, v2};
-        /* the cross-section's coefficients for the lookups (beam_tri's c), in double */
-        double xs[3], zs[3];
-        for (int c = 0; c < 3; c++) {
-            xs[c] = (double)vs[c]->pu + (double)vs[c]->au * ((double)bt->ytop - vs[c]->py);
-            zs[c] = (double)vs[c]->pw + (double)vs[c]->aw * ((double)bt->ytop - vs[c]->py);
-            bt->c[4 * c] = (float)(c ? xs[c] - xs[0] : xs[0]);
-            bt->c[4 * c + 1] = (float)(c ? zs[c] - zs[0] : zs[0]);
-            bt->c[4 * c + 2] = (float)(c ? (double)vs[c]->au - v0->au : v0->au);
-            bt->c[4 * c + 3] = (float)(c ? (double)vs[c]->aw - v0->aw : v0->aw);
-        }
-        if (disc) {
-            /* the beam's kernel: the disc radius times its vertices' mean Jacobian (first
-             * order: the cross-section moves rigidly with the sun direction) */
-            for (int c = 0; c < 4; c++)
-                bt->kern[c] = (float)(p->disc_radius * (jv[4 * (size_t)idx[0] + (size_t)c] + jv[4 * (size_t)idx[1] + (size_t)c] +
-                                                        jv[4 * (size_t)idx[2] + (size_t)c]) / 3.0);
-            bt->ybar = (v0->py + v1->py + v2->py) / 3.0f;
-            const float *M = bt->kern;
-            bt->kr = 1.0001f * sqrtf(M[0] * M[0] + M[1] * M[1] + M[2] * M[2] + M[3] * M[3]);
-        }
-        float d = 0.0f;
-        for (int c = 0; c < 3; c++) d = fmaxf(d, hypotf(vs[c]->au, vs[c]->aw));
-        /* in cells of the grid: a fine triangle's slabs are F times thinner (its box as tight) */
-        drift[t] = lev[t] == 1 ? d * (float)tp.F : d;
-        lit++;
+    for (int i = 0; i < nbj; i++) {
+        bj[i].k0 = ntri * (size_t)i / (size_t)nbj;
+        bj[i].k1 = ntri * (size_t)(i + 1) / (size_t)nbj;
+    }
+    b->stats.par_s += gr_beams_run_jobs(triangle_work, bj, sizeof bj[0], nbj);
+    for (int i = 0; i < nbj; i++) {
+        stopped |= bj[i].stopped;
+        lit += bj[i].lit;
+    }
+    if (stopped) { /* Ctrl-C */
+        free(pos); free(drift); free(jv); free(lev); gr_beams_destroy(b);
+        return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
     }
     /* slabs: about slab_cells cells of drift each, coarsened uniformly if over the primitive budget */
     double scale = p->slab_cells > 0.0 ? p->slab_cells : 1.0;
@@ -487,7 +557,11 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         free(pos); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %u beam primitives", np);
     }
+    double ti = now_s(), ci = gr_ref_cpu_s(), pi = b->stats.par_s;
     gr_status st = gr_beams_index(b, np, p->threads, err); /* the lookups' boxes and grid */
+    b->stats.index_s = now_s() - ti;
+    b->stats.index_cpu_s = gr_ref_cpu_s() - ci;
+    b->stats.index_par_s = b->stats.par_s - pi;
     if (st == GR_OK && p->surface_mesh) st = build_surface_mesh(rtc, b, pos, err);
     free(pos);
     if (st != GR_OK) {

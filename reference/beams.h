@@ -94,6 +94,8 @@ typedef struct gr_beam_stats {
     double refine_radius_m;  /* gr_beam_refine_radius */
     double grid_u0, grid_w0; /* the rest grid's corner (sheared local, m; the jitter included) */
     double build_s;          /* wall time of the build */
+    double par_s;            /* of it, the time with at least two threads busy (reference/phase.h) */
+    double index_s, index_cpu_s, index_par_s; /* the lookup grid's part (boxes, grid fill): wall, CPU, parallel */
 } gr_beam_stats;
 
 gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err);

@@ -264,6 +264,15 @@ gr_dvec3 gr_ref_pass_sun_dir(const gr_ref_renderer *r, int pass)
     return gr_d3_norm(gr_d3_madd(gr_d3_scale(r->I0, cr), off, sr));
 }
 
+/* A beam set's build in the phases: its parallel time, and its lookup grid's part moved
+ * from the beams' phase to the grid's (the switch after the builds charges the whole span) */
+static void account_build(gr_ref_renderer *r, const gr_beams *b)
+{
+    const gr_beam_stats *bs = gr_beams_stats(b);
+    r->phases.par_total += bs->par_s;
+    gr_ref_phases_move(&r->phases, REF_PH_BEAMS, REF_PH_GRID, bs->index_s, bs->index_cpu_s, bs->index_par_s);
+}
+
 gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
 {
     r->Ip = gr_ref_pass_sun_dir(r, pass);
@@ -318,10 +327,13 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
      * cone_box; their set covers it, refined, on the plain grid's lines; the plain grid
      * serves every other ray */
     bp.refine_factor = 1;
+    int prev = gr_ref_phases_switch(&r->phases, REF_PH_BEAMS);
     gr_status st = gr_beams_build(r->rtc, &bp, &r->beams, err);
-    if (st != GR_OK) return st;
-    r->tally.beam_build_s += gr_beams_stats(r->beams)->build_s;
-    if (r->cone_on) {
+    if (st == GR_OK) {
+        account_build(r, r->beams);
+        r->tally.beam_build_s += gr_beams_stats(r->beams)->build_s;
+    }
+    if (r->cone_on && st == GR_OK) {
         const gr_beam_stats *bs = gr_beams_stats(r->beams);
         bp.region.u0 = r->cone_box[0];
         bp.region.u1 = r->cone_box[1];
@@ -335,10 +347,14 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
         /* slabs of a cell's drift: the cone set's refined cells are many and only the cone's
          * rays look them up (measured: its builds 5.6 s -> 3.8 s of a render, the same bias) */
         bp.slab_cells = 1.0;
-        st = gr_beams_build(r->rtc, &bp, &r->cone, err);
-        if (st != GR_OK) return st;
-        r->tally.beam_build_s += gr_beams_stats(r->cone)->build_s;
+        if (st == GR_OK) st = gr_beams_build(r->rtc, &bp, &r->cone, err);
+        if (st == GR_OK) {
+            account_build(r, r->cone);
+            r->tally.beam_build_s += gr_beams_stats(r->cone)->build_s;
+        }
     }
+    gr_ref_phases_switch(&r->phases, prev);
+    if (st != GR_OK) return st;
     r->beams_pass = pass;
     return GR_OK;
 }
@@ -410,6 +426,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         free(acc.sum); free(acc.count); free(acc.aov); gr_ref_pool_destroy(pool); free(keep); gr_progress_destroy(prog);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %dx%d pixels x %d batches", acc.W, acc.H, acc.B);
     }
+    gr_ref_phases_start(&r->phases, REF_PH_OTHER);
     int P = r->passes_per_round;
     int rounds = r->set.target_error > 0.0 ? r->opt.max_rounds : 1;
     gr_status st = GR_OK;
@@ -438,8 +455,10 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     }
     /* adaptive steps: the pilot sets every pixel's steps before the first pass */
     int pilot_done = 1;
+    gr_ref_phases_switch(&r->phases, REF_PH_PILOT);
     st = gr_ref_step_pilot(r, pool, prog, &pilot_done, err);
     if (st == GR_OK && !pilot_done) out->partial = 1;
+    gr_ref_phases_switch(&r->phases, REF_PH_MARCH);
     for (int round = 0; round < rounds && st == GR_OK && !out->partial; round++) {
         for (int pp = 0; pp < P && st == GR_OK; pp++, pass++) {
             if (pass % acc.B < r->opt.batch0 || pass % acc.B >= r->opt.batch1) continue; /* another part's batch */
@@ -466,6 +485,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             if (gr_ref_target_met(&e, acc.B, r->set.target_error)) break;
         }
     }
+    gr_ref_phases_switch(&r->phases, REF_PH_OTHER);
     /* the tessellation's bias, measured on this scene (flat water has none: closed form) */
     r->bias_rel = r->flat ? 0.0 : -1.0;
     /* the main passes' last beam set (the probe builds others) */
@@ -488,7 +508,9 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     ref_march_totals ptot = {0.0, 0, 0, 0};
     if (st == GR_OK && probe && !out->partial) {
         double tp = gr_ref_mono_s();
+        gr_ref_phases_switch(&r->phases, REF_PH_PROBE);
         st = gr_ref_probe_run(r, keep, &cap, pool, prog, mainw, 1.0 - mainw, &ptot, err);
+        gr_ref_phases_switch(&r->phases, REF_PH_OTHER);
         t->probe_s = gr_ref_mono_s() - tp;
     }
     r->rendering = 0;
@@ -502,6 +524,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     t->shadows = tot.shadows;
     t->overflows = 0; /* nothing overflows: the hit list grows */
     if (st == GR_OK) st = gr_ref_finish(r, &acc, &tot, gr_ref_mono_s() - t0, out, err);
+    r->phases.on = 0;
     if (st == GR_OK && keep) { /* the raw sums for a part file (src/farm/parts.h) */
         gr_ref_sums_copy_tallies(keep, t);
         keep->W = acc.W;

@@ -67,6 +67,8 @@ typedef struct gr_ref_result {
     double rel_se_mean;     /* relative standard error of the image mean (mean of RGB) */
     double rel_se_p95;      /* relative standard error of the 95th-percentile pixel value */
     double frac_se_1pct;    /* fraction of pixels whose standard error <= 1% of max(pixel, mean) */
+    double block8_rel_se_max; /* 8x8 blocks: the largest standard error of a block mean over max(block
+                               mean, image mean), worst channel (-1: none) */
     double preview_exposure;/* exposure that maps the 99th percentile to 0.8 in the preview */
     double queries_per_s;   /* beam lookups (or closed-form evaluations) per second, all threads */
     double shadow_rays_per_s;
@@ -79,7 +81,15 @@ typedef struct gr_ref_result {
     double steps_mean;      /* march steps per camera ray, mean over the pixels (adaptive steps) */
     int target_met;         /* --target-error: 1 when met (Student t, batches - 1 dof); 1 if off */
     gr_ref_sums *sums;      /* with gr_ref_options.keep_sums: the raw sums (freed with the result) */
+    /* Per phase (beams, grid, pilot, march, probe, stats, other: GR_REF_PHASES, the metadata's
+     * godrays:phase.NAME.*): wall, CPU (all threads) and serial time (wall with at most one
+     * thread busy); serial_frac = their serial sum over their wall sum. phases 0: not measured
+     * (assembled parts) */
+    int phases;
+    double phase_wall_s[7], phase_cpu_s[7], phase_serial_s[7], serial_frac;
 } gr_ref_result;
+#define GR_REF_PHASES 7
+extern const char *const gr_ref_phase_names[GR_REF_PHASES];
 
 /* Renders the image; `progress_label` may be NULL. On interruption returns GR_OK with
  * out->partial = 1 (the caller writes what is there). */

@@ -13,7 +13,8 @@ typedef struct ref_job {
     /* accumulator pixel (x, y) is image pixel (x stride + off, y stride + off): stride 1 for
      * the image, a sparse grid for the surface-bias probe */
     int stride, off, img_w;
-    int y1;             /* accumulator rows [next_row's start, y1) */
+    int y0, y1;         /* accumulator rows [y0, y1), */
+    int tiles_x, tiles; /* in tiles of MARCH_TILE^2 pixels (w.next_row counts them) */
     gr_ref_work w;      /* the rows, stop, and per-thread counters summed after the pass */
 } ref_job;
 
@@ -90,7 +91,7 @@ int gr_ref_march_ray(const gr_ref_renderer *r, double fx, double fy, int n, cons
     *len = D;
     *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
     if (ck)
-        for (int k = 0; k < n; k++) ck[k] = 0.0;
+        for (int k = 0; k < 3 * n; k++) ck[k] = 0.0;
     if (D == 0.0f) return 0;
     /* March density ~ exp(-lam t) on [0, D], lam = sig_ref (1 - w_y / mu_t0): the camera
      * ray's extinction times the sunlight's extinction down to the point on flat water, so
@@ -154,7 +155,7 @@ int gr_ref_march_ray(const gr_ref_renderer *r, double fx, double fy, int n, cons
                 double tr = ex < 80.0 ? (double)expf((float)-ex) : ex < REF_EXP_LIMIT ? exp(-ex) : 0.0;
                 double v = r->sig_s[ch] * r->E[ch] * base * tr;
                 L[ch] += v;
-                if (ck) ck[k] += v / 3.0;
+                if (ck) ck[3 * k + ch] += v;
             }
         }
     }
@@ -191,10 +192,10 @@ static void *worker(void *arg)
         /* a band of MARCH_TILE rows, in tiles of MARCH_TILE x MARCH_TILE pixels: neighbouring
          * rays look up the same beams while they are still in cache (docs/reference.md 2.2,
          * "Lookups"); the pixels' sums do not depend on the order */
-        int yb = atomic_fetch_add(&job->w.next_row, MARCH_TILE);
-        if (yb >= job->y1) break;
+        int tile = atomic_fetch_add(&job->w.next_row, 1); /* tiles, band by band: the last ones balance the threads */
+        if (tile >= job->tiles) break;
+        int yb = job->y0 + (tile / job->tiles_x) * MARCH_TILE, xb = (tile % job->tiles_x) * MARCH_TILE;
         int ye = job->y1 - yb < MARCH_TILE ? job->y1 : yb + MARCH_TILE;
-        for (int xb = 0; xb < acc->W && !oom; xb += MARCH_TILE)
         for (int y = yb; y < ye && !oom; y++)
         for (int x = xb; x < acc->W && x < xb + MARCH_TILE && !oom; x++) {
             int px = x * job->stride + job->off, py = y * job->stride + job->off;
@@ -246,7 +247,7 @@ static void *worker(void *arg)
             break;
         }
         if (r->opt.interrupt && *r->opt.interrupt) break; /* the band may be unfinished: not counted */
-        atomic_fetch_add(&job->w.rows_done, ye - yb);
+        atomic_fetch_add(&job->w.rows_done, 1);
     }
     atomic_fetch_add(&job->w.queries, cnt.queries);
     atomic_fetch_add(&job->w.shadow_rays, cnt.shadow_rays);
@@ -268,17 +269,21 @@ gr_status gr_ref_march_pass(gr_ref_renderer *r, ref_accum *acc, int pass, int ba
     job.stride = stride;
     job.off = off;
     job.img_w = r->scene.camera.width;
+    job.y0 = y0;
     job.y1 = y1;
-    gr_ref_work_init(&job.w, y0);
+    job.tiles_x = (acc->W + MARCH_TILE - 1) / MARCH_TILE;
+    job.tiles = job.tiles_x * ((y1 - y0 + MARCH_TILE - 1) / MARCH_TILE);
+    gr_ref_work_init(&job.w, 0);
     *complete = 0;
     double tm = gr_ref_mono_s();
-    gr_status st = gr_ref_pool_run(pool, worker, &job, &job.w, y1 - y0, r->opt.interrupt, prog, frac0, span, note, err);
+    gr_status st = gr_ref_pool_run(pool, worker, &job, &job.w, job.tiles, r->opt.interrupt, prog, frac0, span, note, err);
     if (st == GR_E_RUNTIME) return st; /* no worker started */
+    r->phases.par_total += job.w.par_s;
     tot->march_s += gr_ref_mono_s() - tm;
     tot->queries += atomic_load(&job.w.queries);
     tot->shadows += atomic_load(&job.w.shadow_rays);
     if (atomic_load(&job.w.max_hits) > tot->max_hits) tot->max_hits = atomic_load(&job.w.max_hits);
     if (st != GR_OK) return st;
-    *complete = atomic_load(&job.w.rows_done) >= y1 - y0;
+    *complete = atomic_load(&job.w.rows_done) >= job.tiles;
     return GR_OK;
 }

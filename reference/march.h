@@ -69,7 +69,7 @@ static inline int light_at(const gr_ref_renderer *r, const gr_beams *bs, gr_vec3
 }
 
 /* L (RGB) along the camera ray through the image point (fx, fy) (pixels), marched with n
- * steps (n <= the scratch's). With ck, ck[k] receives the RGB mean of march point k's
+ * steps (n <= the scratch's). With ck, ck[3 k + c] receives channel c of march point k's
  * contribution to L (the step pilot). Returns 0, or -1 when out of memory (a growing hit list). */
 int gr_ref_march_ray(const gr_ref_renderer *r, double fx, double fy, int n, const uint16_t *alloc, ref_rng *g, double L[3],
                      double *trans, double *len, ref_counters *cnt, ref_scratch *sc, double *ck);

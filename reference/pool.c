@@ -1,21 +1,26 @@
 #include "reference/pool.h"
 
 #include <stdlib.h>
+
+#include "reference/phase.h"
 #include <time.h>
 #if defined(__SSE2__)
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 #endif
 
-struct gr_ref_pool {
-    int threads;
-    pthread_t *th;
-};
-
 typedef struct pool_call {
     void *(*fn)(void *);
     void *arg;
+    double t0, t1; /* this worker's start and end (the serial part: gr_ref_overlap_s) */
 } pool_call;
+
+struct gr_ref_pool {
+    int threads;
+    pthread_t *th;
+    pool_call *calls;
+};
+
 
 double gr_ref_mono_s(void)
 {
@@ -36,9 +41,12 @@ static void flush_denormals(void)
 
 static void *pool_main(void *arg)
 {
-    const pool_call *c = arg;
+    pool_call *c = arg;
+    c->t0 = gr_ref_mono_s();
     flush_denormals();
-    return c->fn(c->arg);
+    void *ret = c->fn(c->arg);
+    c->t1 = gr_ref_mono_s();
+    return ret;
 }
 
 void gr_ref_work_init(gr_ref_work *w, int row0)
@@ -49,6 +57,7 @@ void gr_ref_work_init(gr_ref_work *w, int row0)
     atomic_init(&w->queries, 0);
     atomic_init(&w->shadow_rays, 0);
     atomic_init(&w->max_hits, 0);
+    w->par_s = 0.0;
 }
 
 gr_ref_pool *gr_ref_pool_create(int threads)
@@ -57,7 +66,10 @@ gr_ref_pool *gr_ref_pool_create(int threads)
     if (!p) return NULL;
     p->threads = threads > 0 ? threads : 1;
     p->th = calloc((size_t)p->threads, sizeof *p->th);
-    if (!p->th) {
+    p->calls = calloc((size_t)p->threads, sizeof *p->calls);
+    if (!p->th || !p->calls) {
+        free(p->th);
+        free(p->calls);
         free(p);
         return NULL;
     }
@@ -68,6 +80,7 @@ void gr_ref_pool_destroy(gr_ref_pool *p)
 {
     if (!p) return;
     free(p->th);
+    free(p->calls);
     free(p);
 }
 
@@ -75,11 +88,11 @@ gr_status gr_ref_pool_run(gr_ref_pool *p, void *(*fn)(void *), void *arg, gr_ref
                           volatile sig_atomic_t *interrupt, gr_progress *prog, double frac0, double span,
                           const char *note, gr_error *err)
 {
-    pool_call call = {fn, arg};
     double t0 = gr_ref_mono_s();
     int started = 0;
     for (int i = 0; i < p->threads; i++) {
-        if (pthread_create(&p->th[i], NULL, pool_main, &call) != 0) break;
+        p->calls[i] = (pool_call){fn, arg, 0.0, 0.0};
+        if (pthread_create(&p->th[i], NULL, pool_main, &p->calls[i]) != 0) break;
         started++;
     }
     if (!started)
@@ -94,6 +107,12 @@ gr_status gr_ref_pool_run(gr_ref_pool *p, void *(*fn)(void *), void *arg, gr_ref
         nanosleep(&ts, NULL);
     }
     for (int i = 0; i < started; i++) pthread_join(p->th[i], NULL);
+    {
+        double a[64], b[64]; /* the workers' spans; past 64 threads the first 64 (an underestimate) */
+        int n = started < 64 ? started : 64;
+        for (int i = 0; i < n; i++) { a[i] = p->calls[i].t0; b[i] = p->calls[i].t1; }
+        w->par_s = gr_ref_overlap_s(a, b, n);
+    }
     if (atomic_load(&w->stop) == 2) return gr_fail(err, GR_E_NOMEM, "reference: out of memory in a worker thread");
     return GR_OK;
 }

@@ -16,6 +16,7 @@
 typedef struct gr_ref_work {
     atomic_int next_row, rows_done, stop;
     atomic_llong queries, shadow_rays, max_hits; /* max_hits: the most beams at one point */
+    double par_s; /* set by gr_ref_pool_run: the time with at least two workers busy */
 } gr_ref_work;
 /* Zeroed, the next row row0. */
 void gr_ref_work_init(gr_ref_work *w, int row0);
@@ -27,7 +28,7 @@ typedef struct gr_ref_pool gr_ref_pool;
 /* Room for `threads` workers (at least one). NULL if no memory. */
 gr_ref_pool *gr_ref_pool_create(int threads);
 void gr_ref_pool_destroy(gr_ref_pool *p); /* accepts NULL */
-/* Runs fn(arg) on every worker and waits for them: until `rows` rows are done, w->stop is
+/* Runs fn(arg) on every worker and waits for them: until `rows` units (rows or tiles) are done, w->stop is
  * set or *interrupt (may be NULL) is; meanwhile the bar goes from frac0 to frac0 + span
  * with the rows done, labelled note. GR_E_RUNTIME when no thread starts, GR_E_NOMEM when a
  * worker ran out of memory (w->stop == 2); otherwise GR_OK (w->rows_done < rows: interrupted). */

@@ -13,6 +13,7 @@
 #include "reference/beams.h"
 #include "reference/embree_scene.h"
 #include "reference/integrator.h"
+#include "reference/phase.h"
 #include "reference/pool.h"
 
 #define REF_DEFAULT_MAX_PRIMS ((size_t)16 * 1024 * 1024)
@@ -117,6 +118,9 @@ struct gr_ref_renderer {
      * a part file carries besides the arrays (gr_ref_sums_copy_tallies), and what the
      * statistics read (reference/stats.h), from a render or from merged parts alike */
     gr_ref_sums tally;
+    /* per-phase wall, CPU and serial time of the render (reference/phase.h; on while
+     * gr_ref_render runs, and then read by the statistics) */
+    gr_ref_phases phases;
 };
 
 /* Per pixel (of the image or of the probe's grid) and batch: RGB sums, counts, the AOVs. */

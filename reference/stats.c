@@ -36,10 +36,13 @@ static int cmp_by_value(const void *a, const void *b)
 int gr_ref_target_met(const ref_errors *e, int batches, double target)
 {
     double k = gr_student_t975(batches - 1) / GR_NORMAL_Q975;
-    return k * e->rel_mean < target && k * e->rel_p95 < target;
+    int met = k * e->rel_mean < target && k * e->rel_p95 < target;
+    for (int c = 0; c < 3; c++) met = met && k * e->ch_rel_mean[c] < target && k * e->ch_rel_p95[c] < target; /* issue 30 */
+    return met;
 }
 
-gr_status gr_ref_image_errors(const ref_accum *acc, ref_errors *e)
+/* One quantity's image errors: channel ch (0..2) or the RGB mean (ch = -1). */
+static gr_status quantity_errors(const ref_accum *acc, int ch, ref_errors *e)
 {
     size_t np = (size_t)acc->W * acc->H;
     int B = acc->B;
@@ -57,7 +60,7 @@ gr_status gr_ref_image_errors(const ref_accum *acc, ref_errors *e)
             uint32_t c = acc->count[p * B + b];
             if (!c) continue;
             const double *s = acc->sum + (p * B + b) * 3;
-            tmp[k++] = (s[0] + s[1] + s[2]) / (3.0 * c);
+            tmp[k++] = ch < 0 ? (s[0] + s[1] + s[2]) / (3.0 * c) : s[ch] / c;
             m += tmp[k - 1];
         }
         if (k < np) continue; /* an unfinished batch (interrupted) does not enter image errors */
@@ -75,14 +78,14 @@ gr_status gr_ref_image_errors(const ref_accum *acc, ref_errors *e)
             uint32_t c = acc->count[p * B + b];
             if (!c) continue;
             const double *sm = acc->sum + (p * B + b) * 3;
-            double mb = (sm[0] + sm[1] + sm[2]) / (3.0 * c);
+            double mb = ch < 0 ? (sm[0] + sm[1] + sm[2]) / (3.0 * c) : sm[ch] / c;
             s += mb;
             s2 += mb * mb;
             kb++;
             n += c;
-            tot += sm[0] + sm[1] + sm[2];
+            tot += ch < 0 ? sm[0] + sm[1] + sm[2] : sm[ch];
         }
-        v[p] = n ? tot / (3.0 * n) : 0.0;
+        v[p] = n ? tot / ((ch < 0 ? 3.0 : 1.0) * n) : 0.0;
         double mm = kb ? s / kb : 0.0;
         se[p] = kb >= 2 ? sqrt(fmax(0.0, (s2 - kb * mm * mm) / (kb - 1)) / kb) : fabs(v[p]);
         if (!n) se[p] = -1.0; /* not rendered (interrupted): no estimate, not "converged" */
@@ -122,6 +125,79 @@ gr_status gr_ref_image_errors(const ref_accum *acc, ref_errors *e)
     }
     free(tmp); free(Mb); free(Qb); free(v); free(se);
     return GR_OK;
+}
+
+gr_status gr_ref_image_errors(const ref_accum *acc, ref_errors *e)
+{
+    gr_status st = quantity_errors(acc, -1, e);
+    for (int c = 0; c < 3 && st == GR_OK; c++) {
+        ref_errors ec;
+        memset(&ec, 0, sizeof ec);
+        st = quantity_errors(acc, c, &ec);
+        e->ch_rel_mean[c] = ec.rel_mean;
+        e->ch_rel_p95[c] = ec.rel_p95;
+        e->ch_frac_1pct[c] = ec.frac_1pct;
+    }
+    return st;
+}
+
+/* 8 x 8 blocks (issue 30): each block's mean per batch (the mean of its pixels' batch means),
+ * its standard error from the spread of those B means (so that what the pixels share, the
+ * passes' beam sets, is counted), relative to max(block mean, image mean) per channel, the
+ * largest channel's. Its 50th and 95th percentiles and maximum over the whole blocks. */
+static void block_noise(const ref_accum *acc, double q[3])
+{
+    enum { BS = 8 };
+    int bw = acc->W / BS, bh = acc->H / BS, B = acc->B;
+    q[0] = q[1] = q[2] = -1.0;
+    double chm[3] = {0.0, 0.0, 0.0};
+    size_t np = (size_t)acc->W * acc->H;
+    for (size_t p = 0; p < np; p++) {
+        uint32_t n = 0;
+        double t[3] = {0.0, 0.0, 0.0};
+        for (int b = 0; b < B; b++) {
+            n += acc->count[p * B + b];
+            for (int c = 0; c < 3; c++) t[c] += acc->sum[(p * B + b) * 3 + c];
+        }
+        for (int c = 0; c < 3; c++) chm[c] += n ? t[c] / n : 0.0;
+    }
+    for (int c = 0; c < 3; c++) chm[c] /= (double)(np ? np : 1);
+    if (bw < 1 || bh < 1 || B < 2) return;
+    double *rel = malloc((size_t)bw * bh * sizeof *rel), *m = malloc((size_t)B * 3 * sizeof *m);
+    if (!rel || !m) { free(rel); free(m); return; }
+    size_t nb = 0;
+    for (int by = 0; by < bh; by++)
+        for (int bx = 0; bx < bw; bx++) {
+            int ok = 1;
+            for (int b = 0; b < B; b++)
+                for (int c = 0; c < 3; c++) m[b * 3 + c] = 0.0;
+            for (int y = by * BS; y < by * BS + BS && ok; y++)
+                for (int x = bx * BS; x < bx * BS + BS && ok; x++) {
+                    size_t p = (size_t)y * acc->W + x;
+                    for (int b = 0; b < B; b++) {
+                        uint32_t k = acc->count[p * B + b];
+                        if (!k) { ok = 0; break; }
+                        for (int c = 0; c < 3; c++) m[b * 3 + c] += acc->sum[(p * B + b) * 3 + c] / k / (BS * BS);
+                    }
+                }
+            if (!ok) continue; /* not rendered in full (interrupted) */
+            double worst = 0.0;
+            for (int c = 0; c < 3; c++) {
+                double s = 0.0, s2 = 0.0;
+                for (int b = 0; b < B; b++) { s += m[b * 3 + c]; s2 += m[b * 3 + c] * m[b * 3 + c]; }
+                double mm = s / B, se = sqrt(fmax(0.0, (s2 - B * mm * mm) / (B - 1)) / B), norm = fmax(mm, chm[c]);
+                double r = norm > 0.0 ? se / norm : 0.0;
+                if (r > worst) worst = r;
+            }
+            rel[nb++] = worst;
+        }
+    if (nb) {
+        q[2] = gr_ref_percentile(rel, nb, 1.0);
+        q[1] = gr_ref_percentile(rel, nb, 0.95);
+        q[0] = gr_ref_percentile(rel, nb, 0.5);
+    }
+    free(rel);
+    free(m);
 }
 
 static gr_status build_image(const gr_ref_renderer *r, const ref_accum *acc, gr_ref_result *out, gr_error *err)
@@ -207,6 +283,18 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     SET(gr_meta_set_double(m, "godrays:image_mean", e->mean));
     SET(gr_meta_set_double(m, "godrays:image_p95", e->p95));
     SET(gr_meta_set_double(m, "godrays:frac_pixels_stderr_le_1pct", e->frac_1pct));
+    for (int c = 0; c < 3; c++) { /* per channel (issue 30): the same figures for R, G and B */
+        snprintf(key, sizeof key, "godrays:frac_pixels_stderr_le_1pct.%c", "RGB"[c]);
+        SET(gr_meta_set_double(m, key, e->ch_frac_1pct[c]));
+        snprintf(key, sizeof key, "godrays:rel_stderr_mean.%c", "RGB"[c]);
+        SET(gr_meta_set_double(m, key, finite_or(e->ch_rel_mean[c], -1.0)));
+        snprintf(key, sizeof key, "godrays:rel_stderr_p95.%c", "RGB"[c]);
+        SET(gr_meta_set_double(m, key, finite_or(e->ch_rel_p95[c], -1.0)));
+    }
+    /* 8 x 8 block noise (block_noise): median, 95th percentile, worst block */
+    SET(gr_meta_set_double(m, "godrays:block8_rel_stderr_median", e->block8[0]));
+    SET(gr_meta_set_double(m, "godrays:block8_rel_stderr_p95", e->block8[1]));
+    SET(gr_meta_set_double(m, "godrays:block8_rel_stderr_max", e->block8[2]));
     SET(gr_meta_set_double(m, "godrays:cutoff_distance_m", r->cutoff_d));
     SET(gr_meta_set_double(m, "godrays:preview_exposure", out->preview_exposure));
     SET(gr_meta_set_double(m, "godrays:queries_per_s", qps));
@@ -279,15 +367,52 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     return st;
 }
 
+/* The render's phases (reference/phase.h), the statistics' own included: into the result and
+ * the metadata (godrays:phase.NAME.wall_s, .cpu_s, .serial_s; godrays:serial_s, serial_fraction).
+ * Nothing when not measured (assembled parts). */
+static gr_status record_phases(gr_ref_renderer *r, gr_ref_result *out)
+{
+    if (!r->phases.on) return GR_OK;
+    gr_ref_phases_switch(&r->phases, REF_PH_OTHER);
+    gr_metadata *m = &out->meta;
+    gr_status st = GR_OK;
+    double wall = 0.0, serial = 0.0, cpu = 0.0;
+    char key[64];
+    out->phases = 1;
+    for (int i = 0; i < REF_PH_COUNT; i++) {
+        double w = r->phases.wall_s[i], s = fmax(0.0, w - r->phases.par_s[i]);
+        out->phase_wall_s[i] = w;
+        out->phase_cpu_s[i] = r->phases.cpu_s[i];
+        out->phase_serial_s[i] = s;
+        wall += w;
+        serial += s;
+        cpu += r->phases.cpu_s[i];
+        snprintf(key, sizeof key, "godrays:phase.%s.wall_s", gr_ref_phase_names[i]);
+        if (st == GR_OK) st = gr_meta_set_double(m, key, w);
+        snprintf(key, sizeof key, "godrays:phase.%s.cpu_s", gr_ref_phase_names[i]);
+        if (st == GR_OK) st = gr_meta_set_double(m, key, r->phases.cpu_s[i]);
+        snprintf(key, sizeof key, "godrays:phase.%s.serial_s", gr_ref_phase_names[i]);
+        if (st == GR_OK) st = gr_meta_set_double(m, key, s);
+    }
+    out->serial_frac = wall > 0.0 ? serial / wall : 0.0;
+    if (st == GR_OK) st = gr_meta_set_double(m, "godrays:phases_wall_s", wall);
+    if (st == GR_OK) st = gr_meta_set_double(m, "godrays:phases_cpu_s", cpu);
+    if (st == GR_OK) st = gr_meta_set_double(m, "godrays:serial_s", serial);
+    if (st == GR_OK) st = gr_meta_set_double(m, "godrays:serial_fraction", out->serial_frac);
+    return st;
+}
+
 gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_march_totals *tot, double wall_s,
                         gr_ref_result *out, gr_error *err)
 {
+    gr_ref_phases_switch(&r->phases, REF_PH_STATS);
     size_t np = (size_t)acc->W * acc->H;
     int P = r->passes_per_round;
     ref_errors e;
     memset(&e, 0, sizeof e);
     gr_status st = GR_OK;
     if (gr_ref_image_errors(acc, &e) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
+    if (st == GR_OK) block_noise(acc, e.block8);
     if (st == GR_OK) st = build_image(r, acc, out, err);
     if (st != GR_OK) return st;
     gr_ref_block_bias(r, out->image, e.mean);
@@ -297,6 +422,7 @@ gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_marc
     out->rel_se_mean = e.rel_mean;
     out->rel_se_p95 = e.rel_p95;
     out->frac_se_1pct = e.frac_1pct;
+    out->block8_rel_se_max = e.block8[2];
     out->queries_per_s = tot->march_s > 0.0 ? (double)tot->queries / tot->march_s : 0.0;
     out->shadow_rays_per_s = tot->march_s > 0.0 ? (double)tot->shadows / tot->march_s : 0.0;
     out->beam_build_s = r->tally.beam_build_s;
@@ -321,5 +447,5 @@ gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_marc
     gr_meta_set_double(&out->meta, "godrays:shadow_rays_per_s", out->shadow_rays_per_s);
     /* the most beams at one march point (the list grows; -1: not carried through parts) */
     gr_meta_set_int(&out->meta, "godrays:beam_max_hits", tot->max_hits);
-    return GR_OK;
+    return record_phases(r, out) == GR_OK ? GR_OK : gr_fail(err, GR_E_NOMEM, "reference: out of memory for metadata");
 }

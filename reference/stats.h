@@ -8,13 +8,18 @@
 #include "reference/march.h"
 #include "reference/renderer.h"
 
-typedef struct ref_errors { double rel_mean, rel_p95, frac_1pct, mean, p95; } ref_errors;
+typedef struct ref_errors {
+    double rel_mean, rel_p95, frac_1pct, mean, p95;      /* of the RGB mean */
+    double ch_rel_mean[3], ch_rel_p95[3], ch_frac_1pct[3]; /* the same per channel (issue 30) */
+    double block8[3]; /* 8 x 8 block noise: median, p95, max of se / max(block mean, image mean), worst channel */
+} ref_errors;
 
 /* The q-quantile of v[0 .. n) (sorts v; linear between ranks). */
 double gr_ref_percentile(double *v, size_t n, double q);
 /* --target-error E: the relative standard errors come from B batch means, B - 1 degrees of
  * freedom; the target is met when their Student-t 95 % half-widths are within those a
- * known standard error E would give, t_{0.975, B-1} se <= 1.96 E (docs/reference.md). */
+ * known standard error E would give, t_{0.975, B-1} se <= 1.96 E (docs/reference.md); for the
+ * RGB mean and for each of R, G and B. */
 int gr_ref_target_met(const ref_errors *e, int batches, double target);
 /* Image-level error estimates from the batch images (docs/reference.md, "Error bars").
  * GR_E_NOMEM (no message) when out of memory. */
