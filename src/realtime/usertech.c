@@ -136,7 +136,10 @@ gr_status gr_technique_add_dir(const char *dir, gr_error *err)
     X(IOR, "float u_ior")                                                \
     X(SEABED_Y, "float u_seabed_y")                                      \
     X(LIGHT_VIEW_PROJ, "mat4 u_light_view_proj")                         \
-    X(SHADOW_HALF_EXTENT, "float u_shadow_half_extent")
+    X(SHADOW_HALF_EXTENT, "float u_shadow_half_extent")                  \
+    X(LIGHT_RADIANCE, "vec3 u_sun_light_radiance")                           \
+    X(LIGHT_UNITS, "vec3 u_sun_light_units")                                 \
+    X(LIGHT_SIZE, "vec2 u_sun_light_size")
 
 enum {
 #define X(id, decl) U_##id,
@@ -219,30 +222,24 @@ static char *make_prelude(const gr_ut_manifest *m, const gr_ut_pass *ps, int fra
     gr_ut_sb_add(&b, "// ---- godrays harness prelude (docs/techniques.md): technique '%s', pass '%s', %s stage\n", m->name,
            ps->name, frag ? "fragment" : "vertex");
     gr_ut_sb_add(&b, "#define GODRAYS 1\n#define GR_MAX_WAVES %d\n#define GR_PI 3.14159265358979\n", GR_MAX_WAVES);
+    int has_in[4] = {0}; /* by -GR_UT_IN_*: the harness inputs this pass reads */
+    for (int k = 0; k < ps->n_inputs; k++)
+        if (ps->inputs[k] < 0) has_in[-ps->inputs[k]] = 1;
     for (int i = 0; i < U_COUNT; i++) {
-        if ((i == U_LIGHT_VIEW_PROJ || i == U_SHADOW_HALF_EXTENT)) {
-            int has = 0;
-            for (int k = 0; k < ps->n_inputs; k++) has |= ps->inputs[k] == GR_UT_IN_SHADOW_MAP;
-            if (!has) continue;
-        }
+        /* a harness input's uniforms only where the pass reads it */
+        if ((i == U_LIGHT_VIEW_PROJ || i == U_SHADOW_HALF_EXTENT) && !has_in[-GR_UT_IN_SHADOW_MAP]) continue;
+        if ((i == U_LIGHT_RADIANCE || i == U_LIGHT_UNITS || i == U_LIGHT_SIZE) && !has_in[-GR_UT_IN_LIGHT]) continue;
         gr_ut_sb_add(&b, "uniform %s;\n", ut_uniform_decl[i]);
     }
     for (int i = 0; i < m->n_settings; i++) {
         static const char *const glsl_types[] = {"float", "int", "bool", "vec3"};
         gr_ut_sb_add(&b, "uniform %s u_set_%s;\n", glsl_types[m->settings[i].type], m->settings[i].key);
     }
-    int has_shadow = 0, has_depth = 0;
-    for (int k = 0; k < ps->n_inputs; k++) {
-        int in = ps->inputs[k];
-        if (in == GR_UT_IN_SHADOW_MAP) has_shadow = 1;
-        else if (in == GR_UT_IN_EYE_DEPTH) has_depth = 1;
-        gr_ut_sb_add(&b, "uniform sampler2D t_%s;\n",
-               in == GR_UT_IN_SHADOW_MAP ? "shadow_map" : in == GR_UT_IN_EYE_DEPTH ? "eye_depth" : m->targets[in].name);
-    }
+    for (int k = 0; k < ps->n_inputs; k++) gr_ut_sb_add(&b, "uniform sampler2D t_%s;\n", gr_ut_input_name(m, ps->inputs[k]));
     if (frag && !ps->vertex_src) gr_ut_sb_add(&b, "in vec2 v_uv;\n");
     gr_ut_sb_add(&b, "%s", ut_helpers);
-    if (has_shadow) gr_ut_sb_add(&b, "%s", ut_shadow_helper);
-    if (has_depth) gr_ut_sb_add(&b, "%s", ut_depth_helper);
+    if (has_in[-GR_UT_IN_SHADOW_MAP]) gr_ut_sb_add(&b, "%s", ut_shadow_helper);
+    if (has_in[-GR_UT_IN_EYE_DEPTH]) gr_ut_sb_add(&b, "%s", ut_depth_helper);
     gr_ut_sb_add(&b, "// ---- end of the prelude\n#line 1\n");
     if (b.failed) {
         free(b.s);
@@ -303,6 +300,8 @@ typedef struct ut_state {
     ut_prog_locs locs[GR_UT_MAX_PASSES];
     GLuint vao;
     gr_target tgt[GR_UT_MAX_TARGETS];
+    gr_light_pass light_pass; /* the toolkit's: the "sun_light" input, as radial_blur's light pass */
+    gr_target light;
     GLuint q_samples[GR_UT_MAX_PASSES];
     gr_gl_timer timer;
     int timer_ready;
@@ -364,15 +363,14 @@ static gr_status ut_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
         }
         for (int k = 0; k < ps->n_inputs; k++) {
             char nm[64];
-            int in = ps->inputs[k];
-            snprintf(nm, sizeof nm, "t_%s",
-                     in == GR_UT_IN_SHADOW_MAP ? "shadow_map" : in == GR_UT_IN_EYE_DEPTH ? "eye_depth" : m->targets[in].name);
+            snprintf(nm, sizeof nm, "t_%s", gr_ut_input_name(m, ps->inputs[k]));
             l->in[k] = glGetUniformLocation(s->prog[p], nm);
         }
     }
-    if (m->uses_shadow_map || m->uses_eye_depth) {
+    if (m->uses_shadow_map || m->uses_eye_depth || m->uses_light) {
         if ((st = gr_scenegl_create(gl, &s->sgl, err)) != GR_OK) goto fail;
     }
+    if (m->uses_light && (st = gr_light_pass_init(&s->light_pass, NULL, err)) != GR_OK) goto fail;
     glGenVertexArrays(1, &s->vao);
     glGenQueries(m->n_passes, s->q_samples);
     gr_gl_timer_init(&s->timer);
@@ -397,6 +395,8 @@ static void ut_destroy(void *state)
     if (s->q_samples[0]) glDeleteQueries(s->m->n_passes, s->q_samples);
     if (s->timer_ready) gr_gl_timer_free(&s->timer);
     gr_scenegl_destroy(s->sgl);
+    gr_light_pass_free(&s->light_pass);
+    gr_target_release(&s->light);
     gr_readback_free(&s->rb);
     free(s);
 }
@@ -446,6 +446,10 @@ static gr_status check_memory(const ut_state *s, const void *settings, int W, in
         need += 4.0 * size * size;
     }
     if (m->uses_eye_depth) need += 8.0 * W * H;
+    if (m->uses_light) { /* its target and its eye depth */
+        double sc = value_of(m, settings, &m->light_scale);
+        need += (px_bytes[m->light_format] + 8.0) * (W * sc + 1) * (H * sc + 1);
+    }
     char what[96], detail[64];
     snprintf(what, sizeof what, "technique %s", m->name);
     snprintf(detail, sizeof detail, "%d render target%s, readback and harness inputs", m->n_targets,
@@ -471,6 +475,7 @@ typedef struct ut_frame_inputs {
     double light_vp[16];
     double shadow_half_extent;
     GLuint shadow_tex, depth_tex;
+    double light_radiance[3], light_units[3];
 } ut_frame_inputs;
 
 static void set_uniforms(const ut_state *s, int p, const ut_frame_inputs *fi, const void *settings, int tw, int th)
@@ -522,6 +527,9 @@ static void set_uniforms(const ut_state *s, int p, const ut_frame_inputs *fi, co
     F1(SEABED_Y, f->seabed_y);
     set_matrix(u[U_LIGHT_VIEW_PROJ], fi->light_vp);
     F1(SHADOW_HALF_EXTENT, fi->shadow_half_extent);
+    set3(u[U_LIGHT_RADIANCE], fi->light_radiance);
+    set3(u[U_LIGHT_UNITS], fi->light_units);
+    if (u[U_LIGHT_SIZE] >= 0) glUniform2f(u[U_LIGHT_SIZE], (float)s->light.w, (float)s->light.h);
 #undef F1
     const gr_ut_manifest *m = s->m;
     for (int i = 0; i < m->n_settings; i++) {
@@ -542,10 +550,45 @@ static void set_uniforms(const ut_state *s, int p, const ut_frame_inputs *fi, co
     for (int k = 0; k < ps->n_inputs; k++) {
         int in = ps->inputs[k];
         glActiveTexture(GL_TEXTURE0 + (GLenum)k);
-        glBindTexture(GL_TEXTURE_2D, in == GR_UT_IN_SHADOW_MAP ? fi->shadow_tex : in == GR_UT_IN_EYE_DEPTH ? fi->depth_tex : s->tgt[in].tex);
+        glBindTexture(GL_TEXTURE_2D, in == GR_UT_IN_SHADOW_MAP  ? fi->shadow_tex
+                                     : in == GR_UT_IN_EYE_DEPTH ? fi->depth_tex
+                                     : in == GR_UT_IN_LIGHT     ? s->light.tex
+                                                                : s->tgt[in].tex);
         if (l->in[k] >= 0) glUniform1i(l->in[k], k);
     }
     glActiveTexture(GL_TEXTURE0);
+}
+
+/* The "sun_light" input: the toolkit's light pass (radial_blur's) at the manifest's size, format,
+ * kernel radius, threshold and occluders, over the eye depth at its size; its units. */
+static gr_status light_input(ut_state *s, const gr_scene *scene, ut_frame_inputs *fi, const void *settings,
+                             gr_error *err)
+{
+    static const GLenum fmts[] = {GL_RGBA8, GL_RGBA16F, GL_RGBA32F};
+    const gr_ut_manifest *m = s->m;
+    const int W = fi->f.width, H = fi->f.height;
+    double sc = value_of(m, settings, &m->light_scale);
+    int lw = (int)lround(W * sc), lh = (int)lround(H * sc);
+    if (lw < 1) lw = 1;
+    if (lh < 1) lh = 1;
+    char what[600];
+    snprintf(what, sizeof what, "%s: sun_light (%s)", m->path, gr_ut_format_names[m->light_format]);
+    gr_status st = gr_target_ensure(&s->light, fmts[m->light_format], lw, lh, GR_TARGET_LINEAR | GR_TARGET_BLACK_BORDER,
+                                    what, err);
+    if (st) return st;
+    unsigned depth_tex = 0;
+    if ((st = gr_scenegl_eye_depth(s->sgl, scene, &fi->f, lw, lh, &depth_tex, err))) return st;
+    const gr_light_params lp = {.radius_deg = value_of(m, settings, &m->light_radius_deg),
+                                .threshold = value_of(m, settings, &m->light_threshold),
+                                .occluders = m->light_occluders,
+                                .dither8 = 0};
+    if ((st = gr_light_pass_draw(&s->light_pass, scene, &fi->f, &lp, &s->light, depth_tex, m->name, err))) return st;
+    static const double one[3] = {1, 1, 1};
+    gr_light_radiance(&fi->f, lp.radius_deg, fi->light_radiance);
+    /* seed 004's exposure 0.2 and sample scale 0.4, fade 1: toolkit.h gr_light_units */
+    gr_light_units(scene, &fi->f, lp.radius_deg, one, 0.2, 0.4, 1.0, fi->light_units);
+    glBindVertexArray(0);
+    return gr_gl_check("sun_light", err);
 }
 
 static GLenum prim_mode(gr_ut_prim p)
@@ -616,6 +659,14 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
     /* harness inputs, timed as passes of their own */
     int slot = 0;
     char names[GR_TECH_MAX_PASSES][24];
+    if (m->uses_light) {
+        /* first: its eye depth (at the light's size) is remade below by "eye_depth" */
+        gr_gl_timer_begin(&s->timer, slot);
+        st = light_input(s, scene, fi, settings, err);
+        gr_gl_timer_end(&s->timer);
+        if (st) goto done;
+        snprintf(names[slot++], 24, "sun_light");
+    }
     if (m->uses_shadow_map) {
         int size = (int)value_of(m, settings, &m->shadow_size);
         fi->shadow_half_extent = value_of(m, settings, &m->shadow_half_extent);

@@ -199,6 +199,16 @@ static int find_setting(const gr_ut_manifest *m, const char *key)
     return -1;
 }
 
+const char *gr_ut_input_name(const gr_ut_manifest *m, int in)
+{
+    switch (in) {
+    case GR_UT_IN_SHADOW_MAP: return "shadow_map";
+    case GR_UT_IN_EYE_DEPTH: return "eye_depth";
+    case GR_UT_IN_LIGHT: return "sun_light";
+    default: return m->targets[in].name;
+    }
+}
+
 static int find_target(const gr_ut_manifest *m, const char *name)
 {
     for (int i = 0; i < m->n_targets; i++)
@@ -509,7 +519,7 @@ static gr_status parse_targets(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
         if (m->n_targets == GR_UT_MAX_TARGETS) return vfail(c, p, "more than %d targets", GR_UT_MAX_TARGETS);
         if (!is_identifier(it->string, 1, GR_UT_NAME_MAX))
             return vfail(c, p, "a target's name must be [a-z][a-z0-9_]* of at most %d characters without '__'", GR_UT_NAME_MAX - 1);
-        if (!strcmp(it->string, "shadow_map") || !strcmp(it->string, "eye_depth"))
+        if (!strcmp(it->string, "shadow_map") || !strcmp(it->string, "eye_depth") || !strcmp(it->string, "sun_light"))
             return vfail(c, p, "'%s' is the name of a harness texture", it->string);
         if ((st = check_object(c, it, p, keys))) return st;
         gr_ut_target *t = &m->targets[m->n_targets];
@@ -672,9 +682,12 @@ static gr_status parse_pass(ut_ctx *c, gr_ut_manifest *m, const cJSON *it, int i
             } else if (!strcmp(nm, "eye_depth")) {
                 in = GR_UT_IN_EYE_DEPTH;
                 m->uses_eye_depth = 1;
+            } else if (!strcmp(nm, "sun_light")) {
+                in = GR_UT_IN_LIGHT;
+                m->uses_light = 1;
             } else {
                 in = find_target(m, nm);
-                if (in < 0) return vfail(c, r, "unknown input '%s' (a target's name, \"shadow_map\" or \"eye_depth\")", nm);
+                if (in < 0) return vfail(c, r, "unknown input '%s' (a target's name, " GR_UT_HARNESS_INPUTS ")", nm);
                 if (in == ps->target)
                     return vfail(c, r, "pass reads its own target '%s' (a feedback loop): render into another target", nm);
                 if (!written[in]) return vfail(c, r, "target '%s' is read before any earlier pass writes it", nm);
@@ -748,10 +761,35 @@ static gr_status parse_ladder(ut_ctx *c, gr_ut_manifest *m, const cJSON *lad)
     return GR_OK;
 }
 
+/* "sun_light": {"scale", "format", "radius_deg", "threshold", "occluders"} (docs/techniques.md
+ * "Harness textures"); the defaults are radial_blur's. */
+static gr_status parse_light(ut_ctx *c, gr_ut_manifest *m, const cJSON *lt)
+{
+    static const char *const keys[] = {"scale", "format", "radius_deg", "threshold", "occluders", NULL};
+    m->light_scale = (gr_ut_value){0.5, -1};
+    m->light_radius_deg = (gr_ut_value){4.0, -1};
+    m->light_threshold = (gr_ut_value){0.0, -1};
+    m->light_format = GR_UT_FMT_RGBA16F;
+    m->light_occluders = 1;
+    if (!lt) return GR_OK;
+    gr_status st = check_object(c, lt, "sun_light", keys);
+    if (st) return st;
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(lt, "scale");
+    if (v && (st = value_at(c, m, v, "sun_light.scale", GR_UT_NUMBER, 1.0 / 64.0, 4.0, &m->light_scale))) return st;
+    v = cJSON_GetObjectItemCaseSensitive(lt, "radius_deg");
+    if (v && (st = value_at(c, m, v, "sun_light.radius_deg", GR_UT_NUMBER, 0.01, 90, &m->light_radius_deg))) return st;
+    v = cJSON_GetObjectItemCaseSensitive(lt, "threshold");
+    if (v && (st = value_at(c, m, v, "sun_light.threshold", GR_UT_NUMBER, 0, 0.999, &m->light_threshold))) return st;
+    int fmt = GR_UT_FMT_RGBA16F;
+    if ((st = get_enum(c, lt, "sun_light", "format", gr_ut_format_names, &fmt))) return st;
+    if (fmt >= 0) m->light_format = (gr_ut_format)fmt;
+    return get_bool(c, lt, "sun_light", "occluders", &m->light_occluders);
+}
+
 static gr_status parse_manifest(ut_ctx *c, gr_ut_manifest *m, const cJSON *root)
 {
     static const char *const keys[] = {"version", "name", "description", "settings", "gain", "ladder", "shadow_map",
-                                       "targets", "passes", "output", "allow_black", NULL};
+                                       "sun_light", "targets", "passes", "output", "allow_black", NULL};
     static const char *const sm_keys[] = {"size", "half_extent_m", NULL};
     gr_status st = check_object(c, root, "", keys);
     if (st) return st;
@@ -834,6 +872,11 @@ static gr_status parse_manifest(ut_ctx *c, gr_ut_manifest *m, const cJSON *root)
         if (v && (st = value_at(c, m, v, "shadow_map.half_extent_m", GR_UT_NUMBER, 0.01, 1e5, &m->shadow_half_extent)))
             return st;
     }
+    if ((st = parse_light(c, m, cJSON_GetObjectItemCaseSensitive(root, "sun_light")))) return st;
+    int timed = m->n_passes + m->uses_shadow_map + m->uses_eye_depth + m->uses_light;
+    if (timed > GR_TECH_MAX_PASSES)
+        return vfail(c, "passes", "%d passes and %d harness inputs make %d timed passes, at most %d", m->n_passes,
+                     timed - m->n_passes, timed, GR_TECH_MAX_PASSES);
     return GR_OK;
 }
 
