@@ -236,6 +236,7 @@ static char *make_prelude(const gr_ut_manifest *m, const gr_ut_pass *ps, int fra
         gr_ut_sb_add(&b, "uniform %s u_set_%s;\n", glsl_types[m->settings[i].type], m->settings[i].key);
     }
     for (int k = 0; k < ps->n_inputs; k++) gr_ut_sb_add(&b, "uniform sampler2D t_%s;\n", gr_ut_input_name(m, ps->inputs[k]));
+    if (ps->defines) gr_ut_sb_add(&b, "// the pass's \"defines\"\n%s", ps->defines);
     if (frag && !ps->vertex_src) gr_ut_sb_add(&b, "in vec2 v_uv;\n");
     gr_ut_sb_add(&b, "%s", ut_helpers);
     if (has_in[-GR_UT_IN_SHADOW_MAP]) gr_ut_sb_add(&b, "%s", ut_shadow_helper);
@@ -282,6 +283,169 @@ static char *with_prelude(const char *prelude, const char *src)
     if (!strncmp(q, "#version", 8))
         while (*q && *q != '\n') *q++ = ' ';
     return out;
+}
+
+/* ---- compiler errors in the user's own files and lines -------------------------------------- */
+
+static int edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    if (la > 63 || lb > 63) return 99;
+    int d[64][64];
+    for (size_t i = 0; i <= la; i++) d[i][0] = (int)i;
+    for (size_t j = 0; j <= lb; j++) d[0][j] = (int)j;
+    for (size_t i = 1; i <= la; i++)
+        for (size_t j = 1; j <= lb; j++) {
+            int sub = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            int del = d[i - 1][j] + 1, ins = d[i][j - 1] + 1;
+            d[i][j] = sub < del ? (sub < ins ? sub : ins) : (del < ins ? del : ins);
+        }
+    return d[la][lb];
+}
+
+/* A hint for an undeclared identifier `name` in pass p: a harness texture or target the pass
+ * does not list in its inputs, or the nearest uniform (harness or setting) to a misspelt one. */
+static void undeclared_hint(const gr_ut_manifest *m, int p, const char *name, gr_ut_strbuf *b)
+{
+    if (!strncmp(name, "t_", 2)) {
+        const char *in = name + 2;
+        int known = !strcmp(in, "shadow_map") || !strcmp(in, "eye_depth") || !strcmp(in, "sun_light");
+        for (int t = 0; t < m->n_targets && !known; t++) known = !strcmp(m->targets[t].name, in);
+        if (known) {
+            gr_ut_sb_add(b, " (hint: add \"%s\" to passes[%d].inputs in %s)", in, p, m->path);
+            return;
+        }
+    }
+    char best[64] = "";
+    int bd = 99;
+    for (int i = 0; i < U_COUNT + m->n_settings; i++) {
+        char cand[64];
+        if (i < U_COUNT) {
+            const char *sp = strchr(ut_uniform_decl[i], ' ') + 1;
+            snprintf(cand, sizeof cand, "%.*s", (int)strcspn(sp, "["), sp);
+        } else {
+            snprintf(cand, sizeof cand, "u_set_%s", m->settings[i - U_COUNT].key);
+        }
+        int d = edit_distance(name, cand);
+        if (d < bd) {
+            bd = d;
+            snprintf(best, sizeof best, "%s", cand);
+        }
+    }
+    int len = (int)strlen(name);
+    if (bd <= (len > 12 ? 3 : 2)) gr_ut_sb_add(b, " (did you mean %s?)", best);
+    else if (!strncmp(name, "u_set_", 6))
+        gr_ut_sb_add(b, " (%s has no setting '%s': settings are u_set_KEY for KEY in \"settings\")", m->name, name + 6);
+}
+
+/* One driver diagnostic line mapped to "FILE:LINE:COL: message" (Mesa "S:L(C): msg", NVIDIA
+ * "S(L) : msg"; anything else verbatim), line numbers through GR_UT_LINE_BASE to the file. */
+static void map_log_line(const gr_ut_manifest *m, int p, const char *stage_file, const char *ln, gr_ut_strbuf *b)
+{
+    unsigned src = 0, line = 0, col = 0;
+    int n = 0;
+    const char *msg = NULL;
+    if (sscanf(ln, "%u:%u(%u): %n", &src, &line, &col, &n) == 3 && n > 0) msg = ln + n;
+    else if (sscanf(ln, "%u(%u) : %n", &src, &line, &n) == 2 && n > 0) msg = ln + n;
+    if (!msg) {
+        gr_ut_sb_add(b, "\n  %s", ln);
+        return;
+    }
+    unsigned k = line / GR_UT_LINE_BASE;
+    char file[600];
+    if (k >= 1 && (int)k <= m->n_files) snprintf(file, sizeof file, "%s/%s", m->dir, m->files[k - 1]);
+    else snprintf(file, sizeof file, "%s", stage_file); /* the prelude or the built-in vertex shader */
+    gr_ut_sb_add(b, "\n  %s:%u:%u: %s", file, line % GR_UT_LINE_BASE, col, msg);
+    /* Mesa: "`name' undeclared"; NVIDIA: "undefined variable \"name\"" */
+    const char *q = strstr(msg, "`");
+    char name[64] = "";
+    if (q && strstr(msg, "undeclared")) sscanf(q + 1, "%63[A-Za-z0-9_]", name);
+    else if ((q = strstr(msg, "undefined variable \"")) != NULL) sscanf(q + 20, "%63[A-Za-z0-9_]", name);
+    if (name[0]) undeclared_hint(m, p, name, b);
+}
+
+/* Compiles one stage; on failure the driver's log, one diagnostic per line. */
+static gr_status compile_stage(const gr_ut_manifest *m, int p, unsigned type, const char *src, const char *label,
+                               GLuint *out, gr_error *err)
+{
+    const gr_ut_pass *ps = &m->passes[p];
+    const int frag = type == GL_FRAGMENT_SHADER;
+    GLuint sh = glCreateShader(type);
+    glShaderSource(sh, 1, &src, NULL);
+    glCompileShader(sh);
+    GLint ok = 0;
+    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    if (ok) {
+        *out = sh;
+        return GR_OK;
+    }
+    char log[8192] = "", stage_file[600];
+    glGetShaderInfoLog(sh, (GLsizei)sizeof log, NULL, log);
+    glDeleteShader(sh);
+    if (frag || ps->vertex_file) snprintf(stage_file, sizeof stage_file, "%s (prelude)", label);
+    else snprintf(stage_file, sizeof stage_file, "built-in full-screen triangle");
+    gr_ut_strbuf b = {0};
+    int lines = 0, left = 0, cands = 0;
+    for (char *ln = strtok(log, "\n"); ln; ln = strtok(NULL, "\n")) {
+        if (!ln[0]) continue;
+        lines++;
+        /* Mesa lists every overload of a builtin as "error:    vec4 texture(...)": counted, not shown */
+        const char *e = strstr(ln, "error:    ");
+        if (e && e[10] != ' ' && e[10]) {
+            cands++;
+            continue;
+        }
+        /* whole lines only, within the message's room */
+        if (b.len > GR_ERROR_MSG_MAX - 300) {
+            left++;
+            continue;
+        }
+        map_log_line(m, p, stage_file, ln, &b);
+    }
+    if (cands) gr_ut_sb_add(&b, "\n  (%d candidate overload%s listed by the driver left out)", cands, cands == 1 ? "" : "s");
+    if (left) gr_ut_sb_add(&b, "\n  ... %d more line%s", left, left == 1 ? "" : "s");
+    /* The one exception to one-line errors (issue 29): a compiler's log is a list, one
+     * "FILE:LINE:COL: message" per line as editors and CI logs read them, after a summary
+     * line. gr_fail joins lines, so the message is written here. */
+    gr_status st = gr_fail(err, GR_E_GL, "%s: passes[%d] '%s': %s shader does not compile", m->path, p, ps->name,
+                           frag ? "fragment" : "vertex");
+    if (err)
+        snprintf(err->msg, sizeof err->msg, "%s: passes[%d] '%s': %s shader does not compile (%d line%s of the driver's log):%s",
+                 m->path, p, ps->name, frag ? "fragment" : "vertex", lines, lines == 1 ? "" : "s", b.s ? b.s : " (empty)");
+    free(b.s);
+    return st;
+}
+
+static gr_status build_program(const gr_ut_manifest *m, int p, const char *label, const char *vs, const char *fs,
+                               GLuint *prog, gr_error *err)
+{
+    GLuint v = 0, f = 0;
+    *prog = 0;
+    gr_status st = compile_stage(m, p, GL_VERTEX_SHADER, vs, label, &v, err);
+    if (st == GR_OK) st = compile_stage(m, p, GL_FRAGMENT_SHADER, fs, label, &f, err);
+    if (st != GR_OK) {
+        if (v) glDeleteShader(v);
+        return st;
+    }
+    /* linking: the toolkit's (gl/glctx.h), whose message is one line */
+    GLuint pr = glCreateProgram();
+    glAttachShader(pr, v);
+    glAttachShader(pr, f);
+    glLinkProgram(pr);
+    glDeleteShader(v);
+    glDeleteShader(f);
+    GLint ok = 0;
+    glGetProgramiv(pr, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[2048] = "";
+        glGetProgramInfoLog(pr, (GLsizei)sizeof log, NULL, log);
+        for (char *q = log; *q; q++)
+            if (*q == '\n') *q = ' ';
+        glDeleteProgram(pr);
+        return gr_fail(err, GR_E_GL, "%s: program does not link: %s", label, log);
+    }
+    *prog = pr;
+    return gr_gl_check(label, err);
 }
 
 /* ---- instances ------------------------------------------------------------------------------ */
@@ -343,7 +507,7 @@ static gr_status ut_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
         snprintf(label, sizeof label, "%s: passes[%d] '%s' (vertex %s%s%s, fragment %s/%s)", m->path, p, ps->name,
                  ps->vertex_file ? m->dir : "", ps->vertex_file ? "/" : "",
                  ps->vertex_file ? ps->vertex_file : "built-in full-screen triangle", m->dir, ps->fragment_file);
-        st = gr_gl_build_program(label, vs, fs, &s->prog[p], err);
+        st = build_program(m, p, label, vs, fs, &s->prog[p], err);
         free(vs);
         free(fs);
         if (st) goto fail;

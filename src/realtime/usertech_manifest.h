@@ -25,6 +25,9 @@
 #define GR_UT_MAX_SIZE 16384
 #define GR_UT_MAX_LADDER 16
 #define GR_UT_MAX_FILE_BYTES (1 << 20) /* a manifest or a shader file: 1 MiB at most */
+#define GR_UT_MAX_FILES 32               /* shader files, includes counted */
+#define GR_UT_MAX_INCLUDE_DEPTH 16
+#define GR_UT_LINE_BASE 10000000 /* > the lines of a 1 MiB file; 33 x it fits an int */
 
 typedef enum { GR_UT_NUMBER, GR_UT_INT, GR_UT_BOOL, GR_UT_RGB } gr_ut_type;
 extern const char *const gr_ut_type_names[];
@@ -82,6 +85,7 @@ typedef struct gr_ut_pass {
     float clear[4];
     int n_inputs;
     int inputs[GR_UT_MAX_INPUTS]; /* target index, or GR_UT_IN_* */
+    char *defines;                /* "#define NAME VALUE\n" lines of its "defines" (NULL: none) */
 } gr_ut_pass;
 
 typedef struct gr_ut_manifest {
@@ -106,6 +110,11 @@ typedef struct gr_ut_manifest {
     gr_ut_value light_scale, light_radius_deg, light_threshold;
     gr_ut_format light_format;
     int light_occluders;
+    /* every shader file read, includes too, relative to dir: line L of files[K] is numbered
+     * GR_UT_LINE_BASE * (K + 1) + L in the sources ("#line"; Mesa ignores #line's source
+     * string number), so a driver's line maps back to the file and its own line */
+    int n_files;
+    char *files[GR_UT_MAX_FILES];
     char source_hash[17]; /* FNV-1a 64 of the manifest and every shader file, hex */
     int n_ladder;
     gr_technique_level ladder[GR_UT_MAX_LADDER];
