@@ -28,6 +28,7 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
                            gr_technique_stats *stats, gr_error *err);
 static gr_status ut_metadata(void *state, const gr_scene *scene, const void *settings, const gr_technique_stats *stats,
                              gr_metadata *meta, gr_error *err);
+static gr_status ut_read_target(void *state, gr_image **out, gr_error *err);
 
 /* Settings of a user technique have no scene-derived defaults: resolving is a copy. */
 static void ut_resolve(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out)
@@ -65,6 +66,7 @@ gr_status gr_usertech_load(const char *dir, gr_technique_class **out, gr_error *
     cls->destroy = ut_destroy;
     cls->render = ut_render;
     cls->metadata = ut_metadata;
+    cls->read_target = ut_read_target;
     *out = cls;
     return GR_OK;
 }
@@ -987,3 +989,41 @@ static gr_status ut_metadata(void *state, const gr_scene *scene, const void *set
     return GR_OK;
 }
 
+
+/* `godrays render --save-target` (issue 29): every target of the last render (the sun_light
+ * input first, if used, then the manifest's targets in their order), side by side in one RGBA
+ * strip, top-aligned at their own sizes, 4 black pixels apart; the metadata (ut_metadata)
+ * gives each target's size, so x offsets follow from the order. */
+static gr_status ut_read_target(void *state, gr_image **out, gr_error *err)
+{
+    ut_state *s = state;
+    const gr_ut_manifest *m = s->m;
+    enum { GAP = 4 };
+    *out = NULL;
+    const gr_target *list[GR_UT_MAX_TARGETS + 1];
+    int n = 0, W = 0, H = 0;
+    if (m->uses_light && s->light.tex) list[n++] = &s->light;
+    for (int t = 0; t < m->n_targets; t++)
+        if (s->tgt[t].tex) list[n++] = &s->tgt[t];
+    if (n == 0) return gr_fail(err, GR_E_RUNTIME, "%s: no render yet, no target to read", m->name);
+    for (int k = 0; k < n; k++) {
+        W += list[k]->w + (k ? GAP : 0);
+        if (list[k]->h > H) H = list[k]->h;
+    }
+    gr_status st = gr_gl_make_current(s->gl, err);
+    if (st != GR_OK) return st;
+    gr_image *img = gr_image_create(W, H, 4, NULL);
+    if (!img) return gr_fail(err, GR_E_NOMEM, "%s: out of memory for the targets' strip", m->name);
+    for (int k = 0, x0 = 0; k < n; x0 += list[k]->w + GAP, k++) {
+        const gr_target *t = list[k];
+        if ((st = gr_readback_fbo(&s->rb, t->fbo, t->w, t->h, m->name, err)) != GR_OK) {
+            gr_image_destroy(img);
+            return st;
+        }
+        for (int y = 0; y < t->h; y++) /* GL rows bottom-up, the image's top row first */
+            memcpy(img->pixels + ((size_t)y * W + (size_t)x0) * 4, s->rb.rgba + (size_t)(t->h - 1 - y) * t->w * 4,
+                   (size_t)t->w * 4 * sizeof *img->pixels);
+    }
+    *out = img;
+    return GR_OK;
+}

@@ -5,7 +5,7 @@
 # compile error exits 1 with a summary line and then one "FILE:LINE:COL: message" line per
 # diagnostic, with the user's own file (an included one too) and the line in that file; an
 # undeclared harness texture hints at the pass's inputs; a misspelt setting uniform gets "did
-# you mean". Nothing is written on failure.
+# you mean". Nothing is written on failure. --save-target writes every target in one strip.
 bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
 dir=$(mktemp -d)
@@ -46,6 +46,17 @@ glsl include_error "lib/common.glsl:3:28: error: \`missing_factor' undeclared"
 glsl undeclared_input "f.frag:3:25: error: \`t_eye_depth' undeclared" 'hint: add "eye_depth" to passes[0].inputs' \
     "candidate overloads listed by the driver left out"
 glsl misspelt_uniform "f.frag:3:17: error: \`u_set_gian' undeclared (did you mean u_set_gain?)"
+
+# --save-target: every target side by side (sun_light 8x5, 4 px, out 16x9): the strip's right
+# part is the layer itself
+if command -v oiiotool >/dev/null 2>&1 && command -v idiff >/dev/null 2>&1; then
+  "$bin" render light_blur "$scene" --technique-dir "$src/tests/techniques/light_blur" --size 16x9 -q --no-preview \
+      -o "$dir/lb.exr" --save-target "$dir/lbt.exr" 2>"$dir/err" || { echo "FAIL: --save-target render"; cat "$dir/err"; fail=1; }
+  oiiotool --info "$dir/lbt.exr" | grep -q "28 x    9, 4 channel" || { echo "FAIL: --save-target strip size"; oiiotool --info "$dir/lbt.exr"; fail=1; }
+  oiiotool "$dir/lbt.exr" --cut 16x9+12+0 --ch R,G,B -o "$dir/cut.exr" && oiiotool "$dir/lb.exr" --ch R,G,B -o "$dir/lb3.exr" &&
+    idiff -fail 0 -failpercent 0 -warn 0 "$dir/cut.exr" "$dir/lb3.exr" >/dev/null 2>&1 \
+    && echo "ok: --save-target: every target in a strip" || { echo "FAIL: --save-target: the strip's output part differs"; fail=1; }
+fi
 
 # techniques: the manifest's own type names, and NAME filters
 "$bin" techniques shadow_march --technique-dir "$src/data/techniques/shadow_march" >"$dir/t" 2>&1 || { echo "FAIL: techniques NAME"; fail=1; }
