@@ -3,7 +3,8 @@
 # technique that runs radial_blur's blur over the "sun_light" input (tests/techniques/light_blur)
 # gives radial_blur's image byte for byte, at the defaults and with other blur settings, on two
 # scenes (one under GODRAYS_TEST_REDUCED): the light is the same program (realtime/toolkit.h gr_light_pass) and u_sun_light_units
-# the same scale. The oracle is OpenImageIO's idiff at zero tolerance.
+# the same scale. The oracle is OpenImageIO's idiff at zero tolerance. Then compare --scene
+# on a scene with light_blur's section works with --technique-dir.
 bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
 dir=$(mktemp -d)
@@ -29,4 +30,14 @@ same() { # NAME SCENE [SETTINGS...]: radial_blur and light_blur with the same se
 same "default scene, defaults" default
 [ -n "${GODRAYS_TEST_REDUCED:-}" ] || same "murky_coastal, defaults" murky_coastal
 same "default scene, 16 taps, no dither, intensity 2" default samples=16 dither=false intensity=2
+
+# compare --scene with a scene holding the user technique's section: needs --technique-dir
+# (exit 2 naming it without), then works (issue 29)
+sed '0,/{/s//{"light_blur": {"samples": 50},/' "$src/data/scenes/default.json" >"$dir/scene.json"
+"$bin" compare "$dir/rb.exr" "$dir/lb.exr" --scene "$dir/scene.json" --set camera.width=96 --set camera.height=54 \
+    >/dev/null 2>"$dir/err"; rc=$?
+[ $rc -eq 2 ] && grep -qF -- "--technique-dir" "$dir/err" || { echo "FAIL: compare --scene without --technique-dir: exit $rc"; cat "$dir/err"; fail=1; }
+"$bin" compare "$dir/rb.exr" "$dir/lb.exr" --scene "$dir/scene.json" --set camera.width=96 --set camera.height=54 \
+    --technique-dir "$tech" >/dev/null 2>"$dir/err" && echo "ok: compare --scene --technique-dir" \
+    || { echo "FAIL: compare --scene --technique-dir"; cat "$dir/err"; fail=1; }
 exit $fail
