@@ -1,6 +1,8 @@
-/* A one-line progress bar with ETA on stderr, for long renders. It shows only when enabled,
- * stderr is a terminal, and the run has lasted longer than a couple of seconds, so short
- * runs, pipes, logs and tests stay silent. Call from one thread. */
+/* Progress of a long step on stderr, once it has lasted a couple of seconds (short runs and
+ * tests stay silent) and only when enabled (--quiet disables it). On a terminal: a one-line
+ * bar with the ETA, redrawn in place. Not on a terminal (a pipe, a CI log, a build farm): one
+ * whole line per 10 % or per 10 s, whichever comes first, "LABEL:  40%  elapsed 00:12
+ * remaining 00:18  NOTE". Call from one thread. */
 #ifndef GR_REF_PROGRESS_H
 #define GR_REF_PROGRESS_H
 

@@ -68,6 +68,8 @@ static void usage(FILE *f)
             "                       point)\n"
             "  --set KEY=VALUE      override a value of that scene, e.g. camera.yaw_deg=120\n"
             "                       (repeatable)\n"
+            "  --technique-dir DIR  add the user technique in DIR (repeatable): a --scene may hold\n"
+            "                       its section\n"
             "  --flip-mode M        ldr or hdr (default: hdr when REF is .exr, .hdr or .pfm, else\n"
             "                       ldr); FLIP is computed on a * TEST with the fitted a if any\n"
             "  --ppd P              FLIP's observer: pixels per degree (default 67.02: 0.7 m from\n"
@@ -319,6 +321,10 @@ static int parse_arg(gr_args *args, compare_opts *o)
         const int rc = gr_args_value(args, &o->outdir);
         return rc ? rc : -1;
     }
+    if (!strcmp(a, "--technique-dir")) { /* a --scene holding a user technique's section */
+        const int rc = gr_args_take_technique_dir(args);
+        return rc ? rc : -1;
+    }
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++) {
         if (strcmp(a, with_value[k])) continue;
         int rc = gr_args_value(args, &v);
@@ -345,6 +351,8 @@ static int parse_args(gr_args *args, compare_opts *o)
         if (rc >= 0) return rc;
     }
     if (o->npos != 2) return gr_cli_usage_error(o->cmd, "need two images, REF and TEST");
+    const int trc = gr_args_add_technique_dirs(args);
+    if (trc) return trc;
     if (o->have_vp && o->scene_path) return gr_cli_usage_error(o->cmd, "give --vp or --scene, not both");
     if (o->n_sets && !o->scene_path) return gr_cli_usage_error(o->cmd, "--set needs --scene");
     if (o->do_struct == 1 && !o->have_vp && !o->scene_path)

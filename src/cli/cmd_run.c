@@ -460,9 +460,15 @@ static gr_status render_techniques(const run_opts *o, run_state *rs, gr_error *e
 {
     gr_gl *gl = NULL;
     gr_status st = gr_gl_create(NULL, &gl, err);
+    const double t0 = now_s();
     for (int k = 0; k < o->nt && st == GR_OK; k++) {
         const gr_technique_class *cls = o->cls[k];
-        if (!o->quiet) fprintf(stderr, "godrays run: rendering %s...\n", cls->name);
+        /* progress in a pipe too (issue 29): which one, elapsed, remaining at the mean so far */
+        double el = now_s() - t0;
+        if (!o->quiet && k == 0) fprintf(stderr, "godrays run: rendering %s (1 of %d)...\n", cls->name, o->nt);
+        else if (!o->quiet)
+            fprintf(stderr, "godrays run: rendering %s (%d of %d; elapsed %.0f s, remaining ~%.0f s)...\n", cls->name,
+                    k + 1, o->nt, el, el / k * (o->nt - k));
         double t = now_s();
         gr_report_technique *ts = &rs->ts[k];
         ts->name = cls->name;

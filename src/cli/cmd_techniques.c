@@ -1,5 +1,6 @@
-/* godrays techniques [--json] [--technique-dir DIR]...: the real-time techniques this build
- * knows (built-in and the user's) and every setting of each (src/realtime/technique.h). */
+/* godrays techniques [NAME...] [--json] [--technique-dir DIR]...: the real-time techniques
+ * this build knows (built-in and the user's), or only those named, and every setting of each
+ * (src/realtime/technique.h). */
 #include "cli/cli.h"
 #include "cli/args.h"
 
@@ -16,12 +17,13 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: godrays techniques [--json] [--technique-dir DIR]...\n"
+            "usage: godrays techniques [NAME...] [--json] [--technique-dir DIR]...\n"
             "\n"
             "Lists the real-time god-ray techniques (the built-in ones and those added with\n"
-            "--technique-dir) with a one-line description and every setting of each: the key of\n"
-            "its scene section (NAME.KEY, as --set and --param take it), type, valid range,\n"
-            "default, unit, default tuning box and a one-line doc.\n"
+            "--technique-dir; only the NAMEs given, if any) with a one-line description and every\n"
+            "setting of each: the key of its scene section (NAME.KEY, as --set and --param take\n"
+            "it), type (number, int, bool, rgb, choice, int64: a manifest's own names), valid\n"
+            "range, default, unit, default tuning box and a one-line doc.\n"
             "\n"
             "options:\n"
             "  --json               one JSON document instead of text\n"
@@ -35,11 +37,11 @@ static const char *type_name(gr_param_type t)
 {
     switch (t) {
     case GR_PT_DOUBLE: return "number";
-    case GR_PT_INT: return "integer";
-    case GR_PT_BOOL: return "boolean";
+    case GR_PT_INT: return "int"; /* a user manifest's own type names (docs/techniques.md) */
+    case GR_PT_BOOL: return "bool";
     case GR_PT_RGB: return "rgb";
     case GR_PT_ENUM: return "choice";
-    case GR_PT_U64: return "integer64";
+    case GR_PT_U64: return "int64";
     }
     return "?";
 }
@@ -96,13 +98,22 @@ static cJSON *param_json(const gr_param *p)
     return o;
 }
 
-static int print_json(void)
+/* Whether technique c is listed: no names given, or c among them. */
+static int wanted(const gr_technique_class *c, char **names, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (!strcmp(names[k], c->name)) return 1;
+    return n == 0;
+}
+
+static int print_json(char **names, int n_names)
 {
     cJSON *root = cJSON_CreateObject();
     cJSON *arr = root ? cJSON_AddArrayToObject(root, "techniques") : NULL;
     int ok = arr != NULL;
     for (int i = 0; ok && i < gr_technique_count(); i++) {
         const gr_technique_class *c = gr_technique_at(i);
+        if (!wanted(c, names, n_names)) continue;
         cJSON *t = cJSON_CreateObject();
         ok = t && cJSON_AddItemToArray(arr, t);
         if (!ok) break;
@@ -146,11 +157,12 @@ static int print_json(void)
     return 0;
 }
 
-static void print_text(void)
+static void print_text(char **names, int n_names)
 {
-    for (int i = 0; i < gr_technique_count(); i++) {
+    for (int i = 0, shown = 0; i < gr_technique_count(); i++) {
         const gr_technique_class *c = gr_technique_at(i);
-        printf("%s%s  (%s)\n  %s\n", i ? "\n" : "", c->name, c->origin ? c->origin : "built-in",
+        if (!wanted(c, names, n_names)) continue;
+        printf("%s%s  (%s)\n  %s\n", shown++ ? "\n" : "", c->name, c->origin ? c->origin : "built-in",
                c->description ? c->description : "");
         char why[512];
         if (!gr_technique_available(c, why, sizeof why)) printf("  unavailable here: %s\n", why);
@@ -180,25 +192,46 @@ static void print_text(void)
     }
 }
 
+static int techniques_args(gr_args *args, char **names, int *n_names, int *json);
+
 static int techniques_with(gr_args *args)
 {
-    int json = 0, rc = 0;
+    int json = 0, rc = 0, n_names = 0;
+    char **names = calloc((size_t)args->argc + 1, sizeof *names);
+    if (!names) return gr_cli_usage_error("techniques", "out of memory");
+    rc = techniques_args(args, names, &n_names, &json);
+    if (rc == 0) rc = gr_args_add_technique_dirs(args);
+    for (int k = 0; rc == 0 && k < n_names; k++)
+        if (!gr_technique_find(names[k]))
+            rc = gr_cli_usage_error("techniques", "unknown technique '%s' (godrays techniques lists them; a user "
+                                                  "technique needs its --technique-dir)", names[k]);
+    if (rc == 0) {
+        if (json) rc = print_json(names, n_names);
+        else print_text(names, n_names);
+    }
+    free(names);
+    return rc < 0 ? 0 : rc;
+}
+
+/* The arguments: -1 after --help (printed), else an exit code. */
+static int techniques_args(gr_args *args, char **names, int *n_names, int *json)
+{
+    int rc;
     for (; args->i < args->argc; args->i++) {
         const char *a = args->argv[args->i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
-            return 0;
+            return -1;
         } else if (!strcmp(a, "--json")) {
-            json = 1;
+            *json = 1;
         } else if (!strcmp(a, "--technique-dir")) {
             if ((rc = gr_args_take_technique_dir(args)) != 0) return rc;
+        } else if (a[0] != '-') {
+            names[(*n_names)++] = args->argv[args->i];
         } else {
             return gr_cli_usage_error("techniques", "unknown argument %s", a);
         }
     }
-    if ((rc = gr_args_add_technique_dirs(args)) != 0) return rc;
-    if (json) return print_json();
-    print_text();
     return 0;
 }
 

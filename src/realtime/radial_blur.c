@@ -15,7 +15,6 @@
 #include "realtime/shaders.h"
 #include "realtime/toolkit.h"
 
-#define MAX_WAVE_GROUPS 16 /* u_waves[MAX_WAVE_GROUPS * 5] in seed_waves.glsl */
 #define MAX_LIGHTS 256
 
 /* Seed 004's listing defaults (GLSL version). */
@@ -101,9 +100,7 @@ const gr_param_table gr_radial_blur_local_param_table = {"radial_blur_local", lo
 
 double gr_radial_blur_gain(int samples, double decay, double weight)
 {
-    /* sum_{i=1..N} decay^(i-1) = (1 - decay^N) / (1 - decay) */
-    double geo = decay == 1.0 ? (double)samples : (1.0 - pow(decay, samples)) / (1.0 - decay);
-    return 1.0 + weight * geo;
+    return gr_light_blur_gain(samples, decay, weight);
 }
 
 double gr_radial_blur_fade(const double ndc[2], double clip_w, double margin)
@@ -117,41 +114,7 @@ double gr_radial_blur_fade(const double ndc[2], double clip_w, double margin)
     return 1.0 - x * x * (3.0 - 2.0 * x);
 }
 
-double gr_radial_blur_kernel_solid_angle(double a0)
-{
-    /* 2 pi int_0^a0 (1 - (a/a0)^2)^2 sin a da, Simpson with 512 intervals. */
-    const int n = 512;
-    double h = a0 / n, sum = 0.0;
-    for (int i = 0; i <= n; i++) {
-        double a = i * h, x = a / a0, k = (1.0 - x * x) * (1.0 - x * x) * sin(a);
-        sum += (i == 0 || i == n) ? k : (i % 2 ? 4.0 * k : 2.0 * k);
-    }
-    return 2.0 * GR_PI * sum * h / 3.0;
-}
-
-/* ---- scale to the ground truth's units ---------------------------------------------------- */
-
-/* Distance D from the eye to the flat surface along the refracted sun (m); <= 0 above it. */
-static double sun_path_m(const gr_scene *scene, const gr_frame *f)
-{
-    double depth = scene->water.rest_height_m - scene->camera.position_m[1];
-    return f->to_refr_sun[1] > 0 ? depth / f->to_refr_sun[1] : 0.0;
-}
-
-/* The scale k_c that puts the layer in the ground truth's units: looking straight at the
- * refracted sun through flat water, with seed 004's defaults, the layer equals the single-
- * scattering closed form sigma_s p_HG(0) T E D exp(-sigma_t D) (docs, "Units"):
- * k_c = sigma_s,c p_HG(0; g) D Omega_eff / (n^2 0.2 0.4 G_seed). */
-static void units_scale(const gr_scene *scene, const gr_frame *f, double light_radius_deg, double k[3])
-{
-    double D = fmax(sun_path_m(scene, f), 0.0);
-    double omega = gr_radial_blur_kernel_solid_angle(light_radius_deg * GR_PI / 180.0);
-    double g_seed = gr_radial_blur_gain(SEED_SAMPLES, SEED_DECAY, SEED_WEIGHT);
-    double n = scene->medium.ior;
-    for (int c = 0; c < 3; c++)
-        k[c] = scene->medium.scattering[c] * gr_hg_phase(1.0, scene->medium.g) * D * omega /
-               (n * n * SEED_EXPOSURE * SEED_SAMPLE_SCALE * g_seed);
-}
+double gr_radial_blur_kernel_solid_angle(double a0) { return gr_light_kernel_solid_angle(a0); }
 
 /* ---- state ------------------------------------------------------------------------------- */
 
@@ -178,14 +141,11 @@ struct rb_state {
     const char *name; /* the class's */
     char *shader_dir;
     gr_scenegl *sg;
-    GLuint prog_light, prog_blur, prog_local, prog_resolve, prog_up;
+    gr_light_pass light_pass; /* the toolkit's, shared with the user techniques' "sun_light" */
+    GLuint prog_blur, prog_local, prog_resolve, prog_up;
     GLint loc_up_src, loc_up_size;
     gr_target small;   /* radial_blur at blur_scale < 1: the reduced blur target */
     int upsampled;     /* the last render blurred at a reduced size */
-    struct {
-        GLint inv_vp_rot, depth, wave_groups, waves, ior, to_sun, a0, extinction, t_flat, threshold, occluders,
-            eye_depth, dither8;
-    } ll;
     struct {
         GLint light, sun_uv, size, samples, density, decay, weight, scale, dither, falloff;
     } lb, lq;
@@ -222,7 +182,7 @@ static void rb_destroy(void *state)
     rb_state *r = state;
     if (!r) return;
     gr_scenegl_destroy(r->sg);
-    if (r->prog_light) glDeleteProgram(r->prog_light);
+    gr_light_pass_free(&r->light_pass);
     if (r->prog_blur) glDeleteProgram(r->prog_blur);
     if (r->prog_local) glDeleteProgram(r->prog_local);
     if (r->prog_resolve) glDeleteProgram(r->prog_resolve);
@@ -262,10 +222,7 @@ static gr_status rb_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
         memcpy(r->shader_dir, dir, n);
     }
     if ((st = gr_scenegl_create_dir(gl, dir, &r->sg, err)) != GR_OK) goto fail;
-    static const gr_shader_stage light[2] = {{GL_VERTEX_SHADER, {"radial_blur_screen.vert.glsl", NULL}},
-                                             {GL_FRAGMENT_SHADER, {"seed_waves.glsl", "radial_blur_light.frag.glsl", NULL}}};
-    if ((st = gr_shader_program_stages(dir, light, 2, NULL, 0, &r->prog_light, NULL, err)) != GR_OK)
-        goto fail;
+    if ((st = gr_light_pass_init(&r->light_pass, dir, err)) != GR_OK) goto fail;
     if ((st = gr_shader_program(dir, "radial_blur_screen.vert.glsl", "radial_blur.frag.glsl", NULL, 0, &r->prog_blur,
                                 NULL, err)) != GR_OK)
         goto fail;
@@ -289,20 +246,6 @@ static gr_status rb_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
         r->loc_rscale = glGetUniformLocation(r->prog_resolve, "u_scale");
         r->loc_normalize = glGetUniformLocation(r->prog_resolve, "u_normalize");
     }
-    GLuint p = r->prog_light;
-    r->ll.inv_vp_rot = glGetUniformLocation(p, "u_inv_vp_rot");
-    r->ll.depth = glGetUniformLocation(p, "u_depth");
-    r->ll.wave_groups = glGetUniformLocation(p, "u_wave_groups");
-    r->ll.waves = glGetUniformLocation(p, "u_waves");
-    r->ll.ior = glGetUniformLocation(p, "u_ior");
-    r->ll.to_sun = glGetUniformLocation(p, "u_to_sun");
-    r->ll.a0 = glGetUniformLocation(p, "u_a0");
-    r->ll.extinction = glGetUniformLocation(p, "u_extinction");
-    r->ll.t_flat = glGetUniformLocation(p, "u_t_flat");
-    r->ll.threshold = glGetUniformLocation(p, "u_threshold");
-    r->ll.occluders = glGetUniformLocation(p, "u_occluders");
-    r->ll.eye_depth = glGetUniformLocation(p, "u_eye_depth");
-    r->ll.dither8 = glGetUniformLocation(p, "u_dither8");
     get_blur_locs(r->prog_blur, &r->lb.light, &r->lb.sun_uv, &r->lb.size, &r->lb.samples, &r->lb.density,
                   &r->lb.decay, &r->lb.weight, &r->lb.scale, &r->lb.dither, &r->lb.falloff);
     glGenVertexArrays(1, &r->vao_empty);
@@ -616,14 +559,6 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     if (out->width != W || out->height != H || ch[0] < 0 || ch[1] < 0 || ch[2] < 0)
         return gr_fail(err, GR_E_INPUT, "%s: output image is %dx%d (needs %dx%d with R, G, B channels)", name,
                        out->width, out->height, W, H);
-    double depth = scene->water.rest_height_m - f.eye[1];
-    if (!(depth > 0))
-        return gr_fail(err, GR_E_INPUT,
-                       "camera.position_m: y = %g is not below the water surface (y = %g); %s needs an underwater viewer",
-                       f.eye[1], scene->water.rest_height_m, name);
-    if (scene->water.n_waves > MAX_WAVE_GROUPS * 4)
-        return gr_fail(err, GR_E_INPUT, "water.waves: %d waves, %s takes at most %d", scene->water.n_waves, name,
-                       MAX_WAVE_GROUPS * 4);
     int tw = (int)lround(W * s->target_scale), th = (int)lround(H * s->target_scale);
     if (tw < 1) tw = 1;
     if (th < 1) th = 1;
@@ -634,28 +569,6 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
                                               "camera.width/height: radial_blur_local accumulator", err)) != GR_OK)
         return st;
 
-    /* Waves in the seed's packing with wt folded to the eye (phase at eye-relative x0, z0). */
-    float waves[MAX_WAVE_GROUPS * 5 * 4];
-    memset(waves, 0, sizeof waves);
-    int groups = f.n_wave_groups;
-    for (int i = 0; i < scene->water.n_waves; i++) {
-        const gr_wave *wv = &scene->water.waves[i];
-        int g = i / 4, lane = i % 4;
-        double kx = wv->k * wv->dir[0], kz = wv->k * wv->dir[1];
-        double c = fmod(wv->omega_rad_s * f.time_s - wv->phase_rad - kx * f.eye[0] - kz * f.eye[2], 2.0 * GR_PI);
-        float *b = waves + (size_t)g * 20;
-        b[0 * 4 + lane] = f.waves_seed[g * 5 + 0][lane];
-        b[1 * 4 + lane] = f.waves_seed[g * 5 + 1][lane];
-        b[2 * 4 + lane] = f.waves_seed[g * 5 + 2][lane];
-        b[3 * 4 + lane] = f.waves_seed[g * 5 + 3][lane];
-        b[4 * 4 + lane] = (float)c;
-    }
-
-    double vp_rot[16], inv_rot[16];
-    float m[16];
-    gr_frame_view_proj_rot(&f, vp_rot);
-    if (gr_mat4_inverse(vp_rot, inv_rot) != 0) return gr_fail(err, GR_E_INPUT, "camera: singular view-projection");
-
     gr_gl_timer_reset(&r->timer);
     /* Pass 0: occluders' (and the seabed's) distance from the eye at the light target's size. */
     unsigned depth_tex = 0;
@@ -664,44 +577,21 @@ static gr_status rb_render(void *state, const gr_scene *scene, const void *setti
     gr_gl_timer_end(&r->timer);
     if (st != GR_OK) return st;
 
-    /* Pass 1: light pass into the reduced target. */
+    /* Pass 1: light pass into the reduced target (the toolkit's, realtime/toolkit.h). */
     gr_gl_timer_begin(&r->timer, PASS_LIGHT);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->light.fbo);
-    glViewport(0, 0, tw, th);
-    glDisable(GL_BLEND);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_DITHER);
-    glUseProgram(r->prog_light);
-    gr_frame_matf(inv_rot, m);
-    glUniformMatrix4fv(r->ll.inv_vp_rot, 1, GL_FALSE, m);
-    glUniform1f(r->ll.depth, (float)depth);
-    glUniform1i(r->ll.wave_groups, groups);
-    glUniform4fv(r->ll.waves, MAX_WAVE_GROUPS * 5, waves);
-    glUniform1f(r->ll.ior, (float)f.ior);
-    glUniform3f(r->ll.to_sun, (float)f.to_sun[0], (float)f.to_sun[1], (float)f.to_sun[2]);
-    glUniform1f(r->ll.a0, (float)(s->light_radius_deg * GR_PI / 180.0));
-    glUniform3f(r->ll.extinction, (float)f.extinction[0], (float)f.extinction[1], (float)f.extinction[2]);
-    glUniform1f(r->ll.t_flat, (float)f.transmittance_flat);
-    glUniform1f(r->ll.threshold, (float)s->threshold);
-    glUniform1i(r->ll.occluders, s->occluders);
-    glUniform1i(r->ll.eye_depth, 1);
-    glUniform1i(r->ll.dither8, s->dither && s->target_format == GR_RB_RGBA8);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, depth_tex);
-    glActiveTexture(GL_TEXTURE0);
-    glBindVertexArray(r->vao_empty);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    const gr_light_params lp = {.radius_deg = s->light_radius_deg,
+                                .threshold = s->threshold,
+                                .occluders = s->occluders,
+                                .dither8 = s->dither && s->target_format == GR_RB_RGBA8};
+    st = gr_light_pass_draw(&r->light_pass, scene, &f, &lp, &r->light, depth_tex, name, err);
     gr_gl_timer_end(&r->timer);
+    if (st != GR_OK) return st;
 
     /* Output scale: k * intensity * exposure * sample_scale * peak * fade, where peak = n^2 T_flat
      * E / Omega_eff is the flat-water light-pass radiance at the sun (docs, "Units"). */
-    double omega = gr_radial_blur_kernel_solid_angle(s->light_radius_deg * GR_PI / 180.0);
     double fade = r->v->fade ? gr_radial_blur_fade(f.sun_ndc, f.sun_clip_w, s->fade_margin) : 1.0;
-    double scale[3], ku[3];
-    units_scale(scene, &f, s->light_radius_deg, ku);
-    for (int c = 0; c < 3; c++)
-        scale[c] = ku[c] * s->intensity[c] * s->exposure * s->sample_scale * f.ior * f.ior * f.transmittance_flat *
-                   f.sun_irradiance[c] / omega * fade;
+    double scale[3];
+    gr_light_units(scene, &f, s->light_radius_deg, s->intensity, s->exposure, s->sample_scale, fade, scale);
     r->sun_uv[0] = f.sun_uv[0];
     r->sun_uv[1] = f.sun_uv[1];
     r->fade = fade;

@@ -7,7 +7,9 @@
 #define GR_TOOLKIT_H
 
 #include "common/status.h"
+#include "realtime/frame.h"
 #include "realtime/technique.h"
+#include "scene/scene.h"
 
 /* ---- clock ----------------------------------------------------------------------------- */
 
@@ -77,5 +79,52 @@ long long gr_gl_timer_primitives(gr_gl_timer *t, int pass);
  * it), each pass's cost counters -1 but its queried primitives (the caller counts the rest),
  * wall_ms the time since t0_ms. */
 void gr_gl_timer_stats(gr_technique_stats *stats, gr_gl_timer *t, const char *const *names, int n, double t0_ms);
+
+/* ---- the light a screen-space effect reads ------------------------------------------------ */
+
+/* The sky and sun seen through the wavy surface from the eye (docs/radial-blur.md "Light
+ * pass"; docs/techniques.md "Harness textures"): per pixel of a target,
+ *   s = T(d, N) / T_flat * K(angle(refract(d, -N, n), to_sun)) * exp(-sigma_t t) * V
+ * dimensionless, 1 = the flat-water peak at the refracted sun (radiance: s times
+ * gr_light_radiance), Snell's window and exact Fresnel included, occluders and the seabed
+ * black (V). radial_blur's light pass and the user techniques' "light" input are this one
+ * program. */
+typedef struct gr_light_pass {
+    unsigned prog, vao;
+    int inv_vp_rot, depth, wave_groups, waves, ior, to_sun, a0, extinction, t_flat, threshold, occluders, eye_depth,
+        dither8;
+} gr_light_pass;
+
+typedef struct gr_light_params {
+    double radius_deg; /* angular radius in air of the bright kernel (1 - (a/a0)^2)^2 */
+    double threshold;  /* subtracted from s (1 = the flat-water peak), then clamped at 0 */
+    int occluders;     /* 1: occluders and the seabed black (needs the eye depth at the target's size) */
+    int dither8;       /* +-half an 8-bit step of noise before 8-bit storage */
+} gr_light_params;
+
+/* Compiles the program in the current context (shader_dir: --shader-dir, may be NULL); zero
+ * lp first. */
+gr_status gr_light_pass_init(gr_light_pass *lp, const char *shader_dir, gr_error *err);
+void gr_light_pass_free(gr_light_pass *lp); /* accepts NULL and one never initialized */
+/* Draws s into t (its size), reading depth_tex (R32F eye depth at t's size, metres:
+ * gr_scenegl_eye_depth) for the occluders. `who` names the caller in errors (GR_E_INPUT: the
+ * camera not under the water, more waves than the shader takes, a singular view). Leaves
+ * t's framebuffer bound, blending, depth test and dithering off. */
+gr_status gr_light_pass_draw(gr_light_pass *lp, const gr_scene *scene, const gr_frame *f,
+                             const gr_light_params *p, const gr_target *t, unsigned depth_tex, const char *who,
+                             gr_error *err);
+/* Effective solid angle (sr) of the kernel (1 - (a/a0)^2)^2 of radius a0 (rad). */
+double gr_light_kernel_solid_angle(double a0);
+/* Gain of a radial blur's taps: 1 + weight sum_{i=1..N} decay^(i-1). */
+double gr_light_blur_gain(int samples, double decay, double weight);
+/* Radiance (W m^-2 sr^-1, per channel) of s = 1: n^2 T_flat E_sun / Omega_eff(radius). */
+void gr_light_radiance(const gr_frame *f, double radius_deg, double out[3]);
+/* The factor that puts a radial blur of s into the ground truth's units (docs/radial-blur.md
+ * "Units"): k_c intensity_c exposure sample_scale n^2 T_flat E_c / Omega_eff fade, with
+ * k_c = sigma_s,c p_HG(0; g) D Omega_eff / (n^2 0.2 0.4 G_seed) (seed 004's exposure 0.2,
+ * sample scale 0.4 and tap gain G_seed). With intensity 1, exposure 0.2, sample scale 0.4
+ * and fade 1 it is sigma_s p_HG(0) D T_flat E / G_seed: the user techniques' u_light_units. */
+void gr_light_units(const gr_scene *scene, const gr_frame *f, double radius_deg,
+                    const double intensity[3], double exposure, double sample_scale, double fade, double out[3]);
 
 #endif

@@ -199,6 +199,16 @@ static int find_setting(const gr_ut_manifest *m, const char *key)
     return -1;
 }
 
+const char *gr_ut_input_name(const gr_ut_manifest *m, int in)
+{
+    switch (in) {
+    case GR_UT_IN_SHADOW_MAP: return "shadow_map";
+    case GR_UT_IN_EYE_DEPTH: return "eye_depth";
+    case GR_UT_IN_LIGHT: return "sun_light";
+    default: return m->targets[in].name;
+    }
+}
+
 static int find_target(const gr_ut_manifest *m, const char *name)
 {
     for (int i = 0; i < m->n_targets; i++)
@@ -363,16 +373,146 @@ gr_status gr_ut_read_file(const char *dir, const char *path, char **out, char *w
     return GR_OK;
 }
 
-/* Reads DIR/file named at JSON path p; a missing or unreadable file is bad input (exit 2). */
-static gr_status shader_file(ut_ctx *c, const gr_ut_manifest *m, const char *file, const char *p, char **src)
+/* The index of `file` (relative to the folder) in m's file table, added if new; -1 when full. */
+static int file_index(gr_ut_manifest *m, const char *file)
 {
-    char full[4096], why[256];
-    if (!file[0]) return vfail(c, p, "empty file name");
-    if (file[0] == '/') return vfail(c, p, "'%s': an absolute path; a shader's file is relative to the technique folder", file);
-    if (snprintf(full, sizeof full, "%s/%s", m->dir, file) >= (int)sizeof full) return vfail(c, p, "file name too long");
-    gr_status st = gr_ut_read_file(m->dir, full, src, why, sizeof why);
+    for (int k = 0; k < m->n_files; k++)
+        if (!strcmp(m->files[k], file)) return k;
+    if (m->n_files == GR_UT_MAX_FILES || !(m->files[m->n_files] = dup_string(file))) return -1;
+    return m->n_files++;
+}
+
+/* `#include "NAME"` on this line (leading blanks allowed): 1 with NAME in name, 0 when the
+ * line is no include, -1 when it is a malformed one. */
+static int include_line(const char *line, size_t len, char *name, size_t n)
+{
+    size_t i = 0;
+    while (i < len && (line[i] == ' ' || line[i] == '\t')) i++;
+    if (i == len || line[i] != '#') return 0;
+    i++;
+    while (i < len && (line[i] == ' ' || line[i] == '\t')) i++;
+    if (len - i < 7 || strncmp(line + i, "include", 7)) return 0;
+    i += 7;
+    while (i < len && (line[i] == ' ' || line[i] == '\t')) i++;
+    if (i == len || line[i] != '"') return -1;
+    const char *e = memchr(line + i + 1, '"', len - i - 1);
+    if (!e || (size_t)(e - (line + i + 1)) >= n || e == line + i + 1) return -1;
+    snprintf(name, n, "%.*s", (int)(e - (line + i + 1)), line + i + 1);
+    for (const char *q = e + 1; q < line + len; q++)
+        if (*q != ' ' && *q != '\t' && *q != '\r') return -1;
+    return 1;
+}
+
+/* Appends file (relative to the folder) to b with its includes expanded in place (docs/
+ * techniques.md "Shared GLSL"): "#line" directives keep every line's file and number
+ * (GR_UT_LINE_BASE * (K + 1) + L for line L of files[K]); a
+ * "#version" line is blanked (the prelude sets it). from/from_line: the including file and
+ * line (NULL for a pass's own file). */
+static gr_status expand_file(ut_ctx *c, gr_ut_manifest *m, const char *file, const char *p, const char *from,
+                             int from_line, int depth, gr_ut_strbuf *b)
+{
+    char full[4096], why[256], *src = NULL, at[600] = "";
+    if (from) snprintf(at, sizeof at, "%s:%d: #include \"%s\": ", from, from_line, file);
+    if (!file[0]) return vfail(c, p, "%sempty file name", at);
+    if (file[0] == '/') return vfail(c, p, "%s'%s': an absolute path; a shader's file is relative to the technique folder", at, file);
+    if (depth > GR_UT_MAX_INCLUDE_DEPTH)
+        return vfail(c, p, "%sincludes nested deeper than %d (an include cycle?)", at, GR_UT_MAX_INCLUDE_DEPTH);
+    if (snprintf(full, sizeof full, "%s/%s", m->dir, file) >= (int)sizeof full) return vfail(c, p, "%sfile name too long", at);
+    gr_status st = gr_ut_read_file(m->dir, full, &src, why, sizeof why);
     if (st == GR_E_NOMEM) return gr_fail(c->err, st, "%s: %s: out of memory", c->path, p);
-    if (st) return vfail(c, p, "cannot read shader %s: %s", full, why);
+    if (st) return vfail(c, p, "%scannot read shader %s: %s", at, full, why);
+    int k = file_index(m, file);
+    if (k < 0) {
+        free(src);
+        return vfail(c, p, "%smore than %d shader files (includes counted)", at, GR_UT_MAX_FILES);
+    }
+    gr_ut_sb_add(b, "#line %d\n", GR_UT_LINE_BASE * (k + 1) + 1);
+    int line = 1;
+    for (const char *q = src; *q; line++) {
+        const char *e = strchr(q, '\n');
+        size_t len = e ? (size_t)(e - q) : strlen(q);
+        char inc[512], rel[1024];
+        int kind = include_line(q, len, inc, sizeof inc);
+        if (kind < 0) {
+            free(src);
+            return vfail(c, p, "%s:%d: malformed #include (expected #include \"file.glsl\")", file, line);
+        }
+        if (kind > 0) {
+            /* relative to the including file's folder, as in C; gr_ut_read_file keeps it inside */
+            const char *slash = strrchr(file, '/');
+            snprintf(rel, sizeof rel, "%.*s%s", slash ? (int)(slash - file + 1) : 0, file, inc);
+            if ((st = expand_file(c, m, rel, p, file, line, depth + 1, b))) {
+                free(src);
+                return st;
+            }
+            gr_ut_sb_add(b, "#line %d\n", GR_UT_LINE_BASE * (k + 1) + line + 1);
+        } else {
+            const char *v = q;
+            while (v < q + len && (*v == ' ' || *v == '\t')) v++;
+            if ((size_t)(q + len - v) >= 8 && !strncmp(v, "#version", 8)) gr_ut_sb_add(b, "\n");
+            else gr_ut_sb_add(b, "%.*s\n", (int)len, q);
+        }
+        q = e ? e + 1 : q + len;
+    }
+    free(src);
+    return b->failed ? gr_fail(c->err, GR_E_NOMEM, "%s: %s: out of memory", c->path, p) : GR_OK;
+}
+
+/* Reads DIR/file named at JSON path p, includes expanded; a missing or unreadable file is bad
+ * input (exit 2). */
+static gr_status shader_file(ut_ctx *c, gr_ut_manifest *m, const char *file, const char *p, char **src)
+{
+    gr_ut_strbuf b = {0};
+    gr_status st = expand_file(c, m, file, p, NULL, 0, 0, &b);
+    if (st) {
+        free(b.s);
+        return st;
+    }
+    *src = b.s;
+    return GR_OK;
+}
+
+/* "defines": {"NAME": number | bool | "text"} -> "#define NAME VALUE" lines. */
+static gr_status parse_defines(ut_ctx *c, gr_ut_pass *ps, const cJSON *d, const char *p)
+{
+    if (!cJSON_IsObject(d)) return vfail(c, p, "must be an object {\"NAME\": value}, got %s", gr_json_type_name(d));
+    gr_ut_strbuf b = {0};
+    for (const cJSON *e = d->child; e; e = e->next) {
+        char q[400], num[40];
+        join(q, sizeof q, p, e->string);
+        const char *nm = e->string;
+        int ok = (isalpha((unsigned char)nm[0]) || nm[0] == '_') && strlen(nm) < 64 && !strstr(nm, "__") &&
+                 strncmp(nm, "GL_", 3) && strncmp(nm, "GR_", 3) && strcmp(nm, "GODRAYS");
+        for (const char *z = nm; ok && *z; z++) ok = isalnum((unsigned char)*z) || *z == '_';
+        if (!ok) {
+            free(b.s);
+            return vfail(c, q, "'%s' is not a macro name: [A-Za-z_][A-Za-z0-9_]*, under 64 characters, no '__', not GL_*, GR_* or GODRAYS", nm);
+        }
+        for (const cJSON *f = d->child; f != e; f = f->next)
+            if (!strcmp(f->string, nm)) {
+                free(b.s);
+                return vfail(c, q, "defined twice");
+            }
+        if (cJSON_IsBool(e)) {
+            gr_ut_sb_add(&b, "#define %s %d\n", nm, cJSON_IsTrue(e) ? 1 : 0);
+        } else if (cJSON_IsNumber(e) && isfinite(e->valuedouble)) {
+            /* an integer stays one (GLSL int), anything else is a float literal */
+            if (e->valuedouble == floor(e->valuedouble) && fabs(e->valuedouble) < 2e9) snprintf(num, sizeof num, "%.0f", e->valuedouble);
+            else snprintf(num, sizeof num, "%.9g", e->valuedouble);
+            if (e->valuedouble != floor(e->valuedouble) && !strpbrk(num, ".e")) strcat(num, ".0");
+            gr_ut_sb_add(&b, "#define %s %s\n", nm, num);
+        } else if (cJSON_IsString(e) && !strpbrk(e->valuestring, "\n\r\\")) {
+            gr_ut_sb_add(&b, "#define %s %s\n", nm, e->valuestring);
+        } else {
+            free(b.s);
+            return vfail(c, q, "must be a number, true/false or a one-line string, got %s", gr_json_type_name(e));
+        }
+    }
+    if (b.failed) {
+        free(b.s);
+        return gr_fail(c->err, GR_E_NOMEM, "%s: out of memory", c->path);
+    }
+    ps->defines = b.s;
     return GR_OK;
 }
 
@@ -509,7 +649,7 @@ static gr_status parse_targets(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
         if (m->n_targets == GR_UT_MAX_TARGETS) return vfail(c, p, "more than %d targets", GR_UT_MAX_TARGETS);
         if (!is_identifier(it->string, 1, GR_UT_NAME_MAX))
             return vfail(c, p, "a target's name must be [a-z][a-z0-9_]* of at most %d characters without '__'", GR_UT_NAME_MAX - 1);
-        if (!strcmp(it->string, "shadow_map") || !strcmp(it->string, "eye_depth"))
+        if (!strcmp(it->string, "shadow_map") || !strcmp(it->string, "eye_depth") || !strcmp(it->string, "sun_light"))
             return vfail(c, p, "'%s' is the name of a harness texture", it->string);
         if ((st = check_object(c, it, p, keys))) return st;
         gr_ut_target *t = &m->targets[m->n_targets];
@@ -556,7 +696,7 @@ static gr_status parse_targets(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
 
 static gr_status parse_pass(ut_ctx *c, gr_ut_manifest *m, const cJSON *it, int idx, const int *written)
 {
-    static const char *const keys[] = {"name", "vertex", "fragment", "draw", "target", "blend", "clear", "inputs", NULL};
+    static const char *const keys[] = {"name", "vertex", "fragment", "draw", "target", "blend", "clear", "inputs", "defines", NULL};
     static const char *const draw_keys[] = {"primitive", "vertices", "instances", NULL};
     char p[64], q[320], list[400];
     gr_status st;
@@ -653,6 +793,9 @@ static gr_status parse_pass(ut_ctx *c, gr_ut_manifest *m, const cJSON *it, int i
         }
         ps->has_clear = 1;
     }
+    const cJSON *vdef = cJSON_GetObjectItemCaseSensitive(it, "defines");
+    join(q, sizeof q, p, "defines");
+    if (vdef && (st = parse_defines(c, ps, vdef, q))) return st;
     /* inputs */
     const cJSON *vin = cJSON_GetObjectItemCaseSensitive(it, "inputs");
     join(q, sizeof q, p, "inputs");
@@ -672,9 +815,12 @@ static gr_status parse_pass(ut_ctx *c, gr_ut_manifest *m, const cJSON *it, int i
             } else if (!strcmp(nm, "eye_depth")) {
                 in = GR_UT_IN_EYE_DEPTH;
                 m->uses_eye_depth = 1;
+            } else if (!strcmp(nm, "sun_light")) {
+                in = GR_UT_IN_LIGHT;
+                m->uses_light = 1;
             } else {
                 in = find_target(m, nm);
-                if (in < 0) return vfail(c, r, "unknown input '%s' (a target's name, \"shadow_map\" or \"eye_depth\")", nm);
+                if (in < 0) return vfail(c, r, "unknown input '%s' (a target's name, " GR_UT_HARNESS_INPUTS ")", nm);
                 if (in == ps->target)
                     return vfail(c, r, "pass reads its own target '%s' (a feedback loop): render into another target", nm);
                 if (!written[in]) return vfail(c, r, "target '%s' is read before any earlier pass writes it", nm);
@@ -748,10 +894,35 @@ static gr_status parse_ladder(ut_ctx *c, gr_ut_manifest *m, const cJSON *lad)
     return GR_OK;
 }
 
+/* "sun_light": {"scale", "format", "radius_deg", "threshold", "occluders"} (docs/techniques.md
+ * "Harness textures"); the defaults are radial_blur's. */
+static gr_status parse_light(ut_ctx *c, gr_ut_manifest *m, const cJSON *lt)
+{
+    static const char *const keys[] = {"scale", "format", "radius_deg", "threshold", "occluders", NULL};
+    m->light_scale = (gr_ut_value){0.5, -1};
+    m->light_radius_deg = (gr_ut_value){4.0, -1};
+    m->light_threshold = (gr_ut_value){0.0, -1};
+    m->light_format = GR_UT_FMT_RGBA16F;
+    m->light_occluders = 1;
+    if (!lt) return GR_OK;
+    gr_status st = check_object(c, lt, "sun_light", keys);
+    if (st) return st;
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(lt, "scale");
+    if (v && (st = value_at(c, m, v, "sun_light.scale", GR_UT_NUMBER, 1.0 / 64.0, 4.0, &m->light_scale))) return st;
+    v = cJSON_GetObjectItemCaseSensitive(lt, "radius_deg");
+    if (v && (st = value_at(c, m, v, "sun_light.radius_deg", GR_UT_NUMBER, 0.01, 90, &m->light_radius_deg))) return st;
+    v = cJSON_GetObjectItemCaseSensitive(lt, "threshold");
+    if (v && (st = value_at(c, m, v, "sun_light.threshold", GR_UT_NUMBER, 0, 0.999, &m->light_threshold))) return st;
+    int fmt = GR_UT_FMT_RGBA16F;
+    if ((st = get_enum(c, lt, "sun_light", "format", gr_ut_format_names, &fmt))) return st;
+    if (fmt >= 0) m->light_format = (gr_ut_format)fmt;
+    return get_bool(c, lt, "sun_light", "occluders", &m->light_occluders);
+}
+
 static gr_status parse_manifest(ut_ctx *c, gr_ut_manifest *m, const cJSON *root)
 {
     static const char *const keys[] = {"version", "name", "description", "settings", "gain", "ladder", "shadow_map",
-                                       "targets", "passes", "output", "allow_black", NULL};
+                                       "sun_light", "targets", "passes", "output", "allow_black", NULL};
     static const char *const sm_keys[] = {"size", "half_extent_m", NULL};
     gr_status st = check_object(c, root, "", keys);
     if (st) return st;
@@ -834,6 +1005,11 @@ static gr_status parse_manifest(ut_ctx *c, gr_ut_manifest *m, const cJSON *root)
         if (v && (st = value_at(c, m, v, "shadow_map.half_extent_m", GR_UT_NUMBER, 0.01, 1e5, &m->shadow_half_extent)))
             return st;
     }
+    if ((st = parse_light(c, m, cJSON_GetObjectItemCaseSensitive(root, "sun_light")))) return st;
+    int timed = m->n_passes + m->uses_shadow_map + m->uses_eye_depth + m->uses_light;
+    if (timed > GR_TECH_MAX_PASSES)
+        return vfail(c, "passes", "%d passes and %d harness inputs make %d timed passes, at most %d", m->n_passes,
+                     timed - m->n_passes, timed, GR_TECH_MAX_PASSES);
     return GR_OK;
 }
 
@@ -845,7 +1021,9 @@ void gr_ut_manifest_free(gr_ut_manifest *m)
         free(m->passes[i].fragment_file);
         free(m->passes[i].vertex_src);
         free(m->passes[i].fragment_src);
+        free(m->passes[i].defines);
     }
+    for (int i = 0; i < m->n_files; i++) free(m->files[i]);
     for (int i = 0; i < GR_UT_MAX_SETTINGS; i++) {
         free(m->param_strings[i][0]);
         free(m->param_strings[i][1]);
@@ -905,6 +1083,7 @@ gr_status gr_ut_manifest_load(const char *dir, gr_ut_manifest **out, gr_error *e
         for (int i = 0; i < m->n_passes; i++) {
             if (m->passes[i].vertex_src) h = fnv1a(h, m->passes[i].vertex_src);
             h = fnv1a(h, m->passes[i].fragment_src);
+            if (m->passes[i].defines) h = fnv1a(h, m->passes[i].defines);
         }
         snprintf(m->source_hash, sizeof m->source_hash, "%016llx", h);
     }

@@ -25,6 +25,9 @@
 #define GR_UT_MAX_SIZE 16384
 #define GR_UT_MAX_LADDER 16
 #define GR_UT_MAX_FILE_BYTES (1 << 20) /* a manifest or a shader file: 1 MiB at most */
+#define GR_UT_MAX_FILES 32               /* shader files, includes counted */
+#define GR_UT_MAX_INCLUDE_DEPTH 16
+#define GR_UT_LINE_BASE 10000000 /* > the lines of a 1 MiB file; 33 x it fits an int */
 
 typedef enum { GR_UT_NUMBER, GR_UT_INT, GR_UT_BOOL, GR_UT_RGB } gr_ut_type;
 extern const char *const gr_ut_type_names[];
@@ -38,8 +41,9 @@ extern const char *const gr_ut_blend_names[];
 typedef enum { GR_UT_PRIM_TRIANGLES, GR_UT_PRIM_TRIANGLE_STRIP, GR_UT_PRIM_LINES, GR_UT_PRIM_POINTS } gr_ut_prim;
 extern const char *const gr_ut_prim_names[];
 
-/* Harness textures a pass may list among its inputs (bound as t_NAME). */
-enum { GR_UT_IN_SHADOW_MAP = -1, GR_UT_IN_EYE_DEPTH = -2 };
+/* Harness textures a pass may list among its inputs (bound as t_NAME; gr_ut_input_name). */
+enum { GR_UT_IN_SHADOW_MAP = -1, GR_UT_IN_EYE_DEPTH = -2, GR_UT_IN_LIGHT = -3 };
+#define GR_UT_HARNESS_INPUTS "\"shadow_map\", \"eye_depth\" or \"sun_light\""
 
 typedef struct gr_ut_setting {
     char key[GR_TECH_NAME_MAX];
@@ -81,6 +85,7 @@ typedef struct gr_ut_pass {
     float clear[4];
     int n_inputs;
     int inputs[GR_UT_MAX_INPUTS]; /* target index, or GR_UT_IN_* */
+    char *defines;                /* "#define NAME VALUE\n" lines of its "defines" (NULL: none) */
 } gr_ut_pass;
 
 typedef struct gr_ut_manifest {
@@ -99,14 +104,26 @@ typedef struct gr_ut_manifest {
     gr_ut_pass passes[GR_UT_MAX_PASSES];
     int output;
     int allow_black;
-    int uses_shadow_map, uses_eye_depth;
+    int uses_shadow_map, uses_eye_depth, uses_light;
     gr_ut_value shadow_size, shadow_half_extent;
+    /* "sun_light": the harness's light texture (realtime/toolkit.h gr_light_pass) */
+    gr_ut_value light_scale, light_radius_deg, light_threshold;
+    gr_ut_format light_format;
+    int light_occluders;
+    /* every shader file read, includes too, relative to dir: line L of files[K] is numbered
+     * GR_UT_LINE_BASE * (K + 1) + L in the sources ("#line"; Mesa ignores #line's source
+     * string number), so a driver's line maps back to the file and its own line */
+    int n_files;
+    char *files[GR_UT_MAX_FILES];
     char source_hash[17]; /* FNV-1a 64 of the manifest and every shader file, hex */
     int n_ladder;
     gr_technique_level ladder[GR_UT_MAX_LADDER];
     char *ladder_text[GR_UT_MAX_LADDER];
     gr_technique_class cls; /* the class made from it (usertech.c fills it): lives as long as m */
 } gr_ut_manifest;
+
+/* t_NAME's NAME of input `in` of a pass (a target's index or GR_UT_IN_*). */
+const char *gr_ut_input_name(const gr_ut_manifest *m, int in);
 
 /* A growable string (zero-initialize; free .s): gr_ut_sb_add appends printf-style; on no
  * memory it sets failed and keeps what it had. Ladder texts here, GLSL preludes in usertech.c. */

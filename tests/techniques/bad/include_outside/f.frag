@@ -1,0 +1,2 @@
+// shared code
+#include "../missing_shader/a.frag"
