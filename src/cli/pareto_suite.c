@@ -301,8 +301,10 @@ static void page_chart(gr_strbuf *pg, const ps_run *r, const char *header, int d
     char why[512];
     gr_sb_puts(pg, "<h2>Fronts</h2>\n");
     gr_chart_html(pg, &c, why, sizeof why);
-    gr_sb_htmlf(pg, "<p>Thumbnails: test case %s; its ground truth: <a href=\"thumbs/truth.png\">thumbs/truth.png</a>. "
-                "Every point's row is in fronts.csv.</p>\n", r->suite->cases[r->thumb_case].name);
+    gr_sb_puts(pg, "<p>Thumbnails: test case ");
+    gr_sb_html(pg, r->suite->cases[r->thumb_case].name);
+    gr_sb_puts(pg, "; its ground truth: <a href=\"thumbs/truth.png\">thumbs/truth.png</a>. Every point's row is in "
+                   "fronts.csv.</p>\n");
     free(cp);
 }
 
@@ -311,7 +313,7 @@ static void page_budgets(gr_strbuf *pg, const gr_ps_opts *o, const ps_run *r, co
 {
     gr_sb_puts(pg, "<h2>Budget table</h2>\n<p><b>");
     gr_sb_html(pg, header);
-    gr_sb_htmlf(pg, "</b>. Chosen by TRAIN error among the points within the budget, scored on the %d test cases. Hover a "
+    gr_sb_printf(pg, "</b>. Chosen by TRAIN error among the points within the budget, scored on the %d test cases. Hover a "
                 "row: its point on the chart.</p>\n<table class=\"budgets\"><tr><th>budget ms</th><th>technique</th>"
                 "<th>time ms</th><th>train</th><th>test</th><th>gap</th><th>eq. blur</th><th>settings</th><th>preset</th>"
                 "<th>thumbnail</th></tr>\n", gr_suite_count(r->suite, GR_SPLIT_TEST));
@@ -327,12 +329,16 @@ static void page_budgets(gr_strbuf *pg, const gr_ps_opts *o, const ps_run *r, co
         gr_chart_thumb_name(pick[b], thumb, sizeof thumb);
         gr_sb_puts(pg, "<tr");
         gr_chart_row_attrs(pg, "fronts", pick[b]);
-        gr_sb_htmlf(pg, "><td>%g</td><td>%s</td><td>%.3f</td><td>%.4g</td><td>%.4g</td><td>%.3g</td><td>%s</td><td>%s%s</td>",
-                    o->budgets_ms[b], p->cls->name, p->timing.cost_ms, p->train_error, p->test_error,
-                    p->test_error - p->train_error, eq, p->tuned ? "tuned: " : "untuned: ", label);
-        gr_sb_htmlf(pg, "<td><a href=\"presets/budget_%gms.json\">budget_%gms.json</a></td>", o->budgets_ms[b],
-                    o->budgets_ms[b]);
-        gr_sb_htmlf(pg, "<td><img src=\"%s\" alt=\"thumbnail\" class=\"thumb\"></td></tr>\n", thumb);
+        gr_sb_printf(pg, "><td>%g</td><td>", o->budgets_ms[b]);
+        gr_sb_html(pg, p->cls->name);
+        gr_sb_printf(pg, "</td><td>%.3f</td><td>%.4g</td><td>%.4g</td><td>%.3g</td><td>", p->timing.cost_ms,
+                     p->train_error, p->test_error, p->test_error - p->train_error);
+        gr_sb_html(pg, eq);
+        gr_sb_puts(pg, "</td><td>");
+        gr_sb_htmlf(pg, "%s%s", p->tuned ? "tuned: " : "untuned: ", label);
+        gr_sb_printf(pg, "</td><td><a href=\"presets/budget_%gms.json\">budget_%gms.json</a></td>", o->budgets_ms[b],
+                     o->budgets_ms[b]);
+        gr_sb_printf(pg, "<td><img src=\"%s\" alt=\"thumbnail\" class=\"thumb\"></td></tr>\n", thumb);
     }
     gr_sb_puts(pg, "</table>\n<style>table.budgets{border-collapse:collapse;margin:1em 0}table.budgets td,table.budgets th"
                    "{border:1px solid #ccc;padding:.2em .5em;text-align:left}img.thumb{width:128px;border:0}</style>\n");

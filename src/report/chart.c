@@ -147,10 +147,12 @@ static const char *const chart_js =
     "document.getElementById(D.id+'-logy').addEventListener('click',function(){var o=ch.options.scales.y;"
     "o.type=o.type==='logarithmic'?'linear':'logarithmic';delete o.min;delete o.max;ch.update();});"
     /* table rows: hovering one highlights its point and shows its tooltip */
-    "document.querySelectorAll('[data-gr-chart=\"'+D.id+'\"]').forEach(function(row){var k=+row.getAttribute('data-gr-point');"
+    "function rows(){document.querySelectorAll('[data-gr-chart=\"'+D.id+'\"]').forEach(function(row){var k=+row.getAttribute('data-gr-point');"
     "row.addEventListener('mouseenter',function(){var w=where[k];if(!w)return;var e=ch.getDatasetMeta(w[0]).data[w[1]];"
     "var act=[{datasetIndex:w[0],index:w[1]}];ch.setActiveElements(act);ch.tooltip.setActiveElements(act,{x:e.x,y:e.y});ch.update();});"
-    "row.addEventListener('mouseleave',function(){ch.setActiveElements([]);ch.tooltip.setActiveElements([],{x:0,y:0});ch.update();});});"
+    "row.addEventListener('mouseleave',function(){ch.setActiveElements([]);ch.tooltip.setActiveElements([],{x:0,y:0});ch.update();});});}"
+    /* the rows come after the chart in the page */
+    "if(document.readyState==='loading')document.addEventListener('DOMContentLoaded',rows);else rows();"
     "}catch(e){st.textContent='The interactive chart failed ('+e.message+'): the PNG chart is shown instead.';"
     "var fb2=document.getElementById(D.id+'-fallback');if(fb2)fb2.style.display='block';"
     "var b2=document.getElementById(D.id+'-box');if(b2)b2.style.display='none';}}\n";
@@ -231,19 +233,19 @@ int gr_chart_html(gr_strbuf *b, const gr_chart *c, char *why, size_t n_why)
     gr_sb_puts(b, chart_css);
     gr_sb_puts(b, "<div class=\"gr-chart\">");
     if (lib) {
-        gr_sb_htmlf(b, "<p><button type=\"button\" id=\"%s-reset\">reset zoom</button> "
+        gr_sb_printf(b, "<p><button type=\"button\" id=\"%s-reset\">reset zoom</button> "
                        "<button type=\"button\" id=\"%s-logy\">error axis: log / linear</button> ", c->id, c->id);
-        gr_sb_htmlf(b, "<span class=\"gr-chart-status\" id=\"%s-status\">", c->id);
+        gr_sb_printf(b, "<span class=\"gr-chart-status\" id=\"%s-status\">", c->id);
         gr_sb_puts(b, "The interactive chart needs JavaScript: the PNG chart is shown instead.</span></p>\n");
-        gr_sb_htmlf(b, "<div class=\"gr-chart-box\" id=\"%s-box\"><canvas id=\"%s-canvas\"></canvas>", c->id, c->id);
-        gr_sb_htmlf(b, "<div class=\"gr-chart-band\" id=\"%s-band\"></div>", c->id);
-        gr_sb_htmlf(b, "<div class=\"gr-chart-tip\" id=\"%s-tip\"></div></div>\n", c->id);
+        gr_sb_printf(b, "<div class=\"gr-chart-box\" id=\"%s-box\"><canvas id=\"%s-canvas\"></canvas>", c->id, c->id);
+        gr_sb_printf(b, "<div class=\"gr-chart-band\" id=\"%s-band\"></div>", c->id);
+        gr_sb_printf(b, "<div class=\"gr-chart-tip\" id=\"%s-tip\"></div></div>\n", c->id);
     } else {
         gr_sb_puts(b, "<p class=\"gr-chart-status\">");
         gr_sb_html(b, why);
         gr_sb_puts(b, ": the PNG chart is shown instead.</p>\n");
     }
-    gr_sb_htmlf(b, "<div id=\"%s-fallback\">", c->id);
+    gr_sb_printf(b, "<div id=\"%s-fallback\">", c->id);
     if (c->png) {
         gr_sb_puts(b, "<img src=\"");
         gr_sb_html(b, c->png);
