@@ -15,6 +15,7 @@
 #include "compare/registry.h"
 #include "realtime/technique.h"
 #include "realtime/timing.h"
+#include "report/chart.h"
 #include "report/profile.h"
 #include "report/report.h"
 #include "tune/page.h"
@@ -151,6 +152,7 @@ typedef struct pareto_opts {
     long repeat;
     int have_repeat;
     gr_ps_opts ps;                 /* --suite and its options (cli/pareto_suite.h) */
+    const char *outdir;            /* the output folder (each point's thumbnail, report/chart.h) */
     gr_gl_platform platform;
     const gr_technique_class *techs[GR_TECH_MAX];
     int n_techs;
@@ -292,6 +294,9 @@ static gr_status reference_points(const pareto_opts *o, const gr_scene *scene, g
         const gr_metrics_options ro = verdict_options(so, 0);
         gr_metrics m;
         st = gr_metrics_compute(*truth, ri, &ro, &m, err);
+        char thumb[64];
+        gr_chart_thumb_name(*n, thumb, sizeof thumb);
+        if (st == GR_OK) st = gr_chart_write_thumb(o->outdir, thumb, *truth, ri, err);
         gr_image_destroy(ri);
         if (st != GR_OK) return st;
         gr_pareto_point *p = &pts[(*n)++];
@@ -367,7 +372,10 @@ static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *
             if (o->quick && cls->n_ladder > 0 && !cls->ladder[l].quick) continue;
             if (*n >= MAX_POINTS) break;
             gr_pareto_point *p = &pts[*n];
+            char thumb[64];
+            gr_chart_thumb_name(*n, thumb, sizeof thumb);
             if ((st = ladder_point(o, cls, r, scene, lvs, truth, so, img, p, err)) != GR_OK) break;
+            if ((st = gr_chart_write_thumb(o->outdir, thumb, truth, img, err)) != GR_OK) break;
             (*n)++;
             p->family = 1 + k;
             if (p->gpu_s >= 0) *gpu_any = 1;
@@ -377,6 +385,58 @@ static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *
     gr_technique_destroy(r);
     gr_image_destroy(img);
     return st;
+}
+
+/* The page's interactive chart (report/chart.h): one series per family, each point's
+ * tooltip (setting, times, verdict) and thumbnail. */
+static void page_chart(gr_strbuf *pg, const char *title, const char *tlabel, const char *glr,
+                       const gr_pareto_point *pts, int n, int drawn)
+{
+    gr_chart c;
+    memset(&c, 0, sizeof c);
+    gr_chart_point *cp = calloc((size_t)(n > 0 ? n : 1), sizeof *cp);
+    if (!cp) {
+        gr_sb_puts(pg, "<p>(no chart: out of memory)</p>\n");
+        return;
+    }
+    int family[GR_CHART_MAX_SERIES];
+    for (int i = 0; i < n; i++) {
+        int s = 0;
+        while (s < c.n_series && family[s] != pts[i].family) s++;
+        if (s == c.n_series && c.n_series < GR_CHART_MAX_SERIES) {
+            family[s] = pts[i].family;
+            snprintf(c.series[s].name, sizeof c.series[s].name, "%s", pts[i].family_name);
+            c.series[s].color = pts[i].family;
+            c.series[s].hollow = pts[i].family == GR_PARETO_REFERENCE;
+            c.n_series++;
+        }
+        char g[32];
+        if (pts[i].gpu_s >= 0) snprintf(g, sizeof g, "%.4g ms", 1e3 * pts[i].gpu_s);
+        else snprintf(g, sizeof g, "n/a");
+        cp[i] = (gr_chart_point){.series = s < c.n_series ? s : -1, .x = 1e3 * pts[i].cost_s, .y = pts[i].error,
+                                 .on_front = pts[i].on_front};
+        snprintf(cp[i].title, sizeof cp[i].title, "%s", pts[i].label);
+        snprintf(cp[i].lines, sizeof cp[i].lines, "settings: %s\ntime: %.4g ms (wall %.4g ms, GL timers %s)\n"
+                 "error (verdict): %.4g%s", pts[i].settings, 1e3 * pts[i].cost_s, 1e3 * pts[i].time_s, g, pts[i].error,
+                 pts[i].on_front ? "\non its family's front" : "");
+        gr_chart_thumb_name(i, cp[i].thumb, sizeof cp[i].thumb);
+    }
+    char xlab[200], sub[300];
+    snprintf(xlab, sizeof xlab, "time per frame (ms, log): %s; reference: whole render", tlabel);
+    c.id = "pareto";
+    snprintf(sub, sizeof sub, "GL_RENDERER: %.200s%s", glr ? glr : "?",
+             gr_timing_is_cpu_renderer(glr) ? ": CPU-rasterizer times, which do NOT stand for a GPU's" : "");
+    c.title = title;
+    c.subtitle = sub;
+    c.x_label = xlab;
+    c.y_label = "error (verdict against the high-quality ground truth)";
+    c.png = drawn ? "pareto.png" : NULL;
+    c.log_y = 1;
+    c.n_points = n;
+    c.points = cp;
+    char why[512];
+    gr_chart_html(pg, &c, why, sizeof why);
+    free(cp);
 }
 
 /* pareto.csv, pareto.png, the summary (printed) and index.html. */
@@ -415,8 +475,8 @@ static gr_status write_outputs(const gr_scene *scene, const gr_truth_info *ti, c
     gr_strbuf pg;
     gr_sb_init(&pg);
     gr_tune_page_begin(&pg, outdir, "godrays pareto: %s", scene->name);
-    if (drawn) gr_tune_page_figure(&pg, "pareto.png", title);
-    st = gr_tune_page_write(&pg, gr_sb_str(&sum), "pareto.csv", outdir, err);
+    page_chart(&pg, title, tlabel, glr, pts, n, drawn);
+    st = gr_tune_page_write(&pg, gr_sb_str(&sum), drawn ? "pareto.csv,pareto.png" : "pareto.csv", outdir, err);
     gr_sb_free(&sum);
     return st;
 }
@@ -436,6 +496,7 @@ static gr_status pareto_scene(pareto_opts *o, const gr_scene *scene, const char 
     float *angles = malloc((size_t)scene->camera.width * (size_t)scene->camera.height * sizeof *angles);
     gr_structure_options so; /* the verdict's structure term (report/profile.h) */
     gr_status st = work && pts && angles ? GR_OK : gr_fail(err, GR_E_NOMEM, "out of memory");
+    o->outdir = outdir;
     if (st == GR_OK && !gr_profile_structure_options(scene, angles, &so) && !o->quiet)
         fprintf(stderr, "godrays pareto: the beams have no vanishing point in this view: error = the error term alone\n");
     if (st == GR_OK) st = gr_gl_create(&glo, &gl, err); /* before the slow ground truths */

@@ -11,6 +11,7 @@
 #include "common/outfile.h"
 #include "compare/baseline.h"
 #include "reference/truth.h"
+#include "report/chart.h"
 #include "report/html.h"
 #include "report/report.h"
 #include "suite/suite.h"
@@ -39,6 +40,8 @@ typedef struct ps_run {
     int n;
     double truth_s, tune_s, time_s;
     gr_baselines *bl;         /* the blur ladder over the test cases (equivalent blur) */
+    const char *dir;          /* the output folder (thumbnails are written as points come) */
+    int thumb_case;           /* the case the thumbnails show: the first test case */
 } ps_run;
 
 static void ps_free(ps_run *r)
@@ -75,6 +78,7 @@ static gr_status truths(const gr_ps_opts *o, ps_run *r, gr_error *err)
         if (st != GR_OK) return gr_error_prefix(err, "%s: case %s", r->suite->path, c->name);
         r->cases[i] = (gr_st_case){&c->scene, r->truths[i], c->split};
         if (first_train < 0 && c->split == GR_SPLIT_TRAIN) first_train = i;
+        if (c->split == GR_SPLIT_TEST && r->suite->cases[r->thumb_case].split != GR_SPLIT_TEST) r->thumb_case = i;
     }
     r->truth_s = now_s() - t0;
     if (first_train < 0 || gr_suite_count(r->suite, GR_SPLIT_TEST) == 0)
@@ -84,6 +88,20 @@ static gr_status truths(const gr_ps_opts *o, ps_run *r, gr_error *err)
     r->timing_scene->camera.width = o->timing_w;
     r->timing_scene->camera.height = o->timing_h;
     return gr_scene_refresh(r->timing_scene, err);
+}
+
+/* Point k's thumbnail (report/chart.h): its settings rendered on the thumbnail case. */
+static gr_status thumbnail(ps_run *r, gr_technique *t, int k, gr_error *err)
+{
+    const gr_scene *sc = &r->suite->cases[r->thumb_case].scene;
+    gr_image *img = gr_image_create(sc->camera.width, sc->camera.height, 3, NULL);
+    gr_status st = img ? GR_OK : gr_fail(err, GR_E_NOMEM, "out of memory");
+    if (st == GR_OK) st = gr_technique_render(t, sc, r->pts[k].settings.bytes, img, NULL, err);
+    char name[64];
+    gr_chart_thumb_name(k, name, sizeof name);
+    if (st == GR_OK) st = gr_chart_write_thumb(r->dir, name, r->truths[r->thumb_case], img, err);
+    gr_image_destroy(img);
+    return st;
 }
 
 /* One technique: each ladder point untuned (and tuned with --tune), each timed. */
@@ -104,6 +122,8 @@ static gr_status technique(const gr_ps_opts *o, ps_run *r, const gr_technique_cl
         if (st == GR_OK) st = gr_st_time_point(t, r->timing_scene, o->repeat, u, err);
         if (st == GR_OK && tu) st = gr_st_time_point(t, r->timing_scene, o->repeat, tu, err);
         r->time_s += now_s() - t0;
+        if (st == GR_OK) st = thumbnail(r, t, r->n, err);
+        if (st == GR_OK && tu) st = thumbnail(r, t, r->n + 1, err);
         if (st != GR_OK) break;
         r->n += tu ? 2 : 1;
         if (!o->quiet)
@@ -177,11 +197,9 @@ static gr_status write_plot(const char *dir, const ps_run *r, const char *header
 }
 
 /* The budget table (printed, budgets.csv) and one preset per row (presets/budget_Bms.json). */
-static gr_status budget_table(const gr_ps_opts *o, const ps_run *r, const char *dir, const char *header,
-                              gr_strbuf *sum, gr_error *err)
+static gr_status budget_table(const gr_ps_opts *o, const ps_run *r, const int *pick, const char *dir,
+                              const char *header, gr_strbuf *sum, gr_error *err)
 {
-    int pick[GR_PS_MAX_BUDGETS];
-    gr_st_pick(r->pts, r->n, o->budgets_ms, o->n_budgets, pick);
     char path[4400];
     snprintf(path, sizeof path, "%s/presets", dir);
     gr_status st = gr_report_make_dir(path, err);
@@ -232,6 +250,100 @@ static gr_status budget_table(const gr_ps_opts *o, const ps_run *r, const char *
     return st;
 }
 
+/* The page's interactive chart (report/chart.h) of the fronts: one series per technique and
+ * kind (tuned filled, untuned hollow), each point's tooltip and thumbnail. */
+static void page_chart(gr_strbuf *pg, const ps_run *r, const char *header, int drawn)
+{
+    gr_chart c;
+    memset(&c, 0, sizeof c);
+    gr_chart_point *cp = calloc((size_t)(r->n > 0 ? r->n : 1), sizeof *cp);
+    if (!cp) {
+        gr_sb_puts(pg, "<p>(no chart: out of memory)</p>\n");
+        return;
+    }
+    char title[600], label[512], ylab[160];
+    const gr_timing *tm = r->n > 0 ? &r->pts[0].timing : NULL;
+    snprintf(title, sizeof title, "Test error against time per frame, tuned and untuned fronts (GL_RENDERER: %s)",
+             tm ? tm->renderer : gr_gl_renderer(r->gl));
+    snprintf(ylab, sizeof ylab, "test error (mean verdict over the %d test cases)", gr_suite_count(r->suite, GR_SPLIT_TEST));
+    int family[GR_CHART_MAX_SERIES];
+    for (int i = 0; i < r->n; i++) {
+        const gr_st_point *p = &r->pts[i];
+        const int fam = 2 * gr_technique_index(p->cls) + p->tuned;
+        int s = 0;
+        while (s < c.n_series && family[s] != fam) s++;
+        if (s == c.n_series && c.n_series < GR_CHART_MAX_SERIES) {
+            family[s] = fam;
+            snprintf(c.series[s].name, sizeof c.series[s].name, "%s %s", p->cls->name, p->tuned ? "tuned" : "untuned");
+            c.series[s].color = gr_technique_index(p->cls);
+            c.series[s].hollow = !p->tuned;
+            c.n_series++;
+        }
+        gr_st_point_label(p, label, sizeof label);
+        cp[i] = (gr_chart_point){.series = s < c.n_series ? s : -1, .x = p->timing.cost_ms, .y = p->test_error,
+                                 .on_front = p->on_front};
+        snprintf(cp[i].title, sizeof cp[i].title, "%s, %s", p->cls->name, p->tuned ? "tuned" : "untuned");
+        snprintf(cp[i].lines, sizeof cp[i].lines, "ladder: %.200s\nsettings: %.400s\ntime: %.4g ms%s\ntrain error: %.4g\n"
+                 "test error: %.4g (gap %+.3g)\nthumbnail: test case %.64s", p->ladder[0] ? p->ladder : "(scene's)", label,
+                 p->timing.cost_ms, p->timing.hardware ? " (GPU)" : " (CPU-rasterizer wall)", p->train_error,
+                 p->test_error, p->test_error - p->train_error, r->suite->cases[r->thumb_case].name);
+        gr_chart_thumb_name(i, cp[i].thumb, sizeof cp[i].thumb);
+    }
+    c.id = "fronts";
+    c.title = title;
+    c.subtitle = header;
+    c.x_label = "time per frame (ms, log)";
+    c.y_label = ylab;
+    c.png = drawn ? "fronts.png" : NULL;
+    c.log_y = 1;
+    c.n_points = r->n;
+    c.points = cp;
+    char why[512];
+    gr_sb_puts(pg, "<h2>Fronts</h2>\n");
+    gr_chart_html(pg, &c, why, sizeof why);
+    gr_sb_puts(pg, "<p>Thumbnails: test case ");
+    gr_sb_html(pg, r->suite->cases[r->thumb_case].name);
+    gr_sb_puts(pg, "; its ground truth: <a href=\"thumbs/truth.png\">thumbs/truth.png</a>. Every point's row is in "
+                   "fronts.csv.</p>\n");
+    free(cp);
+}
+
+/* The budget table in the page: a row per budget, hovering it highlights its point. */
+static void page_budgets(gr_strbuf *pg, const gr_ps_opts *o, const ps_run *r, const int *pick, const char *header)
+{
+    gr_sb_puts(pg, "<h2>Budget table</h2>\n<p><b>");
+    gr_sb_html(pg, header);
+    gr_sb_printf(pg, "</b>. Chosen by TRAIN error among the points within the budget, scored on the %d test cases. Hover a "
+                "row: its point on the chart.</p>\n<table class=\"budgets\"><tr><th>budget ms</th><th>technique</th>"
+                "<th>time ms</th><th>train</th><th>test</th><th>gap</th><th>eq. blur</th><th>settings</th><th>preset</th>"
+                "<th>thumbnail</th></tr>\n", gr_suite_count(r->suite, GR_SPLIT_TEST));
+    for (int b = 0; b < o->n_budgets; b++) {
+        if (pick[b] < 0) {
+            gr_sb_printf(pg, "<tr><td>%g</td><td colspan=\"9\">no point within the budget</td></tr>\n", o->budgets_ms[b]);
+            continue;
+        }
+        const gr_st_point *p = &r->pts[pick[b]];
+        char label[512], eq[32], thumb[64];
+        gr_st_point_label(p, label, sizeof label);
+        gr_equivalent_blur_text(r->bl, p->test_error, eq, sizeof eq);
+        gr_chart_thumb_name(pick[b], thumb, sizeof thumb);
+        gr_sb_puts(pg, "<tr");
+        gr_chart_row_attrs(pg, "fronts", pick[b]);
+        gr_sb_printf(pg, "><td>%g</td><td>", o->budgets_ms[b]);
+        gr_sb_html(pg, p->cls->name);
+        gr_sb_printf(pg, "</td><td>%.3f</td><td>%.4g</td><td>%.4g</td><td>%.3g</td><td>", p->timing.cost_ms,
+                     p->train_error, p->test_error, p->test_error - p->train_error);
+        gr_sb_html(pg, eq);
+        gr_sb_puts(pg, "</td><td>");
+        gr_sb_htmlf(pg, "%s%s", p->tuned ? "tuned: " : "untuned: ", label);
+        gr_sb_printf(pg, "</td><td><a href=\"presets/budget_%gms.json\">budget_%gms.json</a></td>", o->budgets_ms[b],
+                     o->budgets_ms[b]);
+        gr_sb_printf(pg, "<td><img src=\"%s\" alt=\"thumbnail\" class=\"thumb\"></td></tr>\n", thumb);
+    }
+    gr_sb_puts(pg, "</table>\n<style>table.budgets{border-collapse:collapse;margin:1em 0}table.budgets td,table.budgets th"
+                   "{border:1px solid #ccc;padding:.2em .5em;text-align:left}img.thumb{width:128px;border:0}</style>\n");
+}
+
 static gr_status outputs(const gr_ps_opts *o, ps_run *r, const char *dir, double wall_s, gr_error *err)
 {
     char header[512], label[512];
@@ -253,7 +365,10 @@ static gr_status outputs(const gr_ps_opts *o, ps_run *r, const char *dir, double
         gr_sb_printf(&sum, "%-12s %-7s %10.3f %9.4g %9.4g %5s  %s\n", p->cls->name, p->tuned ? "tuned" : "untuned",
                      p->timing.cost_ms, p->train_error, p->test_error, p->on_front ? "*" : "", label);
     }
-    if (st == GR_OK && o->n_budgets > 0) st = budget_table(o, r, dir, header, &sum, err);
+    int pick[GR_PS_MAX_BUDGETS];
+    gr_st_pick(r->pts, r->n, o->budgets_ms, o->n_budgets, pick);
+    if (st == GR_OK && o->n_budgets > 0) st = budget_table(o, r, pick, dir, header, &sum, err);
+    if (st == GR_OK) st = gr_chart_write_thumb(dir, "thumbs/truth.png", NULL, r->truths[r->thumb_case], err);
     gr_sb_printf(&sum, "\nseconds: ground truths %.1f, tuning and scoring %.1f, timing %.1f, all %.1f (seed %llu)\n",
                  r->truth_s, r->tune_s, r->time_s, wall_s, o->seed);
     gr_sb_printf(&sum, "written: %s/fronts.csv%s%s\n", dir, drawn ? ", fronts.png" : " (no chart: PLplot missing)",
@@ -262,8 +377,10 @@ static gr_status outputs(const gr_ps_opts *o, ps_run *r, const char *dir, double
     gr_strbuf pg;
     gr_sb_init(&pg);
     gr_tune_page_begin(&pg, dir, "godrays pareto --suite: %s", r->suite->name);
-    if (drawn) gr_tune_page_figure(&pg, "fronts.png", header);
-    if (st == GR_OK) st = gr_tune_page_write(&pg, gr_sb_str(&sum), "fronts.csv", dir, err);
+    page_chart(&pg, r, header, drawn);
+    if (o->n_budgets > 0) page_budgets(&pg, o, r, pick, header);
+    gr_sb_puts(&pg, "<h2>Summary</h2>\n");
+    if (st == GR_OK) st = gr_tune_page_write(&pg, gr_sb_str(&sum), drawn ? "fronts.csv,fronts.png" : "fronts.csv", dir, err);
     else gr_sb_free(&pg);
     gr_sb_free(&sum);
     return st;
@@ -288,6 +405,7 @@ int gr_pareto_suite(gr_args *args, const gr_ps_opts *o)
         return rc;
     }
     const double t0 = now_s();
+    r.dir = dir;
     gr_gl_options glo;
     memset(&glo, 0, sizeof glo);
     glo.platform = o->platform;

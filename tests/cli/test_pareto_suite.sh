@@ -6,7 +6,8 @@
 # as CPU-rasterizer times on llvmpipe with GL_RENDERER named; a budget nothing fits says so;
 # the preset of a budget row, applied with `run --preset` to the test view, gives the test
 # error the table states (the verdict `run` computes on its own), and `render --preset`
-# reproduces one image byte for byte across runs; --budgets without --suite is refused.
+# reproduces one image byte for byte across runs; --budgets without --suite is refused; the
+# page's interactive chart in headless Chromium (below).
 bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
@@ -54,6 +55,38 @@ awk -v a="$test_err" -v b="$run_err" 'BEGIN {d = a - b; if (d < 0) d = -d; exit 
 if command -v idiff >/dev/null 2>&1; then
   idiff -fail 0 -failpercent 0 -warn 0 "$dir/a.exr" "$dir/b.exr" >/dev/null 2>&1 || { echo "FAIL: preset renders differ"; fail=1; }
 fi
+# The report page in headless Chromium (as tests/cli/test_report_browser.sh drives it), offline
+# from file://: Chart.js inlined (no external script or link), the chart drawn with as many
+# points as fronts.csv has rows (the page's script marks its status element data-ready and
+# data-points), no console message; hovering the budget row shows the tooltip of its point
+# with its settings and its thumbnail decoded (an instrumented copy reports it into the DOM).
+page="$dir/p/index.html"
+browser=""
+for b in chromium chromium-browser; do command -v "$b" >/dev/null 2>&1 && { browser=$b; break; }; done
+if [ -z "$browser" ] && [ "${CI:-}" = "true" ]; then echo "FAIL: chromium is not installed (CI must run this)"; fail=1; fi
+if [ -n "$browser" ]; then
+  grep -q 'Chart.js v3' "$page" || { echo "FAIL: Chart.js is not inlined in index.html"; fail=1; }
+  grep -Eq '(src|href)="(https?:|//|/|file:)' "$page" && { echo "FAIL: the page links outside its folder"; fail=1; }
+  n_rows=$(($(wc -l <"$f") - 1))
+  sed 's#</body>#<script>addEventListener("load",function(){var r=document.querySelector("tr[data-gr-chart]"),o="none";\
+if(r){r.dispatchEvent(new MouseEvent("mouseenter"));var t=document.getElementById("fronts-tip"),i=t.querySelector("img");\
+o="tip="+t.style.display+" img="+(i?i.naturalWidth:-1)+" text="+t.textContent;}\
+var p=document.createElement("pre");p.id="grhover";p.textContent="GR"+"HOVER "+o+" HOVER"+"END";document.body.appendChild(p);});</script></body>#' \
+    "$page" >"$dir/p/check.html"
+  prof="$dir/chromium"
+  # shellcheck disable=SC2086
+  timeout 120 "$browser" --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking \
+    --disable-component-update --disable-sync --user-data-dir="$prof" --enable-logging=stderr --v=0 \
+    --virtual-time-budget=10000 --dump-dom "file://$dir/p/check.html" >"$dir/dom.html" 2>"$dir/dom.err"
+  grep -q "id=\"fronts-status\" data-ready=\"1\" data-points=\"$n_rows\"" "$dir/dom.html" ||
+    { echo "FAIL: the chart is not drawn with the $n_rows points of fronts.csv:"; grep -o 'id="fronts-status"[^<]*' "$dir/dom.html"; fail=1; }
+  hover=$(grep -o 'GRHOVER[^<]*HOVEREND' "$dir/dom.html")
+  echo "browser: $hover"
+  echo "$hover" | grep -Eq 'tip=block img=[1-9][0-9]* text=shafts, (un)?tuned.*test error: ' ||
+    { echo "FAIL: hovering the budget row does not show its point's tooltip with a decoded thumbnail"; fail=1; }
+  grep ':CONSOLE' "$dir/dom.err" && { echo "FAIL: console messages in the report page"; fail=1; }
+fi
+
 "$bin" pareto "$dir/s.json" --budgets 1 2>"$dir/err2"
 [ $? -eq 2 ] && grep -q "need --suite" "$dir/err2" || { echo "FAIL: --budgets without --suite"; cat "$dir/err2"; fail=1; }
 [ "$fail" -eq 0 ] && echo "pareto_suite: all checks passed"
