@@ -157,6 +157,13 @@ static void sq(FILE *f, const char *s)
     fputc('\'', f);
 }
 
+/* " FLAG 'v'": an option and its value, quoted */
+static void sq_flag(FILE *f, const char *flag, const char *v)
+{
+    fprintf(f, " %s ", flag);
+    sq(f, v);
+}
+
 /* s double-quoted for a #SBATCH line, which sbatch splits into words itself (no shell): inside
  * quotes a space or '#' is part of the value, and '"' and '\\' are escaped with a backslash */
 static void dq(FILE *f, const char *s)
@@ -347,26 +354,19 @@ static gr_status write_final(const gr_farm_plan *plan, gr_error *err)
     if (plan->suite[0] && !strcmp(plan->then, "run")) {
         /* the suite itself (its cases' scene files must be visible here), with the farm's
          * overrides: the cases' keys are the parts' */
-        fputs("\"$GODRAYS\" run --suite ", f);
-        sq(f, plan->suite);
-        for (int k = 0; k < plan->n_sets; k++) {
-            fputs(" --set ", f);
-            sq(f, plan->sets[k]);
-        }
+        fputs("\"$GODRAYS\" run", f);
+        sq_flag(f, "--suite", plan->suite);
+        for (int k = 0; k < plan->n_sets; k++) sq_flag(f, "--set", plan->sets[k]);
         fputs(" -o \"$FARM/run\"", f);
         sq_words(f, plan->then_args);
         fputc('\n', f);
     } else if (!strcmp(plan->then, "tune")) {
         fputs("\"$GODRAYS\" tune \"$SCENE\"", f);
         if (plan->frames[0]) {
-            fputs(" --frames ", f);
-            sq(f, plan->frames);
+            sq_flag(f, "--frames", plan->frames);
             fprintf(f, " --fps %.17g", plan->fps);
         }
-        for (int v = 0; v < plan->n_views; v++) {
-            fputs(" --view ", f);
-            sq(f, plan->views[v]);
-        }
+        for (int v = 0; v < plan->n_views; v++) sq_flag(f, "--view", plan->views[v]);
         fputs(" --quiet -o \"$FARM/tune\"", f);
         sq_words(f, plan->then_args);
         fputc('\n', f);
