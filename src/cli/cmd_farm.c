@@ -1,5 +1,6 @@
-/* godrays farm SCENE ...: ground truths of frames and views as a Slurm job array of parts,
- * merged into the shared ground-truth cache (src/farm/farm.h, docs/farm.md);
+/* godrays farm SCENE ...: ground truths of frames and views (or farm --suite SUITE: of a view
+ * suite's cases) as a Slurm job array of parts, merged into the shared ground-truth cache
+ * (src/farm/farm.h, docs/farm.md);
  * godrays farm --status DIR: what is done. */
 #define _DEFAULT_SOURCE
 #include "cli/cli.h"
@@ -22,6 +23,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: godrays farm SCENE.json [options]      write and submit the Slurm jobs\n"
+            "       godrays farm --suite SUITE [options]    the ground truths of a view suite's cases\n"
             "       godrays farm --status DIR               what a farm has done\n"
             "\n"
             "Renders the ground truths of a sequence of frames and views on a Slurm cluster: a job\n"
@@ -31,9 +33,13 @@ static void usage(FILE *f)
             "again. How a site sets it up: docs/farm.md.\n"
             "\n"
             "options:\n"
-            "  -o, --output DIR     farm folder: scripts, scene copy, logs (default farm-SCENENAME)\n"
+            "  -o, --output DIR     farm folder: scripts, scene copies, logs (default farm-NAME,\n"
+            "                       the scene's or the suite's name)\n"
             "  --cache DIR          shared ground-truth cache (default $GODRAYS_CACHE, else the\n"
             "                       user cache that run uses); every node must see it\n"
+            "  --suite SUITE        every case of a view suite (docs/scene-format.md \"Suites\"; the\n"
+            "                       --set/--size overrides apply to each): its scene copy in\n"
+            "                       DIR/cases/NAME/; --then run (the default) is run --suite\n"
             "  --frames A:B:S       frames A, A+S, ..., B at water.time_s + frame/fps (as tune)\n"
             "  --fps F              frames per second (default 30)\n"
             "  --view YAW,PITCH     an extra camera view (repeatable, at most 8; as tune)\n"
@@ -44,7 +50,8 @@ static void usage(FILE *f)
             "  --cpus N             cores per task (sbatch --cpus-per-task; the render's threads)\n"
             "  --max-parallel K     at most K array tasks at once\n"
             "  --retries R          attempts per part before it is reported failed (default 3)\n"
-            "  --then tune|run|none the final job on the merged truths (default tune)\n"
+            "  --then tune|run|none the final job on the merged truths (default tune;\n"
+            "                       --suite: run)\n"
             "  --then-args \"ARGS\"   more arguments for it (tune: default --params with the first\n"
             "                       technique's first two tunable settings, unless ARGS name --params)\n"
             "  --binary PATH        the godrays the jobs run (default: this one)\n"
@@ -90,11 +97,12 @@ static int status(const char *dir)
     gr_error err = {GR_OK, ""};
     if (gr_farm_load(dir, &plan, &err) != GR_OK) return gr_cli_report("farm", &err);
     int per = plan.tiles * plan.batch_parts, merged = 0;
-    printf("farm %s: %d cases x %d parts, cache %s\n", dir, plan.n_cases, per, plan.cache);
+    printf("farm %s: %d cases x %d parts, cache %s%s%s\n", dir, plan.n_cases, per, plan.cache,
+           plan.suite[0] ? ", suite " : "", plan.suite);
     for (int c = 0; c < plan.n_cases; c++) {
         const gr_farm_case *fc = &plan.cases[c];
         merged += fc->merged;
-        printf("  case %d%s%s: %s", c, fc->args[0] ? " " : "", fc->args,
+        printf("  case %d%s%s%s%s: %s", c, fc->name[0] ? " " : "", fc->name, fc->args[0] ? " " : "", fc->args,
                fc->merged ? "merged (in the cache)" : "");
         if (!fc->merged) printf("parts %d/%d", fc->parts_done, per);
         for (int r = 0; r < per && !fc->merged; r++) {
@@ -152,11 +160,11 @@ static int check_outputs(gr_args *args, const char *out)
 
 /* The folder, the cache and the binary as absolute paths (the jobs run elsewhere); the folder
  * and the cache are created. Exit 2 with the message otherwise. */
-static int absolute_paths(gr_farm_plan *plan, const gr_scene *scene, const char *out, const char *cache,
+static int absolute_paths(gr_farm_plan *plan, const char *scene_name, const char *out, const char *cache,
                           const char *binary)
 {
     char name[256], buf[PATH_MAX];
-    snprintf(name, sizeof name, "farm-%s", scene->name[0] ? scene->name : "scene");
+    snprintf(name, sizeof name, "farm-%s", scene_name[0] ? scene_name : "scene");
     if (!out) out = name;
     if (make_dirs(out) != 0 || !realpath(out, buf)) {
         fprintf(stderr, "godrays farm: -o %s: cannot create: %s\n", out, strerror(errno));
@@ -197,16 +205,66 @@ static int default_tune_params(gr_farm_plan *plan)
     return 0;
 }
 
+/* A case's scene can be split into parts: no --target-error, the tiles and batch groups within
+ * its rows and batches. case_name: a suite case's (NULL: the scene). Exit 2 with the message. */
+static int check_scene(const gr_farm_plan *plan, const gr_scene *scene, const char *case_name)
+{
+    char where[96] = "";
+    if (case_name) snprintf(where, sizeof where, "case %s: ", case_name);
+    if (scene->reference.target_error > 0.0)
+        return gr_cli_usage_error("farm", "%sreference.target_error = %g: parts take the fixed passes of one round; set "
+                                  "it to 0 and raise reference.sun_samples or spp instead (docs/farm.md)",
+                                  where, scene->reference.target_error);
+    if (plan->tiles > scene->camera.height || plan->batch_parts > scene->reference.batches)
+        return gr_cli_usage_error("farm", "%s--tiles %d / --batch-parts %d: at most the %d rows / %d batches", where,
+                                  plan->tiles, plan->batch_parts, scene->camera.height, scene->reference.batches);
+    return 0;
+}
+
+/* The farm written: what is left to do, then submit.sh (unless dry). Returns the exit code. */
+static int submit(const gr_farm_plan *plan, int dry)
+{
+    int per = plan->tiles * plan->batch_parts, merged = 0, parts = 0;
+    for (int c = 0; c < plan->n_cases; c++) {
+        merged += plan->cases[c].merged;
+        parts += plan->cases[c].merged ? per : plan->cases[c].parts_done;
+    }
+    char todo[8192];
+    gr_farm_todo(plan, todo, sizeof todo);
+    printf("farm %s: %d cases x %d parts (%d tiles x %d batch groups); in the cache: %d cases merged, %d of %d parts\n",
+           plan->dir, plan->n_cases, per, plan->tiles, plan->batch_parts, merged, parts, plan->n_cases * per);
+    printf("  array tasks to run: %s\n", todo[0] ? todo : "none");
+    if (dry) {
+        printf("dry run: scripts in %s (parts.sh, merge.sh, final.sh); submit with %s/submit.sh\n", plan->dir, plan->dir);
+        return 0;
+    }
+    fflush(stdout);
+    char sub[8400];
+    snprintf(sub, sizeof sub, "%s/submit.sh", plan->dir);
+    pid_t pid = fork();
+    if (pid == 0) {
+        execl("/bin/bash", "bash", sub, (char *)NULL);
+        _exit(127);
+    }
+    int wst = 0;
+    if (pid < 0 || waitpid(pid, &wst, 0) < 0 || !WIFEXITED(wst) || WEXITSTATUS(wst) != 0) {
+        fprintf(stderr, "godrays farm: %s failed (is sbatch on PATH and the cluster up?); the scripts are in %s\n", sub,
+                plan->dir);
+        return 1;
+    }
+    printf("status: godrays farm --status %s\n", plan->dir);
+    return 0;
+}
+
 static int farm_with(gr_args *args)
 {
-    const char *cmd = "farm", *out = NULL, *v = NULL, *status_dir = NULL, *cache = NULL, *binary = NULL;
+    const char *cmd = "farm", *out = NULL, *v = NULL, *status_dir = NULL, *cache = NULL, *binary = NULL, *suite = NULL;
     gr_farm_plan plan;
     memset(&plan, 0, sizeof plan);
     plan.fps = 30.0;
     plan.tiles = 4;
     plan.batch_parts = 1;
     plan.retries = 3;
-    snprintf(plan.then, sizeof plan.then, "tune");
     int dry = 0, rc = 0;
     char extra;
     for (; args->i < args->argc && !rc; args->i++) {
@@ -230,6 +288,7 @@ static int farm_with(gr_args *args)
         else if (!strcmp(a, "-o") || !strcmp(a, "--output")) rc = gr_args_dir(args, &out);
         else if (!strcmp(a, "--cache")) rc = gr_args_dir(args, &cache);
         else if (!strcmp(a, "--binary")) rc = gr_args_value(args, &binary);
+        else if (!strcmp(a, "--suite")) rc = gr_args_value(args, &suite);
         else if (!strcmp(a, "--set")) rc = gr_args_take_set(args);
         else if (!strcmp(a, "--size")) rc = gr_args_take_size(args);
         else if (!strcmp(a, "--fps")) {
@@ -252,11 +311,20 @@ static int farm_with(gr_args *args)
         else rc = gr_args_take_scene(args);
     }
     if (rc) return rc;
-    if (status_dir) return args->scene_path ? gr_cli_usage_error(cmd, "--status DIR takes no scene") : status(status_dir);
-    if ((rc = gr_args_need_scene(args)) != 0) return rc;
+    if (status_dir)
+        return args->scene_path || suite ? gr_cli_usage_error(cmd, "--status DIR takes no scene or suite") : status(status_dir);
+    if (suite && args->scene_path) return gr_cli_usage_error(cmd, "--suite %s and the scene %s: give one of them", suite, args->scene_path);
+    if (!suite && (rc = gr_args_need_scene(args)) != 0) return rc;
+    if (!plan.then[0]) snprintf(plan.then, sizeof plan.then, "%s", suite ? "run" : "tune");
+    if (suite && !strcmp(plan.then, "tune"))
+        return gr_cli_usage_error(cmd, "--suite with --then tune: tune takes one scene; --then run (run --suite) or none");
+    if (suite && (plan.frames[0] || plan.n_views))
+        return gr_cli_usage_error(cmd, "--suite with --frames/--view: a suite's cases are its views and times");
     size_t l = (size_t)snprintf(plan.command, sizeof plan.command, "godrays");
     for (int k = 0; k < args->argc && l < sizeof plan.command; k++)
         l += (size_t)snprintf(plan.command + l, sizeof plan.command - l, " %s", args->argv[k]);
+    plan.sets = gr_args_sets(args);
+    plan.n_sets = args->n_sets;
     gr_error err = {GR_OK, ""};
     if (gr_farm_check(&plan, &err) != GR_OK) return gr_cli_report(cmd, &err); /* before any folder is made */
     if ((rc = check_outputs(args, out)) != 0) return rc;
@@ -273,72 +341,21 @@ static int farm_with(gr_args *args)
                         "that path (docs/farm.md)\n", cache);
     }
     gr_scene *scene = NULL;
-    if ((rc = gr_args_load_scene(args, &scene)) != 0) return rc;
-    if (scene->reference.target_error > 0.0) {
-        rc = gr_cli_usage_error(cmd, "reference.target_error = %g: parts take the fixed passes of one round; set it to 0 "
-                                     "and raise reference.sun_samples or spp instead (docs/farm.md)",
-                                scene->reference.target_error);
-        goto done;
+    gr_suite *s = NULL;
+    if (suite) rc = gr_args_load_suite(args, suite, &s);
+    else rc = gr_args_load_scene(args, &scene);
+    for (int c = 0; !rc && c < (s ? s->n_cases : 1); c++)
+        rc = check_scene(&plan, s ? &s->cases[c].scene : scene, s ? s->cases[c].name : NULL);
+    if (!rc) rc = absolute_paths(&plan, s ? s->name : scene->name, out, cache, binary);
+    if (!rc && suite && !realpath(suite, plan.suite)) rc = gr_cli_usage_error(cmd, "--suite %s: %s", suite, strerror(errno));
+    if (!rc) {
+        gr_status st = s ? gr_farm_plan_suite(&plan, s, &err) : gr_farm_plan_cases(&plan, scene, &err);
+        if (st == GR_OK) st = gr_farm_write(&plan, scene, s, &err);
+        if (st == GR_OK) st = gr_farm_verify_copies(&plan, &err); /* the jobs load the copies: the same keys */
+        rc = st != GR_OK ? gr_cli_report(cmd, &err) : submit(&plan, dry);
     }
-    if (plan.tiles > scene->camera.height || plan.batch_parts > scene->reference.batches) {
-        rc = gr_cli_usage_error(cmd, "--tiles %d / --batch-parts %d: at most the %d rows / %d batches", plan.tiles,
-                                plan.batch_parts, scene->camera.height, scene->reference.batches);
-        goto done;
-    }
-    if ((rc = absolute_paths(&plan, scene, out, cache, binary)) != 0) goto done;
-    gr_status st = gr_farm_plan_cases(&plan, scene, &err);
-    if (st == GR_OK) st = gr_farm_write(&plan, scene, &err);
-    if (st == GR_OK) { /* the jobs load the scene copy: it must give the same keys */
-        char sp[8400];
-        snprintf(sp, sizeof sp, "%s/scene.json", plan.dir);
-        gr_scene *copy = malloc(sizeof *copy);
-        gr_farm_plan check = plan;
-        check.cases = NULL;
-        st = copy ? gr_scene_load_file(sp, NULL, 0, copy, &err) : gr_fail(&err, GR_E_NOMEM, "farm: out of memory");
-        if (st == GR_OK) st = gr_farm_plan_cases(&check, copy, &err);
-        for (int c = 0; st == GR_OK && c < plan.n_cases; c++)
-            if (strcmp(check.cases[c].key, plan.cases[c].key) != 0)
-                st = gr_fail(&err, GR_E_RUNTIME, "%s: case %d reloads with cache key %s, not %s", sp, c, check.cases[c].key,
-                             plan.cases[c].key);
-        gr_farm_plan_free(&check);
-        free(copy);
-    }
-    if (st != GR_OK) {
-        rc = gr_cli_report(cmd, &err);
-        goto done;
-    }
-    int per = plan.tiles * plan.batch_parts, merged = 0, parts = 0;
-    for (int c = 0; c < plan.n_cases; c++) {
-        merged += plan.cases[c].merged;
-        parts += plan.cases[c].merged ? per : plan.cases[c].parts_done;
-    }
-    char todo[8192];
-    gr_farm_todo(&plan, todo, sizeof todo);
-    printf("farm %s: %d cases x %d parts (%d tiles x %d batch groups); in the cache: %d cases merged, %d of %d parts\n",
-           plan.dir, plan.n_cases, per, plan.tiles, plan.batch_parts, merged, parts, plan.n_cases * per);
-    printf("  array tasks to run: %s\n", todo[0] ? todo : "none");
-    if (dry) {
-        printf("dry run: scripts in %s (parts.sh, merge.sh, final.sh); submit with %s/submit.sh\n", plan.dir, plan.dir);
-        goto done;
-    }
-    fflush(stdout);
-    char sub[8400];
-    snprintf(sub, sizeof sub, "%s/submit.sh", plan.dir);
-    pid_t pid = fork();
-    if (pid == 0) {
-        execl("/bin/bash", "bash", sub, (char *)NULL);
-        _exit(127);
-    }
-    int wst = 0;
-    if (pid < 0 || waitpid(pid, &wst, 0) < 0 || !WIFEXITED(wst) || WEXITSTATUS(wst) != 0) {
-        fprintf(stderr, "godrays farm: %s failed (is sbatch on PATH and the cluster up?); the scripts are in %s\n", sub,
-                plan.dir);
-        rc = 1;
-    } else {
-        printf("status: godrays farm --status %s\n", plan.dir);
-    }
-done:
     gr_farm_plan_free(&plan);
+    gr_suite_destroy(s);
     free(scene);
     return rc;
 }

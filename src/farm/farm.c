@@ -70,6 +70,7 @@ gr_status gr_farm_plan_cases(gr_farm_plan *plan, const gr_scene *scene, gr_error
         fc->has_frame = nt > 0;
         fc->frame = nt ? frames[t] : 0;
         fc->view = v;
+        snprintf(fc->scene, sizeof fc->scene, "scene.json");
         /* the case as tune makes it (water.time_s + frame / fps), so the keys are tune's */
         fc->time_s = nt ? times[t] + scene->water.time_s : scene->water.time_s;
         gr_tune_view view = {0.0, 0.0};
@@ -85,6 +86,29 @@ gr_status gr_farm_plan_cases(gr_farm_plan *plan, const gr_scene *scene, gr_error
         if (st == GR_OK) st = gr_cache_key(cs, fc->key, err);
     }
     free(cs);
+    if (st == GR_OK) refresh(plan);
+    return st;
+}
+
+gr_status gr_farm_plan_suite(gr_farm_plan *plan, const gr_suite *suite, gr_error *err)
+{
+    if (plan->frames[0] || plan->n_views > 0) return gr_fail(err, GR_E_USAGE, "--suite: takes no --frames or --view");
+    if (suite->n_cases > GR_FARM_MAX_CASES)
+        return gr_fail(err, GR_E_USAGE, "%s: %d cases, at most %d", suite->path, suite->n_cases, GR_FARM_MAX_CASES);
+    plan->cases = calloc((size_t)suite->n_cases, sizeof *plan->cases);
+    if (!plan->cases) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
+    plan->n_cases = suite->n_cases;
+    gr_status st = GR_OK;
+    for (int c = 0; c < suite->n_cases && st == GR_OK; c++) {
+        const gr_suite_case *sc = &suite->cases[c];
+        gr_farm_case *fc = &plan->cases[c];
+        /* the case's scene is the one run --suite and pareto --suite ask the provider for:
+         * its key is theirs */
+        snprintf(fc->name, sizeof fc->name, "%s", sc->name);
+        snprintf(fc->scene, sizeof fc->scene, "cases/%s/scene.json", sc->name);
+        fc->time_s = sc->scene.water.time_s;
+        st = gr_cache_key(&sc->scene, fc->key, err);
+    }
     if (st == GR_OK) refresh(plan);
     return st;
 }
@@ -131,6 +155,13 @@ static void sq(FILE *f, const char *s)
         else fputc(*s, f);
     }
     fputc('\'', f);
+}
+
+/* " FLAG 'v'": an option and its value, quoted */
+static void sq_flag(FILE *f, const char *flag, const char *v)
+{
+    fprintf(f, " %s ", flag);
+    sq(f, v);
 }
 
 /* s double-quoted for a #SBATCH line, which sbatch splits into words itself (no shell): inside
@@ -190,11 +221,13 @@ gr_status gr_farm_check(const gr_farm_plan *plan, gr_error *err)
         {"-o", plan->dir},           {"--cache", plan->cache},    {"--binary", plan->binary},
         {"--partition", plan->partition}, {"--time", plan->time_limit}, {"--frames", plan->frames},
         {"--then", plan->then},      {"--then-args", plan->then_args}, {"the command line", plan->command},
+        {"--suite", plan->suite},
     };
     gr_status st = GR_OK;
     for (size_t k = 0; st == GR_OK && k < sizeof vals / sizeof vals[0]; k++) st = no_control(vals[k].what, vals[k].v, err);
     if (st == GR_OK) st = plain_word("--frames", plan->frames, err);
     for (int v = 0; st == GR_OK && v < plan->n_views; v++) st = plain_word("--view", plan->views[v], err);
+    for (int k = 0; st == GR_OK && k < plan->n_sets; k++) st = no_control("--set", plan->sets[k], err);
     return st;
 }
 
@@ -258,10 +291,15 @@ static void vars(FILE *f, const gr_farm_plan *plan)
     sq(f, plan->binary);
     fputs("\nFARM=", f);
     sq(f, plan->dir);
-    fputs("\nSCENE=\"$FARM/scene.json\"\nexport GODRAYS_CACHE=", f);
+    fputs("\nexport GODRAYS_CACHE=", f);
     sq(f, plan->cache);
     fprintf(f, "\nTILES=%d\nBATCH_PARTS=%d\n", plan->tiles, plan->batch_parts);
-    fputs("# case C: its reference arguments and its ground truth's cache key\nCASE_ARGS=(", f);
+    fputs("# case C: its scene copy (in $FARM), its reference arguments and its ground truth's cache key\nCASE_SCENES=(", f);
+    for (int c = 0; c < plan->n_cases; c++) {
+        fputs(c ? (c % 3 ? " " : "\n             ") : "", f);
+        sq(f, plan->cases[c].scene);
+    }
+    fputs(")\nCASE_ARGS=(", f);
     for (int c = 0; c < plan->n_cases; c++) {
         fputs(c ? "\n           " : "", f);
         sq(f, plan->cases[c].args);
@@ -271,27 +309,122 @@ static void vars(FILE *f, const gr_farm_plan *plan)
     fputs(")\n", f);
 }
 
-gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_error *err)
+/* The scene copy rel (relative to the farm folder, its folder made) of one case's scene. */
+static gr_status write_scene(const gr_farm_plan *plan, const char *rel, const gr_scene *scene, gr_error *err)
 {
-    gr_status cst = gr_farm_check(plan, err);
-    if (cst != GR_OK) return cst;
     char p[8400];
-    snprintf(p, sizeof p, "%s/logs", plan->dir);
-    if (mkdir(plan->dir, 0755) != 0 && errno != EEXIST)
-        return gr_fail(err, GR_E_IO, "%s: cannot create: %s", plan->dir, strerror(errno));
-    if (mkdir(p, 0755) != 0 && errno != EEXIST) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", p, strerror(errno));
-    wfile w;
-    gr_status st;
-    /* scene.json */
+    const char *slash = strrchr(rel, '/');
+    if (slash) { /* cases/NAME/: both levels */
+        for (const char *q = strchr(rel, '/'); q && q <= slash; q = strchr(q + 1, '/')) {
+            snprintf(p, sizeof p, "%s/%.*s", plan->dir, (int)(q - rel), rel);
+            if (mkdir(p, 0755) != 0 && errno != EEXIST) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", p, strerror(errno));
+        }
+    }
     char *js = gr_scene_to_json(scene);
     if (!js) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
-    st = wopen(&w, plan, "scene.json", err);
+    wfile w;
+    gr_status st = wopen(&w, plan, rel, err);
     if (st == GR_OK) {
         fputs(js, w.f);
         fputc('\n', w.f);
         st = wclose(&w, 0, err);
     }
     free(js);
+    return st;
+}
+
+/* final.sh: the job after a successful merge; its truths come from the cache. */
+static gr_status write_final(const gr_farm_plan *plan, gr_error *err)
+{
+    wfile w;
+    gr_status st = wopen(&w, plan, "final.sh", err);
+    if (st != GR_OK) return st;
+    FILE *f = w.f;
+    header(f, plan, "the final job on the merged ground truths (found in the cache)");
+    sbatch_common(f, plan, "godrays-final", "final");
+    if (plan->cpus > 0) fprintf(f, "#SBATCH --cpus-per-task=%d\n", plan->cpus);
+    fputs("set -u\nGODRAYS=", f);
+    sq(f, plan->binary);
+    fputs("\nFARM=", f);
+    sq(f, plan->dir);
+    if (!plan->suite[0]) fputs("\nSCENE=\"$FARM/scene.json\"", f);
+    fputs("\nexport GODRAYS_CACHE=", f);
+    sq(f, plan->cache);
+    fputc('\n', f);
+    if (plan->suite[0] && !strcmp(plan->then, "run")) {
+        /* the suite itself (its cases' scene files must be visible here), with the farm's
+         * overrides: the cases' keys are the parts' */
+        fputs("\"$GODRAYS\" run", f);
+        sq_flag(f, "--suite", plan->suite);
+        for (int k = 0; k < plan->n_sets; k++) sq_flag(f, "--set", plan->sets[k]);
+        fputs(" -o \"$FARM/run\"", f);
+        sq_words(f, plan->then_args);
+        fputc('\n', f);
+    } else if (!strcmp(plan->then, "tune")) {
+        fputs("\"$GODRAYS\" tune \"$SCENE\"", f);
+        if (plan->frames[0]) {
+            sq_flag(f, "--frames", plan->frames);
+            fprintf(f, " --fps %.17g", plan->fps);
+        }
+        for (int v = 0; v < plan->n_views; v++) sq_flag(f, "--view", plan->views[v]);
+        fputs(" --quiet -o \"$FARM/tune\"", f);
+        sq_words(f, plan->then_args);
+        fputc('\n', f);
+    } else if (!strcmp(plan->then, "run")) {
+        fputs("# run takes the scene's own view; each frame's water time as tune computes it\nfail=0\n", f);
+        for (int c = 0; c < plan->n_cases; c++)
+            if (plan->cases[c].view == 0) {
+                fprintf(f, "\"$GODRAYS\" run \"$SCENE\" --set water.time_s=%.17g --quiet -o \"$FARM/run/case-%d\"",
+                        plan->cases[c].time_s, c);
+                sq_words(f, plan->then_args);
+                fputs(" || fail=1\n", f);
+            }
+        fputs("exit $fail\n", f);
+    } else {
+        fputs("echo \"nothing to do (farm --then none)\"\n", f);
+    }
+    return wclose(&w, 1, err);
+}
+
+gr_status gr_farm_verify_copies(const gr_farm_plan *plan, gr_error *err)
+{
+    gr_scene *copy = malloc(sizeof *copy);
+    if (!copy) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
+    gr_farm_plan check = *plan; /* a frames farm: the cases planned again from the one copy */
+    check.cases = NULL;
+    check.n_cases = 0;
+    char p[8400], key[48];
+    gr_status st = GR_OK;
+    for (int c = 0; st == GR_OK && c < plan->n_cases; c++) {
+        const gr_farm_case *fc = &plan->cases[c];
+        snprintf(p, sizeof p, "%s/%s", plan->dir, fc->scene);
+        if (plan->suite[0] || c == 0) st = gr_scene_load_file(p, NULL, 0, copy, err);
+        if (st == GR_OK && plan->suite[0]) st = gr_cache_key(copy, key, err);
+        else if (st == GR_OK && c == 0) st = gr_farm_plan_cases(&check, copy, err);
+        if (st == GR_OK && !plan->suite[0]) snprintf(key, sizeof key, "%s", check.cases[c].key);
+        if (st == GR_OK && strcmp(key, fc->key) != 0)
+            st = gr_fail(err, GR_E_RUNTIME, "%s: case %d reloads with cache key %s, not %s", p, c, key, fc->key);
+    }
+    gr_farm_plan_free(&check);
+    free(copy);
+    return st;
+}
+
+gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, const gr_suite *suite, gr_error *err)
+{
+    gr_status cst = gr_farm_check(plan, err);
+    if (cst != GR_OK) return cst;
+    if (!scene == !suite) return gr_fail(err, GR_E_USAGE, "farm: a scene or a suite (one of them)");
+    char p[8400];
+    snprintf(p, sizeof p, "%s/logs", plan->dir);
+    if (mkdir(plan->dir, 0755) != 0 && errno != EEXIST)
+        return gr_fail(err, GR_E_IO, "%s: cannot create: %s", plan->dir, strerror(errno));
+    if (mkdir(p, 0755) != 0 && errno != EEXIST) return gr_fail(err, GR_E_IO, "%s: cannot create: %s", p, strerror(errno));
+    wfile w;
+    gr_status st = GR_OK;
+    if (scene) st = write_scene(plan, "scene.json", scene, err);
+    for (int c = 0; suite && c < plan->n_cases && st == GR_OK; c++)
+        st = write_scene(plan, plan->cases[c].scene, &suite->cases[c].scene, err);
     if (st != GR_OK) return st;
     int per = plan->tiles * plan->batch_parts;
 
@@ -320,10 +453,10 @@ gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_erro
           "mkdir -p \"$GODRAYS_CACHE/parts/$KEY\"\n"
           "attempt=1\n"
           "while :; do\n"
-          "  echo \"part $T (case $C: ${CASE_ARGS[$C]}; tile $I/$TILES; batches $J/$BATCH_PARTS): attempt $attempt on $(hostname) at $(date -u +%FT%TZ)\"\n"
+          "  echo \"part $T (case $C: ${CASE_SCENES[$C]} ${CASE_ARGS[$C]}; tile $I/$TILES; batches $J/$BATCH_PARTS): attempt $attempt on $(hostname) at $(date -u +%FT%TZ)\"\n"
           "  start=$(date +%s.%N)\n"
           "  # shellcheck disable=SC2086 (the case's arguments are words)\n"
-          "  \"$GODRAYS\" reference \"$SCENE\" ${CASE_ARGS[$C]} --tile \"$I/$TILES\" --batch-part \"$J/$BATCH_PARTS\" \\\n"
+          "  \"$GODRAYS\" reference \"$FARM/${CASE_SCENES[$C]}\" ${CASE_ARGS[$C]} --tile \"$I/$TILES\" --batch-part \"$J/$BATCH_PARTS\" \\\n"
           "      --threads \"${SLURM_CPUS_PER_TASK:-0}\" --quiet -o \"$PART\" &\n"
           "  pid=$!\n"
           "  echo $pid > \"$FARM/logs/part-$T.pid\"\n"
@@ -363,7 +496,7 @@ gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_erro
           "    T=$((C * TILES * BATCH_PARTS + I * BATCH_PARTS + J))\n"
           "    if [ -e \"$P\" ]; then parts+=(\"$P\"); continue; fi\n"
           "    missing=1\n"
-          "    echo \"case $C (${CASE_ARGS[$C]}): part $T missing (tile $I, batches $J); its log $FARM/logs/part-$T.err:\" >&2\n"
+          "    echo \"case $C (${CASE_SCENES[$C]} ${CASE_ARGS[$C]}): part $T missing (tile $I, batches $J); its log $FARM/logs/part-$T.err:\" >&2\n"
           "    tail -n 5 \"$FARM/logs/part-$T.err\" 2>/dev/null | sed 's/^/    /' >&2\n"
           "  done; done\n"
           "  if [ $missing -ne 0 ]; then fail=1; continue; fi\n"
@@ -376,47 +509,7 @@ gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_erro
           f);
     if ((st = wclose(&w, 1, err)) != GR_OK) return st;
 
-    /* final.sh */
-    if ((st = wopen(&w, plan, "final.sh", err)) != GR_OK) return st;
-    f = w.f;
-    header(f, plan, "the final job on the merged ground truths (found in the cache)");
-    sbatch_common(f, plan, "godrays-final", "final");
-    if (plan->cpus > 0) fprintf(f, "#SBATCH --cpus-per-task=%d\n", plan->cpus);
-    fputs("set -u\nGODRAYS=", f);
-    sq(f, plan->binary);
-    fputs("\nFARM=", f);
-    sq(f, plan->dir);
-    fputs("\nSCENE=\"$FARM/scene.json\"\nexport GODRAYS_CACHE=", f);
-    sq(f, plan->cache);
-    fputc('\n', f);
-    if (!strcmp(plan->then, "tune")) {
-        fputs("\"$GODRAYS\" tune \"$SCENE\"", f);
-        if (plan->frames[0]) {
-            fputs(" --frames ", f);
-            sq(f, plan->frames);
-            fprintf(f, " --fps %.17g", plan->fps);
-        }
-        for (int v = 0; v < plan->n_views; v++) {
-            fputs(" --view ", f);
-            sq(f, plan->views[v]);
-        }
-        fputs(" --quiet -o \"$FARM/tune\"", f);
-        sq_words(f, plan->then_args);
-        fputc('\n', f);
-    } else if (!strcmp(plan->then, "run")) {
-        fputs("# run takes the scene's own view; each frame's water time as tune computes it\nfail=0\n", f);
-        for (int c = 0; c < plan->n_cases; c++)
-            if (plan->cases[c].view == 0) {
-                fprintf(f, "\"$GODRAYS\" run \"$SCENE\" --set water.time_s=%.17g --quiet -o \"$FARM/run/case-%d\"",
-                        plan->cases[c].time_s, c);
-                sq_words(f, plan->then_args);
-                fputs(" || fail=1\n", f);
-            }
-        fputs("exit $fail\n", f);
-    } else {
-        fputs("echo \"nothing to do (farm --then none)\"\n", f);
-    }
-    if ((st = wclose(&w, 1, err)) != GR_OK) return st;
+    if ((st = write_final(plan, err)) != GR_OK) return st;
 
     /* submit.sh */
     char todo[8192];
@@ -469,11 +562,14 @@ gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_erro
     cJSON_AddNumberToObject(j, "tiles", plan->tiles);
     cJSON_AddNumberToObject(j, "batch_parts", plan->batch_parts);
     cJSON_AddStringToObject(j, "then", plan->then);
+    if (plan->suite[0]) cJSON_AddStringToObject(j, "suite", plan->suite);
     cJSON *arr = cJSON_AddArrayToObject(j, "cases");
     for (int c = 0; arr && c < plan->n_cases; c++) {
         cJSON *o = cJSON_CreateObject();
         if (!o) break;
         cJSON_AddStringToObject(o, "args", plan->cases[c].args);
+        cJSON_AddStringToObject(o, "scene", plan->cases[c].scene);
+        if (plan->cases[c].name[0]) cJSON_AddStringToObject(o, "name", plan->cases[c].name);
         cJSON_AddStringToObject(o, "key", plan->cases[c].key);
         cJSON_AddNumberToObject(o, "view", plan->cases[c].view);
         cJSON_AddNumberToObject(o, "time_s", plan->cases[c].time_s);
@@ -523,6 +619,8 @@ gr_status gr_farm_load(const char *dir, gr_farm_plan *plan, gr_error *err)
     }
     snprintf(plan->dir, sizeof plan->dir, "%s", dir);
     snprintf(plan->cache, sizeof plan->cache, "%s", cache->valuestring);
+    const cJSON *suite = cJSON_GetObjectItemCaseSensitive(j, "suite");
+    if (cJSON_IsString(suite)) snprintf(plan->suite, sizeof plan->suite, "%s", suite->valuestring);
     plan->tiles = tiles->valueint;
     plan->batch_parts = bp->valueint;
     int nc = cJSON_GetArraySize(cases);
@@ -535,8 +633,11 @@ gr_status gr_farm_load(const char *dir, gr_farm_plan *plan, gr_error *err)
     cJSON_ArrayForEach(o, cases)
     {
         const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, "args"), *k = cJSON_GetObjectItemCaseSensitive(o, "key");
+        const cJSON *sc = cJSON_GetObjectItemCaseSensitive(o, "scene"), *nm = cJSON_GetObjectItemCaseSensitive(o, "name");
         gr_farm_case *fc = &plan->cases[plan->n_cases++];
         snprintf(fc->args, sizeof fc->args, "%s", cJSON_IsString(a) ? a->valuestring : "");
+        snprintf(fc->scene, sizeof fc->scene, "%s", cJSON_IsString(sc) ? sc->valuestring : "scene.json");
+        snprintf(fc->name, sizeof fc->name, "%s", cJSON_IsString(nm) ? nm->valuestring : "");
         snprintf(fc->key, sizeof fc->key, "%s", cJSON_IsString(k) ? k->valuestring : "");
     }
     cJSON_Delete(j);

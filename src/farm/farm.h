@@ -4,6 +4,7 @@
  *
  * A farm folder holds everything the jobs need, readable and submittable by hand:
  *   scene.json   the scene as normalized JSON (overrides applied): what every job renders
+ *                (a suite farm: cases/NAME/scene.json, one per case of the view suite)
  *   parts.sh     the array job: task T renders one part (case, tile, batch group) into
  *                $GODRAYS_CACHE/parts/KEY/, skipping parts and cases already there, and
  *                retrying a failed attempt (a killed process, a crash) up to `retries` times
@@ -19,6 +20,7 @@
 #include <stddef.h>
 #include "common/status.h"
 #include "scene/scene.h"
+#include "suite/suite.h"
 
 #define GR_FARM_MAX_CASES 4096
 
@@ -28,6 +30,9 @@ typedef struct gr_farm_case {
     int view;               /* 0: the scene's own camera, k: extra view k - 1 */
     double time_s;          /* water.time_s of the case */
     char args[160];         /* reference arguments that select it ("--frame 10 --fps 30 --view 30,-10") */
+    char name[GR_SUITE_NAME_MAX]; /* a suite case's name ("" in a frames farm) */
+    char scene[96];         /* the scene file it renders, relative to the farm folder ("scene.json",
+                               "cases/NAME/scene.json") */
     char key[48];           /* its ground truth's cache key */
     int merged;             /* its truth is in the cache already */
     int parts_done;         /* parts already in the cache */
@@ -45,6 +50,10 @@ typedef struct gr_farm_plan {
     double fps;
     int cpus;               /* --cpus-per-task (0 = not set) */
     int tiles, batch_parts, retries, max_parallel;
+    char suite[4096];       /* a suite farm: the suite file (absolute; "" = a frames farm) */
+    const char *const *sets; /* the command's overrides (--set, --size) for the final run --suite
+                                (borrowed; n_sets of them) */
+    int n_sets;
     char then[16];          /* "tune", "run" or "none" */
     char then_args[1024];
     char command[4096];     /* the farm command line, for the scripts' header */
@@ -55,6 +64,10 @@ typedef struct gr_farm_plan {
 /* Fills plan->cases from the scene and plan's frames, fps and views: each case's key and
  * what the cache already holds (merged truth, parts). GR_E_USAGE for bad --frames/--view. */
 gr_status gr_farm_plan_cases(gr_farm_plan *plan, const gr_scene *scene, gr_error *err);
+/* Fills plan->cases with the cases of a view suite (suite/suite.h; loaded with the command's
+ * overrides), each rendering its own scene copy cases/NAME/scene.json, and what the cache holds
+ * of them. plan->frames and views must be empty. */
+gr_status gr_farm_plan_suite(gr_farm_plan *plan, const gr_suite *suite, gr_error *err);
 void gr_farm_plan_free(gr_farm_plan *plan); /* frees the cases; accepts NULL */
 
 /* Path of part (tile i, batch group j) of case c in the cache. */
@@ -72,8 +85,14 @@ void gr_farm_todo(const gr_farm_plan *plan, char *buf, size_t n);
 gr_status gr_farm_check(const gr_farm_plan *plan, gr_error *err);
 
 /* Writes the farm folder (scene.json, parts.sh, merge.sh, final.sh, submit.sh, farm.json,
- * logs/), after gr_farm_check; each file atomically (common/outfile). GR_E_IO naming the file. */
-gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, gr_error *err);
+ * logs/), after gr_farm_check; each file atomically (common/outfile). GR_E_IO naming the file.
+ * scene: a frames farm's scene (gr_farm_plan_cases); suite: a suite farm's (gr_farm_plan_suite),
+ * whose cases' scenes go to cases/NAME/scene.json. Exactly one of them is not NULL. */
+gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, const gr_suite *suite, gr_error *err);
+
+/* The jobs load the scene copies gr_farm_write wrote: each must reload to its case's cache key
+ * (GR_E_RUNTIME naming the file and both keys otherwise). */
+gr_status gr_farm_verify_copies(const gr_farm_plan *plan, gr_error *err);
 
 /* Reads farm.json of a farm folder back into plan (cases with keys and args; the cache
  * states are refreshed). GR_E_INPUT naming the file. */

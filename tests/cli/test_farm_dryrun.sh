@@ -2,7 +2,8 @@
 # godrays farm --dry-run writes a farm folder a person can read and submit (no Slurm needed):
 # parts.sh, merge.sh, final.sh, submit.sh are bash that parses (bash -n) and names the binary,
 # the scene copy and the cache; the array covers 4 frames x 4 tiles; scene.json is a scene
-# that validates; --status reads the folder back; bad options exit 2.
+# that validates; --status reads the folder back; bad options exit 2. A suite farm (--suite)
+# writes each case's scene copy with the overrides and a run --suite final job.
 set -u
 BIN=${GODRAYS_BINARY:?}
 SRC=${GODRAYS_SOURCE_DIR:?}
@@ -20,7 +21,7 @@ done
 BINABS=$(readlink -f "$BIN")
 check "parts.sh names the binary" grep -q "GODRAYS='$BINABS'" "$T/f/parts.sh"
 check "parts.sh exports the cache" grep -q "export GODRAYS_CACHE='$T/cache'" "$T/f/parts.sh"
-check "parts.sh renders the scene copy" grep -q 'SCENE="$FARM/scene.json"' "$T/f/parts.sh"
+check "parts.sh renders the scene copy" grep -q "CASE_SCENES=('scene.json' 'scene.json'" "$T/f/parts.sh"
 check "four frames" test "$(grep -c -- "--frame " "$T/f/parts.sh")" -eq 4
 check "submit.sh submits the array" grep -q 'ARRAY="0-15"' "$T/f/submit.sh"
 check "merge after the parts" grep -q "afterany" "$T/f/submit.sh"
@@ -38,6 +39,29 @@ bash "$T/g/parts.sh" 0 > "$T/g0b.txt" 2>&1
 check "task 0 again: skipped" grep -q "already in the cache" "$T/g0b.txt"
 bash "$T/g/merge.sh" > "$T/m.txt" 2>&1
 check "merge with a part missing fails, naming it" grep -q "part 1 missing" "$T/m.txt"
+# a suite farm: one scene copy per case (cases/NAME/scene.json, with the suite's and the
+# command's overrides), 2 cases x 2 batch groups, the final job is run --suite with them
+S=$SRC/data/scenes/default.json
+printf '{"name": "tiny", "size": "32x18", "cases": [{"name": "up", "split": "train", "scene": "%s"},
+ {"name": "across", "split": "test", "scene": "%s", "camera": {"yaw_deg": 120}}]}\n' "$S" "$S" > "$T/suite.json"
+GODRAYS_CACHE=$T/cache "$BIN" farm --suite "$T/suite.json" --set reference.steps=48 --tiles 1 --batch-parts 2 \
+  --dry-run -o "$T/s" > "$T/suite.txt" 2>&1
+check "suite: dry run exits 0" test $? -eq 0
+check "suite: 4 tasks (2 cases x 2 batch groups)" grep -q "array tasks to run: 0-3" "$T/suite.txt"
+check "suite: parts.sh lists the cases' copies" \
+  grep -q "CASE_SCENES=('cases/up/scene.json' 'cases/across/scene.json')" "$T/s/parts.sh"
+check "suite: the copies are 32x18 with 48 steps, across's at yaw 120" python3 -c "import json, sys
+u, a = (json.load(open(sys.argv[1] + '/cases/' + c + '/scene.json')) for c in ('up', 'across'))
+sys.exit(not all(s['camera']['width'] == 32 and s['camera']['height'] == 18 and s['reference']['steps'] == 48
+                 for s in (u, a)) or a['camera']['yaw_deg'] != 120 or u['camera']['yaw_deg'] == 120)" "$T/s"
+check "suite: final.sh is run --suite with the overrides" \
+  grep -qF "run --suite '$T/suite.json' --set 'reference.steps=48' -o" "$T/s/final.sh"
+"$BIN" farm --status "$T/s" > "$T/sst.txt" 2>&1
+check "suite: status names the cases" grep -q "case 1 across: parts 0/2" "$T/sst.txt"
+GODRAYS_CACHE=$T/cache "$BIN" farm --suite "$T/suite.json" --frames 0:10:10 --dry-run -o "$T/x" > /dev/null 2>&1
+check "--suite with --frames: exit 2" test $? -eq 2
+GODRAYS_CACHE=$T/cache "$BIN" farm --suite "$T/suite.json" --batch-parts 9 --dry-run -o "$T/x" > "$T/bp.txt" 2>&1
+check "--suite --batch-parts 9: exit 2 naming the case" grep -q "case up: --tiles" "$T/bp.txt"
 # bad options
 GODRAYS_CACHE=$T/cache "$BIN" farm "$SRC/data/scenes/default.json" --tiles 0 --dry-run -o "$T/x" > /dev/null 2>&1
 check "--tiles 0: exit 2" test $? -eq 2

@@ -11,7 +11,9 @@
 #     tune ran on them from the cache (no ground-truth rendering: "ground truth 0.0 s");
 #  3. farm --status says both cases are in the cache;
 #  4. with one frame's truth and one of its parts removed, a resubmission's array is that one
-#     part only; after it the frame is merged again, the same bytes.
+#     part only; after it the frame is merged again, the same bytes;
+#  5. farm --suite of a 2-case suite at 32x18 (2 batch groups each): each merged truth is byte
+#     for byte `godrays reference` of its case, and the final run --suite finds both in the cache.
 # Skips (exit 77) only when not root: the daemons need it. Missing packages are a failure
 # (scripts/setup.sh installs slurm-wlm and munge).
 set -u
@@ -172,6 +174,43 @@ check "resubmission: frame 10 merged again, same bytes" \
 check "resubmission: the other parts' logs are untouched (not re-run)" \
   test "$(cat "$T"/farm/logs/part-[0-57]*.out | md5sum)" = "$before"
 check "resubmission: task 6 ran again" grep -q "done in" "$T/farm/logs/part-6.out"
+
+# ---- 5. a view suite: farm --suite ----
+# 2 cases at 32x18 (one turned and at another water time), 2 batch groups each: 4 part tasks, a
+# 2-task merge array, and the final run --suite (one technique) that must find both truths in
+# the cache. Each merged truth is compared with `godrays reference` of the scene file given the
+# case's overrides by hand (not the farm's copy).
+cat > "$T/suite.json" <<EOF
+{"name": "tiny", "size": "32x18", "cases": [
+ {"name": "up", "split": "train", "scene": "$SCENE"},
+ {"name": "across", "split": "test", "scene": "$SCENE", "camera": {"yaw_deg": 120, "pitch_deg": 5}, "water": {"time_s": 0.5}}]}
+EOF
+SQ=(--set reference.surface_res=64 --set reference.steps=48)
+T1=$("$BIN" techniques | awk 'NR == 1 { print $1 }')
+t0=$(date +%s.%N)
+"$BIN" farm --suite "$T/suite.json" "${SQ[@]}" --tiles 1 --batch-parts 2 --cpus 1 --partition test -o "$T/sfarm" \
+  --then-args "--techniques $T1" > "$T/sfarm.txt" 2>&1
+check "suite: farm submitted (exit 0)" test $? -eq 0
+cat "$T/sfarm.txt"
+check "suite: 4 part tasks (2 cases x 2 batch groups)" grep -q "array tasks to run: 0-3$" "$T/sfarm.txt"
+wait_idle 300
+echo "suite farm run: $(awk "BEGIN { print $(date +%s.%N) - $t0 }") s wall for 4 parts + 2 merges + run --suite"
+grep -h "done in" "$T"/sfarm/logs/part-*.out
+cat "$T"/sfarm/logs/merge-*.out "$T"/sfarm/logs/merge-*.err 2>/dev/null
+CASE_SETS=("" "--set camera.yaw_deg=120 --set camera.pitch_deg=5 --set water.time_s=0.5")
+for c in 0 1; do
+  # shellcheck disable=SC2086 (the case's overrides are words)
+  "$BIN" reference "$SCENE" --size 32x18 "${SQ[@]}" ${CASE_SETS[$c]} --threads 2 --quiet --no-preview -o "$T/slocal$c.exr"
+  check "suite case $c: merged truth = reference of the case (idiff, zero tolerance)" \
+    idiff -q -fail 0 -warn 0 "$T/slocal$c.exr" "$T/sfarm/truth/case-$c.exr"
+  key=$(grep -o '[0-9a-f]\{16\}-[0-9a-f]\{16\}' <<< "$(sed -n "/CASE_KEYS/,/)/p" "$T/sfarm/parts.sh")" | sed -n "$((c + 1))p")
+  check "suite case $c: cached truth = reference of the case" \
+    idiff -q -fail 0 -warn 0 "$T/slocal$c.exr" "$T/cache/reference-$key.exr"
+done
+tail -n 4 "$T/sfarm/logs/final.out" "$T/sfarm/logs/final.err" 2>/dev/null
+check "suite: the final run --suite found both truths in the cache" \
+  test "$(grep -c "ground truth from the cache" "$T/sfarm/logs/final.err")" -eq 2
+check "suite: run --suite wrote its leaderboard" test -s "$T/sfarm/run/metrics.json"
 
 [ $fail -eq 0 ] && echo "all checks passed"
 exit $fail

@@ -167,6 +167,18 @@ int main(void)
         gr_ref_result_free(&res);
     }
 
+    /* beam_refine_radius_m -1: a render whose camera sees no refinement cone (a horizontal
+     * view, reference/beams.h) writes it; such parts merge (the farm refused them once) */
+    s = make_sums(0);
+    write_part(p, s, 0, 2);
+    gr_ref_sums_destroy(s);
+    edit_header(p, "beam_refine_radius_m", -1.0);
+    st = gr_parts_merge(&pp, 1, &scene, &res, key, sizeof key, &err);
+    CHECK_OK(st, err);
+    if (st == GR_OK) gr_ref_result_free(&res);
+    edit_header(p, "beam_refine_radius_m", -2.0);
+    expect_refused("refine radius -2", &pp, 1, "header field beam_refine_radius_m is -2", 0);
+
     /* forged sums, counts and passes with a valid checksum (they merged with exit 0) */
     forged_sum(p, "NaN sum", NAN, 3, 2, "not a finite radiance sum");
     forged_sum(p, "1e308 sum", 1e308, 3, 2, "not a finite radiance sum");
