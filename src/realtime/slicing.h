@@ -15,6 +15,7 @@ typedef struct gr_slicing_settings {
     int slices;             /* planes (32) */
     int distribution;       /* gr_vol_distribution */
     double near_m;          /* exponential: first slab boundary (m of view depth) */
+    double target_scale;    /* slices' target size / frame size per axis (1; < 1: upsampled) */
     gr_vol_settings vol;    /* caustic stack, extinction, g, sun disc, intensity, shadow map */
 } gr_slicing_settings;
 

@@ -2,7 +2,7 @@
  * closed forms on small synthetic cases: the radial blur's taps = pixels x (samples + 1), its
  * queried fragments = pixels; the shafts' final pass = 4 taps a pixel, their pass's vertices =
  * 36 (N - 1)^2; the slices' queried primitives = the slice count (one instanced triangle
- * each); the froxel dispatches' invocations = the grid rounded up to 8 x 8 groups; the caustic
+ * each; at target_scale 0.5 a quarter of the pixels, + an upsample of W x H); the froxel dispatches' invocations = the grid rounded up to 8 x 8 groups; the caustic
  * stack's indices = 6 grid^2 depths; light rays' points = rays^2; the sums and the EXR
  * metadata. Counters read from GL queries are checked against the analytic expectation, so a
  * broken query fails too. */
@@ -106,6 +106,17 @@ static void check_volumes(gr_gl *gl)
     CHECK(cost(&st, "slices", GR_COST_PRIMITIVES) == 4); /* queried: one triangle an instance */
     CHECK(cost(&st, "caustics", GR_COST_VERTICES) == 6LL * 8 * 8 * 2);
     CHECK(cost(&st, "caustics", GR_COST_FRAGMENTS) > 0);
+    CHECK(cost(&st, "upsample", GR_COST_FRAGMENTS) == -2); /* no upsample at target_scale 1 */
+    /* at target_scale 0.5 the slices cover (W / 2) x (H / 2), the upsample one pass of W x H */
+    const char *slh[] = {"slicing.slices=4", "slicing.texture_size=16", "slicing.grid=8", "slicing.caustic_depths=2",
+                         "slicing.target_scale=0.5"};
+    render(gl, "slicing", slh, 5, &st, NULL);
+    CHECK(cost(&st, "slices", GR_COST_FRAGMENTS) == 4LL * (W / 2) * (H / 2));
+    CHECK(cost(&st, "slices", GR_COST_BYTES) == (W / 2) * (H / 2) * 16LL + st.fragments * 16);
+    CHECK(st.fragments > 0 && st.fragments <= 4LL * (W / 2) * (H / 2)); /* queried: the slices' only */
+    CHECK(cost(&st, "upsample", GR_COST_FRAGMENTS) == (long long)W * H);
+    CHECK(cost(&st, "upsample", GR_COST_TAPS) == (long long)W * H);
+    CHECK(cost(&st, "upsample", GR_COST_PRIMITIVES) == 1); /* queried */
     const char *fx[] = {"froxel.grid_x=10", "froxel.grid_y=6", "froxel.grid_z=4", "froxel.texture_size=16",
                         "froxel.grid=8", "froxel.caustic_depths=2"};
     render(gl, "froxel", fx, 6, &st, NULL);
