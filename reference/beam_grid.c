@@ -252,6 +252,11 @@ wedges:
 
 float gr_beam_atan2_fast(float y, float x) { return atan2_fast(y, x); }
 
+/* min and max of non-NaN floats without the libm calls that fminf/fmaxf are here (no
+ * -ffinite-math-only): a NaN b gives a, as fminf/fmaxf do, so the boxes keep their bytes */
+static inline float min_f(float a, float b) { return b < a ? b : a; }
+static inline float max_f(float a, float b) { return b > a ? b : a; }
+
 /* The box of primitive `prim` (a triangle's beam over one slab) in sheared coordinates:
  * lo/hi = {u, y, w}. */
 static void prim_box(const gr_beams *b, uint32_t prim, float lo3[3], float hi3[3])
@@ -269,8 +274,8 @@ static void prim_box(const gr_beams *b, uint32_t prim, float lo3[3], float hi3[3
         for (int e = 0; e < 2; e++) {
             float y = e ? yhi : ylo;
             float u = v->pu + v->au * (y - v->py), w = v->pw + v->aw * (y - v->py);
-            u0 = fminf(u0, u); u1 = fmaxf(u1, u);
-            w0 = fminf(w0, w); w1 = fmaxf(w1, w);
+            u0 = min_f(u0, u); u1 = max_f(u1, u);
+            w0 = min_f(w0, w); w1 = max_f(w1, w);
         }
     }
     if (b->disc) {
@@ -285,8 +290,8 @@ static void prim_box(const gr_beams *b, uint32_t prim, float lo3[3], float hi3[3
         }
     }
     /* widen by a few ulps of the coordinates so float rounding in the test cannot fall outside */
-    float eu = 1e-5f * (1.0f + fmaxf(fabsf(u0), fabsf(u1))), ew = 1e-5f * (1.0f + fmaxf(fabsf(w0), fabsf(w1)));
-    float ey = 1e-5f * (1.0f + fmaxf(fabsf(ylo), fabsf(yhi)));
+    float eu = 1e-5f * (1.0f + max_f(fabsf(u0), fabsf(u1))), ew = 1e-5f * (1.0f + max_f(fabsf(w0), fabsf(w1)));
+    float ey = 1e-5f * (1.0f + max_f(fabsf(ylo), fabsf(yhi)));
     lo3[0] = u0 - eu; hi3[0] = u1 + eu;
     lo3[1] = ylo - ey; hi3[1] = yhi + ey;
     lo3[2] = w0 - ew; hi3[2] = w1 + ew;
@@ -555,8 +560,44 @@ double gr_beams_run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n)
     return gr_ref_overlap_s(a, b, n);
 }
 
+/* The primitives' cell ranges (grid_range of their boxes: lower u, y, w then upper), computed
+ * once per grid by ranges of primitives and then read by the count and the fill, which no
+ * longer recompute them in every worker (each scans every primitive); with each range's
+ * entries, summed exactly (integers: the same total for any thread count), and a coarse
+ * histogram of the entries over the w-layers that balances the workers' layers. */
+enum { RANGE_BINS = 1024 };
+typedef struct range_job {
+    gr_beams *b;
+    int32_t *rng;                 /* 6 per primitive */
+    uint32_t k0, k1;
+    int nbins;                    /* histogram bins over the w-layers */
+    uint64_t total;               /* entries of the job's primitives */
+    uint64_t hist[RANGE_BINS];    /* entries per bin (each primitive's in the bin of its middle layer) */
+} range_job;
+
+static void *range_work(void *arg)
+{
+    range_job *j = arg;
+    const gr_beams *b = j->b;
+    const int gw = b->gn[2];
+    uint64_t total = 0;
+    memset(j->hist, 0, sizeof j->hist);
+    for (uint32_t k = j->k0; k < j->k1; k++) {
+        int l[3], h[3];
+        grid_range(b, b->box + 6 * (size_t)k, l, h);
+        int32_t *r = j->rng + 6 * (size_t)k;
+        for (int a = 0; a < 3; a++) { r[a] = l[a]; r[3 + a] = h[a]; }
+        uint64_t n = (uint64_t)(h[0] - l[0] + 1) * (uint64_t)(h[1] - l[1] + 1) * (uint64_t)(h[2] - l[2] + 1);
+        total += n;
+        j->hist[(int)((int64_t)((l[2] + h[2]) / 2) * j->nbins / gw)] += n;
+    }
+    j->total = total;
+    return NULL;
+}
+
 typedef struct grid_job {
     gr_beams *b;
+    const int32_t *rng;
     uint32_t np;
     int w0, w1;   /* the w-layers of cells this worker owns */
     int fill;     /* 0: count the entries per cell; 1: fill them */
@@ -565,19 +606,21 @@ typedef struct grid_job {
 static void *grid_work(void *arg)
 {
     grid_job *j = arg;
-    gr_beams *b = j->b;
-    const int nu = b->gn[0], ny = b->gn[1];
+    const size_t nu = (size_t)j->b->gn[0], ny = (size_t)j->b->gn[1];
+    uint32_t *cf = j->b->cell_first, *cp = j->b->cell_prim; /* locals: the stores cannot alias them */
+    const int32_t *rng = j->rng;
+    const int fw0 = j->w0, fw1 = j->w1 - 1;
     for (uint32_t k = 0; k < j->np; k++) {
-        int l[3], h[3];
-        grid_range(b, b->box + 6 * (size_t)k, l, h);
-        int w0 = l[2] > j->w0 ? l[2] : j->w0, w1 = h[2] < j->w1 - 1 ? h[2] : j->w1 - 1;
+        const int32_t *r = rng + 6 * (size_t)k;
+        int w0 = r[2] > fw0 ? r[2] : fw0, w1 = r[5] < fw1 ? r[5] : fw1;
         for (int iw = w0; iw <= w1; iw++)
-            for (int iy = l[1]; iy <= h[1]; iy++)
-                for (int iu = l[0]; iu <= h[0]; iu++) {
-                    size_t c = ((size_t)iw * ny + iy) * nu + iu;
-                    if (j->fill) b->cell_prim[b->cell_first[c]++] = k;
-                    else b->cell_first[c + 1]++;
-                }
+            for (int iy = r[1]; iy <= r[4]; iy++) {
+                size_t c0 = ((size_t)iw * ny + (size_t)iy) * nu;
+                if (j->fill)
+                    for (int iu = r[0]; iu <= r[3]; iu++) cp[cf[c0 + (size_t)iu]++] = k;
+                else
+                    for (int iu = r[0]; iu <= r[3]; iu++) cf[c0 + (size_t)iu + 1]++;
+            }
     }
     return NULL;
 }
@@ -679,13 +722,40 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         cell[a] = GRID_CELL_BOX * ext[a] / np;
         if (!(cell[a] > span * 1e-6)) cell[a] = span > 0.0 ? span * 1e-6 : 1.0;
     }
-    /* count the entries per cell (each worker owns a range of w-layers of cells and scans
-     * every box), then prefix-sum them; over the budget, coarser cells and count again */
-    grid_job jobs[GRID_MAX_THREADS];
-    int nt = 1;
-    size_t ncells = 0, entries = SIZE_MAX;
+    /* the 16-bit boxes first (they need only the bounds); the float boxes then become cell ranges */
+    b->qbox = malloc((size_t)np * sizeof *b->qbox);
+    if (!b->qbox) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %u beam boxes", np);
+    double qunit[3];
+    for (int a = 0; a < 3; a++) {
+        double span = hi[a] - lo[a];
+        qunit[a] = span > 0.0 ? span / 65535.0 : 1.0;
+        b->q0[a] = (float)lo[a];
+        b->qinv[a] = (float)(1.0 / qunit[a]);
+    }
+    int nt = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+    {
+        quant_job qj[GRID_MAX_THREADS];
+        for (int i = 0; i < nt; i++) {
+            qj[i].b = b;
+            qj[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nt);
+            qj[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nt);
+            for (int a = 0; a < 3; a++) qj[i].qunit[a] = qunit[a];
+        }
+        b->stats.par_s += gr_beams_run_jobs(quant_work, qj, sizeof qj[0], nt);
+    }
+    free(b->prim_tri); /* each primitive's triangle now travels with its box */
+    b->prim_tri = NULL;
+    /* the cells' ranges and the entries they make; over the budget, coarser cells and again */
+    int32_t *rng = malloc((size_t)np * 6 * sizeof *rng);
+    range_job *rj = malloc((size_t)nt * sizeof *rj);
+    if (!rng || !rj) {
+        free(rng);
+        free(rj);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid");
+    }
+    uint64_t entries = UINT64_MAX;
     const double budget = GRID_ENTRIES_PER_PRIM * np + 1024.0;
-    for (int attempt = 0; attempt < 64 && entries == SIZE_MAX; attempt++) {
+    for (int attempt = 0; attempt < 64 && entries == UINT64_MAX; attempt++) {
         if (attempt > 0)
             for (int a = 0; a < 3; a++) cell[a] *= 1.25;
         double nc = 1.0;
@@ -698,65 +768,70 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
             nc *= n;
         }
         if (nc > budget) continue; /* more cells than entries allowed: coarser */
-        ncells = (size_t)b->gn[0] * (size_t)b->gn[1] * (size_t)b->gn[2];
-        free(b->cell_first);
-        b->cell_first = calloc(ncells + 1, sizeof *b->cell_first);
-        if (!b->cell_first)
-            return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu cells)", ncells);
-        nt = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
-        if (nt > b->gn[2]) nt = b->gn[2];
+        uint64_t total = 0;
         for (int i = 0; i < nt; i++) {
-            jobs[i].b = b;
-            jobs[i].np = np;
-            jobs[i].w0 = (int)((long)b->gn[2] * i / nt);
-            jobs[i].w1 = (int)((long)b->gn[2] * (i + 1) / nt);
-            jobs[i].fill = 0;
+            rj[i].b = b;
+            rj[i].rng = rng;
+            rj[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nt);
+            rj[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nt);
+            rj[i].nbins = b->gn[2] < RANGE_BINS ? b->gn[2] : RANGE_BINS;
         }
-        b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
-        size_t total = 0; /* in size_t: an attempt far over the budget must not wrap the lists' uint32 */
-        for (size_t c = 0; c < ncells && (double)total <= budget; c++) {
-            total += b->cell_first[c + 1];
-            b->cell_first[c + 1] = (uint32_t)total;
-        }
+        b->stats.par_s += gr_beams_run_jobs(range_work, rj, sizeof rj[0], nt);
+        for (int i = 0; i < nt; i++) total += rj[i].total;
         if ((double)total <= budget) entries = total;
     }
-    if (entries == SIZE_MAX || entries >= UINT32_MAX || ncells >= UINT32_MAX)
+    free(b->box); /* the ranges replace the float boxes */
+    b->box = NULL;
+    if (entries == UINT64_MAX || entries >= UINT32_MAX ||
+        (size_t)b->gn[0] * (size_t)b->gn[1] * (size_t)b->gn[2] >= UINT32_MAX) {
+        free(rng);
+        free(rj);
         return gr_fail(err, GR_E_NOMEM, "reference: the beam lookup grid needs more than %.0f entries, too many", budget);
+    }
+    /* the workers' w-layers, balanced by the histogram (each cell is counted and filled by
+     * one worker in primitive order, so the lists do not depend on the split) */
+    size_t ncells = (size_t)b->gn[0] * (size_t)b->gn[1] * (size_t)b->gn[2];
+    grid_job jobs[GRID_MAX_THREADS];
+    {
+        const int nbins = rj[0].nbins;
+        uint64_t hist[RANGE_BINS] = {0}, cum = 0;
+        for (int i = 0; i < nt; i++)
+            for (int k = 0; k < nbins; k++) hist[k] += rj[i].hist[k];
+        int bin = 0;
+        for (int i = 0; i < nt; i++) {
+            jobs[i].b = b;
+            jobs[i].rng = rng;
+            jobs[i].np = np;
+            jobs[i].fill = 0;
+            jobs[i].w0 = i ? jobs[i - 1].w1 : 0;
+            /* this worker's bins: up to the (i + 1)-th share of the entries; its layers end at
+             * the first layer of the next bin (layer l is in bin l nbins / gn[2], rounded down) */
+            while (bin < nbins && (cum + hist[bin]) * (uint64_t)nt <= entries * (uint64_t)(i + 1)) cum += hist[bin++];
+            jobs[i].w1 = i + 1 == nt ? b->gn[2] : (int)(((int64_t)bin * b->gn[2] + nbins - 1) / nbins);
+            if (jobs[i].w1 < jobs[i].w0) jobs[i].w1 = jobs[i].w0;
+        }
+    }
+    free(rj);
+    free(b->cell_first);
+    b->cell_first = calloc(ncells + 1, sizeof *b->cell_first);
     b->cell_prim = malloc((entries ? entries : 1) * sizeof *b->cell_prim);
-    if (!b->cell_prim)
-        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu entries)", entries);
-    /* fill, each cell by one worker in primitive order (deterministic): cell_first[c] runs
-     * ahead as the cursor while filling, restored below */
+    if (!b->cell_first || !b->cell_prim) {
+        free(rng);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu cells, %llu entries)", ncells,
+                       (unsigned long long)entries);
+    }
+    b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
+    for (size_t c = 0, total = 0; c < ncells; c++) {
+        total += b->cell_first[c + 1];
+        b->cell_first[c + 1] = (uint32_t)total;
+    }
+    /* fill: cell_first[c] runs ahead as the cursor while filling, restored below */
     for (int i = 0; i < nt; i++) jobs[i].fill = 1;
     b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
-    for (size_t c = ncells; c > 0; c--) b->cell_first[c] = b->cell_first[c - 1];
+    free(rng);
+    memmove(b->cell_first + 1, b->cell_first, ncells * sizeof *b->cell_first);
     b->cell_first[0] = 0;
-    /* the 16-bit boxes; the float ones are no longer needed */
-    b->qbox = malloc((size_t)np * sizeof *b->qbox);
-    if (!b->qbox) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %u beam boxes", np);
-    double qunit[3];
-    for (int a = 0; a < 3; a++) {
-        double span = hi[a] - lo[a];
-        qunit[a] = span > 0.0 ? span / 65535.0 : 1.0;
-        b->q0[a] = (float)lo[a];
-        b->qinv[a] = (float)(1.0 / qunit[a]);
-    }
-    {
-        quant_job qj[GRID_MAX_THREADS];
-        int nq = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
-        for (int i = 0; i < nq; i++) {
-            qj[i].b = b;
-            qj[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nq);
-            qj[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nq);
-            for (int a = 0; a < 3; a++) qj[i].qunit[a] = qunit[a];
-        }
-        b->stats.par_s += gr_beams_run_jobs(quant_work, qj, sizeof qj[0], nq);
-    }
-    free(b->box);
-    b->box = NULL;
-    free(b->prim_tri); /* each primitive's triangle now travels with its box */
-    b->prim_tri = NULL;
-    b->stats.grid_entries = entries;
+    b->stats.grid_entries = (size_t)entries;
     b->stats.grid_cells = ncells;
     return GR_OK;
 }
