@@ -204,9 +204,8 @@ static void log_line(const watch_ctx *c, const outcome *out, const char *changed
     if (!c->o->log) return;
     char line[GR_ERROR_MSG_MAX + 128];
     if (out->stage) {
-        const char *nl = strchr(out->terr.msg, '\n');
-        snprintf(line, sizeof line, "render %d (%s): %s error: %.*s", c->id, changed, out->stage,
-                 nl ? (int)(nl - out->terr.msg) : (int)strlen(out->terr.msg), out->terr.msg);
+        /* the whole message: a compiler's log is one diagnostic per line */
+        snprintf(line, sizeof line, "render %d (%s): %s error: %s", c->id, changed, out->stage, out->terr.msg);
     } else {
         const gr_metrics_set *s = out->m.have_fit ? &out->m.fit : &out->m.raw;
         snprintf(line, sizeof line, "render %d (%s): %s verdict %.4g (scale %.4g), %.1f ms%s%s", c->id, changed,

@@ -32,8 +32,9 @@ typedef struct gr_watch_options {
     gr_gl_platform platform;
     double debounce_ms;              /* 0: 100 */
     volatile sig_atomic_t *stop;     /* nonzero ends the loop (common/signals' flag) */
-    /* After each render (may be NULL): one line, without a newline: "render 3 (pass.frag):
-     * verdict 0.1234, ..." or "render 4 (pass.frag): compile error: FIRST LINE". */
+    /* After each render (may be NULL): its line, without a final newline: "render 3 (pass.frag):
+     * NAME verdict 0.1234 ..." or "render 4 (pass.frag): compile error: MESSAGE" (a compiler's
+     * log follows on more lines, one diagnostic each). */
     void (*log)(void *user, const char *line);
     void *user;
 } gr_watch_options;
