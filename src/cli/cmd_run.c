@@ -456,10 +456,29 @@ static gr_status render_one(const run_opts *o, run_state *rs, gr_gl *gl, int k, 
 /* The real-time side: it takes seconds, and a GL failure should not cost the user a
  * two-minute ground truth first. One context, one instance per technique; a technique that
  * fails is a failed row (technique_failed). */
+/* A line while a technique's render is long (realtime/technique.h's wait report): every 10 s,
+ * or $GODRAYS_PROGRESS_SECONDS (tests: shorter). */
+static void say_waiting(void *user, const char *technique, const char *what, double elapsed_s, double limit_s)
+{
+    (void)user;
+    fprintf(stderr, "godrays run: %s: still rendering (%s), elapsed %.0f s of its time limit of %g s\n", technique,
+            what, elapsed_s, limit_s);
+    fflush(stderr);
+}
+
+static double progress_seconds(void)
+{
+    const char *env = getenv("GODRAYS_PROGRESS_SECONDS");
+    char *end = NULL;
+    double v = env && env[0] ? strtod(env, &end) : 0.0;
+    return v > 0 && end && !*end ? v : 10.0;
+}
+
 static gr_status render_techniques(const run_opts *o, run_state *rs, gr_error *err)
 {
     gr_gl *gl = NULL;
     gr_status st = gr_gl_create(NULL, &gl, err);
+    if (!o->quiet) gr_technique_set_wait_report(say_waiting, NULL, progress_seconds());
     const double t0 = now_s();
     for (int k = 0; k < o->nt && st == GR_OK; k++) {
         const gr_technique_class *cls = o->cls[k];
@@ -491,6 +510,7 @@ static gr_status render_techniques(const run_opts *o, run_state *rs, gr_error *e
         snprintf(rs->exr_names[k], sizeof rs->exr_names[k], "%s.exr", cls->name);
         ts->exr = rs->exr_names[k];
     }
+    gr_technique_set_wait_report(NULL, NULL, 0);
     gr_gl_destroy(gl);
     return st;
 }
