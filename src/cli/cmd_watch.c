@@ -35,6 +35,8 @@ static void usage(FILE *f)
             "  --size WxH           image size (same as --set camera.width=W --set camera.height=H)\n"
             "  --time-limit S       give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --max-memory SIZE    memory limit of the ground truth's render\n"
+            "  --technique-dir DIR  also register the user technique in DIR (repeatable)\n"
+            "  --preset FILE        apply a preset (docs/tuning.md \"Presets\")\n"
             "  --gl-platform P      auto, surfaceless or device (default auto)\n"
             "  -q, --quiet          no ground-truth progress and no line per render (the URL is printed)\n"
             "  -h, --help           this help\n"
@@ -52,25 +54,19 @@ typedef struct watch_opts {
 
 static int parse_args(gr_args *args, watch_opts *o)
 {
-    int rc = 0;
+    int rc = 0, taken = 0;
+    const char *outdir = NULL;
     for (; args->i < args->argc && !rc; args->i++) {
         const char *a = args->argv[args->i], *v = NULL;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+        if ((rc = gr_args_take_common(args, &outdir, &o->platform, &taken)) != 0 || taken) {
+            if (outdir) return gr_cli_usage_error("watch", "%s: watch writes no files (its page is served)", a);
+            continue; /* --set, --size, --time-limit, --max-memory, --gl-platform, ... */
+        } else if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             usage(stdout);
             o->help = 1;
             return 0;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             o->quiet = 1;
-        } else if (!strcmp(a, "--set")) {
-            rc = gr_args_take_set(args);
-        } else if (!strcmp(a, "--size")) {
-            rc = gr_args_take_size(args);
-        } else if (!strcmp(a, "--time-limit")) {
-            rc = gr_args_take_time_limit(args);
-        } else if (!strcmp(a, "--max-memory")) {
-            rc = gr_args_take_max_memory(args);
-        } else if (!strcmp(a, "--gl-platform")) {
-            rc = gr_args_take_gl_platform(args, &o->platform);
         } else if (!strcmp(a, "--port")) {
             char *end = NULL;
             if ((rc = gr_args_value(args, &v)) != 0) break;
