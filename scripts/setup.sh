@@ -17,6 +17,8 @@ GODRAYS_PACKAGES=(
   libembree-dev libopenexr-dev libopenimageio-dev openimageio-tools libcjson-dev
   # headless OpenGL through EGL (GLVND) with Mesa's software rasterizer
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
+  # the local HTTP server of `godrays watch`
+  libmicrohttpd-dev
   # plots (PNG: PLplot; the interactive charts of the pareto pages: Chart.js, inlined)
   libplplot-dev plplot-driver-qt libjs-chart.js
   # headless browser for the report's test (tests/cli/test_report_browser.sh)

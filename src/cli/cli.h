@@ -25,6 +25,7 @@ int cmd_export(int argc, char **argv);
 int cmd_merge(int argc, char **argv);
 int cmd_farm(int argc, char **argv);
 int cmd_suite(int argc, char **argv);
+int cmd_watch(int argc, char **argv);
 
 /* Prints "godrays NAME: message" on one line to stderr and returns the exit code. */
 int gr_cli_report(const char *cmd, const gr_error *err);

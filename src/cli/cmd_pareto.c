@@ -20,6 +20,7 @@
 #include "report/report.h"
 #include "tune/page.h"
 #include "tune/budget.h"
+#include "reference/progress.h"
 #include "reference/truth.h"
 #include "tune/pareto.h"
 #include "tune/suitetune.h"
@@ -348,6 +349,18 @@ static gr_status ladder_point(pareto_opts *o, const gr_technique_class *cls, gr_
     return GR_OK;
 }
 
+/* The ladder points technique_points renders (--quick: the quick levels). */
+static int count_points(const pareto_opts *o)
+{
+    int total = 0;
+    for (int k = 0; k < o->n_techs; k++) {
+        const gr_technique_class *cls = o->techs[k];
+        for (int l = 0; l < (cls->n_ladder > 0 ? cls->n_ladder : 1); l++)
+            total += !(o->quick && cls->n_ladder > 0 && !cls->ladder[l].quick);
+    }
+    return total;
+}
+
 /* Each technique over the settings of its ladder, which trade speed for quality; points
  * appended to pts[*n]; *gpu_any = 1 when some GL pass timer worked. */
 static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *gl, const gr_image *truth,
@@ -361,6 +374,10 @@ static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *
     gr_tune_budget_plan_line(&o->budget, line, sizeof line);
     if (!o->quiet) fprintf(stderr, "%s\n", line);
     gr_tune_budget_start(&o->budget);
+    /* a line per 10 % or 10 s with elapsed and remaining time when stderr is no terminal */
+    gr_progress *bar = gr_progress_create("godrays pareto", !o->quiet);
+    const int total = count_points(o);
+    int done = 0;
     for (int k = 0; k < o->n_techs && st == GR_OK; k++) {
         const gr_technique_class *cls = o->techs[k];
         gr_technique_destroy(r);
@@ -379,9 +396,13 @@ static gr_status technique_points(pareto_opts *o, const gr_scene *scene, gr_gl *
             (*n)++;
             p->family = 1 + k;
             if (p->gpu_s >= 0) *gpu_any = 1;
+            gr_progress_finish(bar);
             if (!o->quiet) fprintf(stderr, "godrays pareto: %s: %.2f ms, error %.4g\n", p->label, 1e3 * p->time_s, p->error);
+            snprintf(line, sizeof line, "%d of %d ladder points", ++done, total);
+            gr_progress_update(bar, total ? (double)done / total : 1.0, line);
         }
     }
+    gr_progress_destroy(bar);
     gr_technique_destroy(r);
     gr_image_destroy(img);
     return st;

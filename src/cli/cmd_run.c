@@ -82,6 +82,8 @@ static void usage(FILE *f)
             "  --fit MODE           the fit before the errors after the fit: scale (default: one\n"
             "                       least-squares factor), rgb (one per channel: a tint is fitted too)\n"
             "                       or none (docs/metrics.md, \"Scale fits\")\n"
+            "  --save-targets       the report shows each technique's intermediate render targets as a\n"
+            "                       strip (those that have them; off by default: pages stay small)\n"
             "  --no-cache           render the ground truth even if a cached one exists, and do not\n"
             "                       store it\n"
             "  --max-memory SIZE    refuse (exit 2) a ground truth estimated to need more (e.g. 8G;\n"
@@ -117,7 +119,7 @@ static void command_line(int argc, char **argv, gr_strbuf *b)
 /* Technique cls in context gl, as `godrays render --repeat` does: with repeat > 1 a warm-up
  * render, then the median of repeat renders (realtime/timing.h), its spread in the metadata. */
 static gr_status render_technique(const gr_technique_class *cls, gr_gl *gl, const gr_scene *scene, int repeat,
-                                  gr_image **img, gr_metadata *meta, gr_error *err)
+                                  gr_image **img, gr_image **targets, gr_metadata *meta, gr_error *err)
 {
     gr_technique *r = NULL;
     gr_status st = gr_technique_create(cls, gl, NULL, &r, err);
@@ -130,6 +132,8 @@ static gr_status render_technique(const gr_technique_class *cls, gr_gl *gl, cons
     gr_timing tm;
     st = gr_timing_measure(r, scene, NULL, *img, repeat > 1, repeat, &tm, err);
     if (st == GR_OK) st = gr_technique_metadata(r, scene, NULL, &tm.median, meta, err);
+    /* --save-targets: every intermediate target side by side, for the report's strip */
+    if (st == GR_OK && targets && cls->read_target) st = gr_technique_read_target(r, targets, err);
     if (st == GR_OK && repeat > 1 &&
         (gr_meta_set_int(meta, "godrays:timing_repeats", repeat) != GR_OK ||
          gr_meta_set_double(meta, "godrays:wall_min_ms", tm.wall_min_ms) != GR_OK ||
@@ -283,6 +287,7 @@ typedef struct run_opts {
     const char *suite;              /* --suite SUITE: every case of a view suite (run_suite) */
     int quiet, use_cache, help;
     int repeat;                     /* --repeat: renders timed per technique (median; 1: one render) */
+    int save_targets;               /* --save-targets: each technique's targets strip in the report */
     gr_fit_mode fit;                /* --fit: the leaderboard's scaling (default: one scale) */
     const gr_technique_class *cls[GR_REPORT_MAX_TECHNIQUES];
     int nt;                         /* techniques */
@@ -298,6 +303,7 @@ typedef struct run_state {
     gr_scene *cases;                /* a sequence: one scene per frame (NULL otherwise) */
     const gr_scene *scene0;         /* the frame index.html compares */
     gr_image *test[GR_REPORT_MAX_TECHNIQUES];
+    gr_image *targets[GR_REPORT_MAX_TECHNIQUES]; /* --save-targets (NULL: none, or no target) */
     gr_metadata smeta[GR_REPORT_MAX_TECHNIQUES];
     gr_image **seq_test;            /* seq_test[k * nf + i], i >= 1 (frame 0: test[k]) */
     ref_out ro;                     /* frame 0's ground truth */
@@ -335,6 +341,8 @@ static int parse_args(gr_args *args, run_opts *o)
             o->quiet = 1;
         } else if (!strcmp(a, "--no-cache")) {
             o->use_cache = 0;
+        } else if (!strcmp(a, "--save-targets")) {
+            o->save_targets = 1;
         } else if (!strcmp(a, "--techniques")) {
             rc = gr_args_value(args, &o->tech_list);
         } else if (!strcmp(a, "--frames")) {
@@ -439,13 +447,14 @@ static gr_status render_one(const run_opts *o, run_state *rs, gr_gl *gl, int k, 
 {
     const gr_technique_class *cls = o->cls[k];
     const int nf = o->nf;
-    gr_status st = render_technique(cls, gl, rs->scene0, o->repeat, &rs->test[k], &rs->smeta[k], err);
+    gr_status st = render_technique(cls, gl, rs->scene0, o->repeat, &rs->test[k], o->save_targets ? &rs->targets[k] : NULL,
+                                    &rs->smeta[k], err);
     if (st == GR_OK) st = check_not_black(rs->test[k], err);
     if (st != GR_OK) return st; /* its row names it */
     for (int i = 1; i < nf && st == GR_OK; i++) {
         gr_metadata scratch;
         gr_meta_init(&scratch);
-        st = render_technique(cls, gl, &rs->cases[i], 1, &rs->seq_test[k * nf + i], &scratch, err);
+        st = render_technique(cls, gl, &rs->cases[i], 1, &rs->seq_test[k * nf + i], NULL, &scratch, err);
         gr_meta_free(&scratch);
         if (st != GR_OK) gr_error_prefix(err, "%s: frame %d (t = %g s)", cls->name, i, o->times[i]);
     }
@@ -456,10 +465,29 @@ static gr_status render_one(const run_opts *o, run_state *rs, gr_gl *gl, int k, 
 /* The real-time side: it takes seconds, and a GL failure should not cost the user a
  * two-minute ground truth first. One context, one instance per technique; a technique that
  * fails is a failed row (technique_failed). */
+/* A line while a technique's render is long (realtime/technique.h's wait report): every 10 s,
+ * or $GODRAYS_PROGRESS_SECONDS (tests: shorter). */
+static void say_waiting(void *user, const char *technique, const char *what, double elapsed_s, double limit_s)
+{
+    (void)user;
+    fprintf(stderr, "godrays run: %s: still rendering (%s), elapsed %.0f s of its time limit of %g s\n", technique,
+            what, elapsed_s, limit_s);
+    fflush(stderr);
+}
+
+static double progress_seconds(void)
+{
+    const char *env = getenv("GODRAYS_PROGRESS_SECONDS");
+    char *end = NULL;
+    double v = env && env[0] ? strtod(env, &end) : 0.0;
+    return v > 0 && end && !*end ? v : 10.0;
+}
+
 static gr_status render_techniques(const run_opts *o, run_state *rs, gr_error *err)
 {
     gr_gl *gl = NULL;
     gr_status st = gr_gl_create(NULL, &gl, err);
+    if (!o->quiet) gr_technique_set_wait_report(say_waiting, NULL, progress_seconds());
     const double t0 = now_s();
     for (int k = 0; k < o->nt && st == GR_OK; k++) {
         const gr_technique_class *cls = o->cls[k];
@@ -487,10 +515,12 @@ static gr_status render_techniques(const run_opts *o, run_state *rs, gr_error *e
         }
         ts->seconds = now_s() - t;
         ts->test = rs->test[k];
+        ts->targets = rs->targets[k];
         ts->meta = &rs->smeta[k];
         snprintf(rs->exr_names[k], sizeof rs->exr_names[k], "%s.exr", cls->name);
         ts->exr = rs->exr_names[k];
     }
+    gr_technique_set_wait_report(NULL, NULL, 0);
     gr_gl_destroy(gl);
     return st;
 }
@@ -660,6 +690,7 @@ static void run_free(const run_opts *o, run_state *rs)
     free(rs->seq_json);
     for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) {
         gr_image_destroy(rs->test[k]);
+        gr_image_destroy(rs->targets[k]);
         gr_meta_free(&rs->smeta[k]);
     }
     free(rs->mets);

@@ -6,11 +6,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <cjson/cJSON.h>
 
 #include "image/oiio.h"
+#include "reference/progress.h"
 #include "report/report.h"
 #include "tune/page.h"
 #include "tune/budget.h"
@@ -42,20 +42,21 @@ static void usage(FILE *f)
 }
 
 typedef struct progress_ctx {
-    int on, quiet;
+    int quiet;
     gr_tune_budget budget; /* the estimate after the first grid point (tune/budget.h) */
+    gr_progress *bar;      /* a bar on a terminal, a line per 10 % or 10 s otherwise (NULL: -q) */
 } progress_ctx;
 
 static void progress(void *user, int done, int total)
 {
     progress_ctx *p = user;
-    char eta[512];
-    if (!p->quiet && gr_tune_budget_eta(&p->budget, done, eta, sizeof eta)) fprintf(stderr, "%s%s\n", p->on ? "\r" : "", eta);
-    if (!p->on) return;
-    if (done == total || done % 8 == 0) {
-        fprintf(stderr, "\rgodrays sweep: %d/%d grid points", done, total);
-        if (done == total) fputc('\n', stderr);
+    char eta[512], note[64];
+    if (!p->quiet && gr_tune_budget_eta(&p->budget, done, eta, sizeof eta)) {
+        gr_progress_finish(p->bar);
+        fprintf(stderr, "%s\n", eta);
     }
+    snprintf(note, sizeof note, "%d/%d grid points", done, total);
+    gr_progress_update(p->bar, total > 0 ? (double)done / total : 1.0, note);
 }
 
 static cJSON *num_array(const double *v, int n)
@@ -188,7 +189,7 @@ static int sweep_with(gr_args *args)
                 return gr_cli_usage_error(cmd, "--param %s: %s swept twice", param_specs[j], params[k].key);
     }
     if (gr_tune_cli_finish(&c, &err) != GR_OK) return gr_cli_report(cmd, &err);
-    progress_ctx pc = {!c.quiet && isatty(2), c.quiet, {0}}; /* the count before the ground truths */
+    progress_ctx pc = {c.quiet, {0}, NULL}; /* the count before the ground truths */
     const long long points = (long long)params[0].count * (n_params > 1 ? params[1].count : 1);
     if (gr_tune_budget_init(&pc.budget, "godrays sweep", "grid points", points, gr_tune_budget_cases(&c.so), c.yes,
                             &err) != GR_OK)
@@ -229,7 +230,10 @@ static int sweep_with(gr_args *args)
     gr_tune_budget_plan_line(&pc.budget, plan, sizeof plan);
     if (!c.quiet) fprintf(stderr, "%s\n", plan);
     gr_tune_budget_start(&pc.budget);
-    if (gr_sweep_run(p, &r, progress, &pc, &err) != GR_OK) goto fail;
+    pc.bar = gr_progress_create("godrays sweep", !c.quiet);
+    gr_status swst = gr_sweep_run(p, &r, progress, &pc, &err);
+    gr_progress_destroy(pc.bar);
+    if (swst != GR_OK) goto fail;
     /* the sweep's own accounting, before the extra render of best.png */
     const long long sw_renders = p->renders;
     const double sw_render_s = p->render_s, sw_metrics_s = p->metrics_s;

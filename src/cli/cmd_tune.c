@@ -14,6 +14,7 @@
 #include <cjson/cJSON.h>
 
 #include "image/oiio.h"
+#include "reference/progress.h"
 #include "report/report.h"
 #include "tune/page.h"
 #include "tune/budget.h"
@@ -67,7 +68,8 @@ typedef struct traced {
     gr_tune_problem *p;
     FILE *trace;        /* the temporary file of trace.csv (common/outfile), renamed at the end */
     int n;
-    int progress;
+    gr_progress *bar;   /* evaluations of the planned most: a bar on a terminal, a line per 10 % or
+                           10 s otherwise (reference/progress.h; never prints with -q) */
     gr_tune_budget *budget; /* the estimate after the first evaluation; NULL: none (-q) */
 } traced;
 
@@ -82,9 +84,15 @@ static gr_status traced_objective(void *user, const double *x, double *f, gr_err
         for (int k = 0; k < t->p->n_params; k++) fprintf(t->trace, ",%.9g", x[k]);
         fprintf(t->trace, ",%.9g\n", *f);
     }
-    char eta[512];
-    if (t->budget && gr_tune_budget_eta(t->budget, t->n, eta, sizeof eta)) fprintf(stderr, "%s\n", eta);
-    if (t->progress && t->n % 10 == 0) fprintf(stderr, "\rgodrays tune: %d evaluations", t->n);
+    char eta[512], note[64];
+    if (t->budget && gr_tune_budget_eta(t->budget, t->n, eta, sizeof eta)) {
+        gr_progress_finish(t->bar);
+        fprintf(stderr, "%s\n", eta);
+    }
+    /* the plan is an upper bound (the search may stop early): the fraction of it */
+    const long long planned = t->budget && t->budget->planned > 0 ? t->budget->planned : 0;
+    snprintf(note, sizeof note, "%d evaluations", t->n);
+    gr_progress_update(t->bar, planned ? (double)t->n / (double)planned : 0.0, note);
     return GR_OK;
 }
 
@@ -373,7 +381,8 @@ static gr_status search(const tune_opts *t, const gr_tune_session *s, gr_tune_pr
     for (int k = 0; k < n; k++) fprintf(trace.f, ",%s", r->params[k].key);
     fprintf(trace.f, ",%s%s\n", gr_tune_metric_name(p->metric), p->fit == GR_FIT_RGB ? "_fit_rgb" : p->fit ? "_fit" : "");
     st = gr_tune_evaluate(p, r->xb, &r->fb, r->before, r->sc_b, err);
-    traced tr = {.p = p, .trace = trace.f, .progress = !t->c.quiet && isatty(2), .budget = t->c.quiet ? NULL : &r->budget};
+    traced tr = {.p = p, .trace = trace.f, .bar = gr_progress_create("godrays tune", !t->c.quiet),
+                 .budget = t->c.quiet ? NULL : &r->budget};
     char plan[512];
     gr_tune_budget_plan_line(&r->budget, plan, sizeof plan);
     if (!t->c.quiet) fprintf(stderr, "%s (at most)\n", plan);
@@ -382,7 +391,8 @@ static gr_status search(const tune_opts *t, const gr_tune_session *s, gr_tune_pr
     r->render_s0 = p->render_s;
     r->metrics_s0 = p->metrics_s;
     if (st == GR_OK) st = gr_opt_minimize(n, r->lo, r->hi, traced_objective, &tr, &r->oo, &r->res, err);
-    if (st == GR_OK && tr.progress) fprintf(stderr, "\rgodrays tune: %d evaluations\n", tr.n);
+    gr_progress_destroy(tr.bar);
+    if (st == GR_OK && !t->c.quiet && isatty(2)) fprintf(stderr, "godrays tune: %d evaluations\n", tr.n);
     if (st == GR_OK) st = gr_outfile_commit(&trace, 0, err);
     gr_outfile_abort(&trace);
     if (st == GR_OK) st = gr_tune_evaluate(p, r->res.x, &r->fa, r->after, r->sc_a, err);

@@ -24,6 +24,7 @@ static const gr_command commands[] = {
     {"export", "the scene for other engines: glTF 2.0 (water, camera, sun, occluders), shader constants", cmd_export},
     {"merge", "assemble the parts of a ground-truth render (reference --tile) into one EXR, bit for bit", cmd_merge},
     {"farm", "ground truths of frames and views as a Slurm job array of parts, merged into the cache", cmd_farm},
+    {"watch", "re-render and score a user technique on every save of its files; a local page shows it", cmd_watch},
     {"suite", "check and list a view suite: cases (scene, camera, sun, time) split into train and test", cmd_suite},
 };
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);

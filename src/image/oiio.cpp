@@ -11,6 +11,7 @@ extern "C" {
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <new>
@@ -627,5 +628,44 @@ extern "C" gr_status gr_oiio_write_animation(const char *path, const gr_image *c
         return st;
     } catch (...) {
         return exception_status(err, path, "writing animation");
+    }
+}
+
+#include <OpenImageIO/filesystem.h>
+
+extern "C" gr_status gr_oiio_encode_png(const gr_image *img, unsigned char **buf, size_t *len, gr_error *err)
+{
+    *buf = nullptr;
+    *len = 0;
+    if (!image_ok(img) || img->nchannels < 3) return gr_fail(err, GR_E_INPUT, "PNG in memory: no image or fewer than 3 channels");
+    try {
+        const size_t w = static_cast<size_t>(img->width), h = static_cast<size_t>(img->height);
+        const size_t nc = static_cast<size_t>(img->nchannels);
+        std::vector<unsigned char> codes(w * h * 3);
+        for (size_t p = 0; p < w * h; p++)
+            for (size_t k = 0; k < 3; k++) {
+                float v = img->pixels[p * nc + k]; // display-encoded already: codes = round(255 v)
+                if (!std::isfinite(v)) v = 0.0f;
+                v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+                codes[p * 3 + k] = static_cast<unsigned char>(std::floor(v * 255.0f + 0.5f));
+            }
+        std::vector<unsigned char> bytes;
+        OIIO::Filesystem::IOVecOutput vec(bytes);
+        auto out = OIIO::ImageOutput::create("png");
+        if (!out) return gr_fail(err, GR_E_RUNTIME, "PNG in memory: no PNG writer (%s)", OIIO::geterror().c_str());
+        OIIO::ImageSpec spec(img->width, img->height, 3, OIIO::TypeDesc::UINT8);
+        spec.attribute("oiio:ColorSpace", "sRGB");
+        if (!out->supports("ioproxy") || !out->set_ioproxy(&vec) || !out->open("mem.png", spec) ||
+            !out->write_image(OIIO::TypeDesc::UINT8, codes.data()) || !out->close())
+            return gr_fail(err, GR_E_RUNTIME, "PNG in memory: %s", out->geterror().c_str());
+        out.reset();
+        unsigned char *b = static_cast<unsigned char *>(malloc(bytes.size() ? bytes.size() : 1));
+        if (!b) return gr_fail(err, GR_E_NOMEM, "PNG in memory: out of memory");
+        if (!bytes.empty()) memcpy(b, bytes.data(), bytes.size());
+        *buf = b;
+        *len = bytes.size();
+        return GR_OK;
+    } catch (...) {
+        return exception_status(err, "PNG in memory", "encoding");
     }
 }

@@ -264,7 +264,19 @@ static _Thread_local struct {
     const char *name;
     double deadline_ms, limit_s;
     const char *source;
+    double start_ms, next_report_ms; /* gr_technique_set_wait_report's next call */
 } cur_render;
+
+static gr_technique_wait_fn wait_fn; /* gr_technique_set_wait_report */
+static void *wait_user;
+static double wait_every_ms;
+
+void gr_technique_set_wait_report(gr_technique_wait_fn fn, void *user, double every_s)
+{
+    wait_fn = every_s > 0 ? fn : NULL;
+    wait_user = user;
+    wait_every_ms = 1000.0 * every_s;
+}
 
 gr_status gr_technique_parse_time_limit(const char *what, const char *text, double *seconds, gr_error *err)
 {
@@ -306,6 +318,11 @@ gr_status gr_technique_wait_pass(const char *what, gr_error *err)
     for (;;) {
         double left_ms = cur_render.name ? cur_render.deadline_ms - gr_clock_ms() : 50.0;
         if (left_ms <= 0) break;
+        const double now_ms = gr_clock_ms();
+        if (cur_render.name && wait_fn && now_ms >= cur_render.next_report_ms) { /* a long wait: say so */
+            cur_render.next_report_ms = now_ms + wait_every_ms;
+            wait_fn(wait_user, cur_render.name, what, 1e-3 * (now_ms - cur_render.start_ms), cur_render.limit_s);
+        }
         GLuint64 wait_ns = (GLuint64)((left_ms < 50.0 ? left_ms : 50.0) * 1e6);
         GLenum r = glClientWaitSync(fence, flags, wait_ns);
         flags = 0;
@@ -418,6 +435,8 @@ gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void
     cur_render.limit_s = limit_s;
     cur_render.source = source;
     cur_render.deadline_ms = t0 + 1000.0 * limit_s;
+    cur_render.start_ms = t0;
+    cur_render.next_report_ms = t0 + wait_every_ms;
     st = cls->render(t->state, scene, rs.bytes, out, stats, err);
     cur_render.name = NULL;
     if (st == GR_E_TIMEOUT) {

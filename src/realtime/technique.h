@@ -218,6 +218,13 @@ gr_status gr_technique_time_limit(double *seconds, const char **source, gr_error
  * "TECHNIQUE: WHAT: not done after the time limit of S s (SOURCE) ...". Outside a render
  * (gr_technique_render) it waits without a limit. */
 gr_status gr_technique_wait_pass(const char *what, gr_error *err);
+/* A command's word while a render is long (issue 29: piped `run` shows progress): while
+ * gr_technique_wait_pass waits inside a render, fn is called on the render's thread every
+ * every_s seconds of it (elapsed_s since the render began, limit_s its time limit). fn NULL:
+ * none (the default). Only the classes that wait per pass (the user techniques) report. */
+typedef void (*gr_technique_wait_fn)(void *user, const char *technique, const char *what, double elapsed_s,
+                                     double limit_s);
+void gr_technique_set_wait_report(gr_technique_wait_fn fn, void *user, double every_s);
 
 /* ---- instances -------------------------------------------------------------------------- */
 

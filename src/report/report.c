@@ -729,6 +729,8 @@ typedef struct tctx {
     gr_image *disp_fit, *disp_raw, *diff_signed, *diff_abs;
     gr_diffmap_info info_signed, info_abs;
     gr_image *flip_map;            /* per-pixel HDR-FLIP of a * test, magma (docs/metrics.md) */
+    gr_image *disp_targets;        /* t->targets for display (NULL: none) */
+    double exposure_targets;
     gr_flip_result flip;
     char lines[3][512];            /* its summary lines */
 } tctx;
@@ -1429,6 +1431,13 @@ static void html_technique(ctx *c, gr_strbuf *b, int k)
              t->name, tc->flip.mean, tc->flip.median);
     html_figure(b, f[4], tc->flip_map, "FLIP map", cap);
     gr_sb_puts(b, "</div>\n");
+    if (tc->disp_targets) { /* run --save-targets */
+        snprintf(f[0], sizeof f[0], "%s_targets.png", tc->stem);
+        snprintf(cap, sizeof cap,
+                 "Every render target of %s side by side, each at its own size (RGB; own exposure %s): the "
+                 "intermediate images its passes wrote.", t->name, fmt(tc->exposure_targets, tt[0], sizeof tt[0]));
+        html_figure(b, f[0], tc->disp_targets, "render targets", cap);
+    }
     if (t->exr && in->ref_exr) {
         gr_sb_puts(b, "<p class=\"sub\">The linear images: <a href=\"");
         gr_sb_html(b, in->ref_exr);
@@ -1732,6 +1741,10 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
         tctx *tc = &c->t[k];
         if ((st = gr_report_display(tc->t->test, c->exposure * tc->a, &tc->disp_fit, err)) != GR_OK) goto done;
         if ((st = gr_report_display(tc->t->test, tc->exposure_raw, &tc->disp_raw, err)) != GR_OK) goto done;
+        if (tc->t->targets) {
+            tc->exposure_targets = gr_report_exposure(tc->t->targets, 1.0, 0.99, 0.8);
+            if ((st = gr_report_display(tc->t->targets, tc->exposure_targets, &tc->disp_targets, err)) != GR_OK) goto done;
+        }
         for (int s = 0; s < 2; s++) {
             gr_diffmap_options dopt = {.kind = s ? GR_DIFFMAP_SIGNED : GR_DIFFMAP_ABS, .scale = tc->a, .mask = NULL,
                                        .stderr_bound = tc->t->metrics->stderr_bound};
@@ -1770,6 +1783,11 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
             snprintf(file, sizeof file, "%s%s.png", tc->stem, suffix[i]);
             if ((st = join(path, sizeof path, dir, file, err)) != GR_OK) goto done;
             if ((st = gr_oiio_write(path, imgs[i], err)) != GR_OK) goto done;
+        }
+        if (tc->disp_targets) {
+            snprintf(file, sizeof file, "%s_targets.png", tc->stem);
+            if ((st = join(path, sizeof path, dir, file, err)) != GR_OK) goto done;
+            if ((st = gr_oiio_write(path, tc->disp_targets, err)) != GR_OK) goto done;
         }
     }
     /* summary.png: one row per technique in leaderboard order, the first with the global lines */
@@ -1839,6 +1857,7 @@ done:
         gr_image_destroy(tc->diff_signed);
         gr_image_destroy(tc->diff_abs);
         gr_image_destroy(tc->flip_map);
+        gr_image_destroy(tc->disp_targets);
     }
     free_profiles(&c->pr);
     free(cp);

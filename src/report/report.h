@@ -39,6 +39,9 @@ typedef struct gr_report_technique {
     const gr_metrics *metrics;      /* gr_metrics_compute(ref, test) with fit_scale = 1 */
     double seconds;                 /* time in this run: instance, render, readback (< 0: unknown) */
     const char *exr;                /* name (inside DIR) of its EXR copy written beside; NULL: none */
+    const gr_image *targets;        /* its intermediate render targets side by side (RGBA float,
+                                       gr_technique_read_target; `run --save-targets`), shown as a
+                                       strip in its section; NULL: none (the default) */
 } gr_report_technique;
 
 /* A technique that has no image to score: it failed to build, to render, or rendered black or

@@ -15,30 +15,9 @@ export GODRAYS_CACHE="$dir/cache"
 # the durations below are llvmpipe's (a GPU would finish the slow shader within the limit)
 export GODRAYS_GL_PLATFORM=surfaceless LIBGL_ALWAYS_SOFTWARE=1
 
+# a fragment loop of up to 65535 steps drawn many times (tests/techniques/slow_loop)
 slow="$dir/slow"
-mkdir -p "$slow"
-cat >"$slow/manifest.json" <<'JSON'
-{"version": 1, "name": "slow_loop", "description": "a fragment loop of up to 65535 steps, drawn many times",
- "settings": {"loops": {"type": "int", "default": 65535, "min": 1, "max": 65535},
-              "copies": {"type": "int", "default": 3000, "min": 1, "max": 100000}},
- "targets": {"out": {"format": "rgba32f"}},
- "passes": [{"name": "spin", "vertex": "v.vert", "fragment": "f.frag", "target": "out", "blend": "additive",
-             "draw": {"primitive": "triangles", "vertices": 3, "instances": "copies"}}]}
-JSON
-cat >"$slow/v.vert" <<'GLSL'
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-GLSL
-cat >"$slow/f.frag" <<'GLSL'
-out vec4 o_color;
-void main() {
-    float x = gl_FragCoord.x * 1e-3;
-    for (int i = 0; i < u_set_loops; i++) x = fract(x * 1.000173 + 0.1234567);
-    o_color = vec4(x + 1e-3, 1.0, 1.0, 1.0) * 1e-3;
-}
-GLSL
+cp -r "${GODRAYS_SOURCE_DIR:?}/tests/techniques/slow_loop" "$slow"
 scene="$dir/scene.json"
 small_scene "$scene" 32 18 '"reference": {"surface_res": 64, "sun_samples": 2, "batches": 2, "steps": 16, "spp": 1}'
 
