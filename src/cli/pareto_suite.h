@@ -19,7 +19,7 @@ typedef struct gr_ps_opts {
     double budgets_ms[GR_PS_MAX_BUDGETS];
     int max_evals;       /* the global search's, per local search (0: its default) */
     int tune_full;       /* the global search at every ladder point (else only at the anchor) */
-    int local_evals;     /* the continuation's local search (0: GR_ST_LOCAL_EVALS) */
+    int local_evals;     /* the continuation's local search (0: gr_st_local_evals) */
     unsigned long long seed;
     gr_gl_platform platform;
     const gr_technique_class *const *techs;

@@ -127,14 +127,15 @@ static gr_status search(gr_tune_problem *p, int np, const double *x0, double f0,
             extra++;
             if (f < fb) fb = f, memcpy(best, xc, (size_t)np * sizeof *best);
         }
-        /* one start, no first stage, no screening, no polish: a simplex of 5 % of each box side
-         * (the neighbouring point's optimum is that close: docs/tuning.md) and its restart at
-         * a fifth of that */
+        /* one start, no first stage, no screening: a simplex of 5 % of each box side (the
+         * neighbouring point's optimum is that close: docs/tuning.md) and its restart at a fifth
+         * of that, then the compass polish along the axes (on an 8-bit target's stepped error
+         * surface the simplex stalls on a step; the polish moves one setting at a time) */
         oo.x0 = best;
         oo.n_starts = 1;
-        oo.coarse = oo.screen = oo.polish = 0;
+        oo.coarse = oo.screen = 0;
         oo.init_step = 0.05;
-        oo.max_evals = o->local_evals > 0 ? o->local_evals : GR_ST_LOCAL_EVALS;
+        oo.max_evals = oo.polish = o->local_evals > 0 ? o->local_evals : gr_st_local_evals(np);
         gr_status st = gr_opt_minimize(np, lo, hi, gr_tune_objective, p, &oo, res, err);
         if (st == GR_OK && !(res->f <= fb)) { /* never worse than its start (a failed run's f is +inf) */
             res->f = fb;
@@ -229,6 +230,11 @@ gr_status gr_st_time_point(gr_technique *r, const gr_scene *scene, int repeat, d
     pt->timed = st == GR_OK;
     gr_image_destroy(img);
     return st;
+}
+
+int gr_st_local_evals(int n)
+{
+    return 20 + 12 * n;
 }
 
 int gr_st_continuation_order(int n, int *order, int *prev)

@@ -44,14 +44,18 @@ typedef struct gr_st_options {
     int n_starts;             /* 0: 2 */
     int coarse;               /* first-stage sample points (0: 8 per parameter) */
     unsigned long long seed;
-    /* continuation: n_from > 0 replaces the global search by a local one (local_evals, 0: 20)
-     * from the best on the train cases of from[0..n_from) and the untuned point */
+    /* continuation: n_from > 0 replaces the global search by a local one (local_evals for the
+     * simplex and as many for the polish; 0: gr_st_local_evals) from the best on the train
+     * cases of from[0..n_from) and the untuned point */
     int n_from;
     double from[2][GR_TUNE_MAX_PARAMS];
     int local_evals;
 } gr_st_options;
 
-#define GR_ST_LOCAL_EVALS 20
+/* The continuation's default budget for n tuned settings: 20 + 12 n evaluations for the simplex
+ * and as many for the polish (44 each for 2 settings: the least that recovered the
+ * identifiability check's settings within 2 % at every shafts ladder point; 16-30 did not). */
+int gr_st_local_evals(int n);
 
 typedef struct gr_st_point {
     const gr_technique_class *cls;
