@@ -61,7 +61,8 @@ static void usage(FILE *f)
             "  --technique-dir DIR  add the user technique in DIR (repeatable)\n"
             "  --time-limit S     give up a render after S seconds (default 60, or $GODRAYS_TIME_LIMIT)\n"
             "  --quick            fewer points (q0, q1, the quick levels of each ladder), for tests\n"
-            "  --repeat R         renders per setting; time = median (default 5)\n"
+            "  --repeat R         renders per setting; time = median (default 5; with --suite 3 on a CPU\n"
+            "                     rasterizer, 5 on a GPU)\n"
             "  --no-cache         render the high-quality ground truth even if cached\n"
             "  --suite SUITE      over a view suite instead of one scene (docs/tuning.md \"Tuned fronts and\n"
             "                     budgets\"): each technique's ladder points scored against the cases'\n"
@@ -74,7 +75,14 @@ static void usage(FILE *f)
             "  --timing-size WxH  with --suite: the size each point is timed at (default 1920x1080;\n"
             "                     errors are at the suite's size or --size)\n"
             "  --seed S           with --tune: the search's seed (default 0; same seed, same result)\n"
-            "  --max-evals N      with --tune: evaluations per local search (default 60 + 40 per setting)\n"
+            "  --max-evals N      with --tune: evaluations per local search of the global search\n"
+            "                     (default 60 + 40 per setting)\n"
+            "  --local-evals N    with --tune: the continuation's local search at the ladder points other\n"
+            "                     than the anchor (the ladder's middle; default 20 + 12 per setting, and as\n"
+            "                     many for its polish)\n"
+            "  --tune-full        --tune with the global search at every ladder point (slow)\n"
+            "  --timing-cap S     with --suite: time fewer renders once the timed ones took S seconds\n"
+            "                     (default 2; 0: all --repeat; the count is in fronts.csv)\n"
             "  --yes              start more than 20000 technique renders (docs/tuning.md \"Budgets\")\n"
             "  --max-memory SIZE  refuse (exit 2) a ground truth estimated to need more (e.g. 8G;\n"
             "                     default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
@@ -165,12 +173,13 @@ static int take_suite_option(gr_args *args, pareto_opts *o, int *rc)
 {
     const char *a = args->argv[args->i], *v = NULL;
     gr_error e = {GR_OK, ""};
-    if (!strcmp(a, "--tune")) {
+    if (!strcmp(a, "--tune") || !strcmp(a, "--tune-full")) {
         o->ps.tune = 1;
+        o->ps.tune_full |= !strcmp(a, "--tune-full");
         return 1;
     }
     if (strcmp(a, "--suite") && strcmp(a, "--budgets") && strcmp(a, "--timing-size") && strcmp(a, "--seed") &&
-        strcmp(a, "--max-evals"))
+        strcmp(a, "--max-evals") && strcmp(a, "--local-evals") && strcmp(a, "--timing-cap"))
         return 0;
     if ((*rc = gr_args_value(args, &v)) != 0) return 1;
     char *end = NULL, x = 0;
@@ -187,11 +196,15 @@ static int take_suite_option(gr_args *args, pareto_opts *o, int *rc)
     } else if (!strcmp(a, "--seed")) {
         o->ps.seed = strtoull(v, &end, 10);
         if (errno || end == v || *end || v[0] == '-') *rc = gr_cli_usage_error("pareto", "--seed %s: expected an integer >= 0", v);
+    } else if (!strcmp(a, "--timing-cap")) {
+        o->ps.timing_cap_s = strtod(v, &end);
+        if (errno || end == v || *end || !(o->ps.timing_cap_s >= 0) || o->ps.timing_cap_s > 1e6)
+            *rc = gr_cli_usage_error("pareto", "--timing-cap %s: expected seconds >= 0 (0: no cap)", v);
     } else {
         const long m = strtol(v, &end, 10);
         if (errno || end == v || *end || m < 4 || m > 100000)
-            *rc = gr_cli_usage_error("pareto", "--max-evals %s: expected an integer in [4, 100000]", v);
-        o->ps.max_evals = (int)m;
+            *rc = gr_cli_usage_error("pareto", "%s %s: expected an integer in [4, 100000]", a, v);
+        *(!strcmp(a, "--max-evals") ? &o->ps.max_evals : &o->ps.local_evals) = (int)m;
     }
     return 1;
 }
@@ -203,6 +216,7 @@ static int parse_args(gr_args *args, pareto_opts *o)
     int rc = 0, taken = 0;
     o->use_cache = 1;
     o->repeat = 5;
+    o->ps.timing_cap_s = 2; /* --timing-cap */
     o->tech_flag = "--techniques";
     o->platform = GR_GL_AUTO;
     args->size_example = "320x180";
@@ -559,7 +573,7 @@ static int pareto_with(gr_args *args)
     if (o.ps.suite_path) {
         o.ps.outopt = o.outopt;
         o.ps.quick = o.quick, o.ps.quiet = o.quiet, o.ps.use_cache = o.use_cache, o.ps.platform = o.platform;
-        o.ps.repeat = o.have_repeat ? (int)o.repeat : 3;
+        o.ps.repeat = o.have_repeat ? (int)o.repeat : 0; /* 0: 3 on a CPU rasterizer, 5 on a GPU */
         if (o.ps.timing_w <= 0) o.ps.timing_w = 1920, o.ps.timing_h = 1080;
         o.ps.techs = o.techs;
         o.ps.n_techs = o.n_techs;

@@ -41,6 +41,7 @@ typedef struct ps_run {
     double truth_s, tune_s, time_s;
     gr_baselines *bl;         /* the blur ladder over the test cases (equivalent blur) */
     const char *dir;          /* the output folder (thumbnails are written as points come) */
+    int repeat;               /* renders timed per point: --repeat, else 3 on a CPU rasterizer, 5 on a GPU */
     int thumb_case;           /* the case the thumbnails show: the first test case */
 } ps_run;
 
@@ -104,32 +105,61 @@ static gr_status thumbnail(ps_run *r, gr_technique *t, int k, gr_error *err)
     return st;
 }
 
-/* One technique: each ladder point untuned (and tuned with --tune), each timed. */
+/* Ladder position k's point of one technique: untuned (and tuned, *tu non-NULL) at level lv
+ * (-1: the scene's settings), tuned from so (the continuation's from[] set by the caller). */
+static gr_status tune_one(const gr_ps_opts *o, ps_run *r, gr_technique *t, int lv, const gr_st_options *so,
+                          gr_st_point *u, gr_st_point *tu, gr_error *err)
+{
+    const double t0 = now_s();
+    gr_status st = gr_st_tune_level(t, r->cases, r->suite->n_cases, lv, so, u, tu, err);
+    r->tune_s += now_s() - t0;
+    if (st == GR_OK && !o->quiet && tu)
+        fprintf(stderr, "godrays pareto: %s %s: tuned by the %s search (%d evaluations, %.1f s): train %.4g, test %.4g "
+                "(untuned %.4g, %.4g)\n", u->cls->name, u->ladder[0] ? u->ladder : "(scene's)",
+                tu->local ? "local" : "global", tu->evals, now_s() - t0, tu->train_error, tu->test_error, u->train_error,
+                u->test_error);
+    return st;
+}
+
+/* One technique: each ladder point untuned (and tuned with --tune: the global search at the
+ * anchor, the middle of the ladder, the continuation's local search at the others, or the
+ * global one everywhere with --tune-full; tune/suitetune.h), each timed, in ladder order. */
 static gr_status technique(const gr_ps_opts *o, ps_run *r, const gr_technique_class *cls, gr_error *err)
 {
     gr_technique *t = NULL;
     gr_status st = gr_technique_create(cls, r->gl, NULL, &t, err);
-    const gr_st_options so = {.max_evals = o->max_evals, .seed = o->seed};
-    const int n_lv = cls->n_ladder > 0 ? cls->n_ladder : 1;
-    for (int l = 0; l < n_lv && st == GR_OK; l++) {
-        if (o->quick && cls->n_ladder > 0 && !cls->ladder[l].quick) continue;
-        if (r->n + 2 > PS_MAX_POINTS) break;
-        gr_st_point *u = &r->pts[r->n], *tu = o->tune ? &r->pts[r->n + 1] : NULL;
-        double t0 = now_s();
-        st = gr_st_tune_level(t, r->cases, r->suite->n_cases, cls->n_ladder > 0 ? l : -1, &so, u, tu, err);
-        r->tune_s += now_s() - t0;
-        t0 = now_s();
-        if (st == GR_OK) st = gr_st_time_point(t, r->timing_scene, o->repeat, u, err);
-        if (st == GR_OK && tu) st = gr_st_time_point(t, r->timing_scene, o->repeat, tu, err);
+    int lv[PS_MAX_POINTS], n = 0, order[PS_MAX_POINTS], prev[PS_MAX_POINTS];
+    for (int l = 0; l < (cls->n_ladder > 0 ? cls->n_ladder : 1) && n < PS_MAX_POINTS; l++)
+        if (!(o->quick && cls->n_ladder > 0 && !cls->ladder[l].quick)) lv[n++] = cls->n_ladder > 0 ? l : -1;
+    if (r->n + 2 * n > PS_MAX_POINTS) n = (PS_MAX_POINTS - r->n) / 2;
+    gr_st_point *u = &r->pts[r->n], *tu = &r->pts[r->n + n]; /* tuned points after the untuned, then interleaved */
+    const int a = gr_st_continuation_order(n, order, prev);
+    for (int k = 0; k < n && st == GR_OK; k++) {
+        const int i = order[k];
+        gr_st_options so = {.max_evals = o->max_evals, .seed = o->seed, .local_evals = o->local_evals};
+        if (o->tune && !o->tune_full && prev[k] >= 0) gr_st_continue_from(&so, &tu[a], &tu[order[prev[k]]]);
+        st = tune_one(o, r, t, lv[i], &so, &u[i], o->tune ? &tu[i] : NULL, err);
+    }
+    if (st == GR_OK && o->tune) { /* interleave: each untuned point followed by its tuned one */
+        gr_st_point *tmp = malloc((size_t)(2 * (n > 0 ? n : 1)) * sizeof *tmp);
+        if (!tmp) st = gr_fail(err, GR_E_NOMEM, "out of memory");
+        for (int i = 0; i < n && tmp; i++) tmp[2 * i] = u[i], tmp[2 * i + 1] = tu[i];
+        if (tmp) memcpy(u, tmp, (size_t)(2 * n) * sizeof *tmp);
+        free(tmp);
+    }
+    const int m = o->tune ? 2 * n : n;
+    for (int k = 0; k < m && st == GR_OK; k++) {
+        gr_st_point *p = &r->pts[r->n];
+        const double t0 = now_s();
+        st = gr_st_time_point(t, r->timing_scene, r->repeat, o->timing_cap_s, p, err);
         r->time_s += now_s() - t0;
         if (st == GR_OK) st = thumbnail(r, t, r->n, err);
-        if (st == GR_OK && tu) st = thumbnail(r, t, r->n + 1, err);
         if (st != GR_OK) break;
-        r->n += tu ? 2 : 1;
+        r->n++;
         if (!o->quiet)
-            fprintf(stderr, "godrays pareto: %s %s: %.2f ms, test error %.4g untuned%s", cls->name,
-                    u->ladder[0] ? u->ladder : "(scene's)", u->timing.cost_ms, u->test_error, tu ? "" : "\n");
-        if (!o->quiet && tu) fprintf(stderr, ", %.4g tuned (train %.4g)\n", tu->test_error, tu->train_error);
+            fprintf(stderr, "godrays pareto: %s %s %s: %.2f ms (%d timed), train %.4g, test %.4g\n", cls->name,
+                    p->ladder[0] ? p->ladder : "(scene's)", p->tuned ? "tuned" : "untuned", p->timing.cost_ms,
+                    p->timing.n, p->train_error, p->test_error);
     }
     gr_technique_destroy(t);
     return st;
@@ -140,12 +170,15 @@ static void time_header(const ps_run *r, const gr_ps_opts *o, char *buf, size_t 
 {
     const gr_timing *tm = r->n > 0 ? &r->pts[0].timing : NULL;
     const char *glr = tm ? tm->renderer : gr_gl_renderer(r->gl);
+    char cap[96] = "";
+    if (o->timing_cap_s > 0)
+        snprintf(cap, sizeof cap, "; fewer once the timed renders took %g s", o->timing_cap_s);
     if (gr_timing_is_cpu_renderer(glr))
-        snprintf(buf, n, "times on %s at %dx%d: CPU-rasterizer wall times (median of %d after a warm-up), which do NOT "
-                 "stand for a GPU's", glr, o->timing_w, o->timing_h, o->repeat);
+        snprintf(buf, n, "times on %s at %dx%d: CPU-rasterizer wall times (median of up to %d after a warm-up%s), which "
+                 "do NOT stand for a GPU's", glr, o->timing_w, o->timing_h, r->repeat, cap);
     else
-        snprintf(buf, n, "times on %s at %dx%d: GPU time of the GL passes (timer queries; median of %d after a warm-up)",
-                 glr, o->timing_w, o->timing_h, o->repeat);
+        snprintf(buf, n, "times on %s at %dx%d: GPU time of the GL passes (timer queries; median of up to %d after a "
+                 "warm-up%s)", glr, o->timing_w, o->timing_h, r->repeat, cap);
 }
 
 /* fronts.csv: every point. */
@@ -155,7 +188,7 @@ static gr_status write_fronts_csv(const char *dir, const ps_run *r, gr_error *er
     gr_strbuf b;
     gr_sb_init(&b);
     gr_sb_puts(&b, "technique,tuned,ladder,label,cost_ms,wall_ms,gpu_ms,wall_min_ms,wall_max_ms,train_error,test_error,"
-                   "on_front,renderer\n");
+                   "on_front,timed_renders,search,evals,renderer\n");
     for (int i = 0; i < r->n; i++) {
         const gr_st_point *p = &r->pts[i];
         gr_st_point_label(p, label, sizeof label);
@@ -165,9 +198,10 @@ static gr_status write_fronts_csv(const char *dir, const ps_run *r, gr_error *er
         snprintf(lad, sizeof lad, "%s", p->ladder);
         for (char *c = lad; *c; c++)
             if (*c == ',') *c = ';';
-        gr_sb_printf(&b, "%s,%d,%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%s\n", p->cls->name, p->tuned, lad, label,
-                     p->timing.cost_ms, p->timing.wall_ms, p->timing.gpu_ms, p->timing.wall_min_ms, p->timing.wall_max_ms,
-                     p->train_error, p->test_error, p->on_front, p->timing.renderer);
+        gr_sb_printf(&b, "%s,%d,%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%s,%d,%s\n", p->cls->name, p->tuned, lad,
+                     label, p->timing.cost_ms, p->timing.wall_ms, p->timing.gpu_ms, p->timing.wall_min_ms,
+                     p->timing.wall_max_ms, p->train_error, p->test_error, p->on_front, p->timing.n,
+                     !p->tuned ? "none" : p->local ? "local" : "global", p->evals, p->timing.renderer);
     }
     snprintf(path, sizeof path, "%s/fronts.csv", dir);
     gr_status st = gr_outfile_write(path, gr_sb_str(&b), -1, err);
@@ -413,6 +447,7 @@ int gr_pareto_suite(gr_args *args, const gr_ps_opts *o)
     r.bl = malloc(sizeof *r.bl);
     gr_status st = r.pts && r.bl ? GR_OK : gr_fail(&err, GR_E_NOMEM, "out of memory");
     if (st == GR_OK) st = gr_gl_create(&glo, &r.gl, &err); /* before the slow ground truths */
+    if (st == GR_OK) r.repeat = o->repeat > 0 ? o->repeat : gr_timing_is_cpu_renderer(gr_gl_renderer(r.gl)) ? 3 : 5;
     if (st == GR_OK) st = truths(o, &r, &err);
     if (st == GR_OK) st = gr_st_baselines(r.cases, r.suite->n_cases, GR_SPLIT_TEST, r.bl, &err);
     for (int k = 0; k < o->n_techs && st == GR_OK; k++) st = technique(o, &r, o->techs[k], &err);

@@ -11,11 +11,15 @@
 
 typedef struct gr_ps_opts {
     const char *suite_path, *outopt;
-    int tune, quick, quiet, use_cache, repeat;
+    int tune, quick, quiet, use_cache;
+    int repeat;          /* renders timed per point (0: 3 on a CPU rasterizer, 5 on a GPU) */
+    double timing_cap_s; /* fewer timed renders once they took this long (0: no cap) */
     int timing_w, timing_h;
     int n_budgets;
     double budgets_ms[GR_PS_MAX_BUDGETS];
-    int max_evals;
+    int max_evals;       /* the global search's, per local search (0: its default) */
+    int tune_full;       /* the global search at every ladder point (else only at the anchor) */
+    int local_evals;     /* the continuation's local search (0: gr_st_local_evals) */
     unsigned long long seed;
     gr_gl_platform platform;
     const gr_technique_class *const *techs;

@@ -63,6 +63,12 @@ void gr_timing_from_stats(const gr_technique_stats *all, int n, const char *rend
 gr_status gr_timing_measure(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out, int warmup,
                             int n, gr_timing *res, gr_error *err)
 {
+    return gr_timing_measure_capped(t, scene, settings, out, warmup, n, 0, res, err);
+}
+
+gr_status gr_timing_measure_capped(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out,
+                                   int warmup, int n, double cap_s, gr_timing *res, gr_error *err)
+{
     if (n < 1 || n > GR_TIMING_MAX_REPEAT || warmup < 0 || warmup > GR_TIMING_MAX_REPEAT)
         return gr_fail(err, GR_E_INPUT, "timing: %d renders after %d warm-ups (1..%d timed)", n, warmup,
                        GR_TIMING_MAX_REPEAT);
@@ -70,9 +76,15 @@ gr_status gr_timing_measure(gr_technique *t, const gr_scene *scene, const void *
     if (!all) return gr_fail(err, GR_E_NOMEM, "timing: out of memory");
     gr_status st = GR_OK;
     for (int k = 0; st == GR_OK && k < warmup; k++) st = gr_technique_render(t, scene, settings, out, &all[0], err);
-    for (int k = 0; st == GR_OK && k < n; k++) st = gr_technique_render(t, scene, settings, out, &all[k], err);
+    int done = 0;
+    double spent_ms = 0;
+    for (; st == GR_OK && done < n; done++) {
+        if (cap_s > 0 && done > 0 && spent_ms >= 1e3 * cap_s) break;
+        st = gr_technique_render(t, scene, settings, out, &all[done], err);
+        spent_ms += all[done].wall_ms;
+    }
     if (st == GR_OK) {
-        gr_timing_from_stats(all, n, gr_gl_renderer(gr_technique_gl(t)), res);
+        gr_timing_from_stats(all, done, gr_gl_renderer(gr_technique_gl(t)), res);
         res->warmup = warmup;
     }
     free(all);

@@ -33,6 +33,13 @@ int gr_timing_is_cpu_renderer(const char *renderer);
 gr_status gr_timing_measure(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out, int warmup,
                             int n, gr_timing *res, gr_error *err);
 
+/* As gr_timing_measure, but the timed renders stop early, once they took cap_s seconds of wall
+ * time together (cap_s <= 0: no cap): a render of several seconds on a CPU rasterizer is timed
+ * once after its warm-up instead of n times. At least one render is timed; res->n states how
+ * many were (docs/tuning.md "Warm timing"). */
+gr_status gr_timing_measure_capped(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out,
+                                   int warmup, int n, double cap_s, gr_timing *res, gr_error *err);
+
 /* Median and spread of already measured stats (all[0..n)): what gr_timing_measure fills after
  * its renders, for callers that render themselves. */
 void gr_timing_from_stats(const gr_technique_stats *all, int n, const char *renderer, gr_timing *res);

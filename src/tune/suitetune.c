@@ -87,6 +87,11 @@ static gr_status level_params(const gr_technique_class *cls, const gr_st_options
     if (!spec) {
         if (gr_tune_default_params(cls, buf, sizeof buf))
             return gr_fail(err, GR_E_INPUT, "technique %s has no settings to tune", cls->name);
+        /* a class without tune_keys tunes every setting with a tuning box: at most the first
+         * GR_TUNE_MAX_PARAMS of them (radial_blur_local has 10) */
+        char *c = buf;
+        for (int k = 0; c && k < GR_TUNE_MAX_PARAMS; k++) c = strchr(c + (k > 0), ',');
+        if (c) *c = '\0';
         spec = buf;
     }
     return gr_tune_param_parse_list("--params", spec, params, GR_TUNE_MAX_PARAMS, n, err);
@@ -102,6 +107,56 @@ static void point_init(gr_st_point *pt, const gr_technique_class *cls, int level
     pt->n_params = tuned ? p->n_params : 0;
     for (int k = 0; k < pt->n_params; k++) snprintf(pt->keys[k], sizeof pt->keys[k], "%s", p->params[k].p->name);
     pt->train_error = pt->test_error = NAN;
+}
+
+/* The search of one ladder point on the train problem p from the untuned x0 (its value f0):
+ * the global search of optimize.c, or with o->n_from the continuation's local search
+ * (suitetune.h) from the best of x0 and o->from[] (candidates evaluated in order, ties: the
+ * earlier; their evaluations counted in res->evals). */
+static gr_status search(gr_tune_problem *p, int np, const double *x0, double f0, const double *lo, const double *hi,
+                        const gr_st_options *o, gr_opt_result *res, int *local, gr_error *err)
+{
+    gr_opt_options oo;
+    gr_tune_search_defaults(&oo, np, x0);
+    oo.seed = o ? o->seed : 0;
+    *local = o && o->n_from > 0;
+    if (*local) {
+        double best[GR_TUNE_MAX_PARAMS], fb = f0;
+        int extra = 0;
+        memcpy(best, x0, (size_t)np * sizeof *best);
+        for (int c = 0; c < o->n_from && c < 2; c++) {
+            double xc[GR_TUNE_MAX_PARAMS], f;
+            for (int k = 0; k < np; k++) xc[k] = o->from[c][k] < lo[k] ? lo[k] : o->from[c][k] > hi[k] ? hi[k] : o->from[c][k];
+            gr_status st = gr_tune_objective(p, xc, &f, err);
+            if (st != GR_OK) return st;
+            extra++;
+            if (f < fb) fb = f, memcpy(best, xc, (size_t)np * sizeof *best);
+        }
+        /* one start, no first stage, no screening: a simplex of 5 % of each box side (the
+         * neighbouring point's optimum is that close: docs/tuning.md) and its restart at a fifth
+         * of that, then the compass polish along the axes (on an 8-bit target's stepped error
+         * surface the simplex stalls on a step; the polish moves one setting at a time) */
+        oo.x0 = best;
+        oo.n_starts = 1;
+        oo.coarse = oo.screen = 0;
+        oo.init_step = 0.05;
+        oo.max_evals = oo.polish = o->local_evals > 0 ? o->local_evals : gr_st_local_evals(np);
+        gr_status st = gr_opt_minimize(np, lo, hi, gr_tune_objective, p, &oo, res, err);
+        if (st == GR_OK && !(res->f <= fb)) { /* never worse than its start (a failed run's f is +inf) */
+            res->f = fb;
+            memcpy(res->x, best, (size_t)np * sizeof *best);
+        }
+        res->evals += extra;
+        return st;
+    }
+    oo.n_starts = o && o->n_starts > 0 ? o->n_starts : 2;
+    oo.screen = 2 * oo.n_starts;
+    oo.coarse = o && o->coarse > 0 ? o->coarse : 8 * np;
+    if (o && o->max_evals > 0) {
+        oo.max_evals = oo.polish = o->max_evals;
+        if (oo.screen_evals > o->max_evals) oo.screen_evals = o->max_evals;
+    }
+    return gr_opt_minimize(np, lo, hi, gr_tune_objective, p, &oo, res, err);
 }
 
 gr_status gr_st_tune_level(gr_technique *r, const gr_st_case *cases, int n_cases, int level, const gr_st_options *o,
@@ -136,20 +191,10 @@ gr_status gr_st_tune_level(gr_technique *r, const gr_st_case *cases, int n_cases
     if (st == GR_OK) st = gr_tune_evaluate(&test, x0, &u.test_error, NULL, NULL, err);
     if (st == GR_OK && untuned) *untuned = u;
     if (st == GR_OK && tuned) {
-        gr_opt_options oo;
-        gr_tune_search_defaults(&oo, np, x0);
-        oo.n_starts = o && o->n_starts > 0 ? o->n_starts : 2;
-        oo.screen = 2 * oo.n_starts;
-        oo.coarse = o && o->coarse > 0 ? o->coarse : 8 * np;
-        if (o && o->max_evals > 0) {
-            oo.max_evals = oo.polish = o->max_evals;
-            if (oo.screen_evals > o->max_evals) oo.screen_evals = o->max_evals;
-        }
-        oo.seed = o ? o->seed : 0;
         gr_opt_result res;
         gr_st_point *t = tuned;
         point_init(t, cls, level, 1, &train);
-        st = gr_opt_minimize(np, lo, hi, gr_tune_objective, &train, &oo, &res, err);
+        st = search(&train, np, x0, u.train_error, lo, hi, o, &res, &t->local, err);
         if (st == GR_OK) {
             memcpy(t->x, res.x, (size_t)np * sizeof *t->x);
             t->evals = res.evals;
@@ -181,14 +226,39 @@ gr_status gr_st_level_settings(const gr_technique_class *cls, const gr_scene *sc
     return st;
 }
 
-gr_status gr_st_time_point(gr_technique *r, const gr_scene *scene, int repeat, gr_st_point *pt, gr_error *err)
+gr_status gr_st_time_point(gr_technique *r, const gr_scene *scene, int repeat, double cap_s, gr_st_point *pt,
+                           gr_error *err)
 {
     gr_image *img = gr_image_create(scene->camera.width, scene->camera.height, 3, NULL);
     if (!img) return gr_fail(err, GR_E_NOMEM, "out of memory for a %dx%d frame", scene->camera.width, scene->camera.height);
-    gr_status st = gr_timing_measure(r, scene, pt->settings.bytes, img, 1, repeat, &pt->timing, err);
+    gr_status st = gr_timing_measure_capped(r, scene, pt->settings.bytes, img, 1, repeat, cap_s, &pt->timing, err);
     pt->timed = st == GR_OK;
     gr_image_destroy(img);
     return st;
+}
+
+int gr_st_local_evals(int n)
+{
+    return 20 + 12 * n;
+}
+
+int gr_st_continuation_order(int n, int *order, int *prev)
+{
+    const int a = n / 2;
+    int k = 0;
+    for (int l = a; l < n; l++, k++) order[k] = l, prev[k] = l == a ? -1 : k - 1;
+    for (int l = a - 1; l >= 0; l--, k++) order[k] = l, prev[k] = l == a - 1 ? 0 : k - 1;
+    return a;
+}
+
+void gr_st_continue_from(gr_st_options *o, const gr_st_point *anchor, const gr_st_point *neighbour)
+{
+    o->n_from = 0;
+    const gr_st_point *c[2] = {neighbour, anchor};
+    for (int i = 0; i < 2; i++) {
+        if (!c[i] || !c[i]->tuned || (i == 1 && c[1] == c[0])) continue;
+        memcpy(o->from[o->n_from++], c[i]->x, sizeof o->from[0]);
+    }
 }
 
 void gr_st_mark_fronts(gr_st_point *pts, int n)

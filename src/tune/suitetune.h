@@ -7,6 +7,14 @@
  * TRAIN error among those that fit (the test error is never used to choose: it is what the
  * table reports, so the choice does not peek at the views it is judged on).
  *
+ * Continuation along the ladder (docs/tuning.md "Continuation along the ladder"): the full global
+ * search runs at one anchor point per technique (the middle of its ladder); every other point
+ * gets a short local search (Nelder-Mead with a small simplex and its restart, o->local_evals)
+ * started from the best, on the train cases, of the untuned point, the neighbouring point's
+ * tuned values and the anchor's (gr_st_options.from). The look settings that fit a ladder point
+ * move little between neighbouring points (they change cost, not the look), so the local search
+ * starts in the basin the anchor's global search found, at a tenth of its evaluations.
+ *
  * Settings derived from the scene (a descriptor's scene_source: the camera position, the
  * medium's extinction) and not tuned are left unresolved, so that each case resolves them from
  * its own scene; a tuned RGB setting (extinction) is tuned as a scale on case 0's value, and
@@ -36,7 +44,18 @@ typedef struct gr_st_options {
     int n_starts;             /* 0: 2 */
     int coarse;               /* first-stage sample points (0: 8 per parameter) */
     unsigned long long seed;
+    /* continuation: n_from > 0 replaces the global search by a local one (local_evals for the
+     * simplex and as many for the polish; 0: gr_st_local_evals) from the best on the train
+     * cases of from[0..n_from) and the untuned point */
+    int n_from;
+    double from[2][GR_TUNE_MAX_PARAMS];
+    int local_evals;
 } gr_st_options;
+
+/* The continuation's default budget for n tuned settings: 20 + 12 n evaluations for the simplex
+ * and as many for the polish (44 each for 2 settings: the least that recovered the
+ * identifiability check's settings within 2 % at every shafts ladder point; 16-30 did not). */
+int gr_st_local_evals(int n);
 
 typedef struct gr_st_point {
     const gr_technique_class *cls;
@@ -49,6 +68,7 @@ typedef struct gr_st_point {
     double x[GR_TUNE_MAX_PARAMS]; /* the tuned parameters' values (RGB: the scale) */
     double train_error, test_error; /* mean verdict after the scale fit over the split's cases */
     int evals;
+    int local;                    /* 1: tuned by the continuation's local search; 0: the global one */
     gr_timing timing;             /* at the timing size (timed = 1) */
     int timed;
     int on_front;                 /* on the front of (cost, test error) of its technique and kind */
@@ -70,8 +90,19 @@ gr_status gr_st_tune_level(gr_technique *r, const gr_st_case *cases, int n_cases
 gr_status gr_st_level_settings(const gr_technique_class *cls, const gr_scene *scene0, int level, const gr_st_options *o,
                                const double *x, void *out, gr_error *err);
 
-/* Times pt's settings warm (1 warm-up, repeat renders) on scene (a case at the timing size). */
-gr_status gr_st_time_point(gr_technique *r, const gr_scene *scene, int repeat, gr_st_point *pt, gr_error *err);
+/* The continuation's order over n ladder points (positions 0..n-1) from the anchor n / 2:
+ * the anchor, the points above it upwards, then the points below it downwards; prev[k] is the
+ * position of order[k]'s neighbour tuned before it (-1 for the anchor). */
+int gr_st_continuation_order(int n, int *order, int *prev);
+
+/* o with from[] set to the tuned values of the anchor and of the neighbour (either NULL or
+ * untuned: left out; both the same point: once) and n_from to their count. */
+void gr_st_continue_from(gr_st_options *o, const gr_st_point *anchor, const gr_st_point *neighbour);
+
+/* Times pt's settings warm (1 warm-up, then up to repeat renders, fewer once the timed renders
+ * took cap_s seconds: gr_timing_measure_capped) on scene (a case at the timing size). */
+gr_status gr_st_time_point(gr_technique *r, const gr_scene *scene, int repeat, double cap_s, gr_st_point *pt,
+                           gr_error *err);
 
 /* The points of each (technique, tuned) family on the front of (timing cost, test error). */
 void gr_st_mark_fronts(gr_st_point *pts, int n);
