@@ -88,7 +88,7 @@ static gr_status level_params(const gr_technique_class *cls, const gr_st_options
         if (gr_tune_default_params(cls, buf, sizeof buf))
             return gr_fail(err, GR_E_INPUT, "technique %s has no settings to tune", cls->name);
         /* a class without tune_keys tunes every setting with a tuning box: at most the first
-         * GR_TUNE_MAX_PARAMS of them (radial_blur_local has 10) */
+         * GR_TUNE_MAX_PARAMS of them (a built-in class without tune_keys has 10) */
         char *c = buf;
         for (int k = 0; c && k < GR_TUNE_MAX_PARAMS; k++) c = strchr(c + (k > 0), ',');
         if (c) *c = '\0';

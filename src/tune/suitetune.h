@@ -54,7 +54,7 @@ typedef struct gr_st_options {
 
 /* The continuation's default budget for n tuned settings: 20 + 12 n evaluations for the simplex
  * and as many for the polish (44 each for 2 settings: the least that recovered the
- * identifiability check's settings within 2 % at every shafts ladder point; 16-30 did not). */
+ * identifiability check's settings within 2 % at every ladder point; 16-30 did not). */
 int gr_st_local_evals(int n);
 
 typedef struct gr_st_point {
