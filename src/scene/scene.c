@@ -1396,15 +1396,15 @@ static gr_status load_string_impl(const char *json, const char *label, const cha
     return gr_error_prefix(err, "%s", label);
 }
 
-static gr_status load_file_impl(const char *path, const char *const *overrides, int n_overrides, gr_scene *out,
-                                gr_error *err)
+/* A JSON file's text (scene, suite, preset): the one reader; see scene.h. */
+gr_status gr_json_read_file(const char *path, const char *what, size_t max_bytes, char **out, gr_error *err)
 {
-    if (!path) return gr_fail(err, GR_E_RUNTIME, "gr_scene_load_file: no path");
+    *out = NULL;
     gr_status reg = gr_check_regular_input(path, err); /* a FIFO would block the open */
     if (reg != GR_OK) return reg;
     FILE *f = fopen(path, "rb");
     if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, strerror(errno));
-    size_t cap = 1 << 16, len = 0;
+    size_t cap = 1 << 14, len = 0;
     char *buf = malloc(cap);
     if (!buf) {
         fclose(f);
@@ -1412,11 +1412,11 @@ static gr_status load_file_impl(const char *path, const char *const *overrides, 
     }
     for (;;) {
         if (len + 1 >= cap) {
-            if (cap >= GR_MAX_SCENE_BYTES) {
+            if (cap >= max_bytes) {
                 free(buf);
                 fclose(f);
-                return gr_fail(err, GR_E_INPUT, "%s: file too large for a scene (over %u MiB)", path,
-                               GR_MAX_SCENE_BYTES >> 20);
+                return gr_fail(err, GR_E_INPUT, "%s: file too large for a %s (over %zu MiB)", path, what,
+                               max_bytes >> 20);
             }
             char *nb = realloc(buf, cap * 2);
             if (!nb) {
@@ -1442,6 +1442,17 @@ static gr_status load_file_impl(const char *path, const char *const *overrides, 
         free(buf);
         return gr_fail(err, GR_E_INPUT, "%s: not a JSON text (contains a NUL byte)", path);
     }
+    *out = buf;
+    return GR_OK;
+}
+
+static gr_status load_file_impl(const char *path, const char *const *overrides, int n_overrides, gr_scene *out,
+                                gr_error *err)
+{
+    if (!path) return gr_fail(err, GR_E_RUNTIME, "gr_scene_load_file: no path");
+    char *buf = NULL;
+    gr_status rd = gr_json_read_file(path, "scene", GR_MAX_SCENE_BYTES, &buf, err);
+    if (rd != GR_OK) return rd;
     gr_status st = load_string_impl(buf, path, overrides, n_overrides, out, err);
     free(buf);
     if (st == GR_OK) snprintf(out->source_path, sizeof out->source_path, "%s", path);

@@ -116,6 +116,10 @@ gr_status gr_scene_load_string(const char *json, const char *label,
 /* Parses JSON text (a scene, a user technique's manifest) into a cJSON tree (*out, the
  * caller's: cJSON_Delete); GR_E_INPUT "LABEL:LINE:COL: malformed JSON near '...'" (or at end
  * of input, or nested deeper than cJSON's limit): the one wording of a JSON syntax error. */
+/* Reads a JSON file's text (*out, malloc'd, NUL-terminated): a regular file only, at most
+ * max_bytes ("PATH: file too large for a WHAT (over N MiB)", GR_E_INPUT), no NUL byte inside;
+ * GR_E_IO naming the file when it cannot be opened or read. Scenes, suites and presets. */
+gr_status gr_json_read_file(const char *path, const char *what, size_t max_bytes, char **out, gr_error *err);
 struct cJSON;
 gr_status gr_json_parse(const char *text, const char *label, struct cJSON **out, gr_error *err);
 /* "a number", "a string", "a boolean", "null", "an array", "an object" for error messages;

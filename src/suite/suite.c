@@ -55,53 +55,6 @@ void gr_suite_destroy(gr_suite *suite)
     free(suite);
 }
 
-/* The whole file as a NUL-terminated string (the caller frees it). */
-static gr_status read_text(const char *path, char **out, gr_error *err)
-{
-    *out = NULL;
-    gr_status st = gr_check_regular_input(path, err); /* a FIFO would block the open */
-    if (st != GR_OK) return st;
-    FILE *f = fopen(path, "rb");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, strerror(errno));
-    size_t cap = 1 << 14, len = 0;
-    char *buf = malloc(cap);
-    for (;;) {
-        if (!buf) {
-            fclose(f);
-            return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
-        }
-        if (len + 1 >= cap) {
-            if (cap >= SUITE_MAX_BYTES) {
-                free(buf);
-                fclose(f);
-                return gr_fail(err, GR_E_INPUT, "%s: file too large for a suite (over %u MiB)", path,
-                               SUITE_MAX_BYTES >> 20);
-            }
-            char *nb = realloc(buf, cap * 2);
-            if (!nb) free(buf);
-            buf = nb;
-            cap *= 2;
-            continue;
-        }
-        size_t got = fread(buf + len, 1, cap - 1 - len, f);
-        len += got;
-        if (got == 0) break;
-    }
-    const int rerr = ferror(f) ? errno : 0;
-    fclose(f);
-    if (rerr) {
-        free(buf);
-        return gr_fail(err, GR_E_IO, "%s: cannot read: %s", path, strerror(rerr));
-    }
-    buf[len] = '\0';
-    if (memchr(buf, '\0', len)) {
-        free(buf);
-        return gr_fail(err, GR_E_INPUT, "%s: not a JSON text (contains a NUL byte)", path);
-    }
-    *out = buf;
-    return GR_OK;
-}
-
 /* Every key of object v is one of allowed; else "FILE: WHERE.KEY: unknown key (known: ...)". */
 static gr_status check_keys(const char *file, const char *where, const cJSON *v, const char *const *allowed,
                             gr_error *err)
@@ -366,7 +319,7 @@ gr_status gr_suite_load_with(const char *path, const char *const *overrides, int
         return gr_fail(err, GR_E_RUNTIME, "%s: bad override list", path);
     if (strlen(path) >= sizeof((gr_suite *)0)->path) return gr_fail(err, GR_E_INPUT, "%s: path too long", path);
     char *text = NULL;
-    gr_status st = read_text(path, &text, err);
+    gr_status st = gr_json_read_file(path, "suite", SUITE_MAX_BYTES, &text, err);
     if (st != GR_OK) return st;
     cJSON *root = NULL;
     st = gr_json_parse(text, path, &root, err);

@@ -99,27 +99,6 @@ gr_status gr_preset_write(const char *path, const gr_technique_class *cls, const
     return st;
 }
 
-/* The file's text (NUL-terminated, malloc'd). */
-static gr_status read_small(const char *path, char **out, gr_error *err)
-{
-    gr_status st = gr_check_regular_input(path, err);
-    if (st != GR_OK) return st;
-    FILE *f = fopen(path, "rb");
-    if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, strerror(errno));
-    char *buf = malloc(PRESET_MAX_BYTES + 1);
-    size_t len = buf ? fread(buf, 1, PRESET_MAX_BYTES + 1, f) : 0;
-    const int rerr = ferror(f) ? errno : 0;
-    fclose(f);
-    if (!buf) return gr_fail(err, GR_E_NOMEM, "%s: out of memory", path);
-    if (rerr || len > PRESET_MAX_BYTES) {
-        free(buf);
-        return rerr ? gr_fail(err, GR_E_IO, "%s: cannot read: %s", path, strerror(rerr))
-                    : gr_fail(err, GR_E_INPUT, "%s: too large for a preset (over 1 MiB)", path);
-    }
-    buf[len] = '\0';
-    *out = buf;
-    return GR_OK;
-}
 
 /* The override for one setting: "NAME.KEY=JSON", its JSON type checked against the table. */
 static gr_status setting_override(const char *path, const gr_technique_class *cls, const cJSON *v, char **out,
@@ -171,7 +150,7 @@ gr_status gr_preset_load(const char *path, gr_preset *out, gr_error *err)
     memset(out, 0, sizeof *out);
     char *text = NULL;
     cJSON *root = NULL;
-    gr_status st = read_small(path, &text, err);
+    gr_status st = gr_json_read_file(path, "preset", PRESET_MAX_BYTES, &text, err);
     if (st == GR_OK) st = gr_json_parse(text, path, &root, err);
     free(text);
     if (st != GR_OK) return st;
