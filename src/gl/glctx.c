@@ -366,19 +366,10 @@ static gr_status compile(GLenum type, const char *name, const char *src, GLuint 
     return GR_OK;
 }
 
-gr_status gr_gl_build_program(const char *name, const char *vert_src, const char *frag_src,
-                              unsigned *program, gr_error *err)
+gr_status gr_gl_link_program(const char *name, unsigned vs, unsigned fs, unsigned *program, gr_error *err)
 {
     if (!name) name = "shader";
-    if (!program) return gr_fail(err, GR_E_USAGE, "%s: program is NULL", name);
     *program = 0;
-    GLuint vs = 0, fs = 0;
-    gr_status st = compile(GL_VERTEX_SHADER, name, vert_src, &vs, err);
-    if (st == GR_OK) st = compile(GL_FRAGMENT_SHADER, name, frag_src, &fs, err);
-    if (st != GR_OK) {
-        if (vs) glDeleteShader(vs);
-        return st;
-    }
     GLuint prog = glCreateProgram();
     glAttachShader(prog, vs);
     glAttachShader(prog, fs);
@@ -397,6 +388,22 @@ gr_status gr_gl_build_program(const char *name, const char *vert_src, const char
     }
     *program = prog;
     return gr_gl_check(name, err);
+}
+
+gr_status gr_gl_build_program(const char *name, const char *vert_src, const char *frag_src,
+                              unsigned *program, gr_error *err)
+{
+    if (!name) name = "shader";
+    if (!program) return gr_fail(err, GR_E_USAGE, "%s: program is NULL", name);
+    *program = 0;
+    GLuint vs = 0, fs = 0;
+    gr_status st = compile(GL_VERTEX_SHADER, name, vert_src, &vs, err);
+    if (st == GR_OK) st = compile(GL_FRAGMENT_SHADER, name, frag_src, &fs, err);
+    if (st != GR_OK) {
+        if (vs) glDeleteShader(vs);
+        return st;
+    }
+    return gr_gl_link_program(name, vs, fs, program, err);
 }
 
 gr_status gr_gl_check_target_size(const char *what, int w, int h, unsigned internal_format, gr_error *err)

@@ -48,6 +48,11 @@ void gr_gl_context_version(const gr_gl *gl, int *major, int *minor);
  * lines, joined on one line). *program is 0 on failure. Needs a current context. */
 gr_status gr_gl_build_program(const char *name, const char *vert_src, const char *frag_src,
                               unsigned *program, gr_error *err);
+/* Links compiled vertex and fragment shaders vs and fs (deleted here, whatever the outcome)
+ * into *program; a link failure returns GR_E_GL "NAME: program does not link: LOG" (the
+ * driver's log on one line), *program 0. The link step of gr_gl_build_program, for callers that
+ * compile their stages themselves (user techniques, which map the compile log to their files). */
+gr_status gr_gl_link_program(const char *name, unsigned vs, unsigned fs, unsigned *program, gr_error *err);
 
 /* Whether a w x h render target of `internal_format` (GL_RGBA32F for the god-ray layer) fits
  * this context before it is made: against GL_MAX_TEXTURE_SIZE, GL_MAX_RENDERBUFFER_SIZE and

@@ -430,24 +430,7 @@ static gr_status build_program(const gr_ut_manifest *m, int p, const char *label
         return st;
     }
     /* linking: the toolkit's (gl/glctx.h), whose message is one line */
-    GLuint pr = glCreateProgram();
-    glAttachShader(pr, v);
-    glAttachShader(pr, f);
-    glLinkProgram(pr);
-    glDeleteShader(v);
-    glDeleteShader(f);
-    GLint ok = 0;
-    glGetProgramiv(pr, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = "";
-        glGetProgramInfoLog(pr, (GLsizei)sizeof log, NULL, log);
-        for (char *q = log; *q; q++)
-            if (*q == '\n') *q = ' ';
-        glDeleteProgram(pr);
-        return gr_fail(err, GR_E_GL, "%s: program does not link: %s", label, log);
-    }
-    *prog = pr;
-    return gr_gl_check(label, err);
+    return gr_gl_link_program(label, v, f, prog, err);
 }
 
 /* ---- instances ------------------------------------------------------------------------------ */
