@@ -258,13 +258,15 @@ int gr_tune_default_params(const gr_technique_class *cls, char *buf, size_t n)
         }
     } else {
         const gr_param_table *t = cls->params;
-        for (size_t i = 0; i < t->count; i++) {
+        int taken = 0; /* at most GR_TUNE_MAX_PARAMS: the optimizer's limit */
+        for (size_t i = 0; i < t->count && taken < GR_TUNE_MAX_PARAMS; i++) {
             const gr_param *p = &t->params[i];
             if (!(p->tune_hi > p->tune_lo) || (p->type != GR_PT_DOUBLE && p->type != GR_PT_RGB)) continue;
             if (cls->gain_key && !strcmp(p->name, cls->gain_key)) continue;
             int w = snprintf(buf + len, n - len, "%s%s.%s", len ? "," : "", cls->name, p->name);
             if (w < 0 || (size_t)w >= n - len) return -1;
             len += (size_t)w;
+            taken++;
         }
     }
     return len ? 0 : -1;

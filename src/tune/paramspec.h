@@ -53,8 +53,8 @@ gr_status gr_tune_param_parse_list(const char *flag, const char *spec, gr_tune_p
                                    gr_error *err);
 
 /* The --params list `godrays tune` uses when none is given: "NAME.KEY,..." from the class's
- * tune_keys, else every non-integer numeric setting with a tuning box except its gain_key.
- * 0 on success, -1 if it does not fit in n bytes or is empty. */
+ * tune_keys, else the non-integer numeric settings with a tuning box except its gain_key, the
+ * first GR_TUNE_MAX_PARAMS of them (the optimizer's limit). 0 on success, -1 if it does not fit in n bytes or is empty. */
 int gr_tune_default_params(const gr_technique_class *cls, char *buf, size_t n);
 
 /* Parses "NAME.K=0.2:2" and sets the bounds of the matching entry of params[0..n).

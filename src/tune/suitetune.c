@@ -87,11 +87,6 @@ static gr_status level_params(const gr_technique_class *cls, const gr_st_options
     if (!spec) {
         if (gr_tune_default_params(cls, buf, sizeof buf))
             return gr_fail(err, GR_E_INPUT, "technique %s has no settings to tune", cls->name);
-        /* a class without tune_keys tunes every setting with a tuning box: at most the first
-         * GR_TUNE_MAX_PARAMS of them (a built-in class without tune_keys has 10) */
-        char *c = buf;
-        for (int k = 0; c && k < GR_TUNE_MAX_PARAMS; k++) c = strchr(c + (k > 0), ',');
-        if (c) *c = '\0';
         spec = buf;
     }
     return gr_tune_param_parse_list("--params", spec, params, GR_TUNE_MAX_PARAMS, n, err);
