@@ -749,6 +749,9 @@ const gr_technique_class gr_radial_blur_class = {
     .origin = "built-in",
     .class_data = &variant_blur,
     .gain_key = "intensity",
+    /* the look: the march's length and falloff, the light's size and cut, the fade; not exposure
+     * (a multiplier, the gain's twin) nor target_scale (a cost the ladder sets) */
+    .tune_keys = "decay,density,weight,light_radius_deg,threshold,fade_margin",
     .ladder = blur_ladder,
     .n_ladder = (int)(sizeof blur_ladder / sizeof blur_ladder[0]),
     .create = rb_create,
@@ -767,6 +770,8 @@ const gr_technique_class gr_radial_blur_local_class = {
     .origin = "built-in",
     .class_data = &variant_local,
     .gain_key = "intensity",
+    /* as radial_blur's, with the quads' size and falloff and the selection's cell for the fade */
+    .tune_keys = "decay,density,weight,light_radius_deg,threshold,quad_size,falloff,cell_size",
     .ladder = local_ladder,
     .n_ladder = (int)(sizeof local_ladder / sizeof local_ladder[0]),
     .create = rb_create,
