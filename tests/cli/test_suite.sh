@@ -44,7 +44,7 @@ ck "list: the up case keeps the scene's camera" grep -qE "^up +train +s\.json +2
 # run --suite: two cases, the first registered technique, cheap truths
 t1=$("$bin" techniques | awk 'NR == 1 { print $1 }')
 "$bin" run --suite "$dir/ok.json" --set reference.spp=1 --set reference.surface_res=64 --set reference.sun_samples=2 \
-    --set reference.batches=2 --set reference.steps=16 --techniques "$t1" -q -o "$dir/r" > "$dir/run.txt" 2>"$dir/run.err"
+    --set reference.batches=2 --set reference.steps=16 --techniques "$t1,radial_blur" -q -o "$dir/r" > "$dir/run.txt" 2>"$dir/run.err"
 rc=$?
 ck "run --suite: exit 0 or 3 (report complete), got $rc" test $rc -eq 0 -o $rc -eq 3
 cat "$dir/run.txt"
@@ -54,22 +54,31 @@ done
 # the per-case verdicts printed, the mean and worst recomputed here
 v_up=$(awk '$1 == "up" && $2 == "train" { print $4 }' "$dir/run.txt")
 v_ac=$(awk '$1 == "across" && $2 == "test" { print $4 }' "$dir/run.txt")
-p_mean=$(awk '$1 == "mean" && NF == 2 { print $2 }' "$dir/run.txt")
+p_mean=$(awk '$1 == "mean" && NF == 3 { print $2 }' "$dir/run.txt")
 p_worst=$(awk '$1 == "worst" { print $2 }' "$dir/run.txt")
 echo "printed: up $v_up, across $v_ac, mean $p_mean, worst $p_worst"
 ck "the mean is the mean of the cases" awk -v a="$v_up" -v b="$v_ac" -v m="$p_mean" \
     'BEGIN { e = (a + b) / 2; exit !(a > 0 && b > 0 && (m - e) ^ 2 <= (1e-5 * e) ^ 2) }'
 ck "the worst is their max" awk -v a="$v_up" -v b="$v_ac" -v w="$p_worst" \
     'BEGIN { e = a > b ? a : b; exit !((w - e) ^ 2 <= (1e-5 * e) ^ 2) }'
-# metrics.json: the same aggregate, and each case's verdict is its own report's
-j() { tr -d ' \t\n' < "$1" | grep -oE "\"$2\":[-0-9.e+]+" | head -n 1 | cut -d: -f2; }
-j_mean=$(j "$dir/r/metrics.json" mean_verdict)
-j_worst=$(j "$dir/r/metrics.json" worst_verdict)
+# metrics.json: the same aggregate
+# the aggregate entry of the first technique (entries are ranked: find it by name)
+agg1=$(tr -d ' \t\n' < "$dir/r/metrics.json" | grep -oE "\"technique\":\"$t1\",\"rank\":[0-9]+,\"mean_verdict\":[-0-9.e+]+,\"worst_verdict\":[-0-9.e+]+")
+j_mean=$(echo "$agg1" | grep -oE '"mean_verdict":[-0-9.e+]+' | cut -d: -f2)
+j_worst=$(echo "$agg1" | grep -oE '"worst_verdict":[-0-9.e+]+' | cut -d: -f2)
 ck "metrics.json mean = the printed mean ($j_mean)" awk -v a="$j_mean" -v b="$p_mean" 'BEGIN { exit !((a - b) ^ 2 <= (1e-5 * b) ^ 2) }'
 ck "metrics.json worst = the printed worst ($j_worst)" awk -v a="$j_worst" -v b="$p_worst" 'BEGIN { exit !((a - b) ^ 2 <= (1e-5 * b) ^ 2) }'
 ck "metrics.json names the worst case" grep -qE '"worst_case":[[:space:]]*"(up|across)"' "$dir/r/metrics.json"
 ck "index.html: thumbnails of both cases" grep -q 'cases/across/reference.png' "$dir/r/index.html"
 "$bin" validate "$dir/r/cases/across/scene.json" > /dev/null 2>&1
 ck "the test case's scene copy validates" test $? -eq 0
+# the across view has the sun behind the camera: the radial blur draws a black frame, which a
+# suite scores as the black baseline's verdict (not a failed cell)
+rb_ac=$(awk '$1 == "across" && $2 == "test" { print $5 }' "$dir/run.txt")
+black_ac=$(tr -d ' \t\n' < "$dir/r/cases/across/metrics.json" | grep -oE '"kind":"baseline","name":"black","label":"[^"]*","verdict":[-0-9.e+]+' | sed 's/.*://')
+echo "across: radial blur $rb_ac, black baseline $black_ac"
+ck "a black frame in a suite is scored as the black baseline ($rb_ac vs $black_ac)" awk -v a="$rb_ac" -v b="$black_ac" \
+    'BEGIN { exit !(b > 0 && (a - b) ^ 2 <= (1e-5 * b) ^ 2) }'
+ck "no FAILED cell" test "$(grep -c FAILED "$dir/run.txt")" -eq 0
 expect 2 "give one of them" run --suite "$dir/ok.json" "$dir/s.json"
 exit $fail
