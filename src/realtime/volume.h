@@ -20,9 +20,23 @@
 #include "scene/scene.h"
 
 /* ---- what the volume techniques share (volume_common.glsl's uniforms) ---- */
+/* The uniforms of caustic_stack.glsl (t_caustics, u_caustic_*): the one GLSL source that
+ * samples the caustic stack, read by the volume techniques and by user techniques' "caustics"
+ * input alike. */
+typedef struct gr_vol_caustic_locs {
+    int tex, layers, depth, origin, patch, texel, sun_rw;
+} gr_vol_caustic_locs;
+void gr_vol_caustic_locations(unsigned program, gr_vol_caustic_locs *l);
+/* Sets them for the current program from the last build of c with parameters cp: positions
+ * in a frame whose origin is world (frame_x, frame_z) (the eye for the volume techniques, 0 for
+ * world positions), the sun's disc blur on when sun_disc (f's sun radius seen from below), and
+ * binds the stack to texture unit `unit` (GL_TEXTURE_2D_ARRAY; leaves unit 0 active). */
+void gr_vol_caustic_set(const gr_vol_caustic_locs *l, const gr_caustics *c, const gr_caustics_params *cp,
+                        const gr_frame *f, int sun_disc, double frame_x, double frame_z, int unit);
+
 typedef struct gr_vol_locs {
-    int caustics, n_depths, cdepth, corigin, patch, refr, rest, shadow, light_vp, use_shadow, sigma_t, sigma_s, g,
-        esun, texel, sun_rw;
+    gr_vol_caustic_locs caus;
+    int refr, rest, shadow, light_vp, use_shadow, sigma_t, sigma_s, g, esun;
 } gr_vol_locs;
 typedef struct gr_vol_inputs {
     const gr_frame *f;
@@ -97,6 +111,16 @@ typedef struct gr_vol_settings {
     {.name = "shadow_extent_m", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.shadow_extent_m), .min = 0,          \
      .max = 1e5, .flags = GR_PF_MIN_EXCL, .def = 40, .unit = "m",                                                    \
      .doc = "half side of the shadow map's square around the eye"}
+
+/* The caustic stack's parameters from the block's caustic fields (texture_size, grid, patch_m,
+ * caustic_depths and the geometric depths between caustic_first_m and caustic_last_m; exact
+ * Fresnel): the one derivation, used by gr_vol_prepare and by the user techniques' "caustics"
+ * input (realtime/usertech.c). */
+void gr_vol_caustics_params(const gr_vol_settings *s, gr_caustics_params *cp);
+/* The descriptors of the block's caustic fields (GR_VOL_PARAMS_CAUSTICS, then
+ * GR_VOL_PARAMS_SUN_DISC) with offsets into a gr_vol_settings: the same names, ranges and
+ * defaults as every volume technique's section. *n receives their count. */
+const gr_param *gr_vol_caustic_descriptors(size_t *n);
 
 /* The GL passes of the prelude, in this order in each technique's timer and stats; a
  * technique's own passes follow (GR_VOL_PASS_OWN, or GR_VOL_PASS_CAUSTICS without caustics). */
