@@ -27,6 +27,7 @@ gr_status gr_scene_colour_init(gr_scene_colour *sc, const char *shader_dir, gr_e
     sc->seabed = glGetUniformLocation(p, "u_seabed");
     sc->albedo = glGetUniformLocation(p, "u_albedo");
     sc->inv_unit = glGetUniformLocation(p, "u_inv_unit");
+    sc->normal_offset = glGetUniformLocation(p, "u_normal_offset");
     glGenVertexArrays(1, &sc->vao);
     return gr_gl_check("scene colour setup", err);
 }
@@ -71,6 +72,9 @@ gr_status gr_scene_colour_draw(gr_scene_colour *sc, const gr_scene *scene, const
     glUniform3f(sc->albedo, (float)p->albedo[0], (float)p->albedo[1], (float)p->albedo[2]);
     glUniform3f(sc->inv_unit, unit[0] > 0 ? (float)(1.0 / unit[0]) : 0.0f, unit[1] > 0 ? (float)(1.0 / unit[1]) : 0.0f,
                 unit[2] > 0 ? (float)(1.0 / unit[2]) : 0.0f);
+    /* normal-offset shadows: 1.5 texels off the surface, so that a lit face's own texel does
+     * not shadow it (the map's depth slope across a texel, docs "Scene colour") */
+    glUniform1f(sc->normal_offset, (float)(1.5 * p->shadow_texel_m + 0.01));
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, depth_tex);
     glActiveTexture(GL_TEXTURE0);

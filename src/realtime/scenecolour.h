@@ -24,12 +24,13 @@ typedef struct gr_scene_colour {
     gr_light_pass light;          /* the toolkit's light pass: the surface-first pixels */
     unsigned prog, vao;           /* the lit surfaces (scene_colour.frag.glsl) */
     gr_vol_locs locs;
-    int inv_vp_rot, eye_depth, size, far, seabed, albedo, inv_unit;
+    int inv_vp_rot, eye_depth, size, far, seabed, albedo, inv_unit, normal_offset;
 } gr_scene_colour;
 
 typedef struct gr_scene_colour_params {
     double radius_deg;            /* the light pass's sun kernel radius in air (its normalization) */
     double albedo[3];             /* Lambertian albedo of the seabed and the occluders, per channel */
+    double shadow_texel_m;        /* the shadow map's texel side (2 half extent / size); 0: no map */
 } gr_scene_colour_params;
 
 /* Compiles both programs in the current context (shader_dir: --shader-dir, may be NULL); zero

@@ -846,7 +846,8 @@ static gr_status scene_colour_input(ut_state *s, const gr_scene *scene, ut_frame
     if (st) return st;
     unsigned depth_tex = 0;
     if ((st = gr_scenegl_eye_depth(s->sgl, scene, &fi->f, w, h, &depth_tex, err))) return st;
-    gr_scene_colour_params p = {.radius_deg = value_of(m, settings, &m->scol_radius_deg)};
+    gr_scene_colour_params p = {.radius_deg = value_of(m, settings, &m->scol_radius_deg),
+                                .shadow_texel_m = fi->shadow_tex ? 2.0 * fi->shadow_half_extent / s->shadow_size : 0.0};
     for (int c = 0; c < 3; c++)
         p.albedo[c] = m->scol_albedo_setting >= 0 ? gr_param_get_number(&m->params[m->scol_albedo_setting], settings, c)
                                                   : m->scol_albedo[c];

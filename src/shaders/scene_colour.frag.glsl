@@ -16,6 +16,7 @@ uniform float u_far;            // eye depth where nothing is hit
 uniform float u_seabed;         // seabed y - eye y (m); -1e30 without a seabed
 uniform vec3 u_albedo;
 uniform vec3 u_inv_unit;        // 1 / the radiance of 1 (per channel; 0 where E_sun is 0)
+uniform float u_normal_offset;  // m: the shadow map is read this far off the surface along N
 layout(location = 0) out vec4 o_color;
 
 vec3 view_dir(vec2 ndc)
@@ -69,8 +70,8 @@ void main()
     float mu = -u_refr.y;
     float d = max(u_rest - p.y, 0.0);
     float cosl = max(dot(n, -u_refr), 0.0);
-    // the shadow map read 2 cm off the surface along its normal (no self-shadowing acne)
-    vec3 e = u_esun * (vol_caustic(p, d) / mu * cosl) * exp(-u_sigma_t * (d / mu)) * vol_shadow(p + 0.02 * n); // SC1
+    // the shadow map read off the surface along its normal (no self-shadowing acne)
+    vec3 e = u_esun * (vol_caustic(p, d) / mu * cosl) * exp(-u_sigma_t * (d / mu)) * vol_shadow(p + u_normal_offset * n); // SC1
     vec3 L = u_albedo / PI * e * exp(-u_sigma_t * t); // SC2
     o_color = vec4(L * u_inv_unit, 0.0);
 }
