@@ -1212,7 +1212,8 @@ static gr_status ut_read_target(void *state, gr_image **out, gr_error *err)
                 }
                 for (int y = 0; y < ls; y++) /* texel row y = z increasing: drawn bottom-up as GL rows */
                     for (int x = 0; x < ls; x++) {
-                        float v = layer->pixels[(size_t)(ls - 1 - y) * ls + x], *o = img->pixels + ((size_t)y * W + x0 + x) * 4;
+                        float v = layer->pixels[(size_t)(ls - 1 - y) * ls + x];
+                        float *o = img->pixels + ((size_t)y * W + x0 + x) * 4;
                         o[0] = o[1] = o[2] = v;
                         o[3] = 1.0f;
                     }

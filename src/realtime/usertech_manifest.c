@@ -16,7 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "realtime/volume.h"
+#include "realtime/volsettings.h"
 #include "scene/scene.h"
 
 const char *const gr_ut_type_names[] = {"number", "int", "bool", "rgb", NULL};
@@ -924,7 +924,7 @@ static gr_status parse_light(ut_ctx *c, gr_ut_manifest *m, const cJSON *lt)
     return get_bool(c, lt, "sun_light", "occluders", &m->light_occluders);
 }
 
-/* "caustics": the volume techniques' caustic settings (realtime/volume.h
+/* "caustics": the volume techniques' caustic settings (realtime/volsettings.h
  * gr_vol_caustic_descriptors: the same keys, ranges and defaults), each a number or a setting's
  * name, sun_disc a bool; caustic_last_m >= caustic_first_m (gr_vol_check) when both are numbers. */
 static gr_status parse_caustics(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
@@ -958,9 +958,9 @@ static gr_status parse_caustics(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
             const gr_ut_value *u = &m->caustic[i];
             /* an exclusive lower end (patch_m, the depths: > 0): a number equal to it, or a
              * setting whose range reaches it inclusively */
+            const gr_param *sp = u->setting >= 0 ? &m->params[u->setting] : NULL;
             if ((d[i].flags & GR_PF_MIN_EXCL) &&
-                (u->setting < 0 ? u->v <= d[i].min
-                                : m->params[u->setting].min <= d[i].min && !(m->params[u->setting].flags & GR_PF_MIN_EXCL)))
+                (sp ? sp->min <= d[i].min && !(sp->flags & GR_PF_MIN_EXCL) : u->v <= d[i].min))
                 return vfail(c, p, "must be > %g%s", d[i].min, u->setting < 0 ? "" : " over the setting's whole range");
         }
         if (m->caustic[i].setting >= 0) literal = 0;

@@ -52,7 +52,7 @@ enum {
 };
 #define GR_UT_HARNESS_INPUTS "\"shadow_map\", \"eye_depth\", \"sun_light\", \"caustics\" or \"scene_colour\""
 /* The caustic stack's values of a "caustics" object: the volume techniques' caustic settings
- * (realtime/volume.h gr_vol_caustic_descriptors), in their order. */
+ * (realtime/volsettings.h gr_vol_caustic_descriptors), in their order. */
 #define GR_UT_CAUSTIC_VALUES 8
 
 typedef struct gr_ut_setting {

@@ -139,18 +139,6 @@ void gr_vol_caustics_params(const gr_vol_settings *s, gr_caustics_params *cp)
     gr_caustics_depths(cp->n_depths, s->caustic_first_m, s->caustic_last_m, cp->depths_m);
 }
 
-/* The block alone, for its descriptors' offsets (vol first: offsets into gr_vol_settings). */
-typedef struct vol_block {
-    gr_vol_settings vol;
-} vol_block;
-static const gr_param vol_caustic_descriptors[] = {GR_VOL_PARAMS_CAUSTICS(vol_block), GR_VOL_PARAMS_SUN_DISC(vol_block)};
-
-const gr_param *gr_vol_caustic_descriptors(size_t *n)
-{
-    *n = sizeof vol_caustic_descriptors / sizeof vol_caustic_descriptors[0];
-    return vol_caustic_descriptors;
-}
-
 void gr_vol_waves(const gr_scene *scene, const gr_frame *f, double ox, double oz, float *wa, float *wamp)
 {
     memset(wa, 0, GR_MAX_WAVES * 4 * sizeof *wa);
@@ -307,12 +295,4 @@ void gr_vol_cost_prelude(const gr_vol_base *b, const gr_vol_prep *p, gr_techniqu
         gr_caustics_cost(b->caus, &c);
         gr_vol_cost_pass(stats, GR_VOL_PASS_CAUSTICS, &c);
     }
-}
-
-gr_status gr_vol_check(const char *name, const gr_vol_settings *s, gr_error *err)
-{
-    if (!(s->caustic_last_m >= s->caustic_first_m))
-        return gr_fail(err, GR_E_INPUT, "%s.caustic_last_m = %g: must be >= %s.caustic_first_m (%g)", name,
-                       s->caustic_last_m, name, s->caustic_first_m);
-    return GR_OK;
 }

@@ -71,7 +71,8 @@ void main()
     float d = max(u_rest - p.y, 0.0);
     float cosl = max(dot(n, -u_refr), 0.0);
     // the shadow map read off the surface along its normal (no self-shadowing acne)
-    vec3 e = u_esun * (vol_caustic(p, d) / mu * cosl) * exp(-u_sigma_t * (d / mu)) * vol_shadow(p + u_normal_offset * n); // SC1
+    float v = vol_shadow(p + u_normal_offset * n);
+    vec3 e = u_esun * (vol_caustic(p, d) / mu * cosl) * exp(-u_sigma_t * (d / mu)) * v; // SC1
     vec3 L = u_albedo / PI * e * exp(-u_sigma_t * t); // SC2
     o_color = vec4(L * u_inv_unit, 0.0);
 }
