@@ -92,9 +92,12 @@ static gr_status fx_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     if ((st = gr_vol_base_init(&r->base, gl, dir, 1, err)) != GR_OK) goto fail;
     const gr_shader_stage apply[2] = {
         {GL_VERTEX_SHADER, {"volume_screen.vert.glsl", NULL, NULL, NULL}},
-        {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "froxel_apply.frag.glsl"}}};
+        {GL_FRAGMENT_SHADER,
+         {"volume_version.glsl", "volume_fragment.glsl", "caustic_stack.glsl", "volume_common.glsl",
+          "froxel_apply.frag.glsl"}}};
     const gr_shader_stage scatter[1] = {
-        {GL_COMPUTE_SHADER, {"volume_version.glsl", "volume_common.glsl", "froxel_scatter.comp.glsl", NULL}}};
+        {GL_COMPUTE_SHADER,
+         {"volume_version.glsl", "caustic_stack.glsl", "volume_common.glsl", "froxel_scatter.comp.glsl"}}};
     const gr_shader_stage integrate[1] = {{GL_COMPUTE_SHADER, {"froxel_integrate.comp.glsl", NULL, NULL, NULL}}};
     if ((st = gr_shader_program_stages(dir, apply, 2, NULL, 0, &r->prog, NULL, err)) != GR_OK) goto fail;
     if ((st = gr_shader_program_stages(dir, scatter, 1, NULL, 0, &r->prog_scatter, NULL, err)) != GR_OK) goto fail;

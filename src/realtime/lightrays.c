@@ -94,8 +94,12 @@ static gr_status lr_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
                                   {GL_FRAGMENT_SHADER, {"lightrays_surface.frag.glsl", NULL, NULL, NULL}}};
     const gr_shader_stage lines[3] = {
         {GL_VERTEX_SHADER, {"lightrays.vert.glsl", NULL, NULL, NULL}},
-        {GL_GEOMETRY_SHADER, {"volume_version.glsl", "volume_common.glsl", "volume_surface.glsl", "lightrays.geom.glsl"}},
-        {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "lightrays.frag.glsl"}}};
+        {GL_GEOMETRY_SHADER,
+         {"volume_version.glsl", "caustic_stack.glsl", "volume_common.glsl", "volume_surface.glsl",
+          "lightrays.geom.glsl"}},
+        {GL_FRAGMENT_SHADER,
+         {"volume_version.glsl", "volume_fragment.glsl", "caustic_stack.glsl", "volume_common.glsl",
+          "lightrays.frag.glsl"}}};
     if ((st = gr_shader_program_stages(dir, surf, 2, NULL, 0, &r->prog_surf, NULL, err)) != GR_OK) goto fail;
     if ((st = gr_shader_program_stages(dir, lines, 3, NULL, 0, &r->prog_lines, NULL, err)) != GR_OK) goto fail;
     GLuint p = r->prog_surf;

@@ -19,7 +19,7 @@ gr_status gr_shader_check_dir(const char *dir, gr_error *err);
 /* A program's stage: its files, read as gr_shader_source does and compiled as one source
  * in this order (the first starts with #version; the others follow, e.g. a shared prelude
  * then the stage's own file), NULL-ended. */
-#define GR_SHADER_MAX_FILES 4
+#define GR_SHADER_MAX_FILES 6
 #define GR_SHADER_MAX_STAGES 4
 typedef struct gr_shader_stage {
     unsigned type;                         /* GL_VERTEX_SHADER, GL_GEOMETRY_SHADER, ... */

@@ -86,7 +86,9 @@ static gr_status sl_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     if ((st = gr_vol_base_init(&r->base, gl, dir, 1, err)) != GR_OK) goto fail;
     const gr_shader_stage stages[2] = {
         {GL_VERTEX_SHADER, {"volume_screen.vert.glsl", NULL, NULL, NULL}},
-        {GL_FRAGMENT_SHADER, {"volume_version.glsl", "volume_fragment.glsl", "volume_common.glsl", "slicing.frag.glsl"}}};
+        {GL_FRAGMENT_SHADER,
+         {"volume_version.glsl", "volume_fragment.glsl", "caustic_stack.glsl", "volume_common.glsl",
+          "slicing.frag.glsl"}}};
     if ((st = gr_shader_program_stages(dir, stages, 2, NULL, 0, &r->prog, NULL, err)) != GR_OK) goto fail;
     /* the bilinear upsample of target_scale < 1: the radial blur's (the same reduced-resolution
      * post-process, docs/radial-blur.md "Cost") */

@@ -13,10 +13,14 @@
 #include "core/optics.h"
 #include "gl/gl.h"
 #include "realtime/frame.h"
+#include "realtime/caustics.h"
 #include "realtime/readback.h"
+#include "realtime/scenecolour.h"
 #include "realtime/scenegl.h"
+#include "realtime/shaders.h"
 #include "realtime/toolkit.h"
 #include "realtime/usertech_manifest.h"
+#include "realtime/volume.h"
 
 
 /* ---- class callbacks (declared here, GL part below) ------------------------------------- */
@@ -141,7 +145,15 @@ gr_status gr_technique_add_dir(const char *dir, gr_error *err)
     X(SHADOW_HALF_EXTENT, "float u_shadow_half_extent")                  \
     X(LIGHT_RADIANCE, "vec3 u_sun_light_radiance")                           \
     X(LIGHT_UNITS, "vec3 u_sun_light_units")                                 \
-    X(LIGHT_SIZE, "vec2 u_sun_light_size")
+    X(LIGHT_SIZE, "vec2 u_sun_light_size")                               \
+    X(CAUSTIC_LAYERS, "int u_caustic_layers")                            \
+    X(CAUSTIC_DEPTH, "float u_caustic_depth[64]")                        \
+    X(CAUSTIC_ORIGIN, "vec2 u_caustic_origin")                           \
+    X(CAUSTIC_PATCH, "float u_caustic_patch")                            \
+    X(CAUSTIC_TEXEL, "float u_caustic_texel")                            \
+    X(CAUSTIC_SUN_RW, "float u_caustic_sun_rw")                          \
+    X(SCENE_COLOUR_RADIANCE, "vec3 u_scene_colour_radiance")             \
+    X(SCENE_COLOUR_SIZE, "vec2 u_scene_colour_size")
 
 enum {
 #define X(id, decl) U_##id,
@@ -209,6 +221,12 @@ static const char ut_depth_helper[] =
     "// Distance (m) from the eye to the first occluder or the seabed through uv (u_far if none).\n"
     "float gr_eye_depth(vec2 uv) { return texture(t_eye_depth, uv).r; }\n";
 
+/* After the caustic stack's own GLSL (caustic_stack.glsl, the volume techniques' source). */
+static const char ut_caustic_helper[] =
+    "// Horizontal irradiance per unit E_sun at world point p, without extinction (the caustic stack;\n"
+    "// flat water: cos(theta_i) F_t). Irradiance across the beam: times E_sun / mu_t, mu_t = -u_refr_dir.y.\n"
+    "float gr_caustic_irradiance(vec3 p) { return gr_caustic_stack(p, u_refr_dir, u_rest_height - p.y); }\n";
+
 static const char *glsl_version_for(int major, int minor)
 {
     if (major > 4 || (major == 4 && minor >= 5)) return "450 core";
@@ -224,25 +242,39 @@ static char *make_prelude(const gr_ut_manifest *m, const gr_ut_pass *ps, int fra
     gr_ut_sb_add(&b, "// ---- godrays harness prelude (docs/techniques.md): technique '%s', pass '%s', %s stage\n", m->name,
            ps->name, frag ? "fragment" : "vertex");
     gr_ut_sb_add(&b, "#define GODRAYS 1\n#define GR_MAX_WAVES %d\n#define GR_PI 3.14159265358979\n", GR_MAX_WAVES);
-    int has_in[4] = {0}; /* by -GR_UT_IN_*: the harness inputs this pass reads */
+    int has_in[GR_UT_N_HARNESS_INPUTS + 1] = {0}; /* by -GR_UT_IN_*: the harness inputs this pass reads */
     for (int k = 0; k < ps->n_inputs; k++)
         if (ps->inputs[k] < 0) has_in[-ps->inputs[k]] = 1;
     for (int i = 0; i < U_COUNT; i++) {
         /* a harness input's uniforms only where the pass reads it */
         if ((i == U_LIGHT_VIEW_PROJ || i == U_SHADOW_HALF_EXTENT) && !has_in[-GR_UT_IN_SHADOW_MAP]) continue;
         if ((i == U_LIGHT_RADIANCE || i == U_LIGHT_UNITS || i == U_LIGHT_SIZE) && !has_in[-GR_UT_IN_LIGHT]) continue;
+        if ((i == U_SCENE_COLOUR_RADIANCE || i == U_SCENE_COLOUR_SIZE) && !has_in[-GR_UT_IN_SCENE_COLOUR]) continue;
+        /* the caustic stack's uniforms come with its GLSL (caustic_stack.glsl), below */
+        if (i >= U_CAUSTIC_LAYERS && i <= U_CAUSTIC_SUN_RW) continue;
         gr_ut_sb_add(&b, "uniform %s;\n", ut_uniform_decl[i]);
     }
     for (int i = 0; i < m->n_settings; i++) {
         static const char *const glsl_types[] = {"float", "int", "bool", "vec3"};
         gr_ut_sb_add(&b, "uniform %s u_set_%s;\n", glsl_types[m->settings[i].type], m->settings[i].key);
     }
-    for (int k = 0; k < ps->n_inputs; k++) gr_ut_sb_add(&b, "uniform sampler2D t_%s;\n", gr_ut_input_name(m, ps->inputs[k]));
+    for (int k = 0; k < ps->n_inputs; k++)
+        if (ps->inputs[k] != GR_UT_IN_CAUSTICS) /* a sampler2DArray, declared with its GLSL */
+            gr_ut_sb_add(&b, "uniform sampler2D t_%s;\n", gr_ut_input_name(m, ps->inputs[k]));
     if (ps->defines) gr_ut_sb_add(&b, "// the pass's \"defines\"\n%s", ps->defines);
     if (frag && !ps->vertex_src) gr_ut_sb_add(&b, "in vec2 v_uv;\n");
+    if (frag) gr_ut_sb_add(&b, "#define GR_FRAGMENT_STAGE 1\n");
     gr_ut_sb_add(&b, "%s", ut_helpers);
     if (has_in[-GR_UT_IN_SHADOW_MAP]) gr_ut_sb_add(&b, "%s", ut_shadow_helper);
     if (has_in[-GR_UT_IN_EYE_DEPTH]) gr_ut_sb_add(&b, "%s", ut_depth_helper);
+    if (has_in[-GR_UT_IN_CAUSTICS]) {
+        /* the volume techniques' own sampling code, not a copy (embedded shader) */
+        char *caus = NULL;
+        gr_error e;
+        if (gr_shader_source(NULL, "caustic_stack.glsl", &caus, NULL, &e) != GR_OK) b.failed = 1;
+        else gr_ut_sb_add(&b, "%s%s", caus, ut_caustic_helper);
+        free(caus);
+    }
     gr_ut_sb_add(&b, "// ---- end of the prelude\n#line 1\n");
     if (b.failed) {
         free(b.s);
@@ -311,7 +343,7 @@ static void undeclared_hint(const gr_ut_manifest *m, int p, const char *name, gr
 {
     if (!strncmp(name, "t_", 2)) {
         const char *in = name + 2;
-        int known = !strcmp(in, "shadow_map") || !strcmp(in, "eye_depth") || !strcmp(in, "sun_light");
+        int known = gr_ut_harness_input(in) < 0;
         for (int t = 0; t < m->n_targets && !known; t++) known = !strcmp(m->targets[t].name, in);
         if (known) {
             gr_ut_sb_add(b, " (hint: add \"%s\" to passes[%d].inputs in %s)", in, p, m->path);
@@ -437,6 +469,7 @@ static gr_status build_program(const gr_ut_manifest *m, int p, const char *label
 
 typedef struct ut_prog_locs {
     GLint u[U_COUNT];
+    gr_vol_caustic_locs caus; /* caustic_stack.glsl's, set by the volume code's function */
     GLint set[GR_UT_MAX_SETTINGS];
     GLint in[GR_UT_MAX_INPUTS];
 } ut_prog_locs;
@@ -451,6 +484,11 @@ typedef struct ut_state {
     gr_target tgt[GR_UT_MAX_TARGETS];
     gr_light_pass light_pass; /* the toolkit's: the "sun_light" input, as radial_blur's light pass */
     gr_target light;
+    gr_caustics *caus;        /* the "caustics" input: the volume techniques' stack */
+    gr_caustics_params cp;    /* of its last build */
+    gr_scene_colour scol;     /* the "scene_colour" input (realtime/scenecolour.h) */
+    int scol_ready;
+    gr_target scol_tgt;
     GLuint q_samples[GR_UT_MAX_PASSES];
     gr_gl_timer timer;
     int timer_ready;
@@ -515,11 +553,17 @@ static gr_status ut_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
             snprintf(nm, sizeof nm, "t_%s", gr_ut_input_name(m, ps->inputs[k]));
             l->in[k] = glGetUniformLocation(s->prog[p], nm);
         }
+        gr_vol_caustic_locations(s->prog[p], &l->caus);
     }
-    if (m->uses_shadow_map || m->uses_eye_depth || m->uses_light) {
+    if (m->uses_shadow_map || m->uses_eye_depth || m->uses_light || m->uses_scene_colour) {
         if ((st = gr_scenegl_create(gl, &s->sgl, err)) != GR_OK) goto fail;
     }
     if (m->uses_light && (st = gr_light_pass_init(&s->light_pass, NULL, err)) != GR_OK) goto fail;
+    if ((m->uses_caustics || m->uses_scene_colour) && (st = gr_caustics_create(NULL, &s->caus, err)) != GR_OK) goto fail;
+    if (m->uses_scene_colour) {
+        s->scol_ready = 1;
+        if ((st = gr_scene_colour_init(&s->scol, NULL, err)) != GR_OK) goto fail;
+    }
     glGenVertexArrays(1, &s->vao);
     glGenQueries(m->n_passes, s->q_samples);
     gr_gl_timer_init(&s->timer);
@@ -546,6 +590,9 @@ static void ut_destroy(void *state)
     gr_scenegl_destroy(s->sgl);
     gr_light_pass_free(&s->light_pass);
     gr_target_release(&s->light);
+    gr_caustics_destroy(s->caus);
+    if (s->scol_ready) gr_scene_colour_free(&s->scol);
+    gr_target_release(&s->scol_tgt);
     gr_readback_free(&s->rb);
     free(s);
 }
@@ -579,12 +626,30 @@ static gr_status ensure_target(ut_state *s, int t, int w, int h, gr_error *err)
     return gr_target_ensure(&s->tgt[t], fmts[tg->format], w, h, tg->linear ? GR_TARGET_LINEAR : 0, what, err);
 }
 
+/* The "caustics" object's values at these settings as the volume techniques' settings block
+ * (its caustic fields; their descriptors check the ranges and caustic_last_m >= caustic_first_m:
+ * GR_E_INPUT naming NAME.caustics.KEY). */
+static gr_status caustic_block(const gr_ut_manifest *m, const void *settings, gr_vol_settings *vs, gr_error *err)
+{
+    size_t n = 0;
+    const gr_param *d = gr_vol_caustic_descriptors(&n);
+    char section[64];
+    snprintf(section, sizeof section, "%s.caustics", m->name);
+    const gr_param_table tab = {section, d, n};
+    memset(vs, 0, sizeof *vs);
+    for (size_t i = 0; i < n && (int)i < m->n_caustic_values; i++) {
+        gr_status st = gr_param_set_number(&tab, vs, d[i].name, -1, value_of(m, settings, &m->caustic[i]), err);
+        if (st != GR_OK) return st;
+    }
+    return gr_vol_check(section, vs, err);
+}
+
 /* The render's memory before any target is made (docs/reliability.md, issue 31 finding 5: five
  * 8192^2 rgba32f targets, 7.6 GB, were made under a 1 GB limit): every target at its size and
  * format, the readback (RGBA float per pixel) and the harness inputs (the shadow map's 32-bit
  * depth; the eye depth's R32F texture and its 32-bit depth buffer). */
-static gr_status check_memory(const ut_state *s, const void *settings, int W, int H, const int *tw, const int *th,
-                              gr_error *err)
+static gr_status check_memory(const ut_state *s, const void *settings, const gr_vol_settings *vs, int W, int H,
+                              const int *tw, const int *th, gr_error *err)
 {
     static const double px_bytes[] = {4, 8, 16}; /* rgba8, rgba16f, rgba32f */
     const gr_ut_manifest *m = s->m;
@@ -598,6 +663,18 @@ static gr_status check_memory(const ut_state *s, const void *settings, int W, in
     if (m->uses_light) { /* its target and its eye depth */
         double sc = value_of(m, settings, &m->light_scale);
         need += (px_bytes[m->light_format] + 8.0) * (W * sc + 1) * (H * sc + 1);
+    }
+    if (m->uses_scene_colour) { /* its target and its eye depth; the shadow map */
+        double sc = value_of(m, settings, &m->scol_scale);
+        need += (px_bytes[m->scol_format] + 8.0) * (W * sc + 1) * (H * sc + 1);
+        if (!m->uses_shadow_map) {
+            double size = value_of(m, settings, &m->shadow_size);
+            need += 4.0 * size * size;
+        }
+    }
+    if (m->uses_caustics || m->uses_scene_colour) { /* R32F layers at twice the size, mip chain (4/3) */
+        double side = 2.0 * vs->texture_size;
+        need += 4.0 * side * side * vs->caustic_depths * 4.0 / 3.0;
     }
     char what[96], detail[64];
     snprintf(what, sizeof what, "technique %s", m->name);
@@ -625,6 +702,8 @@ typedef struct ut_frame_inputs {
     double shadow_half_extent;
     GLuint shadow_tex, depth_tex;
     double light_radiance[3], light_units[3];
+    double scol_radiance[3];
+    int sun_disc; /* the caustic stack read with the sun disc's blur */
 } ut_frame_inputs;
 
 static void set_uniforms(const ut_state *s, int p, const ut_frame_inputs *fi, const void *settings, int tw, int th)
@@ -679,6 +758,8 @@ static void set_uniforms(const ut_state *s, int p, const ut_frame_inputs *fi, co
     set3(u[U_LIGHT_RADIANCE], fi->light_radiance);
     set3(u[U_LIGHT_UNITS], fi->light_units);
     if (u[U_LIGHT_SIZE] >= 0) glUniform2f(u[U_LIGHT_SIZE], (float)s->light.w, (float)s->light.h);
+    set3(u[U_SCENE_COLOUR_RADIANCE], fi->scol_radiance);
+    if (u[U_SCENE_COLOUR_SIZE] >= 0) glUniform2f(u[U_SCENE_COLOUR_SIZE], (float)s->scol_tgt.w, (float)s->scol_tgt.h);
 #undef F1
     const gr_ut_manifest *m = s->m;
     for (int i = 0; i < m->n_settings; i++) {
@@ -698,10 +779,16 @@ static void set_uniforms(const ut_state *s, int p, const ut_frame_inputs *fi, co
     const gr_ut_pass *ps = &m->passes[p];
     for (int k = 0; k < ps->n_inputs; k++) {
         int in = ps->inputs[k];
+        if (in == GR_UT_IN_CAUSTICS) {
+            /* world positions: the frame's origin is the world's */
+            gr_vol_caustic_set(&l->caus, s->caus, &s->cp, f, fi->sun_disc, 0.0, 0.0, k);
+            continue;
+        }
         glActiveTexture(GL_TEXTURE0 + (GLenum)k);
         glBindTexture(GL_TEXTURE_2D, in == GR_UT_IN_SHADOW_MAP  ? fi->shadow_tex
                                      : in == GR_UT_IN_EYE_DEPTH ? fi->depth_tex
                                      : in == GR_UT_IN_LIGHT     ? s->light.tex
+                                     : in == GR_UT_IN_SCENE_COLOUR ? s->scol_tgt.tex
                                                                 : s->tgt[in].tex);
         if (l->in[k] >= 0) glUniform1i(l->in[k], k);
     }
@@ -738,6 +825,50 @@ static gr_status light_input(ut_state *s, const gr_scene *scene, ut_frame_inputs
     gr_light_units(scene, &fi->f, lp.radius_deg, one, 0.2, 0.4, 1.0, fi->light_units);
     glBindVertexArray(0);
     return gr_gl_check("sun_light", err);
+}
+
+/* The "scene_colour" input (realtime/scenecolour.h) at the manifest's size, format, albedo and
+ * kernel radius, over the eye depth at its size, the caustic stack just built and the shadow
+ * map (if any); its radiance of 1. */
+static gr_status scene_colour_input(ut_state *s, const gr_scene *scene, ut_frame_inputs *fi, const void *settings,
+                                    gr_error *err)
+{
+    static const GLenum fmts[] = {GL_RGBA8, GL_RGBA16F, GL_RGBA32F};
+    const gr_ut_manifest *m = s->m;
+    const int W = fi->f.width, H = fi->f.height;
+    double sc = value_of(m, settings, &m->scol_scale);
+    int w = (int)lround(W * sc), h = (int)lround(H * sc);
+    if (w < 1) w = 1;
+    if (h < 1) h = 1;
+    char what[600];
+    snprintf(what, sizeof what, "%s: scene_colour (%s)", m->path, gr_ut_format_names[m->scol_format]);
+    gr_status st = gr_target_ensure(&s->scol_tgt, fmts[m->scol_format], w, h, GR_TARGET_LINEAR, what, err);
+    if (st) return st;
+    unsigned depth_tex = 0;
+    if ((st = gr_scenegl_eye_depth(s->sgl, scene, &fi->f, w, h, &depth_tex, err))) return st;
+    gr_scene_colour_params p = {.radius_deg = value_of(m, settings, &m->scol_radius_deg),
+                                .shadow_texel_m = fi->shadow_tex ? 2.0 * fi->shadow_half_extent / s->shadow_size : 0.0};
+    for (int c = 0; c < 3; c++)
+        p.albedo[c] = m->scol_albedo_setting >= 0 ? gr_param_get_number(&m->params[m->scol_albedo_setting], settings, c)
+                                                  : m->scol_albedo[c];
+    gr_vol_inputs in;
+    memset(&in, 0, sizeof in);
+    in.f = &fi->f;
+    in.caustics = s->caus;
+    in.cp = &s->cp;
+    in.sun_disc = fi->sun_disc;
+    in.shadow_tex = fi->shadow_tex;
+    for (int i = 0; i < 16; i++) in.light_vp[i] = fi->shadow_tex ? fi->light_vp[i] : (double)(i % 5 == 0);
+    for (int c = 0; c < 3; c++) {
+        in.sigma_t[c] = fi->f.extinction[c];
+        in.sigma_s[c] = fi->f.scattering[c];
+        in.gain[c] = 1.0;
+    }
+    in.g = fi->f.g;
+    if ((st = gr_scene_colour_draw(&s->scol, scene, &in, &p, &s->scol_tgt, depth_tex, m->name, err))) return st;
+    gr_scene_colour_radiance(&fi->f, &p, fi->scol_radiance);
+    glBindVertexArray(0);
+    return gr_gl_check("scene_colour", err);
 }
 
 static GLenum prim_mode(gr_ut_prim p)
@@ -799,7 +930,11 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
             goto done;
         }
     }
-    if ((st = check_memory(s, settings, W, H, tw, th, err)) != GR_OK) goto done;
+    gr_vol_settings vs;
+    memset(&vs, 0, sizeof vs);
+    if ((m->uses_caustics || m->uses_scene_colour) && (st = caustic_block(m, settings, &vs, err)) != GR_OK) goto done;
+    fi->sun_disc = vs.sun_disc;
+    if ((st = check_memory(s, settings, &vs, W, H, tw, th, err)) != GR_OK) goto done;
     if ((st = gr_gl_make_current(s->gl, err)) != GR_OK) goto done;
     for (int t = 0; t < m->n_targets; t++)
         if ((st = ensure_target(s, t, tw[t], th[t], err)) != GR_OK) goto done;
@@ -816,7 +951,8 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
         if (st) goto done;
         snprintf(names[slot++], 24, "sun_light");
     }
-    if (m->uses_shadow_map) {
+    /* the scene colour needs the shadow map where there are occluders, and the caustic stack */
+    if (m->uses_shadow_map || (m->uses_scene_colour && scene->n_occluders > 0)) {
         int size = (int)value_of(m, settings, &m->shadow_size);
         fi->shadow_half_extent = value_of(m, settings, &m->shadow_half_extent);
         gr_gl_timer_begin(&s->timer, slot);
@@ -828,6 +964,25 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
         snprintf(names[slot++], 24, "shadow_map");
         s->shadow_size = size;
         s->shadow_half_extent = fi->shadow_half_extent;
+    }
+    if (m->uses_caustics || m->uses_scene_colour) {
+        /* the volume techniques' stack, its parameters derived by their function */
+        gr_vol_caustics_params(&vs, &s->cp);
+        gr_gl_timer_begin(&s->timer, slot);
+        st = gr_caustics_build(s->caus, scene, &fi->f, &s->cp, err);
+        gr_gl_timer_end(&s->timer);
+        if (st) {
+            gr_error_prefix(err, "%s", m->name);
+            goto done;
+        }
+        snprintf(names[slot++], 24, "caustics");
+    }
+    if (m->uses_scene_colour) {
+        gr_gl_timer_begin(&s->timer, slot);
+        st = scene_colour_input(s, scene, fi, settings, err);
+        gr_gl_timer_end(&s->timer);
+        if (st) goto done;
+        snprintf(names[slot++], 24, "scene_colour");
     }
     if (m->uses_eye_depth) {
         gr_gl_timer_begin(&s->timer, slot);
@@ -880,7 +1035,7 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
         gr_gl_timer_end(&s->timer);
         for (int k = 0; k < ps->n_inputs; k++) {
             glActiveTexture(GL_TEXTURE0 + (GLenum)k);
-            glBindTexture(GL_TEXTURE_2D, 0);
+            glBindTexture(ps->inputs[k] == GR_UT_IN_CAUSTICS ? GL_TEXTURE_2D_ARRAY : GL_TEXTURE_2D, 0);
         }
         glActiveTexture(GL_TEXTURE0);
         if ((st = gr_gl_check(ps->name, err)) != GR_OK) {
@@ -939,16 +1094,25 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
         gr_gl_timer_stats(stats, &s->timer, pass_names, slot, t0);
         stats->fragments = 0;
         for (int p = 0; p < m->n_passes; p++) stats->fragments += s->samples[p];
+        static const int bpp[] = {4, 8, 16};
         /* cost counters (technique.h): the harness inputs' bytes (DEPTH32F shadow map, R32F eye
          * depth); per pass the queried fragments, the vertices drawn, the bytes of its clear
          * and of one texel per fragment; taps are the user's shader's (not counted) */
         for (int k = 0; k < first_pass_slot; k++) {
+            if (!strcmp(names[k], "caustics")) { /* the stack's own counters (caustics.h) */
+                gr_pass_cost c;
+                gr_caustics_cost(s->caus, &c);
+                gr_vol_cost_pass(stats, k, &c);
+                continue;
+            }
             long long side = strcmp(names[k], "shadow_map") == 0 ? s->shadow_size : 0;
-            gr_technique_cost_set(stats, k, GR_COST_BYTES, side > 0 ? side * side * 4 : (long long)W * H * 4, 0);
+            long long bytes = side > 0 ? side * side * 4 : (long long)W * H * 4;
+            if (!strcmp(names[k], "scene_colour")) /* its eye depth (R32F) and its target */
+                bytes = (long long)s->scol_tgt.w * s->scol_tgt.h * (4 + bpp[m->scol_format]);
+            gr_technique_cost_set(stats, k, GR_COST_BYTES, bytes, 0);
             gr_technique_cost_set(stats, k, GR_COST_TAPS, 0, 0);
             gr_technique_cost_set(stats, k, GR_COST_INVOCATIONS, 0, 0);
         }
-        static const int bpp[] = {4, 8, 16};
         for (int p = 0; p < m->n_passes; p++) {
             const int k = first_pass_slot + p, t = m->passes[p].target, b = bpp[m->targets[t].format];
             gr_technique_cost_set(stats, k, GR_COST_FRAGMENTS, s->samples[p], 1);
@@ -988,37 +1152,73 @@ static gr_status ut_metadata(void *state, const gr_scene *scene, const void *set
         snprintf(val, sizeof val, "%.0f px, half extent %.9g m", s->shadow_size, s->shadow_half_extent);
         st = gr_meta_set_string(meta, "godrays:user_shadow_map", val);
     }
+    if (st == GR_OK && (m->uses_caustics || m->uses_scene_colour)) {
+        char cv[160];
+        const gr_caustics_params *cp = &s->cp;
+        snprintf(cv, sizeof cv, "%d texels, grid %d, patch %.9g m, %d depths %.9g..%.9g m", cp->size, cp->grid,
+                 cp->patch_m, cp->n_depths, cp->depths_m[0], cp->depths_m[cp->n_depths > 0 ? cp->n_depths - 1 : 0]);
+        st = gr_meta_set_string(meta, "godrays:user_caustics", cv);
+    }
+    if (st == GR_OK && m->uses_scene_colour) {
+        snprintf(val, sizeof val, "%dx%d %s", s->scol_tgt.w, s->scol_tgt.h, gr_ut_format_names[m->scol_format]);
+        st = gr_meta_set_string(meta, "godrays:user_scene_colour", val);
+    }
     if (st != GR_OK) return gr_fail(err, st, "%s metadata: cannot add an entry (%s)", m->name, gr_status_name(st));
     return GR_OK;
 }
 
 
-/* `godrays render --save-target` (issue 29): every target of the last render (the sun_light
- * input first, if used, then the manifest's targets in their order), side by side in one RGBA
- * strip, top-aligned at their own sizes, 4 black pixels apart; the metadata (ut_metadata)
- * gives each target's size, so x offsets follow from the order. */
+/* `godrays render --save-target` (issue 29): every target of the last render (the harness
+ * inputs first: sun_light, scene_colour, then each layer of the caustic stack, shallowest first,
+ * as grey (R = G = B = the texel, alpha 1); then the manifest's targets in their order), side by
+ * side in one RGBA strip, top-aligned at their own sizes, 4 black pixels apart; the metadata
+ * (ut_metadata) gives each target's size, so x offsets follow from the order. */
 static gr_status ut_read_target(void *state, gr_image **out, gr_error *err)
 {
     ut_state *s = state;
     const gr_ut_manifest *m = s->m;
     enum { GAP = 4 };
     *out = NULL;
-    const gr_target *list[GR_UT_MAX_TARGETS + 1];
-    int n = 0, W = 0, H = 0;
+    const gr_target *list[GR_UT_MAX_TARGETS + 2];
+    int n = 0, W = 0, H = 0, n_layers = 0, ls = 0, n_pre = 0;
     if (m->uses_light && s->light.tex) list[n++] = &s->light;
+    if (m->uses_scene_colour && s->scol_tgt.tex) list[n++] = &s->scol_tgt;
+    n_pre = n;
     for (int t = 0; t < m->n_targets; t++)
         if (s->tgt[t].tex) list[n++] = &s->tgt[t];
+    if (s->caus && gr_caustics_texture(s->caus)) {
+        n_layers = s->cp.n_depths;
+        ls = s->cp.size;
+    }
     if (n == 0) return gr_fail(err, GR_E_RUNTIME, "%s: no render yet, no target to read", m->name);
     for (int k = 0; k < n; k++) {
         W += list[k]->w + (k ? GAP : 0);
         if (list[k]->h > H) H = list[k]->h;
     }
+    W += n_layers * (ls + GAP);
+    if (n_layers && ls > H) H = ls;
     gr_status st = gr_gl_make_current(s->gl, err);
     if (st != GR_OK) return st;
     gr_image *img = gr_image_create(W, H, 4, NULL);
     if (!img) return gr_fail(err, GR_E_NOMEM, "%s: out of memory for the targets' strip", m->name);
     for (int k = 0, x0 = 0; k < n; x0 += list[k]->w + GAP, k++) {
         const gr_target *t = list[k];
+        if (k == n_pre)
+            for (int j = 0; j < n_layers; j++, x0 += ls + GAP) { /* the caustic stack, after the inputs */
+                gr_image *layer = NULL;
+                if ((st = gr_caustics_read(s->caus, j, &layer, err)) != GR_OK) {
+                    gr_image_destroy(img);
+                    return st;
+                }
+                for (int y = 0; y < ls; y++) /* texel row y = z increasing: drawn bottom-up as GL rows */
+                    for (int x = 0; x < ls; x++) {
+                        float v = layer->pixels[(size_t)(ls - 1 - y) * ls + x];
+                        float *o = img->pixels + ((size_t)y * W + x0 + x) * 4;
+                        o[0] = o[1] = o[2] = v;
+                        o[3] = 1.0f;
+                    }
+                gr_image_destroy(layer);
+            }
         if ((st = gr_readback_fbo(&s->rb, t->fbo, t->w, t->h, m->name, err)) != GR_OK) {
             gr_image_destroy(img);
             return st;

@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "realtime/volsettings.h"
 #include "scene/scene.h"
 
 const char *const gr_ut_type_names[] = {"number", "int", "bool", "rgb", NULL};
@@ -205,8 +206,17 @@ const char *gr_ut_input_name(const gr_ut_manifest *m, int in)
     case GR_UT_IN_SHADOW_MAP: return "shadow_map";
     case GR_UT_IN_EYE_DEPTH: return "eye_depth";
     case GR_UT_IN_LIGHT: return "sun_light";
+    case GR_UT_IN_CAUSTICS: return "caustics";
+    case GR_UT_IN_SCENE_COLOUR: return "scene_colour";
     default: return m->targets[in].name;
     }
+}
+
+int gr_ut_harness_input(const char *name)
+{
+    for (int in = -1; in >= -GR_UT_N_HARNESS_INPUTS; in--)
+        if (!strcmp(name, gr_ut_input_name(NULL, in))) return in;
+    return 0;
 }
 
 static int find_target(const gr_ut_manifest *m, const char *name)
@@ -649,8 +659,7 @@ static gr_status parse_targets(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
         if (m->n_targets == GR_UT_MAX_TARGETS) return vfail(c, p, "more than %d targets", GR_UT_MAX_TARGETS);
         if (!is_identifier(it->string, 1, GR_UT_NAME_MAX))
             return vfail(c, p, "a target's name must be [a-z][a-z0-9_]* of at most %d characters without '__'", GR_UT_NAME_MAX - 1);
-        if (!strcmp(it->string, "shadow_map") || !strcmp(it->string, "eye_depth") || !strcmp(it->string, "sun_light"))
-            return vfail(c, p, "'%s' is the name of a harness texture", it->string);
+        if (gr_ut_harness_input(it->string) < 0) return vfail(c, p, "'%s' is the name of a harness texture", it->string);
         if ((st = check_object(c, it, p, keys))) return st;
         gr_ut_target *t = &m->targets[m->n_targets];
         snprintf(t->name, sizeof t->name, "%s", it->string);
@@ -808,17 +817,13 @@ static gr_status parse_pass(ut_ctx *c, gr_ut_manifest *m, const cJSON *it, int i
             if (k == GR_UT_MAX_INPUTS) return vfail(c, q, "more than %d inputs", GR_UT_MAX_INPUTS);
             if (!cJSON_IsString(e)) return vfail(c, r, "must be a string, got %s", gr_json_type_name(e));
             const char *nm = e->valuestring;
-            int in;
-            if (!strcmp(nm, "shadow_map")) {
-                in = GR_UT_IN_SHADOW_MAP;
-                m->uses_shadow_map = 1;
-            } else if (!strcmp(nm, "eye_depth")) {
-                in = GR_UT_IN_EYE_DEPTH;
-                m->uses_eye_depth = 1;
-            } else if (!strcmp(nm, "sun_light")) {
-                in = GR_UT_IN_LIGHT;
-                m->uses_light = 1;
-            } else {
+            int in = gr_ut_harness_input(nm);
+            if (in == GR_UT_IN_SHADOW_MAP) m->uses_shadow_map = 1;
+            else if (in == GR_UT_IN_EYE_DEPTH) m->uses_eye_depth = 1;
+            else if (in == GR_UT_IN_LIGHT) m->uses_light = 1;
+            else if (in == GR_UT_IN_CAUSTICS) m->uses_caustics = 1;
+            else if (in == GR_UT_IN_SCENE_COLOUR) m->uses_scene_colour = 1;
+            if (in == 0) {
                 in = find_target(m, nm);
                 if (in < 0) return vfail(c, r, "unknown input '%s' (a target's name, " GR_UT_HARNESS_INPUTS ")", nm);
                 if (in == ps->target)
@@ -919,10 +924,119 @@ static gr_status parse_light(ut_ctx *c, gr_ut_manifest *m, const cJSON *lt)
     return get_bool(c, lt, "sun_light", "occluders", &m->light_occluders);
 }
 
+/* "caustics": the volume techniques' caustic settings (realtime/volsettings.h
+ * gr_vol_caustic_descriptors: the same keys, ranges and defaults), each a number or a setting's
+ * name, sun_disc a bool; caustic_last_m >= caustic_first_m (gr_vol_check) when both are numbers. */
+static gr_status parse_caustics(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
+{
+    size_t n = 0;
+    const gr_param *d = gr_vol_caustic_descriptors(&n);
+    const char *keys[GR_UT_CAUSTIC_VALUES + 1] = {NULL};
+    if (n > GR_UT_CAUSTIC_VALUES) return gr_fail(c->err, GR_E_RUNTIME, "caustics: %zu descriptors", n);
+    m->n_caustic_values = (int)n;
+    for (size_t i = 0; i < n; i++) {
+        keys[i] = d[i].name;
+        m->caustic[i] = (gr_ut_value){d[i].def, -1};
+    }
+    if (!obj) return GR_OK;
+    gr_status st = check_object(c, obj, "caustics", keys);
+    if (st) return st;
+    gr_vol_settings vs;
+    memset(&vs, 0, sizeof vs);
+    int literal = 1;
+    for (size_t i = 0; i < n; i++) {
+        char p[96];
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, d[i].name);
+        snprintf(p, sizeof p, "caustics.%s", d[i].name);
+        if (d[i].type == GR_PT_BOOL) {
+            int b = d[i].def != 0;
+            if ((st = get_bool(c, obj, "caustics", d[i].name, &b))) return st;
+            m->caustic[i].v = b;
+        } else if (v) {
+            gr_ut_type t = d[i].type == GR_PT_INT ? GR_UT_INT : GR_UT_NUMBER;
+            if ((st = value_at(c, m, v, p, t, d[i].min, d[i].max, &m->caustic[i]))) return st;
+            const gr_ut_value *u = &m->caustic[i];
+            /* an exclusive lower end (patch_m, the depths: > 0): a number equal to it, or a
+             * setting whose range reaches it inclusively */
+            const gr_param *sp = u->setting >= 0 ? &m->params[u->setting] : NULL;
+            if ((d[i].flags & GR_PF_MIN_EXCL) &&
+                (sp ? sp->min <= d[i].min && !(sp->flags & GR_PF_MIN_EXCL) : u->v <= d[i].min))
+                return vfail(c, p, "must be > %g%s", d[i].min, u->setting < 0 ? "" : " over the setting's whole range");
+        }
+        if (m->caustic[i].setting >= 0) literal = 0;
+        const gr_param_table tab = {"caustics", d, n};
+        if ((st = gr_param_set_number(&tab, &vs, d[i].name, -1, m->caustic[i].v, c->err))) return st;
+    }
+    if (literal && gr_vol_check("caustics", &vs, c->err) != GR_OK) {
+        gr_error_prefix(c->err, "%s", c->path);
+        return GR_E_INPUT;
+    }
+    return GR_OK;
+}
+
+/* "scene_colour": {"scale", "format", "albedo", "radius_deg"} (realtime/scenecolour.h); albedo
+ * a number, [r, g, b] or a number or rgb setting's name, in [0, 1]. */
+static gr_status parse_scene_colour(ut_ctx *c, gr_ut_manifest *m, const cJSON *obj)
+{
+    static const char *const keys[] = {"scale", "format", "albedo", "radius_deg", NULL};
+    m->scol_scale = (gr_ut_value){1.0, -1};
+    m->scol_radius_deg = (gr_ut_value){4.0, -1};
+    m->scol_format = GR_UT_FMT_RGBA16F;
+    m->scol_albedo[0] = m->scol_albedo[1] = m->scol_albedo[2] = 0.3;
+    m->scol_albedo_setting = -1;
+    if (!obj) return GR_OK;
+    gr_status st = check_object(c, obj, "scene_colour", keys);
+    if (st) return st;
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, "scale");
+    if (v && (st = value_at(c, m, v, "scene_colour.scale", GR_UT_NUMBER, 1.0 / 64.0, 4.0, &m->scol_scale))) return st;
+    v = cJSON_GetObjectItemCaseSensitive(obj, "radius_deg");
+    if (v && (st = value_at(c, m, v, "scene_colour.radius_deg", GR_UT_NUMBER, 0.01, 90, &m->scol_radius_deg)))
+        return st;
+    int fmt = GR_UT_FMT_RGBA16F;
+    if ((st = get_enum(c, obj, "scene_colour", "format", gr_ut_format_names, &fmt))) return st;
+    if (fmt >= 0) m->scol_format = (gr_ut_format)fmt;
+    v = cJSON_GetObjectItemCaseSensitive(obj, "albedo");
+    if (!v) return GR_OK;
+    const char *p = "scene_colour.albedo";
+    if (cJSON_IsString(v)) {
+        int k = find_setting(m, v->valuestring);
+        if (k < 0) return vfail(c, p, "'%s' is not a setting of this technique", v->valuestring);
+        gr_ut_type t = m->settings[k].type;
+        const gr_param *gp = &m->params[k];
+        if (t != GR_UT_NUMBER && t != GR_UT_RGB)
+            return vfail(c, p, "setting '%s' is of type %s, this field needs a number or rgb setting", v->valuestring,
+                         gr_ut_type_names[t]);
+        if (gp->min < 0 || gp->max > 1)
+            return vfail(c, p, "setting '%s' has range [%g, %g], an albedo needs values within [0, 1]", v->valuestring,
+                         gp->min, gp->max);
+        m->scol_albedo_setting = k;
+        return GR_OK;
+    }
+    if (cJSON_IsArray(v)) {
+        if (cJSON_GetArraySize(v) != 3) return vfail(c, p, "must be a number or [r, g, b] in [0, 1]");
+        for (int k = 0; k < 3; k++) {
+            char q[64];
+            snprintf(q, sizeof q, "%s[%d]", p, k);
+            if ((st = number_at(c, cJSON_GetArrayItem(v, k), q, &m->scol_albedo[k]))) return st;
+            if (!(m->scol_albedo[k] >= 0 && m->scol_albedo[k] <= 1))
+                return vfail(c, q, "must be in [0, 1] (an albedo), got %g", m->scol_albedo[k]);
+        }
+        return GR_OK;
+    }
+    double a = 0;
+    if (!cJSON_IsNumber(v))
+        return vfail(c, p, "must be a number, [r, g, b] or a setting's name, got %s", gr_json_type_name(v));
+    if ((st = number_at(c, v, p, &a))) return st;
+    if (!(a >= 0 && a <= 1)) return vfail(c, p, "must be in [0, 1] (an albedo), got %g", a);
+    m->scol_albedo[0] = m->scol_albedo[1] = m->scol_albedo[2] = a;
+    return GR_OK;
+}
+
 static gr_status parse_manifest(ut_ctx *c, gr_ut_manifest *m, const cJSON *root)
 {
     static const char *const keys[] = {"version", "name", "description", "settings", "gain", "ladder", "shadow_map",
-                                       "sun_light", "targets", "passes", "output", "allow_black", NULL};
+                                       "sun_light", "caustics", "scene_colour", "targets", "passes", "output",
+                                       "allow_black", NULL};
     static const char *const sm_keys[] = {"size", "half_extent_m", NULL};
     gr_status st = check_object(c, root, "", keys);
     if (st) return st;
@@ -1006,7 +1120,11 @@ static gr_status parse_manifest(ut_ctx *c, gr_ut_manifest *m, const cJSON *root)
             return st;
     }
     if ((st = parse_light(c, m, cJSON_GetObjectItemCaseSensitive(root, "sun_light")))) return st;
-    int timed = m->n_passes + m->uses_shadow_map + m->uses_eye_depth + m->uses_light;
+    if ((st = parse_caustics(c, m, cJSON_GetObjectItemCaseSensitive(root, "caustics")))) return st;
+    if ((st = parse_scene_colour(c, m, cJSON_GetObjectItemCaseSensitive(root, "scene_colour")))) return st;
+    /* the scene colour needs the shadow map (with occluders) and the caustic stack too */
+    int timed = m->n_passes + (m->uses_shadow_map || m->uses_scene_colour) + m->uses_eye_depth + m->uses_light +
+                (m->uses_caustics || m->uses_scene_colour) + m->uses_scene_colour;
     if (timed > GR_TECH_MAX_PASSES)
         return vfail(c, "passes", "%d passes and %d harness inputs make %d timed passes, at most %d", m->n_passes,
                      timed - m->n_passes, timed, GR_TECH_MAX_PASSES);

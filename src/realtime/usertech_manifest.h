@@ -42,8 +42,18 @@ typedef enum { GR_UT_PRIM_TRIANGLES, GR_UT_PRIM_TRIANGLE_STRIP, GR_UT_PRIM_LINES
 extern const char *const gr_ut_prim_names[];
 
 /* Harness textures a pass may list among its inputs (bound as t_NAME; gr_ut_input_name). */
-enum { GR_UT_IN_SHADOW_MAP = -1, GR_UT_IN_EYE_DEPTH = -2, GR_UT_IN_LIGHT = -3 };
-#define GR_UT_HARNESS_INPUTS "\"shadow_map\", \"eye_depth\" or \"sun_light\""
+enum {
+    GR_UT_IN_SHADOW_MAP = -1,
+    GR_UT_IN_EYE_DEPTH = -2,
+    GR_UT_IN_LIGHT = -3,
+    GR_UT_IN_CAUSTICS = -4,
+    GR_UT_IN_SCENE_COLOUR = -5,
+    GR_UT_N_HARNESS_INPUTS = 5
+};
+#define GR_UT_HARNESS_INPUTS "\"shadow_map\", \"eye_depth\", \"sun_light\", \"caustics\" or \"scene_colour\""
+/* The caustic stack's values of a "caustics" object: the volume techniques' caustic settings
+ * (realtime/volsettings.h gr_vol_caustic_descriptors), in their order. */
+#define GR_UT_CAUSTIC_VALUES 8
 
 typedef struct gr_ut_setting {
     char key[GR_TECH_NAME_MAX];
@@ -104,12 +114,22 @@ typedef struct gr_ut_manifest {
     gr_ut_pass passes[GR_UT_MAX_PASSES];
     int output;
     int allow_black;
-    int uses_shadow_map, uses_eye_depth, uses_light;
+    int uses_shadow_map, uses_eye_depth, uses_light, uses_caustics, uses_scene_colour;
     gr_ut_value shadow_size, shadow_half_extent;
     /* "sun_light": the harness's light texture (realtime/toolkit.h gr_light_pass) */
     gr_ut_value light_scale, light_radius_deg, light_threshold;
     gr_ut_format light_format;
     int light_occluders;
+    /* "caustics": value i is descriptor i of gr_vol_caustic_descriptors (texture_size, grid,
+     * patch_m, caustic_depths, caustic_first_m, caustic_last_m, sun_disc), defaults theirs */
+    int n_caustic_values;
+    gr_ut_value caustic[GR_UT_CAUSTIC_VALUES];
+    /* "scene_colour" (realtime/scenecolour.h): size, format, the light pass's kernel radius and
+     * the albedo (a number or [r, g, b]; or a number or rgb setting: albedo_setting >= 0) */
+    gr_ut_value scol_scale, scol_radius_deg;
+    gr_ut_format scol_format;
+    double scol_albedo[3];
+    int scol_albedo_setting;
     /* every shader file read, includes too, relative to dir: line L of files[K] is numbered
      * GR_UT_LINE_BASE * (K + 1) + L in the sources ("#line"; Mesa ignores #line's source
      * string number), so a driver's line maps back to the file and its own line */
@@ -122,8 +142,11 @@ typedef struct gr_ut_manifest {
     gr_technique_class cls; /* the class made from it (usertech.c fills it): lives as long as m */
 } gr_ut_manifest;
 
-/* t_NAME's NAME of input `in` of a pass (a target's index or GR_UT_IN_*). */
+/* t_NAME's NAME of input `in` of a pass (a target's index or GR_UT_IN_*; m may be NULL for
+ * GR_UT_IN_*). */
 const char *gr_ut_input_name(const gr_ut_manifest *m, int in);
+/* GR_UT_IN_* of a harness texture's name ("sun_light", ...); 0 for any other name. */
+int gr_ut_harness_input(const char *name);
 
 /* A growable string (zero-initialize; free .s): gr_ut_sb_add appends printf-style; on no
  * memory it sets failed and keeps what it had. Ladder texts here, GLSL preludes in usertech.c. */

@@ -12,13 +12,40 @@
 
 /* ---- shared by the volume techniques ------------------------------------------------------ */
 
+void gr_vol_caustic_locations(unsigned p, gr_vol_caustic_locs *l)
+{
+    l->tex = glGetUniformLocation(p, "t_caustics");
+    l->layers = glGetUniformLocation(p, "u_caustic_layers");
+    l->depth = glGetUniformLocation(p, "u_caustic_depth");
+    l->origin = glGetUniformLocation(p, "u_caustic_origin");
+    l->patch = glGetUniformLocation(p, "u_caustic_patch");
+    l->texel = glGetUniformLocation(p, "u_caustic_texel");
+    l->sun_rw = glGetUniformLocation(p, "u_caustic_sun_rw");
+}
+
+void gr_vol_caustic_set(const gr_vol_caustic_locs *l, const gr_caustics *c, const gr_caustics_params *cp,
+                        const gr_frame *f, int sun_disc, double frame_x, double frame_z, int unit)
+{
+    float d[GR_CAUSTICS_MAX_DEPTHS];
+    for (int i = 0; i < cp->n_depths; i++) d[i] = (float)cp->depths_m[i];
+    double o[2];
+    gr_caustics_origin(c, o);
+    glUniform1i(l->tex, unit);
+    glUniform1i(l->layers, cp->n_depths);
+    glUniform1fv(l->depth, cp->n_depths, d);
+    glUniform2f(l->origin, (float)(o[0] - frame_x), (float)(o[1] - frame_z));
+    glUniform1f(l->patch, (float)cp->patch_m);
+    glUniform1f(l->texel, (float)(cp->patch_m / cp->size));
+    /* the disc seen from below: Snell's law shrinks its angular radius to asin(sin(r) / n) */
+    glUniform1f(l->sun_rw, sun_disc ? (float)asin(sin(f->sun_angular_radius_rad) / f->ior) : 0.0f);
+    glActiveTexture(GL_TEXTURE0 + (GLenum)unit);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, gr_caustics_texture(c));
+    glActiveTexture(GL_TEXTURE0);
+}
+
 void gr_vol_locations(unsigned p, gr_vol_locs *l)
 {
-    l->caustics = glGetUniformLocation(p, "u_caustics");
-    l->n_depths = glGetUniformLocation(p, "u_n_depths");
-    l->cdepth = glGetUniformLocation(p, "u_cdepth");
-    l->corigin = glGetUniformLocation(p, "u_corigin");
-    l->patch = glGetUniformLocation(p, "u_patch");
+    gr_vol_caustic_locations(p, &l->caus);
     l->refr = glGetUniformLocation(p, "u_refr");
     l->rest = glGetUniformLocation(p, "u_rest");
     l->shadow = glGetUniformLocation(p, "u_shadow");
@@ -28,24 +55,13 @@ void gr_vol_locations(unsigned p, gr_vol_locs *l)
     l->sigma_s = glGetUniformLocation(p, "u_sigma_s");
     l->g = glGetUniformLocation(p, "u_g");
     l->esun = glGetUniformLocation(p, "u_esun");
-    l->texel = glGetUniformLocation(p, "u_texel");
-    l->sun_rw = glGetUniformLocation(p, "u_sun_rw");
 }
 
 void gr_vol_set(const gr_vol_locs *l, const gr_vol_inputs *in)
 {
     const gr_frame *f = in->f;
-    if (in->caustics) {
-        float d[GR_CAUSTICS_MAX_DEPTHS];
-        for (int i = 0; i < in->cp->n_depths; i++) d[i] = (float)in->cp->depths_m[i];
-        double o[2];
-        gr_caustics_origin(in->caustics, o);
-        glUniform1i(l->caustics, 2);
-        glUniform1i(l->n_depths, in->cp->n_depths);
-        glUniform1fv(l->cdepth, in->cp->n_depths, d);
-        glUniform2f(l->corigin, (float)(o[0] - f->eye[0]), (float)(o[1] - f->eye[2]));
-        glUniform1f(l->patch, (float)in->cp->patch_m);
-    }
+    /* the stack on unit 2, its origin eye-relative */
+    if (in->caustics) gr_vol_caustic_set(&l->caus, in->caustics, in->cp, f, in->sun_disc, f->eye[0], f->eye[2], 2);
     glUniform3f(l->refr, (float)f->refr_dir[0], (float)f->refr_dir[1], (float)f->refr_dir[2]);
     glUniform1f(l->rest, (float)(f->rest_height_m - f->eye[1]));
     /* light_vp * translate(eye): eye-relative positions */
@@ -61,11 +77,10 @@ void gr_vol_set(const gr_vol_locs *l, const gr_vol_inputs *in)
     glUniform1f(l->g, (float)in->g);
     glUniform3f(l->esun, (float)(f->sun_irradiance[0] * in->gain[0]), (float)(f->sun_irradiance[1] * in->gain[1]),
                 (float)(f->sun_irradiance[2] * in->gain[2]));
-    if (in->caustics) glUniform1f(l->texel, (float)(in->cp->patch_m / in->cp->size));
-    /* the disc seen from below: Snell's law shrinks its angular radius to asin(sin(r) / n) */
-    glUniform1f(l->sun_rw, in->sun_disc ? (float)asin(sin(f->sun_angular_radius_rad) / f->ior) : 0.0f);
-    glActiveTexture(GL_TEXTURE2);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, in->caustics ? gr_caustics_texture(in->caustics) : 0);
+    if (!in->caustics) {
+        glActiveTexture(GL_TEXTURE2);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+    }
     glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_2D, in->shadow_tex);
     glActiveTexture(GL_TEXTURE0);
@@ -112,6 +127,17 @@ void gr_vol_bounds(int n, int exponential, double near_m, double far_m, double *
 }
 
 /* ---- the prelude of a volume technique's render ------------------------------------------- */
+
+void gr_vol_caustics_params(const gr_vol_settings *s, gr_caustics_params *cp)
+{
+    memset(cp, 0, sizeof *cp);
+    cp->size = s->texture_size;
+    cp->grid = s->grid;
+    cp->patch_m = s->patch_m;
+    cp->n_depths = s->caustic_depths;
+    cp->fresnel = 1;
+    gr_caustics_depths(cp->n_depths, s->caustic_first_m, s->caustic_last_m, cp->depths_m);
+}
 
 void gr_vol_waves(const gr_scene *scene, const gr_frame *f, double ox, double oz, float *wa, float *wamp)
 {
@@ -188,14 +214,7 @@ gr_status gr_vol_prepare(const char *name, gr_vol_base *b, const gr_scene *scene
 
     gr_vol_inputs *in = &p->in;
     gr_caustics_params *cp = &p->cp;
-    if (caus) {
-        cp->size = s->texture_size;
-        cp->grid = s->grid;
-        cp->patch_m = s->patch_m;
-        cp->n_depths = s->caustic_depths;
-        cp->fresnel = 1;
-        gr_caustics_depths(cp->n_depths, s->caustic_first_m, s->caustic_last_m, cp->depths_m);
-    }
+    if (caus) gr_vol_caustics_params(s, cp);
     in->f = f;
     in->caustics = caus;
     in->cp = cp;
@@ -276,12 +295,4 @@ void gr_vol_cost_prelude(const gr_vol_base *b, const gr_vol_prep *p, gr_techniqu
         gr_caustics_cost(b->caus, &c);
         gr_vol_cost_pass(stats, GR_VOL_PASS_CAUSTICS, &c);
     }
-}
-
-gr_status gr_vol_check(const char *name, const gr_vol_settings *s, gr_error *err)
-{
-    if (!(s->caustic_last_m >= s->caustic_first_m))
-        return gr_fail(err, GR_E_INPUT, "%s.caustic_last_m = %g: must be >= %s.caustic_first_m (%g)", name,
-                       s->caustic_last_m, name, s->caustic_first_m);
-    return GR_OK;
 }

@@ -3,7 +3,8 @@
  * holds (scenegl, the caustic stack, the colour target, the pass timer), the prelude of each
  * render (frame, checks, shadow map, eye depth, caustic stack, the inputs of
  * volume_common.glsl), the uniforms of volume_common.glsl and volume_surface.glsl, the slab
- * bounds and the stats. Derivations: docs/volume-techniques.md. */
+ * bounds and the stats; their settings block is realtime/volsettings.h. Derivations:
+ * docs/volume-techniques.md. */
 #ifndef GR_VOLUME_H
 #define GR_VOLUME_H
 
@@ -17,12 +18,27 @@
 #include "realtime/scenegl.h"
 #include "realtime/technique.h"
 #include "realtime/toolkit.h"
+#include "realtime/volsettings.h"
 #include "scene/scene.h"
 
 /* ---- what the volume techniques share (volume_common.glsl's uniforms) ---- */
+/* The uniforms of caustic_stack.glsl (t_caustics, u_caustic_*): the one GLSL source that
+ * samples the caustic stack, read by the volume techniques and by user techniques' "caustics"
+ * input alike. */
+typedef struct gr_vol_caustic_locs {
+    int tex, layers, depth, origin, patch, texel, sun_rw;
+} gr_vol_caustic_locs;
+void gr_vol_caustic_locations(unsigned program, gr_vol_caustic_locs *l);
+/* Sets them for the current program from the last build of c with parameters cp: positions
+ * in a frame whose origin is world (frame_x, frame_z) (the eye for the volume techniques, 0 for
+ * world positions), the sun's disc blur on when sun_disc (f's sun radius seen from below), and
+ * binds the stack to texture unit `unit` (GL_TEXTURE_2D_ARRAY; leaves unit 0 active). */
+void gr_vol_caustic_set(const gr_vol_caustic_locs *l, const gr_caustics *c, const gr_caustics_params *cp,
+                        const gr_frame *f, int sun_disc, double frame_x, double frame_z, int unit);
+
 typedef struct gr_vol_locs {
-    int caustics, n_depths, cdepth, corigin, patch, refr, rest, shadow, light_vp, use_shadow, sigma_t, sigma_s, g,
-        esun, texel, sun_rw;
+    gr_vol_caustic_locs caus;
+    int refr, rest, shadow, light_vp, use_shadow, sigma_t, sigma_s, g, esun;
 } gr_vol_locs;
 typedef struct gr_vol_inputs {
     const gr_frame *f;
@@ -47,57 +63,11 @@ void gr_vol_bounds(int n, int exponential, double near_m, double far_m, double *
 
 /* ---- the prelude every volume technique's render shares ---- */
 
-/* Settings the volume techniques share: a block (member `vol`) of each one's settings struct,
- * described by the GR_VOL_PARAMS_* descriptor lists below (same keys, ranges and docs in every
- * technique's scene section). The caustic fields are unused by a technique without the
- * caustic texture (light rays), which lists only GR_VOL_PARAMS_MEDIUM and _LIGHT. */
-typedef struct gr_vol_settings {
-    int texture_size, grid;      /* caustic texture side, water grid cells per patch side */
-    double patch_m;              /* caustic patch side (m) */
-    int caustic_depths;          /* planes in the caustic stack */
-    double caustic_first_m, caustic_last_m; /* stack depths, geometric between these */
-    double extinction[3];        /* sigma_t on both paths; default: the medium's */
-    double g;                    /* HG asymmetry; default: the medium's */
-    int sun_disc;                /* blur the caustic planes by the sun's disc */
-    double intensity[3];         /* gain on the physical result (1) */
-    int shadow_map_size;
-    double shadow_extent_m;      /* half side of the shadow map's square around the eye */
-} gr_vol_settings;
-
-/* Descriptors of the shared block inside settings struct T (its member `vol`). */
-#define GR_VOL_PARAMS_CAUSTICS(T)                                                                                    \
-    {.name = "texture_size", .type = GR_PT_INT, .offset = offsetof(T, vol.texture_size), .min = 8, .max = 4096,      \
-     .def = 512, .unit = "texels", .doc = "caustic texture side (rendered at twice this, 2x2 box filtered)"},         \
-    {.name = "grid", .type = GR_PT_INT, .offset = offsetof(T, vol.grid), .min = 2, .max = 2048, .def = 256,          \
-     .unit = "cells", .doc = "water grid cells per patch side (beam-traced triangles: 2 grid^2 per depth)"},          \
-    {.name = "patch_m", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.patch_m), .min = 0, .max = 1e4,              \
-     .flags = GR_PF_MIN_EXCL, .def = 24, .unit = "m", .doc = "caustic patch side: the texture repeats with this period"}, \
-    {.name = "caustic_depths", .type = GR_PT_INT, .offset = offsetof(T, vol.caustic_depths), .min = 1,               \
-     .max = GR_CAUSTICS_MAX_DEPTHS, .def = 8, .unit = "", .doc = "planes of the caustic stack"},                      \
-    {.name = "caustic_first_m", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.caustic_first_m), .min = 0,          \
-     .max = 1e4, .flags = GR_PF_MIN_EXCL, .def = 1, .unit = "m", .doc = "shallowest caustic plane below the rest height"}, \
-    {.name = "caustic_last_m", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.caustic_last_m), .min = 0,            \
-     .max = 1e4, .flags = GR_PF_MIN_EXCL, .def = 25, .unit = "m",                                                    \
-     .doc = "deepest caustic plane (geometric spacing between)"}
-#define GR_VOL_PARAMS_MEDIUM(T)                                                                                      \
-    {.name = "extinction", .type = GR_PT_RGB, .offset = offsetof(T, vol.extinction), .min = 0, .max = 1e4,           \
-     .flags = GR_PF_FROM_SCENE, .def = NAN, .unit = "1/m", .scene_source = "medium.extinction",                      \
-     .doc = "sigma_t along the sun's and the view path; default: the medium's", .tune_lo = 0.5, .tune_hi = 2.0},     \
-    {.name = "g", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.g), .min = -1, .max = 1,                           \
-     .flags = GR_PF_MIN_EXCL | GR_PF_MAX_EXCL | GR_PF_FROM_SCENE, .def = NAN, .unit = "", .scene_source = "medium.g", \
-     .doc = "HG asymmetry; default: the medium's", .tune_lo = 0.5, .tune_hi = 0.98}
-#define GR_VOL_PARAMS_SUN_DISC(T)                                                                                    \
-    {.name = "sun_disc", .type = GR_PT_BOOL, .offset = offsetof(T, vol.sun_disc), .min = 0, .max = 1, .def = 1,      \
-     .unit = "", .doc = "blur each caustic plane by the sun's disc (the mip level of its blur diameter)"}
-#define GR_VOL_PARAMS_LIGHT(T)                                                                                       \
-    {.name = "intensity", .type = GR_PT_RGB, .offset = offsetof(T, vol.intensity), .min = 0, .max = 1e9, .def = 1,   \
-     .unit = "", .doc = "gain on the physical radiance (1: no fit)", .tune_lo = 0.2, .tune_hi = 5.0},                \
-    {.name = "shadow_map_size", .type = GR_PT_INT, .offset = offsetof(T, vol.shadow_map_size), .min = 16,            \
-     .max = 8192, .def = 1024, .unit = "texels", .doc = "occluders' shadow map side"},                              \
-    {.name = "shadow_extent_m", .type = GR_PT_DOUBLE, .offset = offsetof(T, vol.shadow_extent_m), .min = 0,          \
-     .max = 1e5, .flags = GR_PF_MIN_EXCL, .def = 40, .unit = "m",                                                    \
-     .doc = "half side of the shadow map's square around the eye"}
-
+/* The caustic stack's parameters from the block's caustic fields (texture_size, grid, patch_m,
+ * caustic_depths and the geometric depths between caustic_first_m and caustic_last_m; exact
+ * Fresnel): the one derivation, used by gr_vol_prepare and by the user techniques' "caustics"
+ * input (realtime/usertech.c). */
+void gr_vol_caustics_params(const gr_vol_settings *s, gr_caustics_params *cp);
 /* The GL passes of the prelude, in this order in each technique's timer and stats; a
  * technique's own passes follow (GR_VOL_PASS_OWN, or GR_VOL_PASS_CAUSTICS without caustics). */
 enum { GR_VOL_PASS_SHADOW = 0, GR_VOL_PASS_DEPTH = 1, GR_VOL_PASS_CAUSTICS = 2, GR_VOL_PASS_OWN = 3 };
@@ -162,9 +132,5 @@ gr_status gr_vol_finish(const char *name, gr_vol_base *b, const gr_vol_prep *p, 
 void gr_vol_cost_prelude(const gr_vol_base *b, const gr_vol_prep *p, gr_technique_stats *stats);
 /* Counter k of pass p set analytically, keeping the pass's queried primitives. */
 void gr_vol_cost_pass(gr_technique_stats *stats, int p, const gr_pass_cost *c);
-
-/* Checks of the shared block across its settings (`name` is the technique's section):
- * caustic_last_m >= caustic_first_m. The table's ranges are checked by technique.c. */
-gr_status gr_vol_check(const char *name, const gr_vol_settings *s, gr_error *err);
 
 #endif

@@ -6,7 +6,9 @@
 // (seed eq. 5.5.8 with seed 000's wave packing), T: exact Fresnel transmittance water -> air
 // (zero under total internal reflection: outside Snell's window no sun is seen), K: the
 // bright-region kernel (1 - (a/a0)^2)^2 around the sun in air, V: 0 where an occluder or the
-// seabed is nearer than the surface (occluders drawn black).
+// seabed is nearer than the surface (occluders drawn black). Alpha: 1 where the ray reaches the
+// surface first (it rises, and no occluder or seabed is nearer when u_occluders), else 0: the
+// scene colour (realtime/scenecolour.h) lights the other pixels' surfaces.
 
 in vec2 v_ndc;
 uniform mat4 u_inv_vp_rot;       // clip -> eye-relative direction
@@ -51,6 +53,7 @@ void main()
     vec4 q = u_inv_vp_rot * vec4(v_ndc, 1.0, 1.0);
     vec3 d = normalize(q.xyz / q.w);
     vec3 s = vec3(0.0);
+    float first = 0.0;
     if (d.y > 1e-4) {
         // Rest plane first, then one correction by the wave height there (the horizontal
         // Gerstner displacement is neglected: docs, "Surface point").
@@ -60,6 +63,7 @@ void main()
         water(t * d.x, t * d.z, n, eta);
         t = max(0.0, (u_depth + eta) / d.y);
         water(t * d.x, t * d.z, n, eta);
+        first = (u_occluders != 0 && texelFetch(u_eye_depth, ivec2(gl_FragCoord.xy), 0).r < t) ? 0.0 : 1.0;
         float cos_i = dot(d, n);
         vec3 a = cos_i > 0.0 ? refract(d, -n, u_ior) : vec3(0.0);
         if (dot(a, a) > 0.0) {
@@ -68,10 +72,10 @@ void main()
             float k = x < 1.0 ? (1.0 - x * x) * (1.0 - x * x) : 0.0;
             float tr = 1.0 - fresnel(cos_i, u_ior, 1.0);
             s = vec3(tr / u_t_flat * k) * exp(-u_extinction * t);
-            if (u_occluders != 0 && texelFetch(u_eye_depth, ivec2(gl_FragCoord.xy), 0).r < t) s = vec3(0.0);
+            if (first == 0.0) s = vec3(0.0);
         }
     }
     s = max(s - vec3(u_threshold), vec3(0.0));
     if (u_dither8 != 0) s = max(s + vec3((ign(gl_FragCoord.xy) - 0.5) / 255.0), vec3(0.0));
-    o_color = vec4(s, 1.0);
+    o_color = vec4(s, first);
 }

@@ -1,1 +1,1 @@
-#define VOL_FRAGMENT 1
+#define GR_FRAGMENT_STAGE 1

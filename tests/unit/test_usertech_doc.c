@@ -50,36 +50,46 @@ int main(void)
     gr_technique_class *cls = NULL;
     CHECK_OK(gr_usertech_load(dir, &cls, &err), err);
     if (!cls) CHECK_DONE();
-    /* pass 0 reads shadow_map and eye_depth: its prelude declares everything */
-    char *pre = gr_usertech_prelude(cls, 0, "fragment");
-    CHECK(pre != NULL);
-    if (!pre) CHECK_DONE();
-    /* the prelude ends so that GLSL log line numbers are the user file's own */
-    size_t lp = strlen(pre);
-    CHECK(lp > 8 && !strcmp(pre + lp - 8, "#line 1\n"));
+    /* shadow_march's pass 0 reads shadow_map and eye_depth; scene_probe's reads caustics,
+     * scene_colour and sun_light: together their preludes declare everything */
+    static const char *const techs[2] = {"data/techniques/shadow_march", "tests/techniques/scene_probe"};
     int n_uniforms = 0, n_helpers = 0;
-    for (char *line = pre; line && *line;) {
-        char *nl = strchr(line, '\n');
-        if (nl) *nl = '\0';
-        char type[32], name[64];
-        if (sscanf(line, "uniform %31s %63[A-Za-z0-9_]", type, name) == 2) {
-            if (strncmp(name, "u_set_", 6)) { /* settings are the technique's own */
-                n_uniforms++;
-                CHECK_MSG(documented(doc, name), "docs/techniques.md does not name the uniform `%s`", name);
+    for (int k = 0; k < 2; k++) {
+        snprintf(dir, sizeof dir, "%s/%s", src ? src : GR_SOURCE_DIR, techs[k]);
+        gr_technique_class *c2 = NULL;
+        CHECK_OK(gr_usertech_load(dir, &c2, &err), err);
+        if (!c2) CHECK_DONE();
+        char *pre = gr_usertech_prelude(c2, 0, "fragment");
+        CHECK(pre != NULL);
+        if (!pre) CHECK_DONE();
+        /* the prelude ends so that GLSL log line numbers are the user file's own */
+        size_t lp = strlen(pre);
+        CHECK(lp > 8 && !strcmp(pre + lp - 8, "#line 1\n"));
+        for (char *line = pre; line && *line;) {
+            char *nl = strchr(line, '\n');
+            if (nl) *nl = '\0';
+            char type[32], name[64];
+            if (sscanf(line, "uniform %31s %63[A-Za-z0-9_]", type, name) == 2) {
+                if (strncmp(name, "u_set_", 6)) { /* settings are the technique's own */
+                    n_uniforms++;
+                    CHECK_MSG(documented(doc, name), "docs/techniques.md does not name the uniform `%s`", name);
+                }
+            } else if (sscanf(line, "%31s %63[A-Za-z0-9_](", type, name) == 2 && !strncmp(name, "gr_", 3) &&
+                       (strchr(line, '{') || (nl && nl[1] == '{'))) {
+                n_helpers++;
+                CHECK_MSG(documented(doc, name), "docs/techniques.md does not name the helper `%s`", name);
             }
-        } else if (sscanf(line, "%31s %63[A-Za-z0-9_](", type, name) == 2 && !strncmp(name, "gr_", 3) &&
-                   strchr(line, '{')) {
-            n_helpers++;
-            CHECK_MSG(documented(doc, name), "docs/techniques.md does not name the helper `%s`", name);
+            line = nl ? nl + 1 : NULL;
         }
-        line = nl ? nl + 1 : NULL;
+        free(pre);
+        gr_usertech_free(c2);
     }
     printf("%d uniforms/samplers and %d helpers checked\n", n_uniforms, n_helpers);
-    CHECK(n_uniforms >= 40);
-    CHECK(n_helpers >= 6);
-    free(pre);
+    CHECK(n_uniforms >= 50);
+    CHECK(n_helpers >= 9);
     /* every manifest key of the parser has a row "| `key` |" */
-    static const char *const keys[] = {"version", "name", "description", "settings", "shadow_map", "targets", "passes",
+    static const char *const keys[] = {"version", "name", "description", "settings", "shadow_map", "sun_light",
+                                       "caustics", "scene_colour", "albedo", "radius_deg", "targets", "passes",
                                        "output", "allow_black", "gain", "ladder", "tune", "type", "default", "min", "max", "min_exclusive",
                                        "max_exclusive", "unit", "doc", "scale", "size", "format", "filter", "vertex",
                                        "fragment", "draw", "target", "blend", "clear", "inputs", NULL};

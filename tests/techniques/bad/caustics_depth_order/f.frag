@@ -1,0 +1,1 @@
+out vec4 o; void main() { o = vec4(1.0); }
