@@ -12,6 +12,26 @@
 #include "realtime/shaders.h"
 #include "realtime/volume.h"
 
+/* The reuse cache (gr_caustics_set_reuse): stacks already built, each the sampled levels of a
+ * build (level 1 up, copied to levels 0 up of its own texture) under the inputs that made it. */
+#define CACHE_SLOTS 32
+#define CACHE_BYTES (1024LL * 1024 * 1024)
+
+typedef struct build_key {
+    gr_caustics_params p;
+    double origin[2], sun_dir[3], to_sun[3], ior;
+    float wa[GR_MAX_WAVES * 4], wamp[GR_MAX_WAVES];
+    int n_waves;
+} build_key;
+
+typedef struct cache_slot {
+    build_key key;
+    GLuint tex;
+    long long bytes, triangles;
+    unsigned long long used; /* the build counter when last used (least recently used goes) */
+    gr_pass_cost cost;       /* the build's, with the pass's queried primitives once noted */
+} cache_slot;
+
 struct gr_caustics {
     GLuint prog, vao, fbo, tex;
     GLuint ibo, q_samples;   /* the grid's index buffer (for ibo_grid), the fragments' query */
@@ -21,6 +41,13 @@ struct gr_caustics {
     GLint l_grid, l_L, l_nw, l_wa, l_wamp, l_sun, l_ior, l_fresnel, l_gL, l_plane, l_to_sun, l_texel;
     double origin[2];
     long long triangles;
+    int reuse;               /* gr_caustics_set_reuse */
+    cache_slot slot[CACHE_SLOTS];
+    int n_slots;
+    long long cache_bytes;
+    unsigned long long clock;
+    const cache_slot *active; /* the slot the last build took its stack from; NULL: c->tex */
+    cache_slot *stored;       /* the slot the last build (drawn) was kept in; NULL: none */
 };
 
 /* ---- caustics ------------------------------------------------------------------------------ */
@@ -71,12 +98,15 @@ void gr_caustics_destroy(gr_caustics *c)
     if (c->vao) glDeleteVertexArrays(1, &c->vao);
     if (c->fbo) glDeleteFramebuffers(1, &c->fbo);
     if (c->tex) glDeleteTextures(1, &c->tex);
+    for (int i = 0; i < c->n_slots; i++) glDeleteTextures(1, &c->slot[i].tex);
     if (c->ibo) glDeleteBuffers(1, &c->ibo);
     if (c->q_samples) glDeleteQueries(1, &c->q_samples);
     free(c);
 }
 
-unsigned gr_caustics_texture(const gr_caustics *c) { return c->tex; }
+unsigned gr_caustics_texture(const gr_caustics *c) { return c->active ? c->active->tex : c->tex; }
+int gr_caustics_base_level(const gr_caustics *c) { return c->active ? 0 : 1; }
+void gr_caustics_set_reuse(gr_caustics *c, int on) { c->reuse = on != 0; }
 long long gr_caustics_triangles(const gr_caustics *c) { return c->triangles; }
 void gr_caustics_origin(const gr_caustics *c, double origin[2])
 {
@@ -111,6 +141,76 @@ static gr_status ensure_indices(gr_caustics *c, int grid, gr_error *err)
 
 void gr_caustics_cost(const gr_caustics *c, gr_pass_cost *out) { *out = c->cost; }
 
+void gr_caustics_note_primitives(gr_caustics *c, long long primitives)
+{
+    if (!c->stored || primitives < 0) return;
+    c->stored->cost.v[GR_COST_PRIMITIVES] = primitives;
+    c->stored->cost.queried |= 1u << GR_COST_PRIMITIVES;
+}
+
+/* A stack built from the same inputs: c takes it (texture, cost, triangles); 1 if found. */
+static int cache_find(gr_caustics *c, const build_key *key)
+{
+    for (int i = 0; i < c->n_slots; i++) {
+        cache_slot *s = &c->slot[i];
+        if (memcmp(&s->key, key, sizeof *key) != 0) continue;
+        s->used = ++c->clock;
+        c->active = s;
+        c->cost = s->cost;
+        c->triangles = s->triangles;
+        return 1;
+    }
+    return 0;
+}
+
+/* Keeps the stack just built in c->tex under key: its sampled levels (1 up) copied to a
+ * texture of their own (levels 0 up, the same sampler state), the least recently used slots
+ * deleted while the cache would pass CACHE_BYTES or CACHE_SLOTS. A stack larger than the
+ * whole cache is not kept. */
+static gr_status cache_store(gr_caustics *c, const build_key *key, gr_error *err)
+{
+    const int S2 = 2 * key->p.size, layers = key->p.n_depths;
+    int levels = 0;
+    long long bytes = 0;
+    for (int l = 1; (S2 >> l) >= 1; l++, levels++) bytes += 4LL * (S2 >> l) * (S2 >> l) * layers;
+    if (bytes > CACHE_BYTES || levels < 1) return GR_OK;
+    while (c->n_slots > 0 && (c->n_slots == CACHE_SLOTS || c->cache_bytes + bytes > CACHE_BYTES)) {
+        int lru = 0;
+        for (int i = 1; i < c->n_slots; i++)
+            if (c->slot[i].used < c->slot[lru].used) lru = i;
+        glDeleteTextures(1, &c->slot[lru].tex);
+        c->cache_bytes -= c->slot[lru].bytes;
+        c->slot[lru] = c->slot[--c->n_slots];
+    }
+    cache_slot *s = &c->slot[c->n_slots];
+    memset(s, 0, sizeof *s);
+    glGenTextures(1, &s->tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, s->tex);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, levels, GL_R32F, S2 >> 1, S2 >> 1, layers);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+    for (int l = 0; l < levels; l++)
+        glCopyImageSubData(c->tex, GL_TEXTURE_2D_ARRAY, l + 1, 0, 0, 0, s->tex, GL_TEXTURE_2D_ARRAY, l, 0, 0, 0,
+                           S2 >> (l + 1), S2 >> (l + 1), layers);
+    gr_status st = gr_gl_check("caustic stack: keeping it for reuse", err);
+    if (st != GR_OK) {
+        glDeleteTextures(1, &s->tex);
+        return st;
+    }
+    s->key = *key;
+    s->bytes = bytes;
+    s->used = ++c->clock;
+    s->cost = c->cost;
+    s->triangles = c->triangles;
+    c->cache_bytes += bytes;
+    c->n_slots++;
+    c->stored = s;
+    return GR_OK;
+}
+
 gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_frame *f, const gr_caustics_params *p,
                             gr_error *err)
 {
@@ -142,8 +242,28 @@ gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_fram
     double L = p->patch_m;
     c->origin[0] = floor(f->eye[0] / L) * L;
     c->origin[1] = floor(f->eye[2] / L) * L;
-    float wa[GR_MAX_WAVES * 4], wamp[GR_MAX_WAVES];
+    c->active = NULL;
+    c->stored = NULL;
+    /* everything the build's uniforms are made of, zero-padded so that memcmp compares it */
+    build_key key;
+    memset(&key, 0, sizeof key);
+    float *wa = key.wa, *wamp = key.wamp;
     gr_vol_waves(scene, f, c->origin[0], c->origin[1], wa, wamp);
+    if (c->reuse) {
+        /* field by field: the padding of *p is indeterminate, key's is zero */
+        key.p.size = p->size;
+        key.p.grid = p->grid;
+        key.p.patch_m = p->patch_m;
+        key.p.n_depths = p->n_depths;
+        for (int d = 0; d < p->n_depths; d++) key.p.depths_m[d] = p->depths_m[d];
+        key.p.fresnel = p->fresnel;
+        key.n_waves = scene->water.n_waves;
+        for (int k = 0; k < 3; k++) key.sun_dir[k] = f->sun_dir[k], key.to_sun[k] = f->to_sun[k];
+        key.ior = f->ior;
+        key.origin[0] = c->origin[0];
+        key.origin[1] = c->origin[1];
+        if (cache_find(c, &key)) return GR_OK;
+    }
     glBindTexture(GL_TEXTURE_2D_ARRAY, c->tex);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_BASE_LEVEL, 0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
@@ -198,7 +318,9 @@ gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_fram
     c->cost.v[GR_COST_TAPS] = 4 * mip_texels * layers;
     c->cost.v[GR_COST_BYTES] = (s0 + mip_texels) * 4 * layers + c->cost.v[GR_COST_FRAGMENTS] * 4;
     c->cost.v[GR_COST_INVOCATIONS] = 0;
-    return gr_gl_check("caustic texture build", err);
+    gr_status st = gr_gl_check("caustic texture build", err);
+    if (st == GR_OK && c->reuse) st = cache_store(c, &key, err);
+    return st;
 }
 
 gr_status gr_caustics_read(gr_caustics *c, int layer, gr_image **out, gr_error *err)
@@ -211,7 +333,8 @@ gr_status gr_caustics_read(gr_caustics *c, int layer, gr_image **out, gr_error *
     gr_image *img = gr_image_create(n, n, 1, names);
     if (!img) return gr_fail(err, GR_E_NOMEM, "caustics: out of memory");
     glBindFramebuffer(GL_FRAMEBUFFER, c->fbo);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, c->tex, 1, layer);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, gr_caustics_texture(c), gr_caustics_base_level(c),
+                              layer);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glReadPixels(0, 0, n, n, GL_RED, GL_FLOAT, img->pixels);

@@ -42,6 +42,15 @@ gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_fram
                             gr_error *err);
 /* GL_TEXTURE_2D_ARRAY (R32F, linear, repeat), one layer per depth, base level = the filtered one. */
 unsigned gr_caustics_texture(const gr_caustics *c);
+/* The texture's base level (1: a build's own texture, whose level 0 is the 2x supersampled
+ * one; 0: a reused stack, which holds the sampled levels only). Sampling is the same. */
+int gr_caustics_base_level(const gr_caustics *c);
+/* Reuse (a search's renders, gr_technique_set_reuse): on, each build is kept (up to 1 GiB of
+ * stacks, least recently used dropped) under everything its uniforms are made of (parameters,
+ * the waves at the frame's time, sun, ior, patch origin), and a build with the same inputs
+ * takes the kept stack instead of drawing: the same texels (the build is deterministic), the
+ * same cost counters, no time. Off (the default; every timing): every build draws. */
+void gr_caustics_set_reuse(gr_caustics *c, int on);
 void gr_caustics_origin(const gr_caustics *c, double origin[2]);
 /* Reads layer `layer` of the last build (1 channel "Y", row y = texel row y, i.e. z increasing). */
 gr_status gr_caustics_read(gr_caustics *c, int layer, gr_image **out, gr_error *err);
@@ -52,6 +61,9 @@ long long gr_caustics_triangles(const gr_caustics *c);
  * drawn, texture taps and bytes of the mip chain, bytes cleared and blended; primitives are
  * the caller's timer's. */
 void gr_caustics_cost(const gr_caustics *c, gr_pass_cost *out);
+/* The primitives the caller's query counted around the last build, when it drew and was kept:
+ * a later reuse of that stack reports them (its own pass draws nothing). */
+void gr_caustics_note_primitives(gr_caustics *c, long long primitives);
 
 /* Depths of a stack: n depths geometric between first_m and last_m (n = 1: first_m). */
 void gr_caustics_depths(int n, double first_m, double last_m, double *out);

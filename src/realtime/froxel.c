@@ -294,5 +294,6 @@ const gr_technique_class gr_froxel_class = {
     .create = fx_create,
     .destroy = fx_destroy,
     .render = fx_render,
+    .set_reuse = gr_vol_set_reuse,
     .summary = fx_summary,
 };

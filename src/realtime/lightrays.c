@@ -416,6 +416,7 @@ const gr_technique_class gr_light_rays_class = {
     .create = lr_create,
     .destroy = lr_destroy,
     .render = lr_render,
+    .set_reuse = gr_vol_set_reuse,
     .metadata = lr_metadata,
     .summary = lr_summary,
 };

@@ -237,5 +237,6 @@ const gr_technique_class gr_slicing_class = {
     .create = sl_create,
     .destroy = sl_destroy,
     .render = sl_render,
+    .set_reuse = gr_vol_set_reuse,
     .summary = sl_summary,
 };

@@ -406,6 +406,11 @@ const gr_technique_class *gr_technique_class_of(const gr_technique *t) { return 
 
 gr_gl *gr_technique_gl(const gr_technique *t) { return t ? t->gl : NULL; }
 
+void gr_technique_set_reuse(gr_technique *t, int on)
+{
+    if (t && !t->abandoned && t->cls->set_reuse) t->cls->set_reuse(t->state, on);
+}
+
 gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out,
                               gr_technique_stats *stats, gr_error *err)
 {

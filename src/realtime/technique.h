@@ -149,6 +149,8 @@ struct gr_technique_class {
      * intermediate render target of the last render as an RGBA float image (*out is the
      * caller's). */
     gr_status (*read_target)(void *state, gr_image **out, gr_error *err);
+    /* Optional (may be NULL): gr_technique_set_reuse's switch for this class's state. */
+    void (*set_reuse)(void *state, int on);
 };
 
 /* ---- registry --------------------------------------------------------------------------- */
@@ -239,6 +241,13 @@ const gr_technique_class *gr_technique_class_of(const gr_technique *t);
  * time limit: GR_E_TIMEOUT, and t and its context are abandoned (every later render of t is
  * GR_E_TIMEOUT; gr_technique_create refuses the context; destroy t and the context as
  * usual, neither touches GL then): the caller makes a new context for what follows. */
+/* A search (tuning) renders the same frames again and again with settings that change the
+ * look: on, the instance may keep what depends only on the frame and on settings a search
+ * does not move (the caustic stack of the volume techniques: caustics.h) and take it again
+ * when the same inputs recur: the same pixels, but that pass costs no time, so a timed
+ * render must have it off (the default). A class without set_reuse ignores it. */
+void gr_technique_set_reuse(gr_technique *t, int on);
+
 gr_status gr_technique_render(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out,
                               gr_technique_stats *stats, gr_error *err);
 /* "godrays:technique", every setting (resolved, by name), GL strings, per-pass GPU ns, wall ms,

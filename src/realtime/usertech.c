@@ -33,6 +33,7 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
 static gr_status ut_metadata(void *state, const gr_scene *scene, const void *settings, const gr_technique_stats *stats,
                              gr_metadata *meta, gr_error *err);
 static gr_status ut_read_target(void *state, gr_image **out, gr_error *err);
+static void ut_set_reuse(void *state, int on);
 
 /* Settings of a user technique have no scene-derived defaults: resolving is a copy. */
 static void ut_resolve(const gr_technique_class *cls, const gr_scene *scene, const void *in, void *out)
@@ -71,6 +72,7 @@ gr_status gr_usertech_load(const char *dir, gr_technique_class **out, gr_error *
     cls->render = ut_render;
     cls->metadata = ut_metadata;
     cls->read_target = ut_read_target;
+    cls->set_reuse = ut_set_reuse;
     *out = cls;
     return GR_OK;
 }
@@ -1100,9 +1102,7 @@ static gr_status ut_render(void *state, const gr_scene *scene, const void *setti
          * and of one texel per fragment; taps are the user's shader's (not counted) */
         for (int k = 0; k < first_pass_slot; k++) {
             if (!strcmp(names[k], "caustics")) { /* the stack's own counters (caustics.h) */
-                gr_pass_cost c;
-                gr_caustics_cost(s->caus, &c);
-                gr_vol_cost_pass(stats, k, &c);
+                gr_vol_cost_caustics(stats, k, s->caus);
                 continue;
             }
             long long side = strcmp(names[k], "shadow_map") == 0 ? s->shadow_size : 0;
@@ -1173,6 +1173,13 @@ static gr_status ut_metadata(void *state, const gr_scene *scene, const void *set
  * as grey (R = G = B = the texel, alpha 1); then the manifest's targets in their order), side by
  * side in one RGBA strip, top-aligned at their own sizes, 4 black pixels apart; the metadata
  * (ut_metadata) gives each target's size, so x offsets follow from the order. */
+/* A search's reuse (technique.h): the "caustics" stack (also scene_colour's) kept per frame. */
+static void ut_set_reuse(void *state, int on)
+{
+    ut_state *s = state;
+    if (s && s->caus) gr_caustics_set_reuse(s->caus, on);
+}
+
 static gr_status ut_read_target(void *state, gr_image **out, gr_error *err)
 {
     ut_state *s = state;

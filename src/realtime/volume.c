@@ -174,6 +174,12 @@ int gr_vol_base_current(const gr_vol_base *b)
     return b->gl && gr_gl_make_current(b->gl, NULL) == GR_OK;
 }
 
+void gr_vol_set_reuse(void *state, int on)
+{
+    gr_vol_base *b = state; /* the state's first member */
+    if (b && b->caus) gr_caustics_set_reuse(b->caus, on);
+}
+
 void gr_vol_base_release(gr_vol_base *b)
 {
     if (gr_vol_base_current(b)) {
@@ -291,8 +297,15 @@ void gr_vol_cost_prelude(const gr_vol_base *b, const gr_vol_prep *p, gr_techniqu
     }
     c.v[GR_COST_BYTES] = (long long)p->frame.width * p->frame.height * 4;
     gr_vol_cost_pass(stats, GR_VOL_PASS_DEPTH, &c);
-    if (b->caus) {
-        gr_caustics_cost(b->caus, &c);
-        gr_vol_cost_pass(stats, GR_VOL_PASS_CAUSTICS, &c);
-    }
+    if (b->caus) gr_vol_cost_caustics(stats, GR_VOL_PASS_CAUSTICS, b->caus);
+}
+
+void gr_vol_cost_caustics(gr_technique_stats *stats, int p, gr_caustics *c)
+{
+    if (p < 0 || p >= stats->n_passes) return;
+    const gr_pass_cost *q = &stats->cost[p]; /* the timer's queried primitives of the build */
+    if (q->queried & (1u << GR_COST_PRIMITIVES)) gr_caustics_note_primitives(c, q->v[GR_COST_PRIMITIVES]);
+    gr_pass_cost m;
+    gr_caustics_cost(c, &m);
+    gr_vol_cost_pass(stats, p, &m);
 }

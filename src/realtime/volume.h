@@ -108,6 +108,9 @@ typedef struct gr_vol_base {
 gr_status gr_vol_base_init(gr_vol_base *b, gr_gl *gl, const char *dir, int with_caustics, gr_error *err);
 /* Makes b's context current; 1 when the technique may delete its own GL objects now. */
 int gr_vol_base_current(const gr_vol_base *b);
+/* The class's set_reuse (technique.h) of a state whose first member is its gr_vol_base: the
+ * caustic stack's reuse (caustics.h). */
+void gr_vol_set_reuse(void *state, int on);
 /* Deletes what gr_vol_base_init and gr_vol_prepare made (b may be partly made). */
 void gr_vol_base_release(gr_vol_base *b);
 
@@ -132,5 +135,8 @@ gr_status gr_vol_finish(const char *name, gr_vol_base *b, const gr_vol_prep *p, 
 void gr_vol_cost_prelude(const gr_vol_base *b, const gr_vol_prep *p, gr_technique_stats *stats);
 /* Counter k of pass p set analytically, keeping the pass's queried primitives. */
 void gr_vol_cost_pass(gr_technique_stats *stats, int p, const gr_pass_cost *c);
+/* Pass p's counters from the caustic stack c (gr_caustics_cost), after the pass's timer
+ * results are in stats: a drawn build's queried primitives are noted for its reuse. */
+void gr_vol_cost_caustics(gr_technique_stats *stats, int p, gr_caustics *c);
 
 #endif

@@ -231,7 +231,11 @@ static gr_status render_score(gr_tune_problem *p, int i, const void *s, gr_image
 {
     gr_technique_stats stats;
     double t0 = now_s();
+    /* a search's renders: what depends only on the frame may be reused (technique.h); off
+     * again after, for whoever times this instance next */
+    gr_technique_set_reuse(p->renderer, 1);
     gr_status st = gr_technique_render(p->renderer, p->scenes[i], s, out, &stats, err);
+    gr_technique_set_reuse(p->renderer, 0);
     double t1 = now_s();
     p->render_s += t1 - t0;
     if (st != GR_OK) return st;
