@@ -981,7 +981,7 @@ static gr_status parse_scene_colour(ut_ctx *c, gr_ut_manifest *m, const cJSON *o
     static const char *const keys[] = {"scale", "format", "albedo", "radius_deg", NULL};
     m->scol_scale = (gr_ut_value){1.0, -1};
     m->scol_radius_deg = (gr_ut_value){4.0, -1};
-    m->scol_format = GR_UT_FMT_RGBA16F;
+    m->scol_format = GR_UT_FMT_RGBA32F;
     m->scol_albedo[0] = m->scol_albedo[1] = m->scol_albedo[2] = 0.3;
     m->scol_albedo_setting = -1;
     if (!obj) return GR_OK;
