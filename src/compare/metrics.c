@@ -311,7 +311,18 @@ static gr_status structure_fill(const ctx *cx, const gr_image *test, gr_metrics_
     so.scored = cx->scored;
     gr_structure_compare *c = malloc(sizeof *c);
     if (!c) return gr_fail(err, GR_E_NOMEM, "metrics: out of memory");
-    gr_status st = gr_structure_compare_images(cx->ref, test, &so, c, err);
+    gr_status st = GR_OK;
+    gr_structure_ref **keep = cx->opt->structure_ref;
+    if (!keep) {
+        st = gr_structure_compare_images(cx->ref, test, &so, c, err);
+    } else {
+        if (!gr_structure_ref_matches(*keep, cx->ref, &so)) {
+            gr_structure_ref_destroy(*keep);
+            *keep = NULL;
+            st = gr_structure_ref_create(cx->ref, &so, keep, err);
+        }
+        if (st == GR_OK) st = gr_structure_compare_ref(*keep, test, c, err);
+    }
     if (st == GR_OK) {
         for (int k = 0; k < n; k++) {
             sets[k]->have_structure = 1;

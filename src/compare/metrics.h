@@ -47,6 +47,10 @@ typedef struct gr_metrics_options {
                                      here; vanishing point required); NULL: none */
     int skip_extra;               /* leave out the registry's metrics that have their own compute
                                      function (compare/registry.h; cost GR_METRIC_COST_OWN) */
+    gr_structure_ref **structure_ref; /* may be NULL; else the reference's structure half kept
+                                     between calls (a search): used when it matches this ref and
+                                     these options (gr_structure_ref_matches), else remade into
+                                     it. The caller destroys *structure_ref */
 } gr_metrics_options;
 
 /* Computes every metric between ref and test (same size; any channel layouts). ref may carry

@@ -386,28 +386,112 @@ gr_status gr_structure_image_compute(const gr_image *img, const gr_structure_opt
     return st;
 }
 
-gr_status gr_structure_compare_images(const gr_image *ref, const gr_image *test, const gr_structure_options *opt,
-                                      gr_structure_compare *out, gr_error *err)
-{
-    if (!out) return gr_fail(err, GR_E_INPUT, "structure: NULL result");
-    gr_status st = check_img(ref, "reference", err);
-    if (st == GR_OK) st = check_img(test, "test", err);
-    if (st != GR_OK) return st;
-    if (ref->width != test->width || ref->height != test->height)
-        return gr_fail(err, GR_E_INPUT, "structure: size mismatch: reference %d x %d, test %d x %d", ref->width,
-                       ref->height, test->width, test->height);
+/* The reference's half (structure.h): its resolved options over copies of what they point at,
+ * its R, G, B (to recognize it), its per-image measures and its band-pass contrast. */
+struct gr_structure_ref {
     gr_structure_options o;
-    st = resolve(opt, ref->width, ref->height, &o, err);
+    int w, h;
+    float *rgb;
+    unsigned char *scored;
+    float *radial;
+    gr_structure_image im;
+    double *c;
+};
+
+void gr_structure_ref_destroy(gr_structure_ref *r)
+{
+    if (!r) return;
+    free(r->rgb);
+    free(r->scored);
+    free(r->radial);
+    free(r->c);
+    free(r);
+}
+
+static void copy_rgb(const gr_image *img, float *out)
+{
+    int rgb[3];
+    gr_metrics_pick_rgb(img, rgb);
+    const size_t n = (size_t)img->width * (size_t)img->height;
+    for (size_t p = 0; p < n; p++)
+        for (int k = 0; k < 3; k++) out[3 * p + k] = img->pixels[p * (size_t)img->nchannels + (size_t)rgb[k]];
+}
+
+gr_status gr_structure_ref_create(const gr_image *ref, const gr_structure_options *opt, gr_structure_ref **out,
+                                  gr_error *err)
+{
+    *out = NULL;
+    gr_status st = check_img(ref, "reference", err);
+    gr_structure_options o;
+    if (st == GR_OK) st = resolve(opt, ref->width, ref->height, &o, err);
     if (st != GR_OK) return st;
-    memset(out, 0, sizeof *out);
     const size_t n = (size_t)ref->width * (size_t)ref->height;
-    double *cr = malloc(n * sizeof(double)), *ct = malloc(n * sizeof(double));
-    if (!cr || !ct) {
-        free(cr), free(ct);
+    gr_structure_ref *r = calloc(1, sizeof *r);
+    if (r) {
+        r->rgb = malloc(3 * n * sizeof *r->rgb);
+        r->c = malloc(n * sizeof *r->c);
+        if (o.scored && (r->scored = malloc(n))) memcpy(r->scored, o.scored, n);
+        if (o.radial && (r->radial = malloc(n * sizeof *r->radial))) memcpy(r->radial, o.radial, n * sizeof *r->radial);
+    }
+    if (!r || !r->rgb || !r->c || (o.scored && !r->scored) || (o.radial && !r->radial)) {
+        gr_structure_ref_destroy(r);
         return gr_fail(err, GR_E_NOMEM, "structure: out of memory");
     }
-    st = one_image(ref, &o, &out->ref, cr, err);
-    if (st == GR_OK) st = one_image(test, &o, &out->test, ct, err);
+    o.scored = r->scored;
+    o.radial = r->radial;
+    r->o = o;
+    r->w = ref->width;
+    r->h = ref->height;
+    copy_rgb(ref, r->rgb);
+    if ((st = one_image(ref, &r->o, &r->im, r->c, err)) != GR_OK) {
+        gr_structure_ref_destroy(r);
+        return st;
+    }
+    *out = r;
+    return GR_OK;
+}
+
+int gr_structure_ref_matches(const gr_structure_ref *r, const gr_image *ref, const gr_structure_options *opt)
+{
+    gr_structure_options o;
+    gr_error e;
+    if (!r || check_img(ref, "reference", &e) != GR_OK || ref->width != r->w || ref->height != r->h ||
+        resolve(opt, ref->width, ref->height, &o, &e) != GR_OK)
+        return 0;
+    const gr_structure_options *a = &r->o;
+    if (a->vp_x != o.vp_x || a->vp_y != o.vp_y || a->sigma_fine_px != o.sigma_fine_px ||
+        a->sigma_coarse_px != o.sigma_coarse_px || a->eps_rel != o.eps_rel || a->n_annuli != o.n_annuli ||
+        a->r_min_px != o.r_min_px || a->r_max_px != o.r_max_px || a->n_theta != o.n_theta || a->m_max != o.m_max ||
+        a->m_min != o.m_min || a->radial_bin != o.radial_bin || !a->scored != !o.scored || !a->radial != !o.radial)
+        return 0;
+    const size_t n = (size_t)r->w * (size_t)r->h;
+    if (o.scored && memcmp(a->scored, o.scored, n) != 0) return 0;
+    if (o.radial && memcmp(a->radial, o.radial, n * sizeof *o.radial) != 0) return 0;
+    float *rgb = malloc(3 * n * sizeof *rgb);
+    if (!rgb) return 0;
+    copy_rgb(ref, rgb);
+    const int same = memcmp(rgb, r->rgb, 3 * n * sizeof *rgb) == 0;
+    free(rgb);
+    return same;
+}
+
+gr_status gr_structure_compare_ref(const gr_structure_ref *r, const gr_image *test, gr_structure_compare *out,
+                                   gr_error *err)
+{
+    if (!out || !r) return gr_fail(err, GR_E_INPUT, "structure: NULL result or reference");
+    gr_status st = check_img(test, "test", err);
+    if (st != GR_OK) return st;
+    if (r->w != test->width || r->h != test->height)
+        return gr_fail(err, GR_E_INPUT, "structure: size mismatch: reference %d x %d, test %d x %d", r->w, r->h,
+                       test->width, test->height);
+    const gr_structure_options o = r->o;
+    memset(out, 0, sizeof *out);
+    const size_t n = (size_t)r->w * (size_t)r->h;
+    const double *cr = r->c;
+    double *ct = malloc(n * sizeof(double));
+    if (!ct) return gr_fail(err, GR_E_NOMEM, "structure: out of memory");
+    out->ref = r->im;
+    st = one_image(test, &o, &out->test, ct, err);
     if (st == GR_OK) {
         /* Pearson correlation over scored pixels, sums in double */
         double sr = 0, stt = 0, srr = 0, stt2 = 0, srt = 0;
@@ -446,6 +530,22 @@ gr_status gr_structure_compare_images(const gr_image *ref, const gr_image *test,
             out->spectrum_log_dist = sqrt(s / k);
         }
     }
-    free(cr), free(ct);
+    free(ct);
+    return st;
+}
+
+gr_status gr_structure_compare_images(const gr_image *ref, const gr_image *test, const gr_structure_options *opt,
+                                      gr_structure_compare *out, gr_error *err)
+{
+    if (!out) return gr_fail(err, GR_E_INPUT, "structure: NULL result");
+    gr_status st = check_img(ref, "reference", err);
+    if (st == GR_OK) st = check_img(test, "test", err);
+    if (st != GR_OK) return st;
+    if (ref->width != test->width || ref->height != test->height)
+        return gr_fail(err, GR_E_INPUT, "structure: size mismatch: reference %d x %d, test %d x %d", ref->width,
+                       ref->height, test->width, test->height);
+    gr_structure_ref *r = NULL;
+    if ((st = gr_structure_ref_create(ref, opt, &r, err)) == GR_OK) st = gr_structure_compare_ref(r, test, out, err);
+    gr_structure_ref_destroy(r);
     return st;
 }

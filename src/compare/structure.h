@@ -99,4 +99,17 @@ gr_status gr_structure_image_compute(const gr_image *img, const gr_structure_opt
 gr_status gr_structure_compare_images(const gr_image *ref, const gr_image *test, const gr_structure_options *opt,
                                       gr_structure_compare *out, gr_error *err);
 
+/* The reference's half of a comparison, kept to compare many test images with one reference
+ * under the same options (a search: the same cases again and again). compare_images is
+ * create + compare_ref + destroy, so both give the same numbers to the bit. The options'
+ * arrays (scored, radial) are copied. */
+typedef struct gr_structure_ref gr_structure_ref;
+gr_status gr_structure_ref_create(const gr_image *ref, const gr_structure_options *opt, gr_structure_ref **out,
+                                  gr_error *err);
+void gr_structure_ref_destroy(gr_structure_ref *r); /* accepts NULL */
+/* 1 when r was made from this reference (its R, G, B) with these options (values and arrays). */
+int gr_structure_ref_matches(const gr_structure_ref *r, const gr_image *ref, const gr_structure_options *opt);
+gr_status gr_structure_compare_ref(const gr_structure_ref *r, const gr_image *test, gr_structure_compare *out,
+                                   gr_error *err);
+
 #endif

@@ -144,7 +144,7 @@ static double now_s(void)
 gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
 {
     p->scratch = NULL;
-    for (int i = 0; i < GR_TUNE_MAX_CASES; i++) p->angles[i] = NULL;
+    for (int i = 0; i < GR_TUNE_MAX_CASES; i++) p->angles[i] = NULL, p->sref[i] = NULL;
     if (p->n_cases < 1 || p->n_cases > GR_TUNE_MAX_CASES)
         return gr_fail(err, GR_E_INPUT, "tuning: %d cases (1..%d)", p->n_cases, GR_TUNE_MAX_CASES);
     if (p->n_params < 0 || p->n_params > GR_TUNE_MAX_PARAMS)
@@ -212,6 +212,8 @@ void gr_tune_problem_free(gr_tune_problem *p)
     for (int i = 0; i < GR_TUNE_MAX_CASES; i++) {
         free(p->angles[i]);
         p->angles[i] = NULL;
+        gr_structure_ref_destroy(p->sref[i]);
+        p->sref[i] = NULL;
     }
 }
 
@@ -267,6 +269,7 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
         opt.stderr_bound = p->stderr_bound;
         opt.fit_scale = p->fit;
         opt.skip_ssim = opt.skip_blur = opt.skip_extra = 1;
+        opt.structure_ref = &p->sref[i]; /* the truth's half, made once per case */
         case_options(p, i, &opt, &fo, &so);
         gr_metrics m;
         if ((st = render_score(p, i, s.bytes, p->scratch, &opt, &m, err)) != GR_OK) return st;

@@ -86,6 +86,8 @@ typedef struct gr_tune_problem {
     double stderr_bound;                /* passed to the metrics (0: default) */
     /* filled by gr_tune_problem_init */
     gr_image *scratch;                  /* one frame (R, G, B) */
+    gr_structure_ref *sref[GR_TUNE_MAX_CASES]; /* each case's reference half of the structure
+                                           comparison, kept across evaluations (metrics.h) */
     /* accounting since init */
     long long renders;
     double render_s, metrics_s;         /* wall time in gr_technique_render / gr_metrics_compute */

@@ -9,6 +9,7 @@
  * the kernels). Also the vanishing point of a camera (closed form) and bad input. */
 #include "check.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 #include "compare/blur.h"
@@ -238,6 +239,45 @@ int main(void)
         gr_structure_compare c;
         CHECK(gr_structure_compare_images(base, small, &o, &c, &err) == GR_E_INPUT && strstr(err.msg, "size"));
         gr_image_destroy(small);
+    }
+    /* the reference's half kept (a search): the same numbers to the bit as a whole comparison;
+     * it is recognized for the same reference and options only (a changed pixel, option or
+     * scored mask makes gr_structure_ref_matches false) */
+    {
+        gr_image *rot = pattern(128, 128, 1.0);
+        gr_structure_compare whole, kept;
+        gr_structure_ref *r = NULL;
+        CHECK_OK(gr_structure_compare_images(base, rot, &o, &whole, &err), err);
+        CHECK_OK(gr_structure_ref_create(base, &o, &r, &err), err);
+        CHECK_OK(gr_structure_compare_ref(r, rot, &kept, &err), err);
+        CHECK(!memcmp(&whole, &kept, sizeof whole));
+        CHECK(gr_structure_ref_matches(r, base, &o));
+        gr_structure_options o2 = o;
+        o2.sigma_fine_px = 1.5;
+        CHECK(!gr_structure_ref_matches(r, base, &o2));
+        unsigned char *mask = malloc((size_t)W * H);
+        memset(mask, 1, (size_t)W * H);
+        o2 = o, o2.scored = mask;
+        CHECK(!gr_structure_ref_matches(r, base, &o2));
+        gr_image *moved = pattern(128, 128, 0.0);
+        gr_image_pixel(moved, 3, 5)[1] += 0.25f;
+        CHECK(!gr_structure_ref_matches(r, moved, &o));
+        gr_structure_ref_destroy(r);
+        /* with a scored mask: kept = whole as well */
+        mask[10] = mask[2000] = 0;
+        o2 = o, o2.scored = mask;
+        CHECK_OK(gr_structure_compare_images(base, rot, &o2, &whole, &err), err);
+        CHECK_OK(gr_structure_ref_create(base, &o2, &r, &err), err);
+        mask[11] = 0; /* the kept half holds its own copy of the mask */
+        CHECK(!gr_structure_ref_matches(r, base, &o2));
+        mask[11] = 1;
+        CHECK(gr_structure_ref_matches(r, base, &o2));
+        CHECK_OK(gr_structure_compare_ref(r, rot, &kept, &err), err);
+        CHECK(!memcmp(&whole, &kept, sizeof whole));
+        gr_structure_ref_destroy(r);
+        free(mask);
+        gr_image_destroy(moved);
+        gr_image_destroy(rot);
     }
     gr_image_destroy(base);
     CHECK_DONE();
