@@ -538,14 +538,9 @@ gr_status gr_structure_compare_images(const gr_image *ref, const gr_image *test,
                                       gr_structure_compare *out, gr_error *err)
 {
     if (!out) return gr_fail(err, GR_E_INPUT, "structure: NULL result");
-    gr_status st = check_img(ref, "reference", err);
-    if (st == GR_OK) st = check_img(test, "test", err);
-    if (st != GR_OK) return st;
-    if (ref->width != test->width || ref->height != test->height)
-        return gr_fail(err, GR_E_INPUT, "structure: size mismatch: reference %d x %d, test %d x %d", ref->width,
-                       ref->height, test->width, test->height);
-    gr_structure_ref *r = NULL;
-    if ((st = gr_structure_ref_create(ref, opt, &r, err)) == GR_OK) st = gr_structure_compare_ref(r, test, out, err);
+    gr_structure_ref *r = NULL; /* create checks the reference, compare_ref the test and sizes */
+    gr_status st = gr_structure_ref_create(ref, opt, &r, err);
+    if (st == GR_OK) st = gr_structure_compare_ref(r, test, out, err);
     gr_structure_ref_destroy(r);
     return st;
 }

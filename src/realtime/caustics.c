@@ -326,9 +326,10 @@ gr_status gr_caustics_build(gr_caustics *c, const gr_scene *scene, const gr_fram
 gr_status gr_caustics_read(gr_caustics *c, int layer, gr_image **out, gr_error *err)
 {
     *out = NULL;
-    if (!c->tex || layer < 0 || layer >= c->tex_layers)
-        return gr_fail(err, GR_E_USAGE, "caustics: no layer %d to read", layer);
-    int n = c->tex_size;
+    /* a reused stack's size and layers are its own key's (c->tex may hold another build) */
+    const int layers = c->active ? c->active->key.p.n_depths : c->tex_layers;
+    if (!c->tex || layer < 0 || layer >= layers) return gr_fail(err, GR_E_USAGE, "caustics: no layer %d to read", layer);
+    int n = c->active ? c->active->key.p.size : c->tex_size;
     static const char *const names[1] = {"Y"};
     gr_image *img = gr_image_create(n, n, 1, names);
     if (!img) return gr_fail(err, GR_E_NOMEM, "caustics: out of memory");

@@ -110,6 +110,15 @@ int main(void)
     CHECK_MSG(gr_caustics_base_level(c) == 0, "A with another grid again: its own kept stack");
     CHECK_OK(gr_caustics_build(fresh, sc[0], &f[0], &p2, &err), err);
     CHECK_MSG(same_stack(c, fresh, p2.n_depths), "A with another grid: = a fresh build");
+    /* a kept stack read while the build's own texture holds another size and layer count */
+    gr_caustics_params p3 = p;
+    p3.size = 32;
+    p3.n_depths = 2;
+    CHECK_OK(gr_caustics_build(c, sc[1], &f[1], &p3, &err), err);
+    CHECK_OK(gr_caustics_build(c, sc[0], &f[0], &p, &err), err);
+    CHECK_MSG(gr_caustics_base_level(c) == 0, "A after a smaller build: the kept stack");
+    CHECK_OK(gr_caustics_build(fresh, sc[0], &f[0], &p, &err), err);
+    CHECK_MSG(same_stack(c, fresh, p.n_depths), "A after a smaller build: every layer at its own size");
     /* off: every build draws */
     gr_caustics_set_reuse(c, 0);
     CHECK_OK(gr_caustics_build(c, sc[0], &f[0], &p, &err), err);
