@@ -80,7 +80,11 @@ static void usage(FILE *f)
             "  --local-evals N    with --tune: the continuation's local search at the ladder points other\n"
             "                     than the anchor (the ladder's middle; default 20 + 12 per setting, and as\n"
             "                     many for its polish)\n"
-            "  --tune-full        --tune with the global search at every ladder point (slow)\n"
+            "  --tune-full        --tune with the global search at every ladder point, no search budget\n"
+            "                     (slow)\n"
+            "  --no-search-budget with --tune: every point gets its whole search; by default a point\n"
+            "                     whose render work (cost counters) is r times the ladder's cheapest\n"
+            "                     one's gets 1/r of its evaluations (docs/tuning.md \"Search budgets\")\n"
             "  --timing-cap S     with --suite: time fewer renders once the timed ones took S seconds\n"
             "                     (default 2; 0: all --repeat; the count is in fronts.csv)\n"
             "  --yes              start more than 20000 technique renders (docs/tuning.md \"Budgets\")\n"
@@ -176,6 +180,10 @@ static int take_suite_option(gr_args *args, pareto_opts *o, int *rc)
     if (!strcmp(a, "--tune") || !strcmp(a, "--tune-full")) {
         o->ps.tune = 1;
         o->ps.tune_full |= !strcmp(a, "--tune-full");
+        return 1;
+    }
+    if (!strcmp(a, "--no-search-budget")) {
+        o->ps.no_search_budget = 1;
         return 1;
     }
     if (strcmp(a, "--suite") && strcmp(a, "--budgets") && strcmp(a, "--timing-size") && strcmp(a, "--seed") &&

@@ -113,11 +113,14 @@ static gr_status tune_one(const gr_ps_opts *o, ps_run *r, gr_technique *t, int l
     const double t0 = now_s();
     gr_status st = gr_st_tune_level(t, r->cases, r->suite->n_cases, lv, so, u, tu, err);
     r->tune_s += now_s() - t0;
-    if (st == GR_OK && !o->quiet && tu)
-        fprintf(stderr, "godrays pareto: %s %s: tuned by the %s search (%d evaluations, %.1f s): train %.4g, test %.4g "
-                "(untuned %.4g, %.4g)\n", u->cls->name, u->ladder[0] ? u->ladder : "(scene's)",
-                tu->local ? "local" : "global", tu->evals, now_s() - t0, tu->train_error, tu->test_error, u->train_error,
-                u->test_error);
+    if (st == GR_OK && !o->quiet && tu) {
+        char budget[64] = "";
+        if (tu->budget > 0) snprintf(budget, sizeof budget, " of a budget of %d", tu->budget);
+        fprintf(stderr, "godrays pareto: %s %s: tuned by the %s search (%d evaluations%s, %.1f s): train %.4g, test "
+                "%.4g (untuned %.4g, %.4g)\n", u->cls->name, u->ladder[0] ? u->ladder : "(scene's)",
+                gr_st_search_name(tu->local), tu->evals, budget, now_s() - t0, tu->train_error, tu->test_error,
+                u->train_error, u->test_error);
+    }
     return st;
 }
 
@@ -134,9 +137,18 @@ static gr_status technique(const gr_ps_opts *o, ps_run *r, const gr_technique_cl
     if (r->n + 2 * n > PS_MAX_POINTS) n = (PS_MAX_POINTS - r->n) / 2;
     gr_st_point *u = &r->pts[r->n], *tu = &r->pts[r->n + n]; /* tuned points after the untuned, then interleaved */
     const int a = gr_st_continuation_order(n, order, prev);
+    /* the search budget's reference: the work of the cheapest (first) point's train evaluation */
+    double work_ref = 0.0;
+    if (st == GR_OK && o->tune && !o->tune_full && !o->no_search_budget && n > 1) {
+        gr_st_point u0;
+        const gr_st_options so = {.seed = o->seed};
+        st = gr_st_tune_level(t, r->cases, r->suite->n_cases, lv[0], &so, &u0, NULL, err);
+        work_ref = u0.work;
+    }
     for (int k = 0; k < n && st == GR_OK; k++) {
         const int i = order[k];
-        gr_st_options so = {.max_evals = o->max_evals, .seed = o->seed, .local_evals = o->local_evals};
+        gr_st_options so = {.max_evals = o->max_evals, .seed = o->seed, .local_evals = o->local_evals,
+                            .work_ref = work_ref};
         if (o->tune && !o->tune_full && prev[k] >= 0) gr_st_continue_from(&so, &tu[a], &tu[order[prev[k]]]);
         st = tune_one(o, r, t, lv[i], &so, &u[i], o->tune ? &tu[i] : NULL, err);
     }
@@ -188,7 +200,7 @@ static gr_status write_fronts_csv(const char *dir, const ps_run *r, gr_error *er
     gr_strbuf b;
     gr_sb_init(&b);
     gr_sb_puts(&b, "technique,tuned,ladder,label,cost_ms,wall_ms,gpu_ms,wall_min_ms,wall_max_ms,train_error,test_error,"
-                   "on_front,timed_renders,search,evals,renderer\n");
+                   "on_front,timed_renders,search,evals,budget,work,renderer\n");
     for (int i = 0; i < r->n; i++) {
         const gr_st_point *p = &r->pts[i];
         gr_st_point_label(p, label, sizeof label);
@@ -198,10 +210,11 @@ static gr_status write_fronts_csv(const char *dir, const ps_run *r, gr_error *er
         snprintf(lad, sizeof lad, "%s", p->ladder);
         for (char *c = lad; *c; c++)
             if (*c == ',') *c = ';';
-        gr_sb_printf(&b, "%s,%d,%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%s,%d,%s\n", p->cls->name, p->tuned, lad,
+        gr_sb_printf(&b, "%s,%d,%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%s,%d,%d,%.6g,%s\n", p->cls->name, p->tuned, lad,
                      label, p->timing.cost_ms, p->timing.wall_ms, p->timing.gpu_ms, p->timing.wall_min_ms,
                      p->timing.wall_max_ms, p->train_error, p->test_error, p->on_front, p->timing.n,
-                     !p->tuned ? "none" : p->local ? "local" : "global", p->evals, p->timing.renderer);
+                     !p->tuned ? "none" : gr_st_search_name(p->local), p->evals, p->budget, p->work,
+                     p->timing.renderer);
     }
     snprintf(path, sizeof path, "%s/fronts.csv", dir);
     gr_status st = gr_outfile_write(path, gr_sb_str(&b), -1, err);

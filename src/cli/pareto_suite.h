@@ -20,6 +20,8 @@ typedef struct gr_ps_opts {
     int max_evals;       /* the global search's, per local search (0: its default) */
     int tune_full;       /* the global search at every ladder point (else only at the anchor) */
     int local_evals;     /* the continuation's local search (0: gr_st_local_evals) */
+    int no_search_budget;/* every point its whole search (tune/suitetune.h "Search budgets");
+                            --tune-full implies it */
     unsigned long long seed;
     gr_gl_platform platform;
     const gr_technique_class *const *techs;

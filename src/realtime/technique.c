@@ -517,6 +517,16 @@ void gr_technique_cost_total(const gr_technique_stats *s, gr_pass_cost *out)
             }
 }
 
+long long gr_technique_stats_work(const gr_technique_stats *s)
+{
+    static const int counted[] = {GR_COST_FRAGMENTS, GR_COST_VERTICES, GR_COST_PRIMITIVES, GR_COST_INVOCATIONS};
+    long long w = 0;
+    for (int p = 0; p < s->n_passes && p < GR_TECH_MAX_PASSES; p++)
+        for (size_t k = 0; k < sizeof counted / sizeof counted[0]; k++)
+            if (s->cost[p].v[counted[k]] > 0) w += s->cost[p].v[counted[k]];
+    return w;
+}
+
 void gr_pass_cost_text(const gr_pass_cost *c, char *buf, size_t n)
 {
     size_t used = 0;

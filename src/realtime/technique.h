@@ -71,6 +71,10 @@ gr_pass_cost gr_pass_cost_screen(long long w, long long h, long long taps_per_px
 void gr_technique_cost_set(gr_technique_stats *s, int p, int k, long long v, int queried);
 /* The sum over the passes of each counter (-1 where no pass counted it). */
 void gr_technique_cost_total(const gr_technique_stats *s, gr_pass_cost *out);
+/* A render's work for search budgets (docs/tuning.md "Search budgets"): the sum over its passes
+ * of the fragments, vertices, primitives and invocations counted (taps and bytes left out: a
+ * full-screen pass's taps are cheap beside a rasterized primitive); 0 when none is counted. */
+long long gr_technique_stats_work(const gr_technique_stats *s);
 /* "fragments 2073600, taps 8294400, ..." of a pass cost (counters not counted left out; a
  * queried one marked with '*'), "" when nothing was counted. */
 void gr_pass_cost_text(const gr_pass_cost *c, char *buf, size_t n);

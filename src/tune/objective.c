@@ -199,6 +199,7 @@ gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
         }
     }
     p->renders = 0;
+    p->work = 0.0;
     p->render_s = p->metrics_s = p->wall_ms_sum = p->gpu_ms_sum = 0.0;
     p->gpu_timed = 0;
     return GR_OK;
@@ -242,6 +243,7 @@ static gr_status render_score(gr_tune_problem *p, int i, const void *s, gr_image
     p->render_s += t1 - t0;
     if (st != GR_OK) return st;
     p->renders++;
+    p->work += (double)gr_technique_stats_work(&stats);
     p->wall_ms_sum += stats.wall_ms;
     for (int k = 0; k < stats.n_passes; k++) {
         if (stats.gpu_ns[k] >= 0) {

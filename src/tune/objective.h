@@ -90,6 +90,7 @@ typedef struct gr_tune_problem {
                                            comparison, kept across evaluations (metrics.h) */
     /* accounting since init */
     long long renders;
+    double work;                        /* gr_technique_stats_work summed over the renders */
     double render_s, metrics_s;         /* wall time in gr_technique_render / gr_metrics_compute */
     double wall_ms_sum;                 /* sum of the technique's own wall_ms */
     double gpu_ms_sum;                  /* sum of per-pass GPU times (-1 entries skipped) */

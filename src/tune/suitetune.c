@@ -104,54 +104,103 @@ static void point_init(gr_st_point *pt, const gr_technique_class *cls, int level
     pt->train_error = pt->test_error = NAN;
 }
 
+const char *gr_st_search_name(int local)
+{
+    return local == GR_ST_CARRIED ? "carried" : local == GR_ST_LOCAL ? "local" : "global";
+}
+
+/* The global search's options for np settings (o's overrides applied). */
+static void global_options(gr_opt_options *oo, int np, const double *x0, const gr_st_options *o)
+{
+    gr_tune_search_defaults(oo, np, x0);
+    oo->seed = o ? o->seed : 0;
+    oo->n_starts = o && o->n_starts > 0 ? o->n_starts : 2;
+    oo->screen = 2 * oo->n_starts;
+    oo->coarse = o && o->coarse > 0 ? o->coarse : 8 * np;
+    if (o && o->max_evals > 0) {
+        oo->max_evals = oo->polish = o->max_evals;
+        if (oo->screen_evals > o->max_evals) oo->screen_evals = o->max_evals;
+    }
+}
+
+/* The most evaluations a global search with these options makes: the first stage, each
+ * screened candidate's short run, the continuing starts' remainder, the polish. */
+static int global_evals(const gr_opt_options *oo)
+{
+    const int screened = oo->screen > oo->n_starts ? oo->screen : 0;
+    const int rest = oo->max_evals - (screened ? oo->screen_evals : 0);
+    return oo->coarse + screened * oo->screen_evals + oo->n_starts * (rest > 0 ? rest : 0) + oo->polish;
+}
+
+static int local_budget(int np, const gr_st_options *o)
+{
+    return o && o->local_evals > 0 ? o->local_evals : gr_st_local_evals(np);
+}
+
+/* The evaluations the search of this point makes without a budget (gr_st_options.work_ref). */
+static int full_evals(int np, const double *x0, const gr_st_options *o)
+{
+    if (o && o->n_from > 0) return (o->n_from < 2 ? o->n_from : 2) + 2 * local_budget(np, o);
+    gr_opt_options oo;
+    global_options(&oo, np, x0, o);
+    return global_evals(&oo);
+}
+
 /* The search of one ladder point on the train problem p from the untuned x0 (its value f0):
  * the global search of optimize.c, or with o->n_from the continuation's local search
  * (suitetune.h) from the best of x0 and o->from[] (candidates evaluated in order, ties: the
- * earlier; their evaluations counted in res->evals). */
+ * earlier; their evaluations counted in res->evals). budget > 0: at most about that many
+ * evaluations (suitetune.h "Search budgets"): a global search that does not fit becomes the
+ * local one from x0, a local one is shortened, and below the least local search only the
+ * candidates are evaluated (*local = GR_ST_CARRIED). */
 static gr_status search(gr_tune_problem *p, int np, const double *x0, double f0, const double *lo, const double *hi,
-                        const gr_st_options *o, gr_opt_result *res, int *local, gr_error *err)
+                        const gr_st_options *o, int budget, gr_opt_result *res, int *local, gr_error *err)
 {
     gr_opt_options oo;
-    gr_tune_search_defaults(&oo, np, x0);
-    oo.seed = o ? o->seed : 0;
-    *local = o && o->n_from > 0;
-    if (*local) {
-        double best[GR_TUNE_MAX_PARAMS], fb = f0;
-        int extra = 0;
-        memcpy(best, x0, (size_t)np * sizeof *best);
-        for (int c = 0; c < o->n_from && c < 2; c++) {
-            double xc[GR_TUNE_MAX_PARAMS], f;
-            for (int k = 0; k < np; k++) xc[k] = o->from[c][k] < lo[k] ? lo[k] : o->from[c][k] > hi[k] ? hi[k] : o->from[c][k];
-            gr_status st = gr_tune_objective(p, xc, &f, err);
-            if (st != GR_OK) return st;
-            extra++;
-            if (f < fb) fb = f, memcpy(best, xc, (size_t)np * sizeof *best);
-        }
-        /* one start, no first stage, no screening: a simplex of 5 % of each box side (the
-         * neighbouring point's optimum is that close: docs/tuning.md) and its restart at a fifth
-         * of that, then the compass polish along the axes (on an 8-bit target's stepped error
-         * surface the simplex stalls on a step; the polish moves one setting at a time) */
-        oo.x0 = best;
-        oo.n_starts = 1;
-        oo.coarse = oo.screen = 0;
-        oo.init_step = 0.05;
-        oo.max_evals = oo.polish = o->local_evals > 0 ? o->local_evals : gr_st_local_evals(np);
-        gr_status st = gr_opt_minimize(np, lo, hi, gr_tune_objective, p, &oo, res, err);
-        if (st == GR_OK && !(res->f <= fb)) { /* never worse than its start (a failed run's f is +inf) */
-            res->f = fb;
-            memcpy(res->x, best, (size_t)np * sizeof *best);
-        }
-        res->evals += extra;
-        return st;
+    global_options(&oo, np, x0, o);
+    const int n_from = o && o->n_from > 0 ? (o->n_from < 2 ? o->n_from : 2) : 0;
+    *local = n_from > 0 || (budget > 0 && budget < global_evals(&oo)) ? GR_ST_LOCAL : GR_ST_GLOBAL;
+    if (*local == GR_ST_GLOBAL) return gr_opt_minimize(np, lo, hi, gr_tune_objective, p, &oo, res, err);
+    double best[GR_TUNE_MAX_PARAMS], fb = f0;
+    int extra = 0;
+    memcpy(best, x0, (size_t)np * sizeof *best);
+    for (int c = 0; c < n_from; c++) {
+        double xc[GR_TUNE_MAX_PARAMS], f;
+        for (int k = 0; k < np; k++) xc[k] = o->from[c][k] < lo[k] ? lo[k] : o->from[c][k] > hi[k] ? hi[k] : o->from[c][k];
+        gr_status st = gr_tune_objective(p, xc, &f, err);
+        if (st != GR_OK) return st;
+        extra++;
+        if (f < fb) fb = f, memcpy(best, xc, (size_t)np * sizeof *best);
     }
-    oo.n_starts = o && o->n_starts > 0 ? o->n_starts : 2;
-    oo.screen = 2 * oo.n_starts;
-    oo.coarse = o && o->coarse > 0 ? o->coarse : 8 * np;
-    if (o && o->max_evals > 0) {
-        oo.max_evals = oo.polish = o->max_evals;
-        if (oo.screen_evals > o->max_evals) oo.screen_evals = o->max_evals;
+    /* the continuation's local search, shortened to the budget; an anchor's global search that
+     * does not fit: the local search from x0 with the whole budget */
+    int evals = n_from > 0 ? local_budget(np, o) : budget / 2;
+    if (budget > 0 && n_from + 2 * evals > budget) evals = (budget - n_from) / 2;
+    if (evals < np + 2) { /* not even a simplex and a step along each axis: the best candidate */
+        memset(res, 0, sizeof *res);
+        res->n = np;
+        res->f = fb;
+        memcpy(res->x, best, (size_t)np * sizeof *best);
+        res->evals = extra;
+        *local = GR_ST_CARRIED;
+        return GR_OK;
     }
-    return gr_opt_minimize(np, lo, hi, gr_tune_objective, p, &oo, res, err);
+    /* one start, no first stage, no screening: a simplex of 5 % of each box side (the
+     * neighbouring point's optimum is that close: docs/tuning.md) and its restart at a fifth
+     * of that, then the compass polish along the axes (on an 8-bit target's stepped error
+     * surface the simplex stalls on a step; the polish moves one setting at a time) */
+    oo.x0 = best;
+    oo.n_starts = 1;
+    oo.coarse = oo.screen = 0;
+    oo.init_step = 0.05;
+    oo.max_evals = oo.polish = evals;
+    gr_status st = gr_opt_minimize(np, lo, hi, gr_tune_objective, p, &oo, res, err);
+    if (st == GR_OK && !(res->f <= fb)) { /* never worse than its start (a failed run's f is +inf) */
+        res->f = fb;
+        memcpy(res->x, best, (size_t)np * sizeof *best);
+    }
+    res->evals += extra;
+    return st;
 }
 
 gr_status gr_st_tune_level(gr_technique *r, const gr_st_case *cases, int n_cases, int level, const gr_st_options *o,
@@ -182,23 +231,36 @@ gr_status gr_st_tune_level(gr_technique *r, const gr_st_case *cases, int n_cases
     gr_st_point u;
     point_init(&u, cls, level, 0, &train);
     if (st == GR_OK) st = gr_tune_settings_at(&train, x0, u.settings.bytes, err);
+    train.work = 0.0;
     if (st == GR_OK) st = gr_tune_evaluate(&train, x0, &u.train_error, NULL, NULL, err);
+    u.work = train.work;
     if (st == GR_OK) st = gr_tune_evaluate(&test, x0, &u.test_error, NULL, NULL, err);
     if (st == GR_OK && untuned) *untuned = u;
     if (st == GR_OK && tuned) {
         gr_opt_result res;
         gr_st_point *t = tuned;
         point_init(t, cls, level, 1, &train);
-        st = search(&train, np, x0, u.train_error, lo, hi, o, &res, &t->local, err);
+        /* the search budget: 1 / r of the evaluations for r times the reference work */
+        if (o && o->work_ref > 0 && u.work > o->work_ref)
+            t->budget = (int)ceil(o->work_ref / u.work * (double)full_evals(np, x0, o));
+        st = search(&train, np, x0, u.train_error, lo, hi, o, t->budget, &res, &t->local, err);
         if (st == GR_OK) {
             memcpy(t->x, res.x, (size_t)np * sizeof *t->x);
             t->evals = res.evals;
+            t->work = u.work;
             st = gr_tune_settings_at(&train, res.x, t->settings.bytes, err);
         }
-        /* the train error evaluated again at the best point (the search's own value is the same
-         * number; re-evaluated so that train and test are computed alike) */
-        if (st == GR_OK) st = gr_tune_evaluate(&train, res.x, &t->train_error, NULL, NULL, err);
-        if (st == GR_OK) st = gr_tune_evaluate(&test, res.x, &t->test_error, NULL, NULL, err);
+        /* the errors at the best point: the untuned point's where it is the untuned settings
+         * (renders are deterministic: the same settings give the same images), else the
+         * search's own train value (the same function on the same problem) and the test cases */
+        if (st == GR_OK && memcmp(res.x, x0, (size_t)np * sizeof *x0) == 0) {
+            t->train_error = u.train_error;
+            t->test_error = u.test_error;
+        } else if (st == GR_OK) {
+            if (isfinite(res.f)) t->train_error = res.f;
+            else st = gr_tune_evaluate(&train, res.x, &t->train_error, NULL, NULL, err);
+            if (st == GR_OK) st = gr_tune_evaluate(&test, res.x, &t->test_error, NULL, NULL, err);
+        }
     }
     gr_tune_problem_free(&train);
     gr_tune_problem_free(&test);

@@ -15,6 +15,13 @@
  * move little between neighbouring points (they change cost, not the look), so the local search
  * starts in the basin the anchor's global search found, at a tenth of its evaluations.
  *
+ * Search budgets (docs/tuning.md "Search budgets"; gr_st_options.work_ref): a point whose
+ * render work (cost counters, gr_technique_stats_work) is r times the ladder's cheapest point's
+ * gets 1/r of its search's evaluations: the anchor's global search becomes a local one from the
+ * untuned point when it does not fit, and a point whose budget is below the least local search
+ * takes the best on the train cases of its untuned settings and its candidates (carried). The
+ * budget comes from counted work, not from measured time, so the result stays deterministic.
+ *
  * Settings derived from the scene (a descriptor's scene_source: the camera position, the
  * medium's extinction) and not tuned are left unresolved, so that each case resolves them from
  * its own scene; a tuned RGB setting (extinction) is tuned as a scale on case 0's value, and
@@ -50,7 +57,14 @@ typedef struct gr_st_options {
     int n_from;
     double from[2][GR_TUNE_MAX_PARAMS];
     int local_evals;
+    /* > 0: the search budget (see above): a point whose untuned train evaluation did more work
+     * than this gets work_ref / its work of its search's evaluations (0: no budget) */
+    double work_ref;
 } gr_st_options;
+
+/* How a tuned point was searched (gr_st_point.local). */
+enum { GR_ST_GLOBAL = 0, GR_ST_LOCAL = 1, GR_ST_CARRIED = 2 };
+const char *gr_st_search_name(int local); /* "global", "local", "carried" */
 
 /* The continuation's default budget for n tuned settings: 20 + 12 n evaluations for the simplex
  * and as many for the polish (44 each for 2 settings: the least that recovered the
@@ -68,7 +82,12 @@ typedef struct gr_st_point {
     double x[GR_TUNE_MAX_PARAMS]; /* the tuned parameters' values (RGB: the scale) */
     double train_error, test_error; /* mean verdict after the scale fit over the split's cases */
     int evals;
-    int local;                    /* 1: tuned by the continuation's local search; 0: the global one */
+    int local;                    /* GR_ST_GLOBAL, GR_ST_LOCAL (the continuation's local search, or
+                                     the anchor's under a budget) or GR_ST_CARRIED (the budget
+                                     allowed only the candidates: the best of them on train) */
+    int budget;                   /* evaluations the search budget allowed (0: unbounded) */
+    double work;                  /* untuned: the work of one train evaluation (the sum of
+                                     gr_technique_stats_work over the train cases) */
     gr_timing timing;             /* at the timing size (timed = 1) */
     int timed;
     int on_front;                 /* on the front of (cost, test error) of its technique and kind */

@@ -9,6 +9,10 @@
  *    does worse on the test cases than on its train case, and tuning on the suite's train
  *    cases has the lower test error.
  *  - The budget pick chooses by train error among the points that fit, never by test error.
+ *  - Search budgets: a point's work is the cost counters' work of its train renders (summed
+ *    here render by render); half the reference work halves the evaluations (the anchor's
+ *    global search becomes a local one within the budget); a budget below a local search
+ *    evaluates only the candidates and keeps the best of them (never worse than untuned).
  * Every ladder point of the shafts (rgba8 and rgba16f targets; label slow); reduced
  * (GODRAYS_TEST_REDUCED): two ladder points and a shorter global search, 96 x 54. */
 #include <math.h>
@@ -122,6 +126,59 @@ static void generalization(gr_technique *r, gr_scene **sc, gr_image **truth)
     CHECK(pick[2] == 1);
 }
 
+static void budgets(gr_technique *r, gr_scene **sc, gr_image **truth)
+{
+    gr_error err;
+    const int level = 9;
+    const double xt[2] = {0.8, 1.2};
+    gr_st_options o = {.params = "shafts.K,shafts.extinction", .seed = 2};
+    gr_st_case cases[NCASE];
+    double work = 0.0;
+    for (int c = 0; c < NCASE; c++) {
+        gr_section_store s;
+        CHECK_OK(gr_st_level_settings(&gr_shafts_class, sc[0], level, &o, xt, s.bytes, &err), err);
+        CHECK_OK(gr_technique_render(r, sc[c], s.bytes, truth[c], NULL, &err), err);
+        cases[c] = (gr_st_case){sc[c], truth[c], c < 3 ? GR_SPLIT_TRAIN : GR_SPLIT_TEST};
+    }
+    /* the oracle of the work: the untuned settings rendered case by case, their counters summed */
+    {
+        gr_st_point u;
+        CHECK_OK(gr_st_tune_level(r, cases, NCASE, level, &o, &u, NULL, &err), err);
+        gr_image *img = gr_image_create(W, H, 3, NULL);
+        for (int c = 0; c < 3; c++) {
+            gr_technique_stats stats;
+            CHECK_OK(gr_technique_render(r, sc[c], u.settings.bytes, img, &stats, &err), err);
+            work += (double)gr_technique_stats_work(&stats);
+        }
+        gr_image_destroy(img);
+        CHECK(work > 0 && u.work == work);
+    }
+    /* half the work: the anchor's global search (over 500 evaluations) fits in half of them only
+     * as the local search from the untuned point */
+    gr_st_point u, half, carried;
+    o.work_ref = 0.5 * work;
+    CHECK_OK(gr_st_tune_level(r, cases, NCASE, level, &o, &u, &half, &err), err);
+    printf("budget 1/2: %s search, %d of %d evaluations, train %.4g (untuned %.4g)\n", gr_st_search_name(half.local),
+           half.evals, half.budget, half.train_error, u.train_error);
+    CHECK(half.budget > 200 && half.local == GR_ST_LOCAL && half.evals <= half.budget);
+    CHECK(half.train_error < u.train_error);
+    /* a tiny budget with two candidates (one of them the truth's look): only they are evaluated */
+    o.work_ref = 1e-3 * work;
+    o.n_from = 2;
+    o.from[0][0] = 1.0, o.from[0][1] = 1.0;
+    o.from[1][0] = xt[0], o.from[1][1] = xt[1];
+    CHECK_OK(gr_st_tune_level(r, cases, NCASE, level, &o, &u, &carried, &err), err);
+    printf("budget 1/1000: %s, %d evaluations of a budget of %d: K %.4f ext x%.4f, train %.4g (untuned %.4g)\n",
+           gr_st_search_name(carried.local), carried.evals, carried.budget, carried.x[0], carried.x[1],
+           carried.train_error, u.train_error);
+    CHECK(carried.local == GR_ST_CARRIED && carried.evals == 2 && carried.budget >= 1);
+    CHECK(carried.x[0] == xt[0] && carried.x[1] == xt[1] && carried.train_error <= u.train_error);
+    /* the candidate's train error is the search's value: the same as scoring its settings */
+    double again;
+    CHECK_OK(gr_st_score(r, cases, NCASE, GR_SPLIT_TRAIN, carried.settings.bytes, &again, &err), err);
+    CHECK(again == carried.train_error);
+}
+
 int main(void)
 {
     gr_technique *r = tune_test_renderer();
@@ -136,6 +193,7 @@ int main(void)
         if (!reduced || l == 9 || l == 10) lv[n++] = l;
     identify(r, sc, truth, lv, n, reduced);
     generalization(r, sc, truth);
+    budgets(r, sc, truth);
     for (int i = 0; i < NCASE; i++) {
         gr_image_destroy(truth[i]);
         free(sc[i]);
