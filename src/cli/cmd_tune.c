@@ -531,8 +531,8 @@ static void tune_summary(const tune_opts *t, const gr_tune_session *s, const gr_
         gr_sb_printf(sum, "  %-24s %12.6g %12.6g\n", s->labels[i], r->before[i], r->after[i]);
     gr_sb_printf(sum, "  %-24s %12.6g %12.6g (%.1f %% lower)\n", "mean", r->fb, r->fa,
                  r->fb > 0 ? 100.0 * (1.0 - r->fa / r->fb) : 0.0);
-    gr_sb_printf(sum, "%d evaluations (%lld renders) in %.1f s; ground truth %.1f s\n", res->evals, p->renders,
-                 p->render_s + p->metrics_s, s->truth_seconds);
+    gr_sb_printf(sum, "%d evaluations (%lld renders) in %.1f s (renders %.1f s, comparisons %.1f s); ground truth %.1f s\n",
+                 res->evals, p->renders, p->render_s + p->metrics_s, p->render_s, p->metrics_s, s->truth_seconds);
     gr_sb_printf(sum, "best settings for the scene:\n%s\n", r->snippet);
     gr_sb_printf(sum, "written: %s/tune.json, trace.csv, compare.png, reference_NN.png, before_NN.png, after_NN.png\n",
                  outdir);

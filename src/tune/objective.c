@@ -2,6 +2,7 @@
 #include "tune/objective.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -143,7 +144,7 @@ static double now_s(void)
 
 gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
 {
-    p->scratch = NULL;
+    p->scratch = p->scratch2 = NULL;
     for (int i = 0; i < GR_TUNE_MAX_CASES; i++) p->angles[i] = NULL, p->sref[i] = NULL;
     if (p->n_cases < 1 || p->n_cases > GR_TUNE_MAX_CASES)
         return gr_fail(err, GR_E_INPUT, "tuning: %d cases (1..%d)", p->n_cases, GR_TUNE_MAX_CASES);
@@ -168,7 +169,8 @@ gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
     gr_technique_resolve(p->cls, p->scenes[0], p->base.bytes, r.bytes);
     p->base = r;
     p->scratch = gr_image_create(c0->width, c0->height, 3, NULL);
-    if (!p->scratch) return gr_fail(err, GR_E_NOMEM, "tuning: out of memory for a %dx%d frame", c0->width, c0->height);
+    p->scratch2 = gr_image_create(c0->width, c0->height, 3, NULL);
+    if (!p->scratch || !p->scratch2) return gr_fail(err, GR_E_NOMEM, "tuning: out of memory for a %dx%d frame", c0->width, c0->height);
     if (uses_scene(p)) {
         /* the structure metrics' geometry per case: the vanishing point of the refracted sun's
          * rays and the angle to the sun (their de-glow), once */
@@ -209,7 +211,8 @@ void gr_tune_problem_free(gr_tune_problem *p)
 {
     if (!p) return;
     gr_image_destroy(p->scratch);
-    p->scratch = NULL;
+    gr_image_destroy(p->scratch2);
+    p->scratch = p->scratch2 = NULL;
     for (int i = 0; i < GR_TUNE_MAX_CASES; i++) {
         free(p->angles[i]);
         p->angles[i] = NULL;
@@ -228,9 +231,8 @@ gr_status gr_tune_settings_at(const gr_tune_problem *p, const double *x, void *o
     return GR_OK;
 }
 
-/* One render + metrics; opt chooses which metrics are computed. */
-static gr_status render_score(gr_tune_problem *p, int i, const void *s, gr_image *out,
-                              const gr_metrics_options *opt, gr_metrics *m, gr_error *err)
+/* One render of case i into out (GL: the calling thread), counted in p's accounting. */
+static gr_status render_case(gr_tune_problem *p, int i, const void *s, gr_image *out, gr_error *err)
 {
     gr_technique_stats stats;
     double t0 = now_s();
@@ -239,8 +241,7 @@ static gr_status render_score(gr_tune_problem *p, int i, const void *s, gr_image
     gr_technique_set_reuse(p->renderer, 1);
     gr_status st = gr_technique_render(p->renderer, p->scenes[i], s, out, &stats, err);
     gr_technique_set_reuse(p->renderer, 0);
-    double t1 = now_s();
-    p->render_s += t1 - t0;
+    p->render_s += now_s() - t0;
     if (st != GR_OK) return st;
     p->renders++;
     p->work += (double)gr_technique_stats_work(&stats);
@@ -251,9 +252,60 @@ static gr_status render_score(gr_tune_problem *p, int i, const void *s, gr_image
             p->gpu_timed = 1;
         }
     }
+    return GR_OK;
+}
+
+/* One render + metrics; opt chooses which metrics are computed. */
+static gr_status render_score(gr_tune_problem *p, int i, const void *s, gr_image *out,
+                              const gr_metrics_options *opt, gr_metrics *m, gr_error *err)
+{
+    gr_status st = render_case(p, i, s, out, err);
+    if (st != GR_OK) return st;
+    const double t1 = now_s();
     st = gr_metrics_compute(p->refs[i], out, opt, m, err);
     p->metrics_s += now_s() - t1;
     return st;
+}
+
+/* The comparison of one rendered case, run beside the next case's render (gr_tune_evaluate):
+ * it reads only its own frame, its case's truth and its case's kept structure half. */
+typedef struct score_job {
+    const gr_image *ref, *img;
+    gr_metrics_options opt;
+    gr_flip_options fo;
+    gr_structure_options so;
+    gr_metrics m;
+    gr_status st;
+    gr_error err;
+    double seconds;
+} score_job;
+
+static void *score_run(void *arg)
+{
+    score_job *j = arg;
+    const double t0 = now_s();
+    j->st = gr_metrics_compute(j->ref, j->img, &j->opt, &j->m, &j->err);
+    j->seconds = now_s() - t0;
+    return NULL;
+}
+
+/* The case's value from its finished comparison (taken in case order, so that the sum is the
+ * same as one case after the other). */
+static gr_status take_score(gr_tune_problem *p, int i, score_job *j, double *sum, double *per_case, double *scale,
+                            gr_error *err)
+{
+    p->metrics_s += j->seconds;
+    if (j->st != GR_OK) {
+        if (err) *err = j->err;
+        return j->st;
+    }
+    const gr_metrics_set *set = p->fit ? &j->m.fit : &j->m.raw;
+    const double v = gr_tune_value(p, set);
+    *sum += v;
+    if (per_case) per_case[i] = v;
+    if (scale) scale[i] = p->fit ? j->m.fit.scale : 1.0;
+    for (int c = 0; c < 3; c++) p->scale_rgb[i][c] = p->fit ? j->m.fit.scale_rgb[c] : 1.0;
+    return GR_OK;
 }
 
 gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, double *per_case, double *scale,
@@ -262,28 +314,47 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
     gr_section_store s;
     gr_status st = gr_tune_settings_at(p, x, s.bytes, err);
     if (st != GR_OK) return st;
-    /* Only what the metric needs: the pointwise pass is cheap, SSIM and blurs are not. */
+    /* Case i's comparison runs on a second thread while case i + 1 renders (GL stays on this
+     * thread; the two frames alternate), so that a 2-core machine compares on the core the
+     * rasterizer leaves idle; the values and their order are those of one case after the
+     * other. Only what the metric needs: the pointwise pass is cheap, SSIM and blurs are not. */
+    score_job *jobs = malloc(2 * sizeof *jobs);
+    if (!jobs) return gr_fail(err, GR_E_NOMEM, "tuning: out of memory");
+    gr_image *frames[2] = {p->scratch, p->scratch2};
+    pthread_t th;
+    int pending = -1, threaded = 0; /* the case whose comparison runs (threaded: on th) */
     double sum = 0.0;
-    for (int i = 0; i < p->n_cases; i++) {
-        gr_metrics_options opt = {0};
-        gr_flip_options fo;
-        gr_structure_options so;
-        opt.stderr_bound = p->stderr_bound;
-        opt.fit_scale = p->fit;
-        opt.skip_ssim = opt.skip_blur = opt.skip_extra = 1;
-        opt.structure_ref = &p->sref[i]; /* the truth's half, made once per case */
-        case_options(p, i, &opt, &fo, &so);
-        gr_metrics m;
-        if ((st = render_score(p, i, s.bytes, p->scratch, &opt, &m, err)) != GR_OK) return st;
-        const gr_metrics_set *set = p->fit ? &m.fit : &m.raw;
-        const double v = gr_tune_value(p, set);
-        sum += v;
-        if (per_case) per_case[i] = v;
-        if (scale) scale[i] = p->fit ? m.fit.scale : 1.0;
-        for (int c = 0; c < 3; c++) p->scale_rgb[i][c] = p->fit ? m.fit.scale_rgb[c] : 1.0;
+    for (int i = 0; i < p->n_cases && st == GR_OK; i++) {
+        score_job *j = &jobs[i & 1];
+        st = render_case(p, i, s.bytes, frames[i & 1], err);
+        if (pending >= 0) { /* the previous case's comparison, taken before this one's starts */
+            if (threaded) pthread_join(th, NULL);
+            const gr_status sp = take_score(p, pending, &jobs[pending & 1], &sum, per_case, scale,
+                                            st == GR_OK ? err : NULL);
+            if (st == GR_OK) st = sp;
+            pending = -1;
+        }
+        if (st != GR_OK) break;
+        memset(j, 0, sizeof *j);
+        j->ref = p->refs[i];
+        j->img = frames[i & 1];
+        j->opt.stderr_bound = p->stderr_bound;
+        j->opt.fit_scale = p->fit;
+        j->opt.skip_ssim = j->opt.skip_blur = j->opt.skip_extra = 1;
+        j->opt.structure_ref = &p->sref[i]; /* the truth's half, made once per case */
+        case_options(p, i, &j->opt, &j->fo, &j->so);
+        pending = i;
+        threaded = i + 1 < p->n_cases && pthread_create(&th, NULL, score_run, j) == 0;
+        if (!threaded) score_run(j); /* the last case (or no thread to be had): here */
     }
-    *mean = sum / (double)p->n_cases;
-    return GR_OK;
+    if (pending >= 0) {
+        if (threaded) pthread_join(th, NULL);
+        const gr_status sp = take_score(p, pending, &jobs[pending & 1], &sum, per_case, scale, st == GR_OK ? err : NULL);
+        if (st == GR_OK) st = sp;
+    }
+    free(jobs);
+    if (st == GR_OK) *mean = sum / (double)p->n_cases;
+    return st;
 }
 
 gr_status gr_tune_render_case(gr_tune_problem *p, int i, const void *s, gr_image *out, gr_metrics *m,

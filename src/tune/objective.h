@@ -85,7 +85,7 @@ typedef struct gr_tune_problem {
     float *angles[GR_TUNE_MAX_CASES];
     double stderr_bound;                /* passed to the metrics (0: default) */
     /* filled by gr_tune_problem_init */
-    gr_image *scratch;                  /* one frame (R, G, B) */
+    gr_image *scratch, *scratch2;       /* two frames (R, G, B): one compared while the other renders */
     gr_structure_ref *sref[GR_TUNE_MAX_CASES]; /* each case's reference half of the structure
                                            comparison, kept across evaluations (metrics.h) */
     /* accounting since init */

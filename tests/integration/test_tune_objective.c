@@ -4,8 +4,10 @@
  * same settings, with the vanishing point and the angle field derived here, and the
  * documented combination (docs/tuning.md) written out. A shafts render at known settings
  * stands in for the ground truth: at those settings FLIP and the structure score are 0
- * (identical images); elsewhere the objective equals the independent sum. Also the
- * --objective parser's errors. */
+ * (identical images); elsewhere the objective equals the independent sum. Several cases:
+ * the evaluation compares case i on a second thread while case i + 1 renders; each case's value
+ * must be, to the bit, what a problem of that case alone gives (compared inline), and the
+ * mean their sum in case order. Also the --objective parser's errors. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -88,6 +90,48 @@ int main(void)
     p->metric = GR_METRIC_FLIP;
     CHECK_OK(gr_tune_evaluate(p, x, &f, NULL, NULL, &err), err);
     CHECK_NEAR(f, fr.mean, 1e-12);
+
+    /* three cases (water times 0, 0.4, 0.8): the pipelined evaluation against one problem per case */
+    {
+        gr_scene *sc3[3];
+        gr_image *tr3[3];
+        gr_tune_problem *q = calloc(1, sizeof *q), *one = calloc(1, sizeof *one);
+        *q = *p;
+        q->scratch = q->scratch2 = NULL;
+        q->n_cases = 3;
+        for (int i = 0; i < 3; i++) {
+            sc3[i] = malloc(sizeof *sc3[i]);
+            CHECK_OK(gr_tune_make_case(scene, 0.4 * i, NULL, sc3[i], &err), err);
+            tr3[i] = gr_image_create(160, 90, 3, NULL);
+            CHECK_OK(gr_technique_render(r, sc3[i], &st, tr3[i], NULL, &err), err); /* st: settings x */
+            q->scenes[i] = sc3[i];
+            q->refs[i] = tr3[i];
+        }
+        q->metric = GR_TM_WEIGHTED;
+        CHECK_OK(gr_tune_problem_init(q, &err), err);
+        double mean3 = -1, per[3] = {-1, -1, -1}, sum = 0;
+        CHECK_OK(gr_tune_evaluate(q, xt, &mean3, per, NULL, &err), err);
+        for (int i = 0; i < 3; i++) {
+            *one = *p;
+            one->scratch = one->scratch2 = NULL;
+            one->n_cases = 1;
+            one->scenes[0] = sc3[i];
+            one->refs[0] = tr3[i];
+            one->metric = GR_TM_WEIGHTED;
+            CHECK_OK(gr_tune_problem_init(one, &err), err);
+            double f1 = -1;
+            CHECK_OK(gr_tune_evaluate(one, xt, &f1, NULL, NULL, &err), err);
+            printf("case %d: %.17g pipelined, %.17g alone\n", i, per[i], f1);
+            CHECK(per[i] == f1 && f1 > 0);
+            sum += f1;
+            gr_tune_problem_free(one);
+        }
+        CHECK(mean3 == sum / 3.0);
+        gr_tune_problem_free(q);
+        free(q);
+        free(one);
+        for (int i = 0; i < 3; i++) gr_image_destroy(tr3[i]), free(sc3[i]);
+    }
 
     /* the parser's errors */
     double w[GR_METRIC_MAX];
