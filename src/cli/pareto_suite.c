@@ -169,9 +169,9 @@ static gr_status technique(const gr_ps_opts *o, ps_run *r, const gr_technique_cl
         if (st != GR_OK) break;
         r->n++;
         if (!o->quiet)
-            fprintf(stderr, "godrays pareto: %s %s %s: %.2f ms (%d timed), train %.4g, test %.4g\n", cls->name,
+            fprintf(stderr, "godrays pareto: %s %s %s: %.2f ms (%d timed%s), train %.4g, test %.4g\n", cls->name,
                     p->ladder[0] ? p->ladder : "(scene's)", p->tuned ? "tuned" : "untuned", p->timing.cost_ms,
-                    p->timing.n, p->train_error, p->test_error);
+                    p->timing.n, p->timing.warmup ? "" : ", no warm-up", p->train_error, p->test_error);
     }
     gr_technique_destroy(t);
     return st;
@@ -200,7 +200,7 @@ static gr_status write_fronts_csv(const char *dir, const ps_run *r, gr_error *er
     gr_strbuf b;
     gr_sb_init(&b);
     gr_sb_puts(&b, "technique,tuned,ladder,label,cost_ms,wall_ms,gpu_ms,wall_min_ms,wall_max_ms,train_error,test_error,"
-                   "on_front,timed_renders,search,evals,budget,work,renderer\n");
+                   "on_front,timed_renders,warmups,search,evals,budget,work,renderer\n");
     for (int i = 0; i < r->n; i++) {
         const gr_st_point *p = &r->pts[i];
         gr_st_point_label(p, label, sizeof label);
@@ -210,10 +210,10 @@ static gr_status write_fronts_csv(const char *dir, const ps_run *r, gr_error *er
         snprintf(lad, sizeof lad, "%s", p->ladder);
         for (char *c = lad; *c; c++)
             if (*c == ',') *c = ';';
-        gr_sb_printf(&b, "%s,%d,%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%s,%d,%d,%.6g,%s\n", p->cls->name, p->tuned, lad,
+        gr_sb_printf(&b, "%s,%d,%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%s,%d,%d,%.6g,%s\n", p->cls->name, p->tuned, lad,
                      label, p->timing.cost_ms, p->timing.wall_ms, p->timing.gpu_ms, p->timing.wall_min_ms,
                      p->timing.wall_max_ms, p->train_error, p->test_error, p->on_front, p->timing.n,
-                     !p->tuned ? "none" : gr_st_search_name(p->local), p->evals, p->budget, p->work,
+                     p->timing.warmup, !p->tuned ? "none" : gr_st_search_name(p->local), p->evals, p->budget, p->work,
                      p->timing.renderer);
     }
     snprintf(path, sizeof path, "%s/fronts.csv", dir);

@@ -36,7 +36,11 @@ gr_status gr_timing_measure(gr_technique *t, const gr_scene *scene, const void *
 /* As gr_timing_measure, but the timed renders stop early, once they took cap_s seconds of wall
  * time together (cap_s <= 0: no cap): a render of several seconds on a CPU rasterizer is timed
  * once after its warm-up instead of n times. At least one render is timed; res->n states how
- * many were (docs/tuning.md "Warm timing"). */
+ * many were (docs/tuning.md "Warm timing"). A warm-up render that alone took
+ * GR_TIMING_LONG_CAPS x cap_s or more is itself the one timed render (res->warmup = 0, res->n =
+ * 1): the first-use costs a warm-up removes (shader compiles, allocations: milliseconds) are
+ * then under a percent of it, and a 100 s render on a CPU rasterizer is not rendered twice. */
+#define GR_TIMING_LONG_CAPS 5
 gr_status gr_timing_measure_capped(gr_technique *t, const gr_scene *scene, const void *settings, gr_image *out,
                                    int warmup, int n, double cap_s, gr_timing *res, gr_error *err);
 

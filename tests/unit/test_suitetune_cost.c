@@ -52,7 +52,8 @@ static const gr_technique_class clock_class = {
 };
 
 /* Timed renders of ms each, up to n after one warm-up, capped at cap_s: the count timed. */
-static int timed(gr_technique *t, const gr_scene *scene, gr_image *img, double ms, int n, double cap_s, int *made)
+static int timed(gr_technique *t, const gr_scene *scene, gr_image *img, double ms, int n, double cap_s, int *made,
+                 int warmup)
 {
     gr_error err = {GR_OK, ""};
     gr_timing res;
@@ -60,7 +61,7 @@ static int timed(gr_technique *t, const gr_scene *scene, gr_image *img, double m
     renders = 0;
     CHECK_OK(gr_timing_measure_capped(t, scene, &s, img, 1, n, cap_s, &res, &err), err);
     *made = renders;
-    CHECK(res.warmup == 1);
+    CHECK(res.warmup == warmup);
     CHECK_MSG(res.wall_ms == ms && res.cost_ms == ms, "median %g ms of renders of %g ms", res.wall_ms, ms);
     return res.n;
 }
@@ -77,12 +78,16 @@ int main(void)
     CHECK_OK(gr_technique_create(&clock_class, NULL, NULL, &t, &err), err);
     int made = 0;
     /* 2 s cap: 10 ms renders all 5; 800 ms ones stop after the third (2.4 s >= 2 s); a 3 s
-     * render is timed once; without a cap every render is */
-    CHECK(timed(t, scene, img, 10, 5, 2.0, &made) == 5 && made == 6);
-    CHECK(timed(t, scene, img, 800, 5, 2.0, &made) == 3 && made == 4);
-    CHECK(timed(t, scene, img, 3000, 5, 2.0, &made) == 1 && made == 2);
-    CHECK(timed(t, scene, img, 3000, 5, 0, &made) == 5 && made == 6);
-    CHECK(timed(t, scene, img, 3000, 3, -1, &made) == 3 && made == 4);
+     * render is timed once; a 10 s one (5 caps) is its warm-up alone, timed as it is; without a
+     * cap every render is */
+    CHECK(timed(t, scene, img, 10, 5, 2.0, &made, 1) == 5 && made == 6);
+    CHECK(timed(t, scene, img, 800, 5, 2.0, &made, 1) == 3 && made == 4);
+    CHECK(timed(t, scene, img, 3000, 5, 2.0, &made, 1) == 1 && made == 2);
+    CHECK(timed(t, scene, img, 9999, 5, 2.0, &made, 1) == 1 && made == 2);
+    CHECK(timed(t, scene, img, 10000, 5, 2.0, &made, 0) == 1 && made == 1);
+    CHECK(timed(t, scene, img, 10000, 5, 0, &made, 1) == 5 && made == 6);
+    CHECK(timed(t, scene, img, 3000, 5, 0, &made, 1) == 5 && made == 6);
+    CHECK(timed(t, scene, img, 3000, 3, -1, &made, 1) == 3 && made == 4);
     gr_technique_destroy(t);
     gr_image_destroy(img);
     free(scene);
