@@ -28,7 +28,7 @@ static const gr_param params[] = {
      .doc = "each line's beam is kernel x kernel texels wide, with 1 / kernel^2 of the flux per area (smooths waves)"},
     {.name = "line_width", .type = GR_PT_DOUBLE, .offset = LR(line_width), .min = 0, .max = 64, .flags = GR_PF_MIN_EXCL,
      .def = 1, .unit = "px",
-     .doc = "pixels added to the prism's screen cover; the ribbon's least width", .tune_lo = 0.5, .tune_hi = 8.0},
+     .doc = "the ribbon's least width (the prism is drawn as its own faces: no effect there)", .tune_lo = 0.5, .tune_hi = 8.0},
     {.name = "max_length_m", .type = GR_PT_DOUBLE, .offset = LR(max_length_m), .min = 0, .max = 1e4,
      .flags = GR_PF_MIN_EXCL, .def = 200, .unit = "m",
      .doc = "longest line from the surface (the seabed and the occluders end them first)",
@@ -412,7 +412,7 @@ const gr_technique_class gr_light_rays_class = {
     .gain_key = "intensity",
     .ladder = ladder,
     .n_ladder = sizeof ladder / sizeof ladder[0],
-    .tune_keys = "extinction,g", /* the attenuation and the phase: line_width only sizes the cover */
+    .tune_keys = "extinction,g", /* the attenuation and the phase: line_width is the ribbon's alone */
     .create = lr_create,
     .destroy = lr_destroy,
     .render = lr_render,

@@ -6,8 +6,8 @@
 // cross-section across T is the footprint of u_kernel x u_kernel texels (u1, u2: the lattice of the light's texels
 // carried along the sun to the rest plane and along T across it; m1, m2 its dual vectors).
 // Drawn as (docs/volume-techniques.md, "Light rays"):
-//   u_footprint 0 (prism): a screen-space quad over the prism's projection, widened by
-//     u_line_width pixels; the fragment integrates the pixel's ray through the prism exactly;
+//   u_footprint 0 (prism): the prism's faces that look at the eye (its exact cover); the
+//     fragment integrates the pixel's ray through the prism exactly;
 //   u_footprint 1 (ribbon): a camera-facing ribbon, the sheet spanned by T and b = T x p0 / D
 //     (D = |T x p0|, the line's distance from the eye), world width w = max(beam, u_line_width
 //     pixels at the distance), NSEG pieces; the fragment adds sigma_s p Phi exp(...) r / (w D).
@@ -39,10 +39,29 @@ flat out float g_ybot;         // prism: y of the line's end (eye-relative)
 
 const int NSEG = 8;
 
+// the prism's flat outputs, written again before each vertex (outputs are undefined after
+// EmitVertex)
+vec3 s_p0, s_t, s_m1, s_m2;
+float s_flux, s_d, s_ybot;
+
+void emit_prism(vec4 pos)
+{
+    g_p = vec3(0.0);
+    g_w = 0.0;
+    g_p0 = s_p0;
+    g_t = s_t;
+    g_flux = s_flux;
+    g_d = s_d;
+    g_m1 = s_m1;
+    g_m2 = s_m2;
+    g_ybot = s_ybot;
+    gl_Position = pos;
+    EmitVertex();
+}
+
 void emit_ndc(vec2 ndc)
 {
-    gl_Position = vec4(ndc, 0.0, 1.0);
-    EmitVertex();
+    emit_prism(vec4(ndc, 0.0, 1.0));
 }
 
 void main()
@@ -74,24 +93,22 @@ void main()
     }
     if (!(len > 0.0)) return;
     vec3 pe = p0 + T * len;
-    g_p0 = p0;
-    g_t = T;
-    g_ybot = pe.y;
+    s_p0 = p0;
+    s_t = T;
+    s_ybot = pe.y;
     // the prism's cross-section across T: the rest-plane footprint h1, h2 carried along T
     // (u_kernel texels wide: the prisms of a lattice then cover each point u_kernel^2 times, and
     // each carries 1 / u_kernel^2 of its flux per area)
     vec3 u1 = (u_h1 - T * dot(u_h1, T)) * u_kernel, u2 = (u_h2 - T * dot(u_h2, T)) * u_kernel;
     float area = abs(dot(cross(u1, u2), T));      // = A_perp |T.y| / |I.y|
-    g_m1 = cross(u2, T) / dot(cross(u1, u2), T);
-    g_m2 = cross(T, u1) / dot(cross(u1, u2), T);
+    s_m1 = cross(u2, T) / dot(cross(u1, u2), T);
+    s_m2 = cross(T, u1) / dot(cross(u1, u2), T);
     vec3 b = cross(T, p0);
     float D = length(b);
 
     if (u_footprint == 0) {
-        g_flux = ft * u_texel_area / area;        // E_beam / E_sun = F_t |I.y| / |T.y| on flat water
-        g_p = vec3(0.0);
-        g_w = 0.0;
-        g_d = D;
+        s_flux = ft * u_texel_area / area;        // E_beam / E_sun = F_t |I.y| / |T.y| on flat water
+        s_d = D;
         float rho = 0.525 * (length(u1) + length(u2)); // 1.05 x a radius holding the cross-section
         if (D < 2.0 * rho) {
             // the prism passes by the eye: its projection is most of the view
@@ -102,30 +119,37 @@ void main()
             EndPrimitive();
             return;
         }
-        // the axis clipped to view depth >= zmin (nearer parts of a prism this far from the eye
-        // lie outside the view)
-        float zmin = max(0.05, rho);
-        float z0 = dot(p0, u_fwd), z1 = dot(pe, u_fwd);
-        if (z0 < zmin && z1 < zmin) return;
-        vec3 a = p0, c = pe;
-        if (z0 < zmin) a = p0 + (pe - p0) * ((zmin - z0) / (z1 - z0));
-        if (z1 < zmin) c = p0 + (pe - p0) * ((zmin - z0) / (z1 - z0));
-        vec4 ca = u_vp_rot * vec4(a, 1.0), cc = u_vp_rot * vec4(c, 1.0);
-        vec2 half_px = 0.5 * u_size;
-        vec2 sa = ca.xy / ca.w * half_px, sc = cc.xy / cc.w * half_px;
-        // half-width in pixels: rho at depth z, magnified off axis by up to (1 + tan)
-        float ta = length(ca.xy / ca.w) * 2.0, tc = length(cc.xy / cc.w) * 2.0;
-        float ha = rho * (1.0 + ta) / (dot(a, u_fwd) * u_pix) + 0.5 * u_line_width + 0.5;
-        float hc = rho * (1.0 + tc) / (dot(c, u_fwd) * u_pix) + 0.5 * u_line_width + 0.5;
-        vec2 d = sc - sa;
-        float ld = length(d);
-        d = ld > 1e-3 ? d / ld : vec2(1.0, 0.0);
-        vec2 q = vec2(-d.y, d.x);
-        emit_ndc((sa - d * ha - q * ha) / half_px);
-        emit_ndc((sa - d * ha + q * ha) / half_px);
-        emit_ndc((sc + d * hc - q * hc) / half_px);
-        emit_ndc((sc + d * hc + q * hc) / half_px);
-        EndPrimitive();
+        // the prism itself (a parallelepiped: the slabs |(x - p0) . m_i| <= 1/2 between the
+        // horizontal caps y = p0.y and y = pe.y): its faces that look at the eye, at most three,
+        // cover each pixel whose ray meets it exactly once (docs/volume-techniques.md, "Light
+        // rays", the prism's cover). Corner (a, b) = +-1/2 of the cross-section: on the top cap
+        // p0 + o + T o.y / mu, on the bottom one pe + o + T o.y / mu (o = a u1 + b u2, mu = -T.y).
+        float mu = -T.y;
+        vec4 cp[8];
+        vec3 cw[8];
+        // clipped at view depth zn: every point of the prism is farther than rho from the eye
+        // (D >= 2 rho), so no pixel's ray meets it nearer than zn sec(theta_max) < rho
+        float zn = 0.5 * rho / sqrt(1.0 + 0.25 * u_pix * u_pix * dot(u_size, u_size));
+        for (int k = 0; k < 8; k++) {
+            vec3 o = (float(k & 1) - 0.5) * u1 + (float((k >> 1) & 1) - 0.5) * u2;
+            cw[k] = ((k & 4) == 0 ? p0 : pe) + o + T * (o.y / mu);
+            vec4 c = u_vp_rot * vec4(cw[k], 1.0);
+            cp[k] = vec4(c.xy, c.w - 2.0 * zn, c.w);      // -w <= z <=> w (view depth) >= zn
+        }
+        // faces: corners in cyclic order, outward normal; a face looks at the eye (the origin)
+        // when its normal points away from the eye side: dot(n, corner) < 0
+        const ivec4 face[6] = ivec4[6](ivec4(1, 3, 7, 5), ivec4(0, 2, 6, 4), ivec4(2, 3, 7, 6),
+                                       ivec4(0, 1, 5, 4), ivec4(0, 1, 3, 2), ivec4(4, 5, 7, 6));
+        vec3 nf[6] = vec3[6](s_m1, -s_m1, s_m2, -s_m2, vec3(0.0, 1.0, 0.0), vec3(0.0, -1.0, 0.0));
+        for (int f = 0; f < 6; f++) {
+            ivec4 q = face[f];
+            if (!(dot(nf[f], cw[q.x]) < 0.0)) continue;
+            emit_prism(cp[q.x]);
+            emit_prism(cp[q.y]);
+            emit_prism(cp[q.w]);
+            emit_prism(cp[q.z]);
+            EndPrimitive();
+        }
         return;
     }
 

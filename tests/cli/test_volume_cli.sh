@@ -37,6 +37,25 @@ if ls "$dir"/bad* >/dev/null 2>&1; then echo "FAIL: a failed run left output fil
 maxrow=$("$bin" compare "$dir/light_rays.exr" "$dir/lr2.exr" 2>&1 | grep 'max |t - r|')
 echo "$maxrow" | awk '{for (i = NF - 4; i <= NF; i++) if ($i + 0 != 0) bad = 1} END {exit bad}' && [ -n "$maxrow" ] ||
   { echo "FAIL: two light_rays renders differ: $maxrow"; fail=1; }
+# light_rays' prism cover (its faces that look at the eye) against the brute-force cover (every
+# pixel runs the fragment, which keeps only the rays that meet the prism): the same pixels up to
+# the silhouettes' float-size chords (rel MSE < 1e-8 in RGB); a face left out or drawn twice
+# shows as whole streaks (rel MSE 1e-3 and more)
+if [ -n "$src" ]; then
+  mkdir -p "$dir/brute"
+  sed 's/if (D < 2.0 \* rho) {/if (true) {/' "$src/src/shaders/lightrays.geom.glsl" >"$dir/brute/lightrays.geom.glsl"
+  grep -q 'if (true) {' "$dir/brute/lightrays.geom.glsl" || { echo "FAIL: the brute-force cover's edit did not apply"; fail=1; }
+  for sc in "$dir/s.json" "$src/data/scenes/default.json"; do
+    a=$dir/cover_faces.exr; b=$dir/cover_brute.exr
+    "$bin" render light_rays "$sc" --size 64x36 --set light_rays.rays=64 -o "$a" -q &&
+      "$bin" render light_rays "$sc" --size 64x36 --set light_rays.rays=64 --shader-dir "$dir/brute" -o "$b" -q ||
+      { echo "FAIL: render light_rays for the cover check ($sc)"; fail=1; continue; }
+    rel=$("$bin" compare "$b" "$a" 2>&1 | awk '/^ *rel MSE/ {print $6}')
+    awk -v r="$rel" 'BEGIN {exit !(r != "" && r + 0 < 1e-8)}' &&
+      echo "ok: light_rays' prism faces cover as the brute force ($sc: rel MSE $rel)" ||
+      { echo "FAIL: light_rays' prism faces against the brute-force cover ($sc): rel MSE '$rel'"; fail=1; }
+  done
+fi
 for p in slicing.extinction froxel.g; do
   if "$bin" tune "$dir/s.json" --params $p --starts 1 --max-evals 4 --size 32x18 --no-cache \
        --set reference.spp=1 --set reference.steps=16 -o "$dir/tune_$p" >"$dir/out" 2>"$dir/err"; then
