@@ -182,6 +182,11 @@ static void time_header(const ps_run *r, const gr_ps_opts *o, char *buf, size_t 
 {
     const gr_timing *tm = r->n > 0 ? &r->pts[0].timing : NULL;
     const char *glr = tm ? tm->renderer : gr_gl_renderer(r->gl);
+    if (!o) { /* the chart's short form (its page and the tables carry the whole header) */
+        snprintf(buf, n, "%s: %s", glr,
+                 gr_timing_is_cpu_renderer(glr) ? "CPU-rasterizer wall times, NOT a GPU's" : "GPU time of the GL passes");
+        return;
+    }
     char cap[96] = "";
     if (o->timing_cap_s > 0)
         snprintf(cap, sizeof cap, "; fewer once the timed renders took %g s", o->timing_cap_s);
@@ -234,10 +239,12 @@ static gr_status write_plot(const char *dir, const ps_run *r, const char *header
         pp[i].cost_s = pp[i].time_s = 1e-3 * p->timing.cost_ms;
         pp[i].error = p->test_error;
         pp[i].on_front = p->on_front;
+        pp[i].colour = 1 + gr_technique_index(p->cls); /* one colour per technique, untuned lighter */
+        pp[i].light = !p->tuned;
     }
-    char path[4300], title[600];
+    char path[4300], title[700];
     snprintf(path, sizeof path, "%s/fronts.png", dir);
-    snprintf(title, sizeof title, "test error vs time (%s)", header);
+    snprintf(title, sizeof title, "test error vs time per frame (%s)", header);
     gr_status st = gr_pareto_write_plot(path, pp, r->n, title, "", drawn, err);
     free(pp);
     return st;
@@ -399,7 +406,10 @@ static gr_status outputs(const gr_ps_opts *o, ps_run *r, const char *dir, double
     gr_status st = gr_report_make_dir(dir, err);
     int drawn = 0;
     if (st == GR_OK) st = write_fronts_csv(dir, r, err);
-    if (st == GR_OK) st = write_plot(dir, r, header, &drawn, err);
+    char chart[512], chart_head[600];
+    time_header(r, NULL, chart, sizeof chart);
+    snprintf(chart_head, sizeof chart_head, "at %dx%d on %s", o->timing_w, o->timing_h, chart);
+    if (st == GR_OK) st = write_plot(dir, r, chart_head, &drawn, err);
     gr_strbuf sum;
     gr_sb_init(&sum);
     gr_sb_printf(&sum, "suite %s: %d cases (%d train, %d test) at %dx%d; %s\n", r->suite->path, r->suite->n_cases,

@@ -106,6 +106,9 @@ static gr_status check_spec(const gr_plot_spec *spec, int *w, int *h, gr_error *
             return gr_fail(err, GR_E_INPUT, "plot '%s': series %d: unknown line style %d",
                            spec->title ? spec->title : "", k, (int)s->style);
     }
+    if (!(spec->legend_outside >= 0.0 && spec->legend_outside <= 0.6))
+        return gr_fail(err, GR_E_INPUT, "plot '%s': legend_outside %g outside [0, 0.6]", spec->title ? spec->title : "",
+                       spec->legend_outside);
     if (spec->n_categories < 0 || spec->n_categories > 32 || (spec->n_categories > 0 && (!spec->x_categories || spec->log_x)))
         return gr_fail(err, GR_E_INPUT, "plot '%s': %d x categories (at most 32, with labels, linear axis)",
                        spec->title ? spec->title : "", spec->n_categories);
@@ -174,7 +177,10 @@ static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, in
     pladv(0);
     plschr(0.0, 1.0);
     const double ox = (double)dx / W, oy = -(double)dy / H;
-    plvpor(GR_PLOT_VP_X0 + ox, GR_PLOT_VP_X1 + ox, GR_PLOT_VP_Y0 + oy, GR_PLOT_VP_Y1 + oy);
+    if (part == PART_LEGEND && spec->legend_outside > 0.0) /* the margin right of the plot area */
+        plvpor(GR_PLOT_VP_X1 - spec->legend_outside + 0.015 + ox, 0.995 + ox, GR_PLOT_VP_Y0 + oy, GR_PLOT_VP_Y1 + oy);
+    else
+        plvpor(GR_PLOT_VP_X0 + ox, GR_PLOT_VP_X1 - spec->legend_outside + ox, GR_PLOT_VP_Y0 + oy, GR_PLOT_VP_Y1 + oy);
     double x0, x1, y0, y1;
     axis_range(spec, 0, &x0, &x1);
     axis_range(spec, 1, &y0, &y1);
@@ -225,7 +231,43 @@ static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, in
         plot_text(spec->xlabel, t[0], sizeof t[0]);
         plot_text(spec->ylabel, t[1], sizeof t[1]);
         plot_text(spec->title, t[2], sizeof t[2]);
-        pllab(t[0], t[1], t[2]);
+        /* a title wider than the plot area goes on up to three lines across the whole chart,
+         * broken at spaces, at 0.85 of the size (PLplot's characters here: at most 0.0125 of the
+         * chart's width wide at size 1, measured at 600 and 1240 pixels) */
+        const double vx0 = GR_PLOT_VP_X0, vx1 = GR_PLOT_VP_X1 - spec->legend_outside;
+        const int cw = spec->width ? spec->width : 800;
+        const double chw = 0.0125 * cw;
+        if (strlen(t[2]) * chw <= (vx1 - vx0) * cw) {
+            pllab(t[0], t[1], t[2]);
+        } else {
+            pllab(t[0], t[1], "");
+            const size_t fit = (size_t)(0.97 * cw / (0.85 * chw));
+            char lines[3][512];
+            int nl = 0;
+            const char *c = t[2];
+            while (*c && nl < 3) {
+                size_t len = strlen(c), take = len;
+                int dots = 0;
+                if (len > fit && nl < 2) {
+                    take = fit;
+                    while (take > 0 && c[take] != ' ') take--;
+                    if (take == 0) take = fit;
+                } else if (len > fit) { /* the third line: cut, with an ellipsis */
+                    take = fit > 3 ? fit - 3 : fit;
+                    dots = 1;
+                }
+                if (take >= sizeof lines[0] - 4) take = sizeof lines[0] - 4;
+                memcpy(lines[nl], c, take);
+                memcpy(lines[nl] + take, "...", dots ? 4 : 1);
+                lines[nl++][take + (dots ? 3 : 0)] = '\0';
+                c += take;
+                while (*c == ' ') c++;
+            }
+            plschr(0.0, 0.85);
+            const double mid = (0.5 - vx0) / (vx1 - vx0); /* the chart's centre in viewport units */
+            for (int i = 0; i < nl; i++) plmtex("t", 1.0 + 1.6 * (nl - 1 - i), mid, 0.5, lines[i]);
+            plschr(0.0, 1.0);
+        }
     } else {
         PLINT opt[GR_PLOT_MAX_SERIES], tcol[GR_PLOT_MAX_SERIES], lcol[GR_PLOT_MAX_SERIES], lsty[GR_PLOT_MAX_SERIES];
         PLFLT lwid[GR_PLOT_MAX_SERIES];
@@ -247,8 +289,11 @@ static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, in
         if (n > 0) {
             PLFLT lw = 0, lh = 0;
             pllegend(&lw, &lh, PL_LEGEND_BOUNDING_BOX,
-                     PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE, 0.02, 0.03, 0.08, 0, 1, 1, 0, 0, n,
-                     opt, 0.8, 0.8, 2.0, 0.0, tcol, tp, NULL, NULL, NULL, NULL, lcol, lsty, lwid, NULL, NULL, NULL,
+                     spec->legend_outside > 0.0 ? PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE
+                                                : PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE,
+                     spec->legend_outside > 0.0 ? 0.0 : 0.02, spec->legend_outside > 0.0 ? 0.0 : 0.03, 0.08, 0, 1, 1, 0,
+                     0, n,
+                     opt, 0.8, spec->legend_outside > 0.0 ? 0.72 : 0.8, 2.0, 0.0, tcol, tp, NULL, NULL, NULL, NULL, lcol, lsty, lwid, NULL, NULL, NULL,
                      NULL);
         }
     }
@@ -287,8 +332,11 @@ gr_status gr_plot_render(const gr_plot_spec *spec, gr_image **out, gr_error *err
         memset(leg, 255, (size_t)W * (size_t)H * 3);
         for (int k = 0; k < 4; k++) draw_session(spec, leg, W, H, k & 1, k >> 1, PART_LEGEND);
         int x0 = W, x1 = -1, y0 = H, y1 = -1;
+        /* outside: only the margin right of the plot area (a legend wider than the margin is
+         * cut at the chart's edge; what the memory device wraps past it is not pasted) */
+        const int xs = spec->legend_outside > 0.0 ? (int)((GR_PLOT_VP_X1 - spec->legend_outside) * W) + 2 : 0;
         for (int y = 0; y < H; y++)
-            for (int x = 0; x < W; x++) {
+            for (int x = xs; x < W; x++) {
                 const unsigned char *q = leg + ((size_t)y * (size_t)W + (size_t)x) * 3;
                 if (q[0] == 255 && q[1] == 255 && q[2] == 255) continue;
                 if (x < x0) x0 = x;

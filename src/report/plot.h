@@ -41,6 +41,9 @@ typedef struct gr_plot_spec {
     /* With the y range from the data: this fraction of it is added above the data (room for
      * the legend, drawn opaque in the top right corner). */
     double legend_headroom;
+    /* > 0: the legend goes right of the plot area, in this fraction of the chart's width (the
+     * plot area narrowed by it), instead of inside its top right corner. */
+    double legend_outside;
     const gr_plot_series *series;
     int n_series;                /* 0..GR_PLOT_MAX_SERIES */
     /* Categorical x axis (n_categories > 0, log_x = 0): x values are the indices 0..n-1 and

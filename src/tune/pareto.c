@@ -124,22 +124,31 @@ gr_status gr_pareto_write_plot(const char *path, const gr_pareto_point *pts, int
         double *x = buf + cap * 4 * (size_t)k, *y = x + cap, *fx = y + cap, *fy = fx + cap;
         int nf = 0, m = family_series(pts, n, fams[k], x, y, fx, fy, &nf);
         const char *name = "";
+        int slot = fams[k] == GR_PARETO_REFERENCE ? 0 : 1 + (fams[k] - 1) % 9, light = 0;
         for (int i = 0; i < n; i++)
-            if (pts[i].family == fams[k]) name = pts[i].family_name;
+            if (pts[i].family == fams[k]) {
+                name = pts[i].family_name;
+                if (pts[i].colour > 0) slot = 1 + (pts[i].colour - 1) % 9;
+                light = pts[i].light;
+            }
         if (fams[k] == GR_PARETO_REFERENCE)
             snprintf(labels[k], sizeof labels[k], "ground truth at lower quality");
+        else if (time_label && !time_label[0])
+            snprintf(labels[k], sizeof labels[k], "%s", name);
         else
             snprintf(labels[k], sizeof labels[k], "%s (%s)", name, time_label ? time_label : "wall time");
-        const unsigned char *rgb = palette[(fams[k] == GR_PARETO_REFERENCE ? 0 : 1 + (fams[k] - 1) % 9)];
+        unsigned char rgb[3];
+        for (int c = 0; c < 3; c++) /* the lighter shade: halfway to white */
+            rgb[c] = (unsigned char)(light ? (palette[slot][c] + 255 + 1) / 2 : palette[slot][c]);
         gr_plot_series a = {.label = labels[k], .x = x, .y = y, .n = m, .rgb = {rgb[0], rgb[1], rgb[2]}, .markers = 1};
         gr_plot_series b = {.label = k == nfam - 1 ? "Pareto fronts (dashed)" : "", .x = fx, .y = fy, .n = nf,
                             .rgb = {rgb[0], rgb[1], rgb[2]}, .style = GR_PLOT_DASHED};
         s[ns++] = a;
         s[ns++] = b;
     }
-    gr_plot_spec spec = {.width = 900, .height = 560, .title = title, .xlabel = "time per frame (s)",
+    gr_plot_spec spec = {.width = 1240, .height = 600, .title = title, .xlabel = "time per frame (s)",
                          .ylabel = "verdict vs HQ ground truth", .log_x = 1, .log_y = 1,
-                         .series = s, .n_series = ns, .legend_headroom = 0.0};
+                         .series = s, .n_series = ns, .legend_outside = 0.29};
     gr_status st = gr_plot_write(path, &spec, err);
     free(buf);
     free(s);

@@ -23,6 +23,8 @@ typedef struct gr_pareto_point {
                                 there is mostly the harness's synchronous float readback) */
     double error;            /* the verdict (compare/registry.h) against the high-quality reference */
     int on_front;            /* set by gr_pareto_mark_fronts */
+    int colour;              /* the chart's colour slot, 1..9 (0: from the family) */
+    int light;               /* 1: a lighter shade of it (e.g. untuned beside tuned) */
 } gr_pareto_point;
 
 /* on_front[i] = 1 iff no j with cost[j] <= cost[i] and err[j] <= err[i], one strictly

@@ -153,6 +153,42 @@ int main(void)
     gr_image_destroy(img);
     img = NULL;
 
+    /* the legend right of the plot area (legend_outside): the plot area narrows to
+     * [VP_X0, VP_X1 - f] of the width, the legend's sample line lies right of it, and a line at
+     * the legend's height stays whole across the plot area (the legend is pasted over the
+     * margin only); a title too long for one line is wrapped, not cut */
+    {
+        const double f = 0.3, top = 80.0;
+        double tx[2] = {0, 10}, ty[2] = {top, top};
+        char longt[400];
+        memset(longt, 0, sizeof longt);
+        for (int i = 0; i < 30; i++) strcat(longt, "word word ");
+        gr_plot_series os = {"a rather long legend label", tx, ty, 2, {0, 0, 255}, GR_PLOT_SOLID, 0};
+        spec = (gr_plot_spec){.width = 600, .height = 300, .title = longt, .log_y = 1, .xmin = 0, .xmax = 10,
+                              .ymin = 1, .ymax = 100, .series = &os, .n_series = 1, .legend_outside = f};
+        CHECK_OK(gr_plot_render(&spec, &img, &err), err);
+        if (img) {
+            const double ax0 = GR_PLOT_VP_X0 * 600, ax1 = (GR_PLOT_VP_X1 - f) * 600;
+            const double erow = (1.0 - (GR_PLOT_VP_Y0 + (GR_PLOT_VP_Y1 - GR_PLOT_VP_Y0) * log10(top) / 2.0)) * 300;
+            long in_row = 0, right = 0, stray = 0;
+            for (int y = 0; y < 300; y++)
+                for (int x = 0; x < 600; x++) {
+                    if (!is_col(img, x, y, blue)) continue;
+                    if (x + 0.5 > ax1 + 3) right++;
+                    else if (fabs(y + 0.5 - erow) < 3) in_row++;
+                    else stray++;
+                }
+            CHECK_MSG(right > 10, "legend outside: no sample line right of the plot area (%ld pixels)", right);
+            CHECK_MSG(in_row > 0.9 * (ax1 - ax0), "legend outside: the line at the legend's height has %ld pixels of "
+                      "%.0f columns", in_row, ax1 - ax0);
+            CHECK_MSG(stray == 0, "legend outside: %ld blue pixels elsewhere", stray);
+        }
+        gr_image_destroy(img);
+        img = NULL;
+        spec.legend_outside = 0.7;
+        CHECK(gr_plot_render(&spec, &img, &err) == GR_E_INPUT && !img);
+    }
+
     /* categorical x axis, dashed styles and markers, automatic ranges: draws */
     static const char *const cats[4] = {"none", "1", "4", "16"};
     const double cx[4] = {0, 1, 2, 3}, cy[4] = {0.5, 0.4, 0.2, 0.1}, cy2[4] = {5, 4, 3, NAN};
