@@ -481,7 +481,9 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         }
         if (st != GR_OK || out->partial) break;
         if (rounds > 1) {
-            if (gr_ref_image_errors(&acc, &e) != GR_OK) { st = gr_fail(err, GR_E_NOMEM, "reference: out of memory"); break; }
+            gr_status est = GR_OK;
+            r->phases.par_total += gr_ref_image_errors(&acc, r->threads, 0, &e, &est);
+            if (est != GR_OK) { st = gr_fail(err, GR_E_NOMEM, "reference: out of memory"); break; }
             if (gr_ref_target_met(&e, acc.B, r->set.target_error)) break;
         }
     }

@@ -5,7 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <stdatomic.h>
+
 #include "core/student.h"
+#include "reference/beam_grid.h"
 #include "reference/probe.h"
 #include "scene/settings.h"
 
@@ -26,11 +29,17 @@ double gr_ref_percentile(double *v, size_t n, double q)
     return v[i] * (1.0 - f) + v[i + 1] * f;
 }
 
-static const double *sort_v; /* values that cmp_by_value orders indices by (one caller at a time) */
-static int cmp_by_value(const void *a, const void *b)
+/* A pixel's value and index, ranked by value, ties by index (the order a stable sort of the
+ * indices by value gives; no shared state, so the quantities may rank on several threads). */
+typedef struct ranked {
+    double v;
+    size_t i;
+} ranked;
+static int cmp_ranked(const void *a, const void *b)
 {
-    double x = sort_v[*(const size_t *)a], y = sort_v[*(const size_t *)b];
-    return (x > y) - (x < y);
+    const ranked *x = a, *y = b;
+    if (x->v != y->v) return (x->v > y->v) - (x->v < y->v);
+    return (x->i > y->i) - (x->i < y->i);
 }
 
 int gr_ref_target_met(const ref_errors *e, int batches, double target)
@@ -109,15 +118,14 @@ static gr_status quantity_errors(const ref_accum *acc, int ch, ref_errors *e)
          * 95th percentile of the final image, their RMS standard error over their RMS value.
          * (The spread of the batch images' own percentiles would mix in the upward bias that
          * noise gives an order statistic, and does not shrink like the noise.) */
-        size_t *ord = malloc(np * sizeof *ord);
+        ranked *ord = malloc(np * sizeof *ord);
         if (!ord) { free(tmp); free(Mb); free(Qb); free(v); free(se); return GR_E_NOMEM; }
-        for (size_t p = 0; p < np; p++) ord[p] = p;
-        sort_v = v;
-        qsort(ord, np, sizeof *ord, cmp_by_value);
+        for (size_t p = 0; p < np; p++) ord[p] = (ranked){v[p], p};
+        qsort(ord, np, sizeof *ord, cmp_ranked);
         size_t c = (size_t)(0.95 * (double)(np - 1)), band = np / 100;
         size_t lo = c > band ? c - band : 0, hi = c + band < np ? c + band : np - 1;
         double sv = 0.0, ss = 0.0;
-        for (size_t i = lo; i <= hi; i++) { sv += v[ord[i]] * v[ord[i]]; ss += se[ord[i]] * se[ord[i]]; }
+        for (size_t i = lo; i <= hi; i++) { sv += v[ord[i].i] * v[ord[i].i]; ss += se[ord[i].i] * se[ord[i].i]; }
         free(ord);
         e->rel_p95 = sv > 0.0 ? sqrt(ss / sv) : (ss > 0.0 ? INFINITY : 0.0);
     } else {
@@ -127,18 +135,61 @@ static gr_status quantity_errors(const ref_accum *acc, int ch, ref_errors *e)
     return GR_OK;
 }
 
-gr_status gr_ref_image_errors(const ref_accum *acc, ref_errors *e)
+static void block_noise(const ref_accum *acc, double q[3]);
+
+/* The statistics' jobs (issue 30: no serial phase): the RGB mean's errors, each channel's,
+ * and (optionally) the block noise, taken from a counter by `threads` threads; each job
+ * writes only its own result, so the values do not depend on the thread count. */
+typedef struct stats_work {
+    const ref_accum *acc;
+    ref_errors q[4];          /* [0] the RGB mean, [1 + c] channel c */
+    gr_status st[4];
+    int blocks;               /* 1: also the block noise, into block8 */
+    double block8[3];
+    atomic_int next;
+} stats_work;
+typedef struct stats_thread {
+    stats_work *w;
+} stats_thread;
+
+static void *stats_job(void *arg)
 {
-    gr_status st = quantity_errors(acc, -1, e);
-    for (int c = 0; c < 3 && st == GR_OK; c++) {
-        ref_errors ec;
-        memset(&ec, 0, sizeof ec);
-        st = quantity_errors(acc, c, &ec);
-        e->ch_rel_mean[c] = ec.rel_mean;
-        e->ch_rel_p95[c] = ec.rel_p95;
-        e->ch_frac_1pct[c] = ec.frac_1pct;
+    stats_work *w = ((stats_thread *)arg)->w;
+    for (;;) {
+        int k = atomic_fetch_add(&w->next, 1);
+        if (k < 4) w->st[k] = quantity_errors(w->acc, k - 1, &w->q[k]);
+        else if (k == 4 && w->blocks) block_noise(w->acc, w->block8);
+        else break;
     }
-    return st;
+    return NULL;
+}
+
+double gr_ref_image_errors(const ref_accum *acc, int threads, int blocks, ref_errors *e, gr_status *st)
+{
+    stats_work *w = calloc(1, sizeof *w);
+    if (!w) {
+        *st = GR_E_NOMEM;
+        return 0.0;
+    }
+    w->acc = acc;
+    w->blocks = blocks;
+    atomic_init(&w->next, 0);
+    stats_thread th[5];
+    int n = threads < 1 ? 1 : threads > 5 ? 5 : threads;
+    for (int i = 0; i < n; i++) th[i].w = w;
+    double par = gr_beams_run_jobs(stats_job, th, sizeof th[0], n);
+    *e = w->q[0];
+    memcpy(e->block8, w->block8, sizeof e->block8);
+    *st = GR_OK;
+    for (int k = 0; k < 4; k++)
+        if (w->st[k] != GR_OK) *st = w->st[k];
+    for (int c = 0; c < 3; c++) {
+        e->ch_rel_mean[c] = w->q[1 + c].rel_mean;
+        e->ch_rel_p95[c] = w->q[1 + c].rel_p95;
+        e->ch_frac_1pct[c] = w->q[1 + c].frac_1pct;
+    }
+    free(w);
+    return par;
 }
 
 /* 8 x 8 blocks (issue 30): each block's mean per batch (the mean of its pixels' batch means),
@@ -411,8 +462,9 @@ gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_marc
     ref_errors e;
     memset(&e, 0, sizeof e);
     gr_status st = GR_OK;
-    if (gr_ref_image_errors(acc, &e) != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
-    if (st == GR_OK) block_noise(acc, e.block8);
+    gr_status est = GR_OK;
+    r->phases.par_total += gr_ref_image_errors(acc, r->threads, 1, &e, &est);
+    if (est != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
     if (st == GR_OK) st = build_image(r, acc, out, err);
     if (st != GR_OK) return st;
     gr_ref_block_bias(r, out->image, e.mean);

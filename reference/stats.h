@@ -21,9 +21,12 @@ double gr_ref_percentile(double *v, size_t n, double q);
  * known standard error E would give, t_{0.975, B-1} se <= 1.96 E (docs/reference.md); for the
  * RGB mean and for each of R, G and B. */
 int gr_ref_target_met(const ref_errors *e, int batches, double target);
-/* Image-level error estimates from the batch images (docs/reference.md, "Error bars").
- * GR_E_NOMEM (no message) when out of memory. */
-gr_status gr_ref_image_errors(const ref_accum *acc, ref_errors *e);
+/* Image-level error estimates from the batch images (docs/reference.md, "Error bars"): the
+ * RGB mean's and each channel's, and with `blocks` the 8 x 8 block noise (else block8 is
+ * zero), computed on up to `threads` threads (the same values for any count). *st: GR_OK, or
+ * GR_E_NOMEM (no message) when out of memory. Returns the time with two or more of its threads
+ * busy (for the phases' serial part). */
+double gr_ref_image_errors(const ref_accum *acc, int threads, int blocks, ref_errors *e, gr_status *st);
 /* The end of a render from its sums: image, error bars, statistics, metadata (shared by
  * gr_ref_render and gr_ref_assemble, so merged parts give the same bytes). */
 gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_march_totals *tot, double wall_s,
