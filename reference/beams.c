@@ -178,6 +178,9 @@ static gr_status build_surface_mesh(gr_rtc *rtc, gr_beams *b, const gr_dvec3 *po
     size_t nv = b->nv, nt = b->ntri;
     b->surface = rtcNewScene(dev);
     if (!b->surface) return gr_rtc_check(rtc, "reference: surface mesh", err);
+    /* the camera rays meet it once a pass (one query per pixel against millions of beam
+     * lookups): the quick build serves (issue 30: the commit runs on one thread) */
+    rtcSetSceneBuildQuality(b->surface, RTC_BUILD_QUALITY_LOW);
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv);
     unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt);
