@@ -178,7 +178,7 @@ static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, in
     plschr(0.0, 1.0);
     const double ox = (double)dx / W, oy = -(double)dy / H;
     if (part == PART_LEGEND && spec->legend_outside > 0.0) /* the margin right of the plot area */
-        plvpor(GR_PLOT_VP_X1 - spec->legend_outside + 0.015 + ox, 0.995 + ox, GR_PLOT_VP_Y0 + oy, GR_PLOT_VP_Y1 + oy);
+        plvpor(GR_PLOT_VP_X1 - spec->legend_outside + 0.035 + ox, 0.995 + ox, GR_PLOT_VP_Y0 + oy, GR_PLOT_VP_Y1 + oy);
     else
         plvpor(GR_PLOT_VP_X0 + ox, GR_PLOT_VP_X1 - spec->legend_outside + ox, GR_PLOT_VP_Y0 + oy, GR_PLOT_VP_Y1 + oy);
     double x0, x1, y0, y1;
@@ -334,7 +334,7 @@ gr_status gr_plot_render(const gr_plot_spec *spec, gr_image **out, gr_error *err
         int x0 = W, x1 = -1, y0 = H, y1 = -1;
         /* outside: only the margin right of the plot area (a legend wider than the margin is
          * cut at the chart's edge; what the memory device wraps past it is not pasted) */
-        const int xs = spec->legend_outside > 0.0 ? (int)((GR_PLOT_VP_X1 - spec->legend_outside) * W) + 2 : 0;
+        const int xs = spec->legend_outside > 0.0 ? (int)((GR_PLOT_VP_X1 - spec->legend_outside + 0.02) * W) : 0;
         for (int y = 0; y < H; y++)
             for (int x = xs; x < W; x++) {
                 const unsigned char *q = leg + ((size_t)y * (size_t)W + (size_t)x) * 3;
