@@ -23,7 +23,7 @@ typedef struct gr_light_rays_settings {
     int rays;               /* texels per side of the light's view: rays^2 lines (512) */
     int footprint;          /* gr_light_rays_footprint: how a line reaches the pixels (prism) */
     int kernel;             /* the footprint's side in texels (1) */
-    double line_width;      /* pixels added to the prism's cover / the ribbon's least width */
+    double line_width;      /* the ribbon's least width (not used by the prism) */
     double max_length_m;    /* longest line (m) */
     double margin_m;        /* extra border of the light's window around the lit volume (m) */
     gr_vol_settings vol;    /* extinction, g, intensity, shadow map (caustic fields unused) */
