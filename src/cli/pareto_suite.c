@@ -178,15 +178,14 @@ static gr_status technique(const gr_ps_opts *o, ps_run *r, const gr_technique_cl
 }
 
 /* The header every table and chart of times carries: the renderer and what its times mean. */
+static const char *run_renderer(const ps_run *r)
+{
+    return r->n > 0 ? r->pts[0].timing.renderer : gr_gl_renderer(r->gl);
+}
+
 static void time_header(const ps_run *r, const gr_ps_opts *o, char *buf, size_t n)
 {
-    const gr_timing *tm = r->n > 0 ? &r->pts[0].timing : NULL;
-    const char *glr = tm ? tm->renderer : gr_gl_renderer(r->gl);
-    if (!o) { /* the chart's short form (its page and the tables carry the whole header) */
-        snprintf(buf, n, "%s: %s", glr,
-                 gr_timing_is_cpu_renderer(glr) ? "CPU-rasterizer wall times, NOT a GPU's" : "GPU time of the GL passes");
-        return;
-    }
+    const char *glr = run_renderer(r);
     char cap[96] = "";
     if (o->timing_cap_s > 0)
         snprintf(cap, sizeof cap, "; fewer once the timed renders took %g s", o->timing_cap_s);
@@ -316,9 +315,8 @@ static void page_chart(gr_strbuf *pg, const ps_run *r, const char *header, int d
         return;
     }
     char title[600], label[512], ylab[160];
-    const gr_timing *tm = r->n > 0 ? &r->pts[0].timing : NULL;
     snprintf(title, sizeof title, "Test error against time per frame, tuned and untuned fronts (GL_RENDERER: %s)",
-             tm ? tm->renderer : gr_gl_renderer(r->gl));
+             run_renderer(r));
     snprintf(ylab, sizeof ylab, "test error (mean verdict over the %d test cases)", gr_suite_count(r->suite, GR_SPLIT_TEST));
     int family[GR_CHART_MAX_SERIES];
     for (int i = 0; i < r->n; i++) {
@@ -406,9 +404,11 @@ static gr_status outputs(const gr_ps_opts *o, ps_run *r, const char *dir, double
     gr_status st = gr_report_make_dir(dir, err);
     int drawn = 0;
     if (st == GR_OK) st = write_fronts_csv(dir, r, err);
-    char chart[512], chart_head[600];
-    time_header(r, NULL, chart, sizeof chart);
-    snprintf(chart_head, sizeof chart_head, "at %dx%d on %s", o->timing_w, o->timing_h, chart);
+    /* the chart's header, short (its page and the tables carry the whole one) */
+    char chart_head[600];
+    const char *glr = run_renderer(r);
+    snprintf(chart_head, sizeof chart_head, "at %dx%d on %s: %s", o->timing_w, o->timing_h, glr,
+             gr_timing_is_cpu_renderer(glr) ? "CPU-rasterizer wall times, NOT a GPU's" : "GPU time of the GL passes");
     if (st == GR_OK) st = write_plot(dir, r, chart_head, &drawn, err);
     gr_strbuf sum;
     gr_sb_init(&sum);

@@ -60,7 +60,7 @@ typedef struct lr_state {
     gr_vol_locs vl;
     GLint s_cells, s_half, s_win, s_zr, s_c, s_e1, s_e2, s_sun, s_nw, s_wa, s_wamp;
     GLint l_pos, l_nrm, l_rays, l_vp, l_sun, l_ior, l_area, l_footprint, l_pix, l_width, l_max, l_seabed, l_eye_depth,
-        l_size, l_tmax, l_fwd, l_h1, l_h2, l_inv, l_kernel;
+        l_size, l_tmax, l_h1, l_h2, l_inv, l_kernel;
     int n_rays;
     double window_m;
 } lr_state;
@@ -124,7 +124,6 @@ static gr_status lr_create(const gr_technique_class *cls, gr_gl *gl, const gr_te
     r->l_ior = glGetUniformLocation(p, "u_ior");
     r->l_area = glGetUniformLocation(p, "u_texel_area");
     r->l_footprint = glGetUniformLocation(p, "u_footprint");
-    r->l_fwd = glGetUniformLocation(p, "u_fwd");
     r->l_h1 = glGetUniformLocation(p, "u_h1");
     r->l_h2 = glGetUniformLocation(p, "u_h2");
     r->l_inv = glGetUniformLocation(p, "u_inv_vp_rot");
@@ -332,7 +331,6 @@ static gr_status lr_render(void *state, const gr_scene *scene, const void *setti
     glUniform1f(r->l_area, (float)(texel * texel));
     glUniform1i(r->l_footprint, s->footprint);
     glUniform1f(r->l_kernel, (float)s->kernel);
-    glUniform3f(r->l_fwd, (float)f->forward[0], (float)f->forward[1], (float)f->forward[2]);
     glUniform3f(r->l_h1, (float)h[0][0], (float)h[0][1], (float)h[0][2]);
     glUniform3f(r->l_h2, (float)h[1][0], (float)h[1][1], (float)h[1][2]);
     glUniformMatrix4fv(r->l_inv, 1, GL_FALSE, mi);

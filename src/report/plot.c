@@ -288,13 +288,12 @@ static void draw_session(const gr_plot_spec *spec, unsigned char *buf, int W, in
         }
         if (n > 0) {
             PLFLT lw = 0, lh = 0;
+            /* outside: the top left of its own viewport (the margin), a smaller text */
+            const int out = spec->legend_outside > 0.0;
             pllegend(&lw, &lh, PL_LEGEND_BOUNDING_BOX,
-                     spec->legend_outside > 0.0 ? PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE
-                                                : PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE,
-                     spec->legend_outside > 0.0 ? 0.0 : 0.02, spec->legend_outside > 0.0 ? 0.0 : 0.03, 0.08, 0, 1, 1, 0,
-                     0, n,
-                     opt, 0.8, spec->legend_outside > 0.0 ? 0.72 : 0.8, 2.0, 0.0, tcol, tp, NULL, NULL, NULL, NULL, lcol, lsty, lwid, NULL, NULL, NULL,
-                     NULL);
+                     PL_POSITION_TOP | PL_POSITION_INSIDE | (out ? PL_POSITION_LEFT : PL_POSITION_RIGHT), out ? 0.0 : 0.02,
+                     out ? 0.0 : 0.03, 0.08, 0, 1, 1, 0, 0, n, opt, 0.8, out ? 0.72 : 0.8, 2.0, 0.0, tcol, tp, NULL, NULL,
+                     NULL, NULL, lcol, lsty, lwid, NULL, NULL, NULL, NULL);
         }
     }
     plend1();

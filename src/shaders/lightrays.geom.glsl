@@ -16,7 +16,6 @@ layout(triangle_strip, max_vertices = 18) out;
 in vec4 v_pos[];
 in vec4 v_nrm[];
 uniform mat4 u_vp_rot;         // eye-relative position -> clip
-uniform vec3 u_fwd;            // camera forward
 uniform vec3 u_sun_dir;        // I: direction sunlight travels in air
 uniform float u_ior;
 uniform float u_texel_area;    // the texel's area across the sun's direction (m^2)
