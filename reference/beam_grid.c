@@ -2,6 +2,7 @@
 
 #include <float.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -560,6 +561,45 @@ double gr_beams_run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n)
     return gr_ref_overlap_s(a, b, n);
 }
 
+typedef struct chunk_run {
+    gr_chunk_fn fn;
+    size_t total;
+    int nchunks;
+    atomic_int next;
+} chunk_run;
+
+typedef struct chunk_call {
+    chunk_run *run;
+    void *job;
+} chunk_call;
+
+static void *chunk_main(void *arg)
+{
+    chunk_call *c = arg;
+    chunk_run *r = c->run;
+    for (int k; (k = atomic_fetch_add(&r->next, 1)) < r->nchunks;)
+        r->fn(c->job, k, r->total * (size_t)k / (size_t)r->nchunks, r->total * (size_t)(k + 1) / (size_t)r->nchunks);
+    return NULL;
+}
+
+double gr_beams_run_chunks(gr_chunk_fn fn, void *jobs, size_t size, int n, size_t total, int nchunks)
+{
+    if (n < 1) n = 1;
+    if (n > GRID_MAX_THREADS) n = GRID_MAX_THREADS;
+    chunk_run run = {fn, total, nchunks < 1 ? 1 : nchunks, 0};
+    atomic_init(&run.next, 0);
+    chunk_call call[GRID_MAX_THREADS];
+    for (int i = 0; i < n; i++) call[i] = (chunk_call){&run, (char *)jobs + (size_t)i * size};
+    return gr_beams_run_jobs(chunk_main, call, sizeof call[0], n);
+}
+
+int gr_beams_chunks(size_t total, int n)
+{
+    size_t c = (size_t)(n < 1 ? 1 : n) * 16u;
+    if (c > total) c = total ? total : 1;
+    return c > GRID_CHUNKS_MAX ? GRID_CHUNKS_MAX : (int)c;
+}
+
 /* The primitives' cell ranges (grid_range of their boxes: lower u, y, w then upper), computed
  * once per grid by ranges of primitives and then read by the count and the fill, which no
  * longer recompute them in every worker (each scans every primitive); with each range's
@@ -569,20 +609,19 @@ enum { RANGE_BINS = 1024 };
 typedef struct range_job {
     gr_beams *b;
     int32_t *rng;                 /* 6 per primitive */
-    uint32_t k0, k1;
     int nbins;                    /* histogram bins over the w-layers */
     uint64_t total;               /* entries of the job's primitives */
     uint64_t hist[RANGE_BINS];    /* entries per bin (each primitive's in the bin of its middle layer) */
 } range_job;
 
-static void *range_work(void *arg)
+static void range_work(void *arg, int chunk, size_t k0, size_t k1)
 {
     range_job *j = arg;
     const gr_beams *b = j->b;
     const int gw = b->gn[2];
     uint64_t total = 0;
-    memset(j->hist, 0, sizeof j->hist);
-    for (uint32_t k = j->k0; k < j->k1; k++) {
+    (void)chunk;
+    for (uint32_t k = (uint32_t)k0; k < (uint32_t)k1; k++) {
         int l[3], h[3];
         grid_range(b, b->box + 6 * (size_t)k, l, h);
         int32_t *r = j->rng + 6 * (size_t)k;
@@ -591,8 +630,7 @@ static void *range_work(void *arg)
         total += n;
         j->hist[(int)((int64_t)((l[2] + h[2]) / 2) * j->nbins / gw)] += n;
     }
-    j->total = total;
-    return NULL;
+    j->total += total;
 }
 
 typedef struct grid_job {
@@ -601,6 +639,7 @@ typedef struct grid_job {
     uint32_t np;
     int w0, w1;   /* the w-layers of cells this worker owns */
     int fill;     /* 0: count the entries per cell; 1: fill them */
+    uint64_t total, offset; /* the count: the layers' entries; the fill: the entries before them */
 } grid_job;
 
 static void *grid_work(void *arg)
@@ -610,31 +649,47 @@ static void *grid_work(void *arg)
     uint32_t *cf = j->b->cell_first, *cp = j->b->cell_prim; /* locals: the stores cannot alias them */
     const int32_t *rng = j->rng;
     const int fw0 = j->w0, fw1 = j->w1 - 1;
-    for (uint32_t k = 0; k < j->np; k++) {
+    const size_t c_lo = (size_t)j->w0 * ny * nu, c_hi = (size_t)j->w1 * ny * nu; /* the layers' cells */
+    if (!j->fill) {
+        /* each cell's entries, then their running sum over the layers (its end, local) */
+        for (uint32_t k = 0; k < j->np; k++) {
+            const int32_t *r = rng + 6 * (size_t)k;
+            int w0 = r[2] > fw0 ? r[2] : fw0, w1 = r[5] < fw1 ? r[5] : fw1;
+            for (int iw = w0; iw <= w1; iw++)
+                for (int iy = r[1]; iy <= r[4]; iy++) {
+                    size_t c0 = ((size_t)iw * ny + (size_t)iy) * nu;
+                    for (int iu = r[0]; iu <= r[3]; iu++) cf[c0 + (size_t)iu]++;
+                }
+        }
+        uint64_t sum = 0;
+        for (size_t c = c_lo; c < c_hi; c++) {
+            sum += cf[c];
+            cf[c] = (uint32_t)sum;
+        }
+        j->total = sum;
+        return NULL;
+    }
+    /* the ends made global, then each cell filled from its end down in reverse primitive
+     * order: the lists ascend and cf[c] ends at the cell's start */
+    const uint32_t off = (uint32_t)j->offset;
+    for (size_t c = c_lo; c < c_hi; c++) cf[c] += off;
+    for (uint32_t k = j->np; k-- > 0;) {
         const int32_t *r = rng + 6 * (size_t)k;
         int w0 = r[2] > fw0 ? r[2] : fw0, w1 = r[5] < fw1 ? r[5] : fw1;
         for (int iw = w0; iw <= w1; iw++)
             for (int iy = r[1]; iy <= r[4]; iy++) {
                 size_t c0 = ((size_t)iw * ny + (size_t)iy) * nu;
-                if (j->fill)
-                    for (int iu = r[0]; iu <= r[3]; iu++) cp[cf[c0 + (size_t)iu]++] = k;
-                else
-                    for (int iu = r[0]; iu <= r[3]; iu++) cf[c0 + (size_t)iu + 1]++;
+                for (int iu = r[0]; iu <= r[3]; iu++) cp[--cf[c0 + (size_t)iu]] = k;
             }
     }
     return NULL;
 }
 
-typedef struct box_job {
-    gr_beams *b;
-    uint32_t k0, k1;
-} box_job;
-
-static void *box_work(void *arg)
+static void box_work(void *arg, int chunk, size_t k0, size_t k1)
 {
-    box_job *j = arg;
-    for (uint32_t k = j->k0; k < j->k1; k++) prim_box(j->b, k, j->b->box + 6 * (size_t)k, j->b->box + 6 * (size_t)k + 3);
-    return NULL;
+    gr_beams *b = arg;
+    (void)chunk;
+    for (uint32_t k = (uint32_t)k0; k < (uint32_t)k1; k++) prim_box(b, k, b->box + 6 * (size_t)k, b->box + 6 * (size_t)k + 3);
 }
 
 /* The boxes' bounds and summed extents over BOUND_CHUNKS fixed chunks of the primitives (the
@@ -642,17 +697,14 @@ static void *box_work(void *arg)
 enum { BOUND_CHUNKS = 64 };
 typedef struct bound_job {
     const gr_beams *b;
-    uint32_t np;
-    int c0, c1;                              /* chunks */
     double lo[BOUND_CHUNKS][3], hi[BOUND_CHUNKS][3], ext[BOUND_CHUNKS][3];
 } bound_job;
 
-static void *bound_work(void *arg)
+static void bound_work(void *arg, int ck, size_t c0, size_t c1)
 {
     bound_job *j = arg;
-    for (int ck = j->c0; ck < j->c1; ck++) {
-        uint32_t k0 = (uint32_t)((uint64_t)j->np * (uint64_t)ck / BOUND_CHUNKS);
-        uint32_t k1 = (uint32_t)((uint64_t)j->np * (uint64_t)(ck + 1) / BOUND_CHUNKS);
+    {
+        uint32_t k0 = (uint32_t)c0, k1 = (uint32_t)c1;
         double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
         for (uint32_t k = k0; k < k1; k++) {
             const float *bx = j->b->box + 6 * (size_t)k;
@@ -664,21 +716,20 @@ static void *bound_work(void *arg)
         }
         for (int a = 0; a < 3; a++) { j->lo[ck][a] = lo[a]; j->hi[ck][a] = hi[a]; j->ext[ck][a] = ext[a]; }
     }
-    return NULL;
 }
 
 /* The 16-bit boxes of primitives [k0, k1) (the job's range) */
 typedef struct quant_job {
     gr_beams *b;
-    uint32_t k0, k1;
     double qunit[3];
 } quant_job;
 
-static void *quant_work(void *arg)
+static void quant_work(void *arg, int chunk, size_t k0, size_t k1)
 {
     quant_job *j = arg;
     gr_beams *b = j->b;
-    for (uint32_t k = j->k0; k < j->k1; k++) {
+    (void)chunk;
+    for (uint32_t k = (uint32_t)k0; k < (uint32_t)k1; k++) {
         const float *bx = b->box + 6 * (size_t)k;
         uint16_t *q = b->qbox[k].q;
         b->qbox[k].tri = b->prim_tri[k];
@@ -689,7 +740,6 @@ static void *quant_work(void *arg)
             q[3 + a] = (uint16_t)(h < 0.0 ? 0.0 : h > 65535.0 ? 65535.0 : h);
         }
     }
-    return NULL;
 }
 
 static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err)
@@ -698,22 +748,16 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
     {
         int nb = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
-        bound_job *bj = malloc((size_t)nb * sizeof *bj);
+        bound_job *bj = malloc(sizeof *bj); /* one table: each chunk writes its own row */
         if (!bj) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid");
-        for (int i = 0; i < nb; i++) {
-            bj[i].b = b;
-            bj[i].np = np;
-            bj[i].c0 = BOUND_CHUNKS * i / nb;
-            bj[i].c1 = BOUND_CHUNKS * (i + 1) / nb;
-        }
-        b->stats.par_s += gr_beams_run_jobs(bound_work, bj, sizeof bj[0], nb);
-        for (int i = 0; i < nb; i++)
-            for (int ck = bj[i].c0; ck < bj[i].c1; ck++)
-                for (int a = 0; a < 3; a++) {
-                    lo[a] = fmin(lo[a], bj[i].lo[ck][a]);
-                    hi[a] = fmax(hi[a], bj[i].hi[ck][a]);
-                    ext[a] += bj[i].ext[ck][a];
-                }
+        bj->b = b;
+        b->stats.par_s += gr_beams_run_chunks(bound_work, bj, 0, nb, np, BOUND_CHUNKS);
+        for (int ck = 0; ck < BOUND_CHUNKS; ck++)
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fmin(lo[a], bj->lo[ck][a]);
+                hi[a] = fmax(hi[a], bj->hi[ck][a]);
+                ext[a] += bj->ext[ck][a];
+            }
         free(bj);
     }
     double cell[3];
@@ -734,14 +778,8 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     }
     int nt = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
     {
-        quant_job qj[GRID_MAX_THREADS];
-        for (int i = 0; i < nt; i++) {
-            qj[i].b = b;
-            qj[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nt);
-            qj[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nt);
-            for (int a = 0; a < 3; a++) qj[i].qunit[a] = qunit[a];
-        }
-        b->stats.par_s += gr_beams_run_jobs(quant_work, qj, sizeof qj[0], nt);
+        quant_job qj = {b, {qunit[0], qunit[1], qunit[2]}};
+        b->stats.par_s += gr_beams_run_chunks(quant_work, &qj, 0, nt, np, gr_beams_chunks(np, nt));
     }
     free(b->prim_tri); /* each primitive's triangle now travels with its box */
     b->prim_tri = NULL;
@@ -769,14 +807,14 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         }
         if (nc > budget) continue; /* more cells than entries allowed: coarser */
         uint64_t total = 0;
-        for (int i = 0; i < nt; i++) {
+        for (int i = 0; i < nt; i++) { /* integer sums: the same for any split */
             rj[i].b = b;
             rj[i].rng = rng;
-            rj[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nt);
-            rj[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nt);
             rj[i].nbins = b->gn[2] < RANGE_BINS ? b->gn[2] : RANGE_BINS;
+            rj[i].total = 0;
+            memset(rj[i].hist, 0, sizeof rj[i].hist);
         }
-        b->stats.par_s += gr_beams_run_jobs(range_work, rj, sizeof rj[0], nt);
+        b->stats.par_s += gr_beams_run_chunks(range_work, rj, sizeof rj[0], nt, np, gr_beams_chunks(np, nt));
         for (int i = 0; i < nt; i++) total += rj[i].total;
         if ((double)total <= budget) entries = total;
     }
@@ -820,17 +858,17 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu cells, %llu entries)", ncells,
                        (unsigned long long)entries);
     }
+    /* count (each worker's layers, with their running sum), the workers' offsets, fill: the
+     * prefix sum on the workers' threads, each cell's first entry at cell_first[c] */
     b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
-    for (size_t c = 0, total = 0; c < ncells; c++) {
-        total += b->cell_first[c + 1];
-        b->cell_first[c + 1] = (uint32_t)total;
+    for (uint64_t i = 0, off = 0; i < (uint64_t)nt; i++) {
+        jobs[i].offset = off;
+        off += jobs[i].total;
+        jobs[i].fill = 1;
     }
-    /* fill: cell_first[c] runs ahead as the cursor while filling, restored below */
-    for (int i = 0; i < nt; i++) jobs[i].fill = 1;
     b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
     free(rng);
-    memmove(b->cell_first + 1, b->cell_first, ncells * sizeof *b->cell_first);
-    b->cell_first[0] = 0;
+    b->cell_first[ncells] = (uint32_t)entries;
     b->stats.grid_entries = (size_t)entries;
     b->stats.grid_cells = ncells;
     return GR_OK;
@@ -838,14 +876,8 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
 
 gr_status gr_beams_index(gr_beams *b, uint32_t np, int threads, gr_error *err)
 {
-    /* the boxes, in parallel (disjoint outputs) */
-    box_job jobs[GRID_MAX_THREADS];
+    /* the boxes, in parallel (disjoint outputs; every thread's job is the set) */
     int nt = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
-    for (int i = 0; i < nt; i++) {
-        jobs[i].b = b;
-        jobs[i].k0 = (uint32_t)((uint64_t)np * (uint64_t)i / (uint64_t)nt);
-        jobs[i].k1 = (uint32_t)((uint64_t)np * (uint64_t)(i + 1) / (uint64_t)nt);
-    }
-    b->stats.par_s += gr_beams_run_jobs(box_work, jobs, sizeof jobs[0], nt);
+    b->stats.par_s += gr_beams_run_chunks(box_work, b, 0, nt, np, gr_beams_chunks(np, nt));
     return build_grid(b, np, threads, err);
 }

@@ -103,4 +103,16 @@ gr_status gr_beams_index(gr_beams *b, uint32_t np, int threads, gr_error *err);
 #define GRID_MAX_THREADS 64
 double gr_beams_run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n);
 
+/* Runs fn(job, c, k0, k1) for the chunks c = 0 .. nchunks - 1 of [0, total) (chunk c:
+ * [total c / nchunks, total (c + 1) / nchunks)), taken from a shared counter by n threads,
+ * thread i passing job i (each `size` bytes apart: its own accumulators). Which thread runs a
+ * chunk varies; what a chunk writes must not (disjoint outputs, integer sums). Many chunks per
+ * thread keep the last one's tail short (equal ranges end a millisecond apart on a shared
+ * machine: time with one thread busy). Returns the time with at least two threads busy. */
+typedef void (*gr_chunk_fn)(void *job, int chunk, size_t k0, size_t k1);
+double gr_beams_run_chunks(gr_chunk_fn fn, void *jobs, size_t size, int n, size_t total, int nchunks);
+/* The chunks for `total` items on n threads: 16 per thread, at most `total` and GRID_CHUNKS_MAX. */
+#define GRID_CHUNKS_MAX 1024
+int gr_beams_chunks(size_t total, int n);
+
 #endif

@@ -172,30 +172,6 @@ static int cell_tris(topo *T, const uint8_t *ref, int i, int j, uint32_t *vi, ui
     return np;
 }
 
-static gr_status build_surface_mesh(gr_rtc *rtc, gr_beams *b, const gr_dvec3 *pos, gr_error *err)
-{
-    RTCDevice dev = rtc->device;
-    size_t nv = b->nv, nt = b->ntri;
-    b->surface = rtcNewScene(dev);
-    if (!b->surface) return gr_rtc_check(rtc, "reference: surface mesh", err);
-    /* the camera rays meet it once a pass (one query per pixel against millions of beam
-     * lookups): the quick build serves (issue 30: the commit runs on one thread) */
-    rtcSetSceneBuildQuality(b->surface, RTC_BUILD_QUALITY_LOW);
-    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv);
-    unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt);
-    if (v && idx) {
-        for (size_t i = 0; i < nv; i++) {
-            v[3 * i] = (float)pos[i].x; v[3 * i + 1] = (float)pos[i].y; v[3 * i + 2] = (float)pos[i].z;
-        }
-        for (size_t t = 0; t < nt; t++) tri_vertices(b, (uint32_t)t, idx + 3 * t);
-        rtcCommitGeometry(g);
-        rtcAttachGeometry(b->surface, g);
-    }
-    rtcReleaseGeometry(g);
-    rtcCommitScene(b->surface);
-    return gr_rtc_check(rtc, "reference: building the surface mesh", err);
-}
 
 
 /* Number of depth slabs for a beam whose corners drift by up to `drift` metres per metre
@@ -223,22 +199,40 @@ typedef struct build_job {
     size_t k0, k1;    /* the range */
     size_t lit;       /* triangles: the lit ones counted */
     int stopped;      /* 1: Ctrl-C seen */
+    double y_min, scale; /* slabs: the region's bottom, cells of drift per slab */
+    size_t *chunk_slabs; /* slabs: each chunk's count, then its first primitive (the fill) */
+    uint32_t *prim_tri;  /* slabs: the primitives' triangles (the fill) */
+    float *mv;           /* the surface mesh's vertex buffer (3 floats per vertex) */
+    unsigned *mi;        /* its index buffer */
 } build_job;
+
+/* Triangles [k0, k1) zeroed (their pages first touched on the build's threads). */
+static void zero_work(void *arg, int chunk, size_t k0, size_t k1)
+{
+    build_job *j = arg;
+    (void)chunk;
+    for (size_t t = k0; t < k1; t += 65536) {
+        if (j->p->interrupt && *j->p->interrupt) { j->stopped = 1; return; }
+        size_t e = t + 65536 < k1 ? t + 65536 : k1;
+        memset(&j->b->tri[t], 0, (e - t) * sizeof j->b->tri[0]);
+    }
+}
 
 /* Vertices [k0, k1): displaced (seed eq. 5.5.7), normal (5.5.8), refraction, Fresnel, the
  * disc's slope Jacobian. */
-static void *vertex_work(void *arg)
+static void vertex_work(void *arg, int chunk, size_t k0, size_t k1)
 {
     build_job *j = arg;
+    (void)chunk;
     const gr_beam_params *p = j->p;
     gr_beams *b = j->b;
     const topo *tp = j->tp;
     gr_dvec3 I = p->sun_dir;
     double eta = 1.0 / p->ior; /* air (n = 1) to water, seed eq. 5.5.1 with eta = n1 / n2 */
-    for (size_t k = j->k0; k < j->k1; k++) {
+    for (size_t k = k0; k < k1; k++) {
         if ((k & 4095) == 0 && p->interrupt && *p->interrupt) { /* Ctrl-C: a cheap read per 4096 vertices */
             j->stopped = 1;
-            return NULL;
+            return;
         }
         double x0, z0;
         if (k < tp->nv0) {
@@ -278,13 +272,13 @@ static void *vertex_work(void *arg)
         v->aw = (float)(T.z / T.y - p->shear_z);
         v->ity = (float)(1.0 / T.y);
     }
-    return NULL;
 }
 
 /* Triangles [k0, k1): flux, the cross-section's coefficients, the disc kernel, the drift. */
-static void *triangle_work(void *arg)
+static void triangle_work(void *arg, int chunk, size_t k0, size_t k1)
 {
     build_job *j = arg;
+    (void)chunk;
     const gr_beam_params *p = j->p;
     gr_beams *b = j->b;
     const gr_dvec3 *pos = j->pos;
@@ -293,11 +287,10 @@ static void *triangle_work(void *arg)
     const uint8_t *lev = j->lev;
     gr_dvec3 I = p->sun_dir;
     int disc = j->disc;
-    j->lit = 0;
-    for (size_t t = j->k0; t < j->k1; t++) {
+    for (size_t t = k0; t < k1; t++) {
         if ((t & 65535) == 0 && p->interrupt && *p->interrupt) { /* Ctrl-C, every 65536 triangles */
             j->stopped = 1;
-            return NULL;
+            return;
         }
         beam_tri *bt = &b->tri[t];
         uint32_t idx[3];
@@ -340,7 +333,97 @@ static void *triangle_work(void *arg)
         drift[t] = lev[t] == 1 ? d * (float)j->tp->F : d;
         j->lit++;
     }
-    return NULL;
+}
+
+/* Triangles [k0, k1): their slabs at `scale` counted (the primitive budget's check). */
+static void slab_count_work(void *arg, int chunk, size_t k0, size_t k1)
+{
+    build_job *j = arg;
+    const gr_beams *b = j->b;
+    size_t n = 0;
+    for (size_t t = k0; t < k1; t++)
+        if (b->tri[t].phi > 0.0f) n += slab_count(b->tri[t].ytop - j->y_min, j->drift[t], j->h, j->scale);
+    j->chunk_slabs[chunk] = n;
+}
+
+/* Triangles [k0, k1): their slabs (first, count, height) and primitives from the chunk's
+ * first on. */
+static void slab_fill_work(void *arg, int chunk, size_t k0, size_t k1)
+{
+    build_job *j = arg;
+    gr_beams *b = j->b;
+    size_t np = j->chunk_slabs[chunk];
+    for (size_t t = k0; t < k1; t++) {
+        beam_tri *bt = &b->tri[t];
+        bt->first = (uint32_t)np;
+        bt->nslab = 0;
+        bt->dy = 1.0f;
+        if (!(bt->phi > 0.0f)) continue;
+        double depth = bt->ytop - j->y_min;
+        uint32_t ns = slab_count(depth, j->drift[t], j->h, j->scale);
+        bt->dy = depth > 0.0 ? (float)(depth / ns) : 1.0f;
+        bt->nslab = ns;
+        for (uint32_t k = 0; k < ns; k++) j->prim_tri[np++] = (uint32_t)t;
+    }
+}
+
+/* The surface mesh's buffers: vertices [k0, k1) in float, then (mesh_tri_work) triangles. */
+static void mesh_vert_work(void *arg, int chunk, size_t k0, size_t k1)
+{
+    build_job *j = arg;
+    (void)chunk;
+    for (size_t i = k0; i < k1; i++) {
+        j->mv[3 * i] = (float)j->pos[i].x; j->mv[3 * i + 1] = (float)j->pos[i].y; j->mv[3 * i + 2] = (float)j->pos[i].z;
+    }
+}
+
+static void mesh_tri_work(void *arg, int chunk, size_t k0, size_t k1)
+{
+    build_job *j = arg;
+    (void)chunk;
+    for (size_t t = k0; t < k1; t++) tri_vertices(j->b, (uint32_t)t, j->mi + 3 * t);
+}
+
+static gr_status build_surface_mesh(gr_rtc *rtc, gr_beams *b, const gr_dvec3 *pos, int threads, gr_error *err)
+{
+    RTCDevice dev = rtc->device;
+    size_t nv = b->nv, nt = b->ntri;
+    b->surface = rtcNewScene(dev);
+    if (!b->surface) return gr_rtc_check(rtc, "reference: surface mesh", err);
+    /* the camera rays meet it once a pass (one query per pixel against millions of beam
+     * lookups): the quick build serves (issue 30: the commit runs on one thread) */
+    rtcSetSceneBuildQuality(b->surface, RTC_BUILD_QUALITY_LOW);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv);
+    unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt);
+    int n = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+    if (v && idx) {
+        build_job mj[GRID_MAX_THREADS];
+        for (int i = 0; i < n; i++) {
+            memset(&mj[i], 0, sizeof mj[i]);
+            mj[i].b = b;
+            mj[i].pos = (gr_dvec3 *)pos;
+            mj[i].mv = v;
+            mj[i].mi = idx;
+        }
+        b->stats.par_s += gr_beams_run_chunks(mesh_vert_work, mj, sizeof mj[0], n, nv, gr_beams_chunks(nv, n));
+        b->stats.par_s += gr_beams_run_chunks(mesh_tri_work, mj, sizeof mj[0], n, nt, gr_beams_chunks(nt, n));
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(b->surface, g);
+    }
+    rtcReleaseGeometry(g);
+    /* Embree builds on its own threads (the device's `threads`), which the jobs' records do
+     * not see: the time with at most one thread busy is bounded from the process's CPU time
+     * over the commit, s <= (n w - cpu) / (n - 1) (during s at most one thread runs, during
+     * w - s at most n), and the rest counted as parallel (docs/reference.md 2.8) */
+    double w0 = now_s(), c0 = gr_ref_cpu_s();
+    rtcCommitScene(b->surface);
+    double w = now_s() - w0, cpu = gr_ref_cpu_s() - c0;
+    if (n > 1 && w > 0.0) {
+        double ser = ((double)n * w - cpu) / (double)(n - 1);
+        b->stats.par_s += w - (ser < 0.0 ? 0.0 : ser > w ? w : ser);
+    }
+    return gr_rtc_check(rtc, "reference: building the surface mesh", err);
 }
 
 gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err)
@@ -435,14 +518,23 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         free(ref); free(lev); free(tp.fmap); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu surface triangles (reference.surface_res)", ntri);
     }
-    /* Ctrl-C at a fine surface (gigabytes of triangles): a cheap read per 65536 triangles and
-     * per row of cells below */
-    for (size_t t = 0; t < ntri; t++) {
-        if ((t & 65535) == 0 && p->interrupt && *p->interrupt) {
+    /* zeroed on the build's threads; Ctrl-C at a fine surface (gigabytes of triangles): a
+     * cheap read per 65536 triangles and per row of cells below */
+    build_job bj[GRID_MAX_THREADS];
+    int nbj = p->threads < 1 ? 1 : p->threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : p->threads;
+    {
+        int stop = 0;
+        for (int i = 0; i < nbj; i++) {
+            memset(&bj[i], 0, sizeof bj[i]);
+            bj[i].p = p;
+            bj[i].b = b;
+        }
+        b->stats.par_s += gr_beams_run_chunks(zero_work, bj, sizeof bj[0], nbj, ntri, gr_beams_chunks(ntri, nbj));
+        for (int i = 0; i < nbj; i++) stop |= bj[i].stopped;
+        if (stop) {
             free(ref); free(lev); free(tp.fmap); gr_beams_destroy(b);
             return gr_fail(err, GR_E_INTERRUPTED, "reference: interrupted while building the beams");
         }
-        memset(&b->tri[t], 0, sizeof b->tri[t]);
     }
     {
         /* one cell's triangles: at most 2 F^2 (refined) or 4 F (a fan) */
@@ -486,14 +578,11 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     }
     /* vertices, then triangles, on the build's threads (disjoint outputs: the same bytes for
      * any number of threads) */
-    build_job bj[GRID_MAX_THREADS];
-    int nbj = p->threads < 1 ? 1 : p->threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : p->threads;
     for (int i = 0; i < nbj; i++) {
-        bj[i] = (build_job){p, b, &tp, pos, jv, drift, lev, start_u, start_w, h, disc, 0, 0, 0, 0};
-        bj[i].k0 = nv * (size_t)i / (size_t)nbj;
-        bj[i].k1 = nv * (size_t)(i + 1) / (size_t)nbj;
+        bj[i] = (build_job){.p = p, .b = b, .tp = &tp, .pos = pos, .jv = jv, .drift = drift, .lev = lev, .start_u = start_u, .start_w = start_w, .h = h, .disc = disc};
+        bj[i].y_min = r->y_min;
     }
-    b->stats.par_s += gr_beams_run_jobs(vertex_work, bj, sizeof bj[0], nbj);
+    b->stats.par_s += gr_beams_run_chunks(vertex_work, bj, sizeof bj[0], nbj, nv, gr_beams_chunks(nv, nbj));
     int stopped = 0;
     for (int i = 0; i < nbj; i++) stopped |= bj[i].stopped;
     if (stopped) { /* Ctrl-C */
@@ -502,11 +591,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     }
     free(tp.rx);
     size_t lit = 0;
-    for (int i = 0; i < nbj; i++) {
-        bj[i].k0 = ntri * (size_t)i / (size_t)nbj;
-        bj[i].k1 = ntri * (size_t)(i + 1) / (size_t)nbj;
-    }
-    b->stats.par_s += gr_beams_run_jobs(triangle_work, bj, sizeof bj[0], nbj);
+    b->stats.par_s += gr_beams_run_chunks(triangle_work, bj, sizeof bj[0], nbj, ntri, gr_beams_chunks(ntri, nbj));
     for (int i = 0; i < nbj; i++) {
         stopped |= bj[i].stopped;
         lit += bj[i].lit;
@@ -518,10 +603,16 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     /* slabs: about slab_cells cells of drift each, coarsened uniformly if over the primitive budget */
     double scale = p->slab_cells > 0.0 ? p->slab_cells : 1.0;
     size_t total = 0;
+    size_t chunk_slabs[GRID_CHUNKS_MAX];
+    const int nch = gr_beams_chunks(ntri, nbj);
     for (int attempt = 0; attempt < 64; attempt++) {
         total = 0;
-        for (size_t t = 0; t < ntri; t++)
-            if (b->tri[t].phi > 0.0f) total += slab_count(b->tri[t].ytop - r->y_min, drift[t], h, scale);
+        for (int i = 0; i < nbj; i++) {
+            bj[i].scale = scale;
+            bj[i].chunk_slabs = chunk_slabs;
+        }
+        b->stats.par_s += gr_beams_run_chunks(slab_count_work, bj, sizeof bj[0], nbj, ntri, nch);
+        for (int c = 0; c < nch; c++) total += chunk_slabs[c];
         if (total <= p->max_prims || total <= lit) break;
         scale *= 1.25 * (double)total / (double)p->max_prims;
     }
@@ -540,19 +631,15 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         free(pos); free(drift); free(jv); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu beam primitives", total);
     }
-    uint32_t np = 0;
-    for (size_t t = 0; t < ntri; t++) {
-        beam_tri *bt = &b->tri[t];
-        bt->first = np;
-        bt->nslab = 0;
-        bt->dy = 1.0f;
-        if (!(bt->phi > 0.0f)) continue;
-        double depth = bt->ytop - r->y_min;
-        uint32_t ns = slab_count(depth, drift[t], h, scale);
-        bt->dy = depth > 0.0 ? (float)(depth / ns) : 1.0f;
-        bt->nslab = ns;
-        for (uint32_t k = 0; k < ns; k++) b->prim_tri[np++] = (uint32_t)t;
+    /* each range's primitives from the sum of the ranges before it: the serial order */
+    for (size_t c = 0, f = 0; c < (size_t)nch; c++) { /* each chunk's count -> its first primitive */
+        size_t n = chunk_slabs[c];
+        chunk_slabs[c] = f;
+        f += n;
     }
+    for (int i = 0; i < nbj; i++) bj[i].prim_tri = b->prim_tri;
+    b->stats.par_s += gr_beams_run_chunks(slab_fill_work, bj, sizeof bj[0], nbj, ntri, nch);
+    uint32_t np = (uint32_t)total;
     free(drift);
     free(jv);
     b->box = malloc((np ? np : 1) * 6 * sizeof *b->box);
@@ -565,7 +652,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->stats.index_s = now_s() - ti;
     b->stats.index_cpu_s = gr_ref_cpu_s() - ci;
     b->stats.index_par_s = b->stats.par_s - pi;
-    if (st == GR_OK && p->surface_mesh) st = build_surface_mesh(rtc, b, pos, err);
+    if (st == GR_OK && p->surface_mesh) st = build_surface_mesh(rtc, b, pos, p->threads, err);
     free(pos);
     if (st != GR_OK) {
         gr_beams_destroy(b);

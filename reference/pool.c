@@ -9,16 +9,23 @@
 #include <xmmintrin.h>
 #endif
 
+typedef struct gr_ref_pool gr_ref_pool;
 typedef struct pool_call {
     void *(*fn)(void *);
     void *arg;
     double t0, t1; /* this worker's start and end (the serial part: gr_ref_overlap_s) */
+    gr_ref_pool *pool;
 } pool_call;
 
 struct gr_ref_pool {
     int threads;
     pthread_t *th;
     pool_call *calls;
+    /* the workers that ended, signalled as each ends: the caller wakes at the last one, not
+     * at its next poll (a poll's sleep after the last worker is time with no thread busy) */
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int ended;
 };
 
 
@@ -46,6 +53,10 @@ static void *pool_main(void *arg)
     flush_denormals();
     void *ret = c->fn(c->arg);
     c->t1 = gr_ref_mono_s();
+    pthread_mutex_lock(&c->pool->mu);
+    c->pool->ended++;
+    pthread_cond_signal(&c->pool->cv);
+    pthread_mutex_unlock(&c->pool->mu);
     return ret;
 }
 
@@ -67,7 +78,14 @@ gr_ref_pool *gr_ref_pool_create(int threads)
     p->threads = threads > 0 ? threads : 1;
     p->th = calloc((size_t)p->threads, sizeof *p->th);
     p->calls = calloc((size_t)p->threads, sizeof *p->calls);
-    if (!p->th || !p->calls) {
+    if (!p->th || !p->calls || pthread_mutex_init(&p->mu, NULL) != 0) {
+        free(p->th);
+        free(p->calls);
+        free(p);
+        return NULL;
+    }
+    if (pthread_cond_init(&p->cv, NULL) != 0) {
+        pthread_mutex_destroy(&p->mu);
         free(p->th);
         free(p->calls);
         free(p);
@@ -79,6 +97,8 @@ gr_ref_pool *gr_ref_pool_create(int threads)
 void gr_ref_pool_destroy(gr_ref_pool *p)
 {
     if (!p) return;
+    pthread_cond_destroy(&p->cv);
+    pthread_mutex_destroy(&p->mu);
     free(p->th);
     free(p->calls);
     free(p);
@@ -90,8 +110,9 @@ gr_status gr_ref_pool_run(gr_ref_pool *p, void *(*fn)(void *), void *arg, gr_ref
 {
     double t0 = gr_ref_mono_s();
     int started = 0;
+    p->ended = 0;
     for (int i = 0; i < p->threads; i++) {
-        p->calls[i] = (pool_call){fn, arg, 0.0, 0.0};
+        p->calls[i] = (pool_call){fn, arg, 0.0, 0.0, p};
         if (pthread_create(&p->th[i], NULL, pool_main, &p->calls[i]) != 0) break;
         started++;
     }
@@ -101,11 +122,19 @@ gr_status gr_ref_pool_run(gr_ref_pool *p, void *(*fn)(void *), void *arg, gr_ref
         int done = atomic_load(&w->rows_done);
         gr_progress_update(prog, frac0 + span * (double)done / rows, note);
         if (done >= rows || atomic_load(&w->stop) || (interrupt && *interrupt)) break;
-        /* short sleeps first so tiny renders (tests) do not wait on the poll */
-        double waited = gr_ref_mono_s() - t0;
-        struct timespec ts = {0, waited < 0.05 ? 500 * 1000 : 20 * 1000 * 1000};
-        nanosleep(&ts, NULL);
+        /* wait for the workers to end, waking every 20 ms (the bar, a stop, Ctrl-C) */
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        ts.tv_nsec += 20 * 1000 * 1000;
+        if (ts.tv_nsec >= 1000000000L) { ts.tv_sec++; ts.tv_nsec -= 1000000000L; }
+        pthread_mutex_lock(&p->mu);
+        int all = p->ended >= started;
+        if (!all) pthread_cond_timedwait(&p->cv, &p->mu, &ts);
+        all = p->ended >= started;
+        pthread_mutex_unlock(&p->mu);
+        if (all) break;
     }
+    (void)t0;
     for (int i = 0; i < started; i++) pthread_join(p->th[i], NULL);
     {
         double a[64], b[64]; /* the workers' spans; past 64 threads the first 64 (an underestimate) */
