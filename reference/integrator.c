@@ -8,6 +8,7 @@
 
 #include "core/gerstner.h"
 #include "core/optics.h"
+#include "reference/beam_grid.h"
 #include "reference/march.h"
 #include "reference/pilot.h"
 #include "reference/probe.h"
@@ -273,6 +274,12 @@ static void account_build(gr_ref_renderer *r, const gr_beams *b)
     gr_ref_phases_move(&r->phases, REF_PH_BEAMS, REF_PH_GRID, bs->index_s, bs->index_cpu_s, bs->index_par_s);
 }
 
+static void *destroy_job(void *arg)
+{
+    gr_beams_destroy(*(gr_beams **)arg);
+    return NULL;
+}
+
 gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
 {
     r->Ip = gr_ref_pass_sun_dir(r, pass);
@@ -289,8 +296,14 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     r->mu_t = (float)(-T.y);
     r->flat_eperp = (float)(ft * cos_i / -T.y);
     if (r->flat || r->beams_pass == pass) return GR_OK;
-    gr_beams_destroy(r->beams);
-    gr_beams_destroy(r->cone);
+    /* the last pass's two sets freed side by side (their pages go back: issue 30's serial part) */
+    gr_beams *old[2] = {r->beams, r->cone};
+    if (old[0] && old[1] && r->threads > 1)
+        r->phases.par_total += gr_beams_run_jobs(destroy_job, old, sizeof old[0], 2);
+    else {
+        gr_beams_destroy(old[0]);
+        gr_beams_destroy(old[1]);
+    }
     r->beams = r->cone = NULL;
     r->beams_pass = -1;
     gr_beam_params bp;
