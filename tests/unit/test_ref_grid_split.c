@@ -6,7 +6,9 @@
  * 2, 3, 8 and 64 threads (uneven splits, threads with no layers) must equal it entry for
  * entry; every list must be strictly increasing in primitive id (the order the lookups'
  * sums rely on), and the lookups at points through a focus must return the same hits. One
- * wave, the sun's disc on, surface_res 96: about 0.1 s a build. */
+ * wave, the sun's disc on, surface_res 96: about 0.1 s a build. The set's own arrays (vertices,
+ * triangles, boxes: built in chunks taken by whichever thread is free) must equal one thread's
+ * byte for byte too, and gr_beams_run_chunks must run every chunk once over its range. */
 #include "check.h"
 #include "test_ref_util.h"
 
@@ -14,6 +16,22 @@
 #include "core/optics.h"
 #include "reference/beam_grid.h"
 #include "reference/embree_scene.h"
+
+/* gr_beams_run_chunks' bookkeeping: how often each chunk ran, its range, each thread's items */
+typedef struct chunk_seen {
+    int *runs;
+    size_t *lo, *hi;
+    size_t items;
+} chunk_seen;
+
+static void note_chunk(void *job, int chunk, size_t k0, size_t k1)
+{
+    chunk_seen *s = job;
+    __atomic_fetch_add(&s->runs[chunk], 1, __ATOMIC_RELAXED);
+    s->lo[chunk] = k0;
+    s->hi[chunk] = k1;
+    s->items += k1 - k0;
+}
 
 static gr_beams *build(gr_rtc *rtc, gr_beam_params *p, int threads)
 {
@@ -78,6 +96,19 @@ int main(void)
                   "%d threads: the cells' list bounds differ from one thread's", threads[k]);
         CHECK_MSG(b->cell_first[nc] == ne && memcmp(b->cell_prim, ref->cell_prim, ne * sizeof *b->cell_prim) == 0,
                   "%d threads: the cells' lists differ from one thread's", threads[k]);
+        /* the set's own arrays, built in chunks taken by whichever thread is free: vertices,
+         * triangles (with their slabs' first primitive and count), the primitives' boxes */
+        int same_set = b->nv == ref->nv && b->ntri == ref->ntri && b->stats.prims == ref->stats.prims &&
+                       b->stats.lit_triangles == ref->stats.lit_triangles;
+        CHECK_MSG(same_set, "%d threads: %zu vertices, %zu triangles, %zu primitives, %zu lit against %zu, %zu, %zu, %zu",
+                  threads[k], b->nv, b->ntri, b->stats.prims, b->stats.lit_triangles, ref->nv, ref->ntri, ref->stats.prims,
+                  ref->stats.lit_triangles);
+        if (same_set) {
+            CHECK_MSG(memcmp(b->v, ref->v, ref->nv * sizeof *b->v) == 0, "%d threads: the vertices differ", threads[k]);
+            CHECK_MSG(memcmp(b->tri, ref->tri, ref->ntri * sizeof *b->tri) == 0, "%d threads: the triangles differ", threads[k]);
+            CHECK_MSG(memcmp(b->qbox, ref->qbox, ref->stats.prims * sizeof *b->qbox) == 0, "%d threads: the boxes differ",
+                      threads[k]);
+        }
         /* lookups along a vertical line through the focus (about 5.5 m down) and off it */
         int diff = 0, hits = 0;
         for (int i = 0; i < 400; i++) {
@@ -90,7 +121,31 @@ int main(void)
         CHECK_MSG(hits > 400 && diff == 0, "%d threads: %d of the lookups' hits (%d) differ", threads[k], diff, hits);
         gr_beams_destroy(b);
     }
-    printf("grid %dx%dx%d, %zu entries, the same lists for 1, 2, 3, 8 and 64 threads\n", ref->gn[0], ref->gn[1], ref->gn[2], ne);
+    printf("grid %dx%dx%d, %zu entries, the same lists and set for 1, 2, 3, 8 and 64 threads\n", ref->gn[0], ref->gn[1], ref->gn[2], ne);
+
+    /* gr_beams_run_chunks: every chunk once, the chunks tiling [0, total) as documented */
+    const int ns[] = {1, 2, 7}, cs[] = {1, 5, 64, 1000};
+    for (int a = 0; a < 3; a++)
+        for (int c = 0; c < 4; c++) {
+            chunk_seen seen[8];
+            memset(seen, 0, sizeof seen);
+            static int runs[1000];
+            static size_t lo[1000], hi[1000];
+            memset(runs, 0, sizeof runs);
+            for (int i = 0; i < 8; i++) { seen[i].runs = runs; seen[i].lo = lo; seen[i].hi = hi; }
+            size_t total = 12345;
+            gr_beams_run_chunks(note_chunk, seen, sizeof seen[0], ns[a], total, cs[c]);
+            int bad = 0;
+            size_t sum = 0;
+            for (int k = 0; k < cs[c]; k++) {
+                bad += runs[k] != 1 || lo[k] != total * (size_t)k / (size_t)cs[c] || hi[k] != total * (size_t)(k + 1) / (size_t)cs[c];
+                sum += hi[k] - lo[k];
+            }
+            size_t items = 0;
+            for (int i = 0; i < ns[a]; i++) items += seen[i].items;
+            CHECK_MSG(bad == 0 && sum == total && items == total, "run_chunks, %d threads, %d chunks: %d chunks wrong, %zu of %zu items",
+                      ns[a], cs[c], bad, items, total);
+        }
     gr_beam_hits_free(&h1);
     gr_beam_hits_free(&h2);
     gr_beams_destroy(ref);
