@@ -633,27 +633,62 @@ static void range_work(void *arg, int chunk, size_t k0, size_t k1)
     j->total += total;
 }
 
-typedef struct grid_job {
+/* The grid's count and fill by layer chunks: the w-layers cut into L chunks balanced by their
+ * entries, each chunk with the list of the primitives that reach its layers (ascending), built
+ * by ranges of primitives (their per-chunk counts, then their writes at the prefix sums). A
+ * chunk's cells are counted and filled by whichever thread takes it, in primitive order: the
+ * lists do not depend on the split, and every thread reads only its chunks' primitives (the
+ * per-thread layers before scanned every primitive on every thread). */
+typedef struct layer_plan {
     gr_beams *b;
-    const int32_t *rng;
-    uint32_t np;
-    int w0, w1;   /* the w-layers of cells this worker owns */
-    int fill;     /* 0: count the entries per cell; 1: fill them */
-    uint64_t total, offset; /* the count: the layers' entries; the fill: the entries before them */
-} grid_job;
+    const int32_t *rng;      /* 6 per primitive: cell ranges */
+    int L;                   /* layer chunks */
+    const int *lw;           /* chunk c: layers [lw[c], lw[c + 1]) */
+    const int *chunk_of;     /* layer -> its chunk */
+    int P;                   /* primitive chunks (the list builds) */
+    uint64_t *cnt;           /* P x L: primitives of chunk p reaching layer chunk c, then the write offsets */
+    uint32_t *list;          /* the layer chunks' primitive lists, chunk after chunk */
+    uint64_t *first;         /* L + 1: each layer chunk's list start */
+    uint64_t *total;         /* L: each layer chunk's entries (the count), then its first entry (the fill) */
+    int fill;
+} layer_plan;
 
-static void *grid_work(void *arg)
+static void list_count_work(void *arg, int pc, size_t k0, size_t k1)
 {
-    grid_job *j = arg;
-    const size_t nu = (size_t)j->b->gn[0], ny = (size_t)j->b->gn[1];
-    uint32_t *cf = j->b->cell_first, *cp = j->b->cell_prim; /* locals: the stores cannot alias them */
-    const int32_t *rng = j->rng;
-    const int fw0 = j->w0, fw1 = j->w1 - 1;
-    const size_t c_lo = (size_t)j->w0 * ny * nu, c_hi = (size_t)j->w1 * ny * nu; /* the layers' cells */
-    if (!j->fill) {
-        /* each cell's entries, then their running sum over the layers (its end, local) */
-        for (uint32_t k = 0; k < j->np; k++) {
-            const int32_t *r = rng + 6 * (size_t)k;
+    const layer_plan *lp = arg;
+    uint64_t *cnt = lp->cnt + (size_t)pc * (size_t)lp->L;
+    for (size_t k = k0; k < k1; k++) {
+        const int32_t *r = lp->rng + 6 * k;
+        for (int c = lp->chunk_of[r[2]], c1 = lp->chunk_of[r[5]]; c <= c1; c++) cnt[c]++;
+    }
+}
+
+static void list_fill_work(void *arg, int pc, size_t k0, size_t k1)
+{
+    const layer_plan *lp = arg;
+    uint64_t *off = lp->cnt + (size_t)pc * (size_t)lp->L;
+    for (size_t k = k0; k < k1; k++) {
+        const int32_t *r = lp->rng + 6 * k;
+        for (int c = lp->chunk_of[r[2]], c1 = lp->chunk_of[r[5]]; c <= c1; c++) lp->list[off[c]++] = (uint32_t)k;
+    }
+}
+
+static void grid_work(void *arg, int lc, size_t unused0, size_t unused1)
+{
+    const layer_plan *lp = arg;
+    (void)unused0;
+    (void)unused1;
+    const size_t nu = (size_t)lp->b->gn[0], ny = (size_t)lp->b->gn[1];
+    uint32_t *cf = lp->b->cell_first, *cp = lp->b->cell_prim; /* locals: the stores cannot alias them */
+    const int32_t *rng = lp->rng;
+    const uint32_t *list = lp->list + lp->first[lc];
+    const uint64_t nl = lp->first[lc + 1] - lp->first[lc];
+    const int fw0 = lp->lw[lc], fw1 = lp->lw[lc + 1] - 1;
+    const size_t c_lo = (size_t)lp->lw[lc] * ny * nu, c_hi = (size_t)lp->lw[lc + 1] * ny * nu; /* the chunk's cells */
+    if (!lp->fill) {
+        /* each cell's entries, then their running sum over the chunk (its end, local) */
+        for (uint64_t i = 0; i < nl; i++) {
+            const int32_t *r = rng + 6 * (size_t)list[i];
             int w0 = r[2] > fw0 ? r[2] : fw0, w1 = r[5] < fw1 ? r[5] : fw1;
             for (int iw = w0; iw <= w1; iw++)
                 for (int iy = r[1]; iy <= r[4]; iy++) {
@@ -666,14 +701,15 @@ static void *grid_work(void *arg)
             sum += cf[c];
             cf[c] = (uint32_t)sum;
         }
-        j->total = sum;
-        return NULL;
+        lp->total[lc] = sum;
+        return;
     }
     /* the ends made global, then each cell filled from its end down in reverse primitive
      * order: the lists ascend and cf[c] ends at the cell's start */
-    const uint32_t off = (uint32_t)j->offset;
+    const uint32_t off = (uint32_t)lp->total[lc];
     for (size_t c = c_lo; c < c_hi; c++) cf[c] += off;
-    for (uint32_t k = j->np; k-- > 0;) {
+    for (uint64_t i = nl; i-- > 0;) {
+        const uint32_t k = list[i];
         const int32_t *r = rng + 6 * (size_t)k;
         int w0 = r[2] > fw0 ? r[2] : fw0, w1 = r[5] < fw1 ? r[5] : fw1;
         for (int iw = w0; iw <= w1; iw++)
@@ -682,7 +718,6 @@ static void *grid_work(void *arg)
                 for (int iu = r[0]; iu <= r[3]; iu++) cp[--cf[c0 + (size_t)iu]] = k;
             }
     }
-    return NULL;
 }
 
 static void box_work(void *arg, int chunk, size_t k0, size_t k1)
@@ -826,47 +861,70 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         free(rj);
         return gr_fail(err, GR_E_NOMEM, "reference: the beam lookup grid needs more than %.0f entries, too many", budget);
     }
-    /* the workers' w-layers, balanced by the histogram (each cell is counted and filled by
-     * one worker in primitive order, so the lists do not depend on the split) */
+    /* the layer chunks, balanced by the histogram: 8 per thread, at most one per layer */
     size_t ncells = (size_t)b->gn[0] * (size_t)b->gn[1] * (size_t)b->gn[2];
-    grid_job jobs[GRID_MAX_THREADS];
+    const int gw = b->gn[2];
+    int L = 8 * nt < gw ? 8 * nt : gw;
+    const int P = gr_beams_chunks(np, nt);
+    int *lw = malloc(((size_t)L + 1) * sizeof *lw), *chunk_of = malloc((size_t)gw * sizeof *chunk_of);
+    uint64_t *cnt = calloc((size_t)P * (size_t)L, sizeof *cnt), *lfirst = malloc(((size_t)L + 1) * sizeof *lfirst);
+    uint64_t *ltotal = malloc((size_t)L * sizeof *ltotal);
+    if (!lw || !chunk_of || !cnt || !lfirst || !ltotal) {
+        free(lw); free(chunk_of); free(cnt); free(lfirst); free(ltotal); free(rng); free(rj);
+        return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid");
+    }
     {
         const int nbins = rj[0].nbins;
         uint64_t hist[RANGE_BINS] = {0}, cum = 0;
         for (int i = 0; i < nt; i++)
             for (int k = 0; k < nbins; k++) hist[k] += rj[i].hist[k];
         int bin = 0;
-        for (int i = 0; i < nt; i++) {
-            jobs[i].b = b;
-            jobs[i].rng = rng;
-            jobs[i].np = np;
-            jobs[i].fill = 0;
-            jobs[i].w0 = i ? jobs[i - 1].w1 : 0;
-            /* this worker's bins: up to the (i + 1)-th share of the entries; its layers end at
+        lw[0] = 0;
+        for (int i = 0; i < L; i++) {
+            /* this chunk's bins: up to the (i + 1)-th share of the entries; its layers end at
              * the first layer of the next bin (layer l is in bin l nbins / gn[2], rounded down) */
-            while (bin < nbins && (cum + hist[bin]) * (uint64_t)nt <= entries * (uint64_t)(i + 1)) cum += hist[bin++];
-            jobs[i].w1 = i + 1 == nt ? b->gn[2] : (int)(((int64_t)bin * b->gn[2] + nbins - 1) / nbins);
-            if (jobs[i].w1 < jobs[i].w0) jobs[i].w1 = jobs[i].w0;
+            while (bin < nbins && (cum + hist[bin]) * (uint64_t)L <= entries * (uint64_t)(i + 1)) cum += hist[bin++];
+            lw[i + 1] = i + 1 == L ? gw : (int)(((int64_t)bin * gw + nbins - 1) / nbins);
+            if (lw[i + 1] < lw[i]) lw[i + 1] = lw[i];
         }
+        for (int i = 0; i < L; i++)
+            for (int l = lw[i]; l < lw[i + 1]; l++) chunk_of[l] = i;
     }
     free(rj);
+    layer_plan lp = {b, rng, L, lw, chunk_of, P, cnt, NULL, lfirst, ltotal, 0};
+    /* the chunks' primitive lists: counts by ranges of primitives, their offsets, the writes */
+    b->stats.par_s += gr_beams_run_chunks(list_count_work, &lp, 0, nt, np, P);
+    lfirst[0] = 0;
+    for (int c = 0; c < L; c++) {
+        uint64_t f = lfirst[c];
+        for (int pc = 0; pc < P; pc++) {
+            uint64_t n = cnt[(size_t)pc * (size_t)L + (size_t)c];
+            cnt[(size_t)pc * (size_t)L + (size_t)c] = f;
+            f += n;
+        }
+        lfirst[c + 1] = f;
+    }
+    lp.list = malloc((lfirst[L] ? lfirst[L] : 1) * sizeof *lp.list);
     free(b->cell_first);
     b->cell_first = calloc(ncells + 1, sizeof *b->cell_first);
     b->cell_prim = malloc((entries ? entries : 1) * sizeof *b->cell_prim);
-    if (!b->cell_first || !b->cell_prim) {
-        free(rng);
+    if (!lp.list || !b->cell_first || !b->cell_prim) {
+        free(lw); free(chunk_of); free(cnt); free(lfirst); free(ltotal); free(lp.list); free(rng);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu cells, %llu entries)", ncells,
                        (unsigned long long)entries);
     }
-    /* count (each worker's layers, with their running sum), the workers' offsets, fill: the
+    b->stats.par_s += gr_beams_run_chunks(list_fill_work, &lp, 0, nt, np, P);
+    /* count (each chunk's cells, with their running sum), the chunks' offsets, fill: the
      * prefix sum on the workers' threads, each cell's first entry at cell_first[c] */
-    b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
-    for (uint64_t i = 0, off = 0; i < (uint64_t)nt; i++) {
-        jobs[i].offset = off;
-        off += jobs[i].total;
-        jobs[i].fill = 1;
+    b->stats.par_s += gr_beams_run_chunks(grid_work, &lp, 0, nt, (size_t)L, L);
+    for (uint64_t c = 0, off = 0; c < (uint64_t)L; c++) {
+        uint64_t n = ltotal[c];
+        ltotal[c] = off;
+        off += n;
     }
-    b->stats.par_s += gr_beams_run_jobs(grid_work, jobs, sizeof jobs[0], nt);
+    lp.fill = 1;
+    b->stats.par_s += gr_beams_run_chunks(grid_work, &lp, 0, nt, (size_t)L, L);
+    free(lw); free(chunk_of); free(cnt); free(lfirst); free(ltotal); free(lp.list);
     free(rng);
     b->cell_first[ncells] = (uint32_t)entries;
     b->stats.grid_entries = (size_t)entries;
