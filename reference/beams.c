@@ -186,7 +186,8 @@ static uint32_t slab_count(double depth, double drift, double cell, double scale
     return (uint32_t)n;
 }
 
-/* A range of a beam build's vertices or triangles (gr_beams_run_jobs; disjoint outputs). */
+/* One thread's part of a beam build's chunked steps (gr_beams_run_chunks: the chunks' outputs
+ * disjoint, the thread's own counters). */
 typedef struct build_job {
     const gr_beam_params *p;
     gr_beams *b;
@@ -196,8 +197,7 @@ typedef struct build_job {
     const uint8_t *lev;
     double start_u, start_w, h;
     int disc;
-    size_t k0, k1;    /* the range */
-    size_t lit;       /* triangles: the lit ones counted */
+    size_t lit;       /* triangles: the lit ones counted (this thread's chunks) */
     int stopped;      /* 1: Ctrl-C seen */
     double y_min, scale; /* slabs: the region's bottom, cells of drift per slab */
     size_t *chunk_slabs; /* slabs: each chunk's count, then its first primitive (the fill) */

@@ -108,7 +108,6 @@ gr_status gr_ref_pool_run(gr_ref_pool *p, void *(*fn)(void *), void *arg, gr_ref
                           volatile sig_atomic_t *interrupt, gr_progress *prog, double frac0, double span,
                           const char *note, gr_error *err)
 {
-    double t0 = gr_ref_mono_s();
     int started = 0;
     p->ended = 0;
     for (int i = 0; i < p->threads; i++) {
@@ -134,7 +133,6 @@ gr_status gr_ref_pool_run(gr_ref_pool *p, void *(*fn)(void *), void *arg, gr_ref
         pthread_mutex_unlock(&p->mu);
         if (all) break;
     }
-    (void)t0;
     for (int i = 0; i < started; i++) pthread_join(p->th[i], NULL);
     {
         double a[64], b[64]; /* the workers' spans; past 64 threads the first 64 (an underestimate) */

@@ -1,7 +1,8 @@
 /* The integrator's worker threads (internal to reference/): a pass over rows, shared by the
  * march (reference/march.h) and the step pilot (reference/pilot.h). Threads take bands of rows
- * from a shared counter; the caller's thread polls the rows done for the progress bar, and
- * stops waiting on a stop flag or an interrupt. Every worker runs with denormals flushed. */
+ * from a shared counter; the caller's thread waits for the last worker to end (woken by it),
+ * updating the progress bar every 20 ms meanwhile, and stops waiting on a stop flag or an
+ * interrupt. Every worker runs with denormals flushed. */
 #ifndef GR_REF_POOL_H
 #define GR_REF_POOL_H
 
