@@ -584,13 +584,17 @@ static void *chunk_main(void *arg)
 
 double gr_beams_run_chunks(gr_chunk_fn fn, void *jobs, size_t size, int n, size_t total, int nchunks)
 {
-    if (n < 1) n = 1;
-    if (n > GRID_MAX_THREADS) n = GRID_MAX_THREADS;
+    n = gr_beams_threads(n);
     chunk_run run = {fn, total, nchunks < 1 ? 1 : nchunks, 0};
     atomic_init(&run.next, 0);
     chunk_call call[GRID_MAX_THREADS];
     for (int i = 0; i < n; i++) call[i] = (chunk_call){&run, (char *)jobs + (size_t)i * size};
     return gr_beams_run_jobs(chunk_main, call, sizeof call[0], n);
+}
+
+int gr_beams_threads(int threads)
+{
+    return threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
 }
 
 int gr_beams_chunks(size_t total, int n)
@@ -645,7 +649,6 @@ typedef struct layer_plan {
     int L;                   /* layer chunks */
     const int *lw;           /* chunk c: layers [lw[c], lw[c + 1]) */
     const int *chunk_of;     /* layer -> its chunk */
-    int P;                   /* primitive chunks (the list builds) */
     uint64_t *cnt;           /* P x L: primitives of chunk p reaching layer chunk c, then the write offsets */
     uint32_t *list;          /* the layer chunks' primitive lists, chunk after chunk */
     uint64_t *first;         /* L + 1: each layer chunk's list start */
@@ -735,22 +738,19 @@ typedef struct bound_job {
     double lo[BOUND_CHUNKS][3], hi[BOUND_CHUNKS][3], ext[BOUND_CHUNKS][3];
 } bound_job;
 
-static void bound_work(void *arg, int ck, size_t c0, size_t c1)
+static void bound_work(void *arg, int ck, size_t k0, size_t k1)
 {
     bound_job *j = arg;
-    {
-        uint32_t k0 = (uint32_t)c0, k1 = (uint32_t)c1;
-        double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
-        for (uint32_t k = k0; k < k1; k++) {
-            const float *bx = j->b->box + 6 * (size_t)k;
-            for (int a = 0; a < 3; a++) {
-                lo[a] = fmin(lo[a], bx[a]);
-                hi[a] = fmax(hi[a], bx[3 + a]);
-                ext[a] += (double)bx[3 + a] - bx[a];
-            }
+    double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
+    for (size_t k = k0; k < k1; k++) {
+        const float *bx = j->b->box + 6 * k;
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], bx[a]);
+            hi[a] = fmax(hi[a], bx[3 + a]);
+            ext[a] += (double)bx[3 + a] - bx[a];
         }
-        for (int a = 0; a < 3; a++) { j->lo[ck][a] = lo[a]; j->hi[ck][a] = hi[a]; j->ext[ck][a] = ext[a]; }
     }
+    for (int a = 0; a < 3; a++) { j->lo[ck][a] = lo[a]; j->hi[ck][a] = hi[a]; j->ext[ck][a] = ext[a]; }
 }
 
 /* The 16-bit boxes of primitives [k0, k1) (the job's range) */
@@ -782,7 +782,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     if (np == 0) return GR_OK;
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, ext[3] = {0, 0, 0};
     {
-        int nb = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+        int nb = gr_beams_threads(threads);
         bound_job *bj = malloc(sizeof *bj); /* one table: each chunk writes its own row */
         if (!bj) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid");
         bj->b = b;
@@ -811,7 +811,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         b->q0[a] = (float)lo[a];
         b->qinv[a] = (float)(1.0 / qunit[a]);
     }
-    int nt = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+    int nt = gr_beams_threads(threads);
     {
         quant_job qj = {b, {qunit[0], qunit[1], qunit[2]}};
         b->stats.par_s += gr_beams_run_chunks(quant_work, &qj, 0, nt, np, gr_beams_chunks(np, nt));
@@ -891,7 +891,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
             for (int l = lw[i]; l < lw[i + 1]; l++) chunk_of[l] = i;
     }
     free(rj);
-    layer_plan lp = {b, rng, L, lw, chunk_of, P, cnt, NULL, lfirst, ltotal, 0};
+    layer_plan lp = {b, rng, L, lw, chunk_of, cnt, NULL, lfirst, ltotal, 0};
     /* the chunks' primitive lists: counts by ranges of primitives, their offsets, the writes */
     b->stats.par_s += gr_beams_run_chunks(list_count_work, &lp, 0, nt, np, P);
     lfirst[0] = 0;
@@ -935,7 +935,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
 gr_status gr_beams_index(gr_beams *b, uint32_t np, int threads, gr_error *err)
 {
     /* the boxes, in parallel (disjoint outputs; every thread's job is the set) */
-    int nt = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+    int nt = gr_beams_threads(threads);
     b->stats.par_s += gr_beams_run_chunks(box_work, b, 0, nt, np, gr_beams_chunks(np, nt));
     return build_grid(b, np, threads, err);
 }

@@ -111,6 +111,8 @@ double gr_beams_run_jobs(void *(*fn)(void *), void *jobs, size_t size, int n);
  * machine: time with one thread busy). Returns the time with at least two threads busy. */
 typedef void (*gr_chunk_fn)(void *job, int chunk, size_t k0, size_t k1);
 double gr_beams_run_chunks(gr_chunk_fn fn, void *jobs, size_t size, int n, size_t total, int nchunks);
+/* The threads a build step runs on: `threads` within [1, GRID_MAX_THREADS]. */
+int gr_beams_threads(int threads);
 /* The chunks for `total` items on n threads: 16 per thread, at most `total` and GRID_CHUNKS_MAX. */
 #define GRID_CHUNKS_MAX 1024
 int gr_beams_chunks(size_t total, int n);

@@ -391,12 +391,12 @@ static gr_status build_surface_mesh(gr_rtc *rtc, gr_beams *b, const gr_dvec3 *po
     b->surface = rtcNewScene(dev);
     if (!b->surface) return gr_rtc_check(rtc, "reference: surface mesh", err);
     /* the camera rays meet it once a pass (one query per pixel against millions of beam
-     * lookups): the quick build serves (issue 30: the commit runs on one thread) */
+     * lookups): the quick build serves */
     rtcSetSceneBuildQuality(b->surface, RTC_BUILD_QUALITY_LOW);
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv);
     unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt);
-    int n = threads < 1 ? 1 : threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : threads;
+    int n = gr_beams_threads(threads);
     if (v && idx) {
         build_job mj[GRID_MAX_THREADS];
         for (int i = 0; i < n; i++) {
@@ -521,7 +521,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     /* zeroed on the build's threads; Ctrl-C at a fine surface (gigabytes of triangles): a
      * cheap read per 65536 triangles and per row of cells below */
     build_job bj[GRID_MAX_THREADS];
-    int nbj = p->threads < 1 ? 1 : p->threads > GRID_MAX_THREADS ? GRID_MAX_THREADS : p->threads;
+    int nbj = gr_beams_threads(p->threads);
     {
         int stop = 0;
         for (int i = 0; i < nbj; i++) {
@@ -631,8 +631,8 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
         free(pos); free(drift); free(jv); gr_beams_destroy(b);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %zu beam primitives", total);
     }
-    /* each range's primitives from the sum of the ranges before it: the serial order */
-    for (size_t c = 0, f = 0; c < (size_t)nch; c++) { /* each chunk's count -> its first primitive */
+    /* each chunk's count -> its first primitive (the sum of the chunks before it: the serial order) */
+    for (size_t c = 0, f = 0; c < (size_t)nch; c++) {
         size_t n = chunk_slabs[c];
         chunk_slabs[c] = f;
         f += n;
