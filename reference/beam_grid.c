@@ -1,6 +1,9 @@
 #include "reference/beam_grid.h"
 
 #include <float.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -458,17 +461,12 @@ void gr_beam_hits_free(gr_beam_hits *h)
     h->n = h->cap = 0;
 }
 
-/* The grid cell holding the sheared point (u, y, w), or -1 outside the grid. */
-static inline long grid_cell(const gr_beams *b, float u, float y, float w)
-{
-    float fu = (u - b->g0[0]) * b->ginv[0], fy = (y - b->g0[1]) * b->ginv[1], fw = (w - b->g0[2]) * b->ginv[2];
-    if (!(fu >= 0.0f && fy >= 0.0f && fw >= 0.0f)) return -1; /* also NaN */
-    int iu = (int)fu, iy = (int)fy, iw = (int)fw;
-    if (iu >= b->gn[0] || iy >= b->gn[1] || iw >= b->gn[2]) return -1;
-    return ((long)iw * b->gn[1] + iy) * b->gn[0] + iu;
-}
+/* A sheared coordinate in cells from the grid's corner along axis a: the one expression that
+ * the cell ranges, the entries' bytes and the lookups use (so they agree to the bit). */
+static inline float grid_f(const gr_beams *b, int a, float x) { return (x - b->g0[a]) * b->ginv[a]; }
 
 #define LOOKUP_CHUNK 64
+
 int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
 {
     out->n = 0;
@@ -479,49 +477,88 @@ int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
     s.w = p.z - b->sz * p.y;
     s.out = out;
     s.oom = 0;
-    long c = grid_cell(b, s.u, s.y, s.w);
-    if (c < 0) return 0;
-    /* the point in the boxes' 16-bit units (clamped: a point past the span tests as at its
-     * end, conservatively) */
-    int qp[3];
-    float pc[3] = {s.u, s.y, s.w};
+    /* the grid cell holding the point (none outside the grid, NaN included) and the point in
+     * that cell's bytes */
+    float f[3] = {grid_f(b, 0, s.u), grid_f(b, 1, s.y), grid_f(b, 2, s.w)};
+    if (!(f[0] >= 0.0f && f[1] >= 0.0f && f[2] >= 0.0f)) return 0;
+    int ic[3];
+    uint8_t qp[3];
     for (int a = 0; a < 3; a++) {
-        float q = (pc[a] - b->q0[a]) * b->qinv[a];
-        qp[a] = q <= 0.0f ? 0 : q >= 65535.0f ? 65535 : (int)q;
+        ic[a] = (int)f[a];
+        if (ic[a] >= b->gn[a]) return 0;
+        qp[a] = grid_qbyte(grid_qcoord(f[a]), ic[a]);
     }
+    long c = ((long)ic[2] * b->gn[1] + ic[1]) * b->gn[0] + ic[0];
     /* the cell's primitives in increasing id: the hits come out sorted, whatever the grid */
-    const uint32_t *cp = b->cell_prim;
-    const beam_qbox *qbox = b->qbox; /* locals: the hit list's writes cannot alias them */
+    const uint32_t *cp = b->cell_prim, *pt = b->prim_tri; /* locals: the hit list's writes cannot alias them */
+    const uint8_t *q = b->cell_q;
+    const size_t qs = b->cell_q_stride;
     uint32_t pass[LOOKUP_CHUNK];
+#if defined(__SSE2__)
+    const __m128i pv[3] = {_mm_set1_epi8((char)qp[0]), _mm_set1_epi8((char)qp[1]), _mm_set1_epi8((char)qp[2])};
+#endif
     for (uint32_t i0 = b->cell_first[c], e = b->cell_first[c + 1]; i0 < e; i0 += LOOKUP_CHUNK) {
         uint32_t e1 = e - i0 < LOOKUP_CHUNK ? e : i0 + LOOKUP_CHUNK;
         int np = 0;
+#if defined(__SSE2__)
+        /* 16 entries at a time: lo <= p as max(lo, p) == p, p <= hi as min(hi, p) == p */
+        for (uint32_t i = i0; i < e1; i += 16) {
+            __m128i m = _mm_set1_epi8((char)0xff);
+            for (int a = 0; a < 3; a++) {
+                __m128i lo = _mm_loadu_si128((const __m128i *)(q + (size_t)(2 * a) * qs + i));
+                __m128i hi = _mm_loadu_si128((const __m128i *)(q + (size_t)(2 * a + 1) * qs + i));
+                m = _mm_and_si128(m, _mm_cmpeq_epi8(_mm_max_epu8(lo, pv[a]), pv[a]));
+                m = _mm_and_si128(m, _mm_cmpeq_epi8(_mm_min_epu8(hi, pv[a]), pv[a]));
+            }
+            unsigned bits = (unsigned)_mm_movemask_epi8(m);
+            if (e1 - i < 16) bits &= (1u << (e1 - i)) - 1u;
+            while (bits) {
+                pass[np++] = cp[i + (uint32_t)__builtin_ctz(bits)];
+                bits &= bits - 1u;
+            }
+        }
+#else
         for (uint32_t i = i0; i < e1; i++) {
-            const uint16_t *bx = qbox[cp[i]].q;
-            /* the box test without branches (most candidates fail it, unpredictably) */
-            int in = (qp[0] >= bx[0]) & (qp[0] <= bx[3]) & (qp[1] >= bx[1]) & (qp[1] <= bx[4]) & (qp[2] >= bx[2]) & (qp[2] <= bx[5]);
+            /* without branches (most candidates fail, unpredictably) */
+            int in = 1;
+            for (int a = 0; a < 3; a++) in &= (q[(size_t)(2 * a) * qs + i] <= qp[a]) & (qp[a] <= q[(size_t)(2 * a + 1) * qs + i]);
             pass[np] = cp[i];
             np += in;
         }
-        for (int k = 0; k < np; k++) beam_test(b, pass[k], qbox[pass[k]].tri, &s);
+#endif
+        for (int k = 0; k < np; k++) beam_test(b, pass[k], pt[pass[k]], &s);
     }
     if (s.oom) return -1;
     sort_hits(out->h, out->n);
     return out->n;
 }
 
+int gr_beams_lookup_brute(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
+{
+    out->n = 0;
+    if (!b || !b->prim_tri) return 0;
+    lookup_state s = {p.x - b->sx * p.y, p.y, p.z - b->sz * p.y, out, 0};
+    for (uint32_t k = 0; k < (uint32_t)b->stats.prims; k++) beam_test(b, k, b->prim_tri[k], &s);
+    if (s.oom) return -1;
+    sort_hits(out->h, out->n);
+    return out->n;
+}
+
 /* The lookup grid over the primitives' boxes (docs/reference.md 2.2, "Lookups"). Cells of
- * GRID_CELL_BOX times the mean box extent per axis (measured on the default scene: 0.35
- * against 0.25, 0.5, 1 and 2; a box then spans about 22 cells and a cell lists about 16
- * boxes), coarsened uniformly while the entries exceed GRID_ENTRIES_PER_PRIM per primitive. Filled in primitive order, so every
- * cell's list is sorted by primitive id. */
-#define GRID_CELL_BOX 0.35
+ * GRID_CELL_BOX times the mean box extent per axis, coarsened uniformly while the entries
+ * exceed GRID_ENTRIES_PER_PRIM per primitive. With the boxes in the lists (16 candidates a
+ * test) a candidate costs little and an entry a byte write per end: 1.0 (0.35 when each
+ * candidate read its box from a primitive array; issue 30 measured 0.7, 1.0 and 1.4: the
+ * march the same within the machine's drift, the grid 4.0, 2.7 and 1.9 CPU-s a render, peak
+ * memory 440, 386 and 353 MB). Filled in primitive order, so every cell's list is sorted by
+ * primitive id. */
+#define GRID_CELL_BOX 1.0
 #define GRID_ENTRIES_PER_PRIM 32.0
 
 static void grid_range(const gr_beams *b, const float *bx, int lo[3], int hi[3])
 {
     for (int a = 0; a < 3; a++) {
-        float f0 = (bx[a] - b->g0[a]) * b->ginv[a], f1 = (bx[3 + a] - b->g0[a]) * b->ginv[a];
+        float f0 = grid_f(b, a, bx[a]), f1 = grid_f(b, a, bx[3 + a]);
         int i0 = f0 > 0.0f ? (int)f0 : 0, i1 = f1 > 0.0f ? (int)f1 : 0;
         lo[a] = i0 < b->gn[a] ? i0 : b->gn[a] - 1;
         hi[a] = i1 < b->gn[a] ? i1 : b->gn[a] - 1;
@@ -613,6 +650,7 @@ enum { RANGE_BINS = 1024 };
 typedef struct range_job {
     gr_beams *b;
     int32_t *rng;                 /* 6 per primitive */
+    int32_t *gq;                  /* 6 per primitive: the box's ends in cell units (grid_qcoord) */
     int nbins;                    /* histogram bins over the w-layers */
     uint64_t total;               /* entries of the job's primitives */
     uint64_t hist[RANGE_BINS];    /* entries per bin (each primitive's in the bin of its middle layer) */
@@ -627,9 +665,15 @@ static void range_work(void *arg, int chunk, size_t k0, size_t k1)
     (void)chunk;
     for (uint32_t k = (uint32_t)k0; k < (uint32_t)k1; k++) {
         int l[3], h[3];
-        grid_range(b, b->box + 6 * (size_t)k, l, h);
-        int32_t *r = j->rng + 6 * (size_t)k;
-        for (int a = 0; a < 3; a++) { r[a] = l[a]; r[3 + a] = h[a]; }
+        const float *bx = b->box + 6 * (size_t)k;
+        grid_range(b, bx, l, h);
+        int32_t *r = j->rng + 6 * (size_t)k, *g = j->gq + 6 * (size_t)k;
+        for (int a = 0; a < 3; a++) {
+            r[a] = l[a];
+            r[3 + a] = h[a];
+            g[a] = grid_qcoord(grid_f(b, a, bx[a]));
+            g[3 + a] = grid_qcoord(grid_f(b, a, bx[3 + a]));
+        }
         uint64_t n = (uint64_t)(h[0] - l[0] + 1) * (uint64_t)(h[1] - l[1] + 1) * (uint64_t)(h[2] - l[2] + 1);
         total += n;
         j->hist[(int)((int64_t)((l[2] + h[2]) / 2) * j->nbins / gw)] += n;
@@ -646,6 +690,7 @@ static void range_work(void *arg, int chunk, size_t k0, size_t k1)
 typedef struct layer_plan {
     gr_beams *b;
     const int32_t *rng;      /* 6 per primitive: cell ranges */
+    const int32_t *gq;       /* 6 per primitive: box ends in cell units */
     int L;                   /* layer chunks */
     const int *lw;           /* chunk c: layers [lw[c], lw[c + 1]) */
     const int *chunk_of;     /* layer -> its chunk */
@@ -711,6 +756,7 @@ static void grid_work(void *arg, int lc, size_t unused0, size_t unused1)
      * order: the lists ascend and cf[c] ends at the cell's start */
     const uint32_t off = (uint32_t)lp->total[lc];
     for (size_t c = c_lo; c < c_hi; c++) cf[c] += off;
+    const uint32_t end = c_hi > c_lo ? cf[c_hi - 1] : off; /* the chunk's last entry + 1 */
     for (uint64_t i = nl; i-- > 0;) {
         const uint32_t k = list[i];
         const int32_t *r = rng + 6 * (size_t)k;
@@ -721,6 +767,27 @@ static void grid_work(void *arg, int lc, size_t unused0, size_t unused1)
                 for (int iu = r[0]; iu <= r[3]; iu++) cp[--cf[c0 + (size_t)iu]] = k;
             }
     }
+    /* each entry's box in its cell's bytes, cell after cell (sequential writes; the boxes of
+     * a cell's primitives are mostly those of the cell before) */
+    uint8_t *q = lp->b->cell_q;
+    const size_t qs = lp->b->cell_q_stride;
+    uint8_t *qu0 = q, *qu1 = q + qs, *qy0 = q + 2 * qs, *qy1 = q + 3 * qs, *qw0 = q + 4 * qs, *qw1 = q + 5 * qs;
+    const int32_t *gq = lp->gq;
+    size_t c = c_lo;
+    for (int iw = lp->lw[lc]; iw < lp->lw[lc + 1]; iw++)
+        for (int iy = 0; iy < (int)ny; iy++)
+            for (int iu = 0; iu < (int)nu; iu++, c++) {
+                const uint32_t e1 = c + 1 < c_hi ? cf[c + 1] : end;
+                for (uint32_t e = cf[c]; e < e1; e++) {
+                    const int32_t *g = gq + 6 * (size_t)cp[e];
+                    qu0[e] = grid_qbyte(g[0], iu);
+                    qu1[e] = grid_qbyte(g[3], iu);
+                    qy0[e] = grid_qbyte(g[1], iy);
+                    qy1[e] = grid_qbyte(g[4], iy);
+                    qw0[e] = grid_qbyte(g[2], iw);
+                    qw1[e] = grid_qbyte(g[5], iw);
+                }
+            }
 }
 
 static void box_work(void *arg, int chunk, size_t k0, size_t k1)
@@ -753,30 +820,6 @@ static void bound_work(void *arg, int ck, size_t k0, size_t k1)
     for (int a = 0; a < 3; a++) { j->lo[ck][a] = lo[a]; j->hi[ck][a] = hi[a]; j->ext[ck][a] = ext[a]; }
 }
 
-/* The 16-bit boxes of primitives [k0, k1) (the job's range) */
-typedef struct quant_job {
-    gr_beams *b;
-    double qunit[3];
-} quant_job;
-
-static void quant_work(void *arg, int chunk, size_t k0, size_t k1)
-{
-    quant_job *j = arg;
-    gr_beams *b = j->b;
-    (void)chunk;
-    for (uint32_t k = (uint32_t)k0; k < (uint32_t)k1; k++) {
-        const float *bx = b->box + 6 * (size_t)k;
-        uint16_t *q = b->qbox[k].q;
-        b->qbox[k].tri = b->prim_tri[k];
-        for (int a = 0; a < 3; a++) {
-            double l = floor(((double)bx[a] - (double)b->q0[a]) / j->qunit[a]) - 1.0;
-            double h = ceil(((double)bx[3 + a] - (double)b->q0[a]) / j->qunit[a]) + 1.0;
-            q[a] = (uint16_t)(l < 0.0 ? 0.0 : l > 65535.0 ? 65535.0 : l);
-            q[3 + a] = (uint16_t)(h < 0.0 ? 0.0 : h > 65535.0 ? 65535.0 : h);
-        }
-    }
-}
-
 static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err)
 {
     if (np == 0) return GR_OK;
@@ -801,28 +844,13 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         cell[a] = GRID_CELL_BOX * ext[a] / np;
         if (!(cell[a] > span * 1e-6)) cell[a] = span > 0.0 ? span * 1e-6 : 1.0;
     }
-    /* the 16-bit boxes first (they need only the bounds); the float boxes then become cell ranges */
-    b->qbox = malloc((size_t)np * sizeof *b->qbox);
-    if (!b->qbox) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for %u beam boxes", np);
-    double qunit[3];
-    for (int a = 0; a < 3; a++) {
-        double span = hi[a] - lo[a];
-        qunit[a] = span > 0.0 ? span / 65535.0 : 1.0;
-        b->q0[a] = (float)lo[a];
-        b->qinv[a] = (float)(1.0 / qunit[a]);
-    }
     int nt = gr_beams_threads(threads);
-    {
-        quant_job qj = {b, {qunit[0], qunit[1], qunit[2]}};
-        b->stats.par_s += gr_beams_run_chunks(quant_work, &qj, 0, nt, np, gr_beams_chunks(np, nt));
-    }
-    free(b->prim_tri); /* each primitive's triangle now travels with its box */
-    b->prim_tri = NULL;
     /* the cells' ranges and the entries they make; over the budget, coarser cells and again */
-    int32_t *rng = malloc((size_t)np * 6 * sizeof *rng);
+    int32_t *rng = malloc((size_t)np * 6 * sizeof *rng), *gq = malloc((size_t)np * 6 * sizeof *gq);
     range_job *rj = malloc((size_t)nt * sizeof *rj);
-    if (!rng || !rj) {
+    if (!rng || !gq || !rj) {
         free(rng);
+        free(gq);
         free(rj);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid");
     }
@@ -845,6 +873,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
         for (int i = 0; i < nt; i++) { /* integer sums: the same for any split */
             rj[i].b = b;
             rj[i].rng = rng;
+            rj[i].gq = gq;
             rj[i].nbins = b->gn[2] < RANGE_BINS ? b->gn[2] : RANGE_BINS;
             rj[i].total = 0;
             memset(rj[i].hist, 0, sizeof rj[i].hist);
@@ -858,6 +887,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     if (entries == UINT64_MAX || entries >= UINT32_MAX ||
         (size_t)b->gn[0] * (size_t)b->gn[1] * (size_t)b->gn[2] >= UINT32_MAX) {
         free(rng);
+        free(gq);
         free(rj);
         return gr_fail(err, GR_E_NOMEM, "reference: the beam lookup grid needs more than %.0f entries, too many", budget);
     }
@@ -870,7 +900,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     uint64_t *cnt = calloc((size_t)P * (size_t)L, sizeof *cnt), *lfirst = malloc(((size_t)L + 1) * sizeof *lfirst);
     uint64_t *ltotal = malloc((size_t)L * sizeof *ltotal);
     if (!lw || !chunk_of || !cnt || !lfirst || !ltotal) {
-        free(lw); free(chunk_of); free(cnt); free(lfirst); free(ltotal); free(rng); free(rj);
+        free(lw); free(chunk_of); free(cnt); free(lfirst); free(ltotal); free(rng); free(gq); free(rj);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid");
     }
     {
@@ -891,7 +921,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
             for (int l = lw[i]; l < lw[i + 1]; l++) chunk_of[l] = i;
     }
     free(rj);
-    layer_plan lp = {b, rng, L, lw, chunk_of, cnt, NULL, lfirst, ltotal, 0};
+    layer_plan lp = {b, rng, gq, L, lw, chunk_of, cnt, NULL, lfirst, ltotal, 0};
     /* the chunks' primitive lists: counts by ranges of primitives, their offsets, the writes */
     b->stats.par_s += gr_beams_run_chunks(list_count_work, &lp, 0, nt, np, P);
     lfirst[0] = 0;
@@ -908,8 +938,11 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     free(b->cell_first);
     b->cell_first = calloc(ncells + 1, sizeof *b->cell_first);
     b->cell_prim = malloc((entries ? entries : 1) * sizeof *b->cell_prim);
-    if (!lp.list || !b->cell_first || !b->cell_prim) {
-        free(lw); free(chunk_of); free(cnt); free(lfirst); free(ltotal); free(lp.list); free(rng);
+    free(b->cell_q);
+    b->cell_q_stride = (size_t)entries + 16; /* the lookups' last 16-byte read */
+    b->cell_q = calloc(6 * b->cell_q_stride, 1);
+    if (!lp.list || !b->cell_first || !b->cell_prim || !b->cell_q) {
+        free(lw); free(chunk_of); free(cnt); free(lfirst); free(ltotal); free(lp.list); free(rng); free(gq);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the beam lookup grid (%zu cells, %llu entries)", ncells,
                        (unsigned long long)entries);
     }
@@ -926,6 +959,7 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     b->stats.par_s += gr_beams_run_chunks(grid_work, &lp, 0, nt, (size_t)L, L);
     free(lw); free(chunk_of); free(cnt); free(lfirst); free(ltotal); free(lp.list);
     free(rng);
+    free(gq);
     b->cell_first[ncells] = (uint32_t)entries;
     b->stats.grid_entries = (size_t)entries;
     b->stats.grid_cells = ncells;

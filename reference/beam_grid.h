@@ -39,12 +39,22 @@ typedef struct beam_tri {
 } beam_tri;
 _Static_assert(sizeof(beam_tri) == 128, "beam_tri fills two cache lines (aligned_alloc needs a multiple of 64)");
 
-/* A primitive as the lookups read it: its box in 16-bit units {u, y, w} lower then upper, and
- * its triangle (in the same 16 bytes: one load serves the box test and the triangle's address). */
-typedef struct beam_qbox {
-    uint16_t q[6];
-    uint32_t tri;
-} beam_qbox;
+/* The cell-local box units (docs/reference.md 2.2, "Lookups"): a grid coordinate f (cells
+ * from the grid's corner, f >= 0) in 1/GRID_QUNITS of a cell, rounded down. Monotone in f, so
+ * an entry's ends and a point quantized by it keep their order: the byte test is a superset of
+ * the float box test. */
+#define GRID_QUNITS 255
+static inline int32_t grid_qcoord(float f)
+{
+    float g = f * (float)GRID_QUNITS;
+    return g > 0.0f ? (g < 2.0e9f ? (int32_t)g : 2000000000) : 0;
+}
+/* The byte of quantized coordinate g in cell i: clamped to [0, 255] (monotone in g). */
+static inline uint8_t grid_qbyte(int32_t g, int i)
+{
+    int64_t d = (int64_t)g - (int64_t)i * GRID_QUNITS;
+    return (uint8_t)(d < 0 ? 0 : d > 255 ? 255 : d);
+}
 
 struct gr_beams {
     gr_beam_stats stats;
@@ -54,7 +64,7 @@ struct gr_beams {
     beam_tri *tri;           /* per triangle */
     int disc;                /* 1: the sun-disc kernel is on */
 
-    uint32_t *prim_tri;      /* per primitive: its triangle */
+    uint32_t *prim_tri;      /* per primitive: its triangle (read for the box test's passes) */
     float *box;              /* per primitive: its box, sheared {u, y, w} lower then upper */
     double y_min;
     float sx, sz;            /* shear: T0x / T0y, T0z / T0y */
@@ -65,11 +75,12 @@ struct gr_beams {
     int gn[3];               /* cells per axis */
     uint32_t *cell_first;    /* gn[0] gn[1] gn[2] + 1 */
     uint32_t *cell_prim;
-    /* the boxes as the lookups test them: 16-bit units of the grid's span per axis, lower
-     * ends rounded down and upper ends up, one unit wider each side (half the bytes of the
-     * float boxes: fewer cache misses in the candidate loop) */
-    beam_qbox *qbox;         /* per primitive */
-    float q0[3], qinv[3];
+    /* each entry's box clipped to its cell, in cell-local bytes (grid_qbyte): six arrays of
+     * cell_q_stride bytes (lower u, upper u, lower y, upper y, lower w, upper w), entry i at
+     * [i] of each, padded by 16 so that the lookups read 16 entries at a time; streamed with
+     * the list (the boxes per primitive were a cache miss per candidate) */
+    uint8_t *cell_q;
+    size_t cell_q_stride;
     RTCScene surface;
 };
 
@@ -95,6 +106,10 @@ static inline void slab_range(const gr_beams *b, uint32_t t, uint32_t k, uint32_
  * boxes, then the grid over them, on up to `threads` threads (the result does not depend on
  * them). GR_E_NOMEM naming the grid. */
 gr_status gr_beams_index(gr_beams *b, uint32_t np, int threads, gr_error *err);
+
+/* gr_beams_lookup without the grid: every primitive's exact test (the checks' oracle for the
+ * grid and its byte boxes, which may only drop primitives that cannot hold the point). */
+int gr_beams_lookup_brute(const gr_beams *b, gr_vec3 p, gr_beam_hits *out);
 
 /* Runs fn on n jobs (each `size` bytes apart; at most GRID_MAX_THREADS), job 0 on the calling
  * thread and the others on their own threads (serially if a thread cannot be started: the

@@ -667,8 +667,8 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->stats.vertices = nv;
     b->stats.lit_triangles = lit;
     b->stats.prims = np;
-    b->stats.bytes = nv * sizeof *b->v + ntri * sizeof *b->tri + np * (sizeof(uint32_t) + sizeof(beam_qbox)) +
-                     (b->stats.grid_cells + 1 + b->stats.grid_entries) * sizeof(uint32_t);
+    b->stats.bytes = nv * sizeof *b->v + ntri * sizeof *b->tri + np * sizeof(uint32_t) +
+                     (b->stats.grid_cells + 1 + b->stats.grid_entries) * sizeof(uint32_t) + 6 * b->cell_q_stride;
     b->stats.build_s = now_s() - t_start;
     *out = b;
     return GR_OK;
@@ -702,6 +702,6 @@ void gr_beams_destroy(gr_beams *b)
     free(b->box);
     free(b->cell_first);
     free(b->cell_prim);
-    free(b->qbox);
+    free(b->cell_q);
     free(b);
 }

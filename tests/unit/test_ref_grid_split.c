@@ -8,7 +8,9 @@
  * sums rely on), and the lookups at points through a focus must return the same hits. One
  * wave, the sun's disc on, surface_res 96: about 0.1 s a build. The set's own arrays (vertices,
  * triangles, boxes: built in chunks taken by whichever thread is free) must equal one thread's
- * byte for byte too, and gr_beams_run_chunks must run every chunk once over its range. */
+ * byte for byte too (and the entries' cell-local byte boxes), gr_beams_run_chunks must run
+ * every chunk once over its range, and the grid's lookups must equal every primitive's exact
+ * test (gr_beams_lookup_brute, no grid, no box) bit for bit: the byte boxes are a superset. */
 #include "check.h"
 #include "test_ref_util.h"
 
@@ -96,6 +98,8 @@ int main(void)
                   "%d threads: the cells' list bounds differ from one thread's", threads[k]);
         CHECK_MSG(b->cell_first[nc] == ne && memcmp(b->cell_prim, ref->cell_prim, ne * sizeof *b->cell_prim) == 0,
                   "%d threads: the cells' lists differ from one thread's", threads[k]);
+        CHECK_MSG(b->cell_q_stride == ref->cell_q_stride && memcmp(b->cell_q, ref->cell_q, 6 * ref->cell_q_stride) == 0,
+                  "%d threads: the entries' cell-local boxes differ from one thread's", threads[k]);
         /* the set's own arrays, built in chunks taken by whichever thread is free: vertices,
          * triangles (with their slabs' first primitive and count), the primitives' boxes */
         int same_set = b->nv == ref->nv && b->ntri == ref->ntri && b->stats.prims == ref->stats.prims &&
@@ -106,8 +110,8 @@ int main(void)
         if (same_set) {
             CHECK_MSG(memcmp(b->v, ref->v, ref->nv * sizeof *b->v) == 0, "%d threads: the vertices differ", threads[k]);
             CHECK_MSG(memcmp(b->tri, ref->tri, ref->ntri * sizeof *b->tri) == 0, "%d threads: the triangles differ", threads[k]);
-            CHECK_MSG(memcmp(b->qbox, ref->qbox, ref->stats.prims * sizeof *b->qbox) == 0, "%d threads: the boxes differ",
-                      threads[k]);
+            CHECK_MSG(memcmp(b->prim_tri, ref->prim_tri, ref->stats.prims * sizeof *b->prim_tri) == 0,
+                      "%d threads: the primitives' triangles differ", threads[k]);
         }
         /* lookups along a vertical line through the focus (about 5.5 m down) and off it */
         int diff = 0, hits = 0;
@@ -121,7 +125,39 @@ int main(void)
         CHECK_MSG(hits > 400 && diff == 0, "%d threads: %d of the lookups' hits (%d) differ", threads[k], diff, hits);
         gr_beams_destroy(b);
     }
-    printf("grid %dx%dx%d, %zu entries, the same lists and set for 1, 2, 3, 8 and 64 threads\n", ref->gn[0], ref->gn[1], ref->gn[2], ne);
+    printf("grid %dx%dx%d, %zu entries (%.1f per primitive), the same lists and set for 1, 2, 3, 8 and 64 threads\n", ref->gn[0],
+           ref->gn[1], ref->gn[2], ne, (double)ne / (double)ref->stats.prims);
+
+    /* the grid and its entries' cell-local byte boxes against every primitive's exact test:
+     * the same hits, bit for bit (a box test that dropped a primitive holding the point, or a
+     * cell list missing one, shows here); points on the line through the focus and spread
+     * over the lit volume, some on cell faces */
+    {
+        int diff = 0, hits = 0, pts = 0;
+        uint32_t x = 12345u;
+        for (int i = 0; i < 600; i++) {
+            gr_vec3 q;
+            if (i < 200) q = gr_v3(-0.3f + 0.3f * (float)(i % 3), -0.5f - 0.032f * (float)i, -0.9f + 0.009f * (float)i);
+            else {
+                float r[3];
+                for (int a = 0; a < 3; a++) { x = x * 1664525u + 1013904223u; r[a] = (float)(x >> 8) / 16777216.0f; }
+                q = gr_v3(-1.6f + 3.2f * r[0], -0.2f - 6.6f * r[1], -1.6f + 3.2f * r[2]);
+                if (i % 4 == 0) { /* on a cell face of the grid (u and y), exactly */
+                    float fu = floorf((q.x - ref->sx * q.y - ref->g0[0]) * ref->ginv[0]);
+                    q.x = ref->g0[0] + fu / ref->ginv[0] + ref->sx * q.y;
+                }
+            }
+            int n1 = gr_beams_lookup(ref, q, &h1), n2 = gr_beams_lookup_brute(ref, q, &h2);
+            pts++;
+            hits += n2;
+            diff += n1 != n2;
+            for (int j = 0; j < n1 && n1 == n2; j++)
+                diff += h1.h[j].prim != h2.h[j].prim || h1.h[j].e_h != h2.h[j].e_h || h1.h[j].path_m != h2.h[j].path_m;
+        }
+        CHECK_MSG(hits > 600 && diff == 0, "the grid's lookups differ from every primitive's test at %d of %d points (%d hits)",
+                  diff, pts, hits);
+        printf("the grid's lookups equal every primitive's exact test at %d points (%d hits)\n", pts, hits);
+    }
 
     /* gr_beams_run_chunks: every chunk once, the chunks tiling [0, total) as documented */
     const int ns[] = {1, 2, 7}, cs[] = {1, 5, 64, 1000};
