@@ -135,7 +135,7 @@ static gr_status quantity_errors(const ref_accum *acc, int ch, ref_errors *e)
     return GR_OK;
 }
 
-static void block_noise(const ref_accum *acc, double q[3]);
+static void block_noise(const ref_accum *acc, double q[3], double *p99, int at[2]);
 
 /* The statistics' jobs (issue 30: no serial phase): the RGB mean's errors, each channel's,
  * and (optionally) the block noise, taken from a counter by `threads` threads; each job
@@ -145,7 +145,8 @@ typedef struct stats_work {
     ref_errors q[4];          /* [0] the RGB mean, [1 + c] channel c */
     gr_status st[4];
     int blocks;               /* 1: also the block noise, into block8 */
-    double block8[3];
+    double block8[3], block8_p99;
+    int block8_at[2];
     atomic_int next;
 } stats_work;
 typedef struct stats_thread {
@@ -158,7 +159,7 @@ static void *stats_job(void *arg)
     for (;;) {
         int k = atomic_fetch_add(&w->next, 1);
         if (k < 4) w->st[k] = quantity_errors(w->acc, k - 1, &w->q[k]);
-        else if (k == 4 && w->blocks) block_noise(w->acc, w->block8);
+        else if (k == 4 && w->blocks) block_noise(w->acc, w->block8, &w->block8_p99, w->block8_at);
         else break;
     }
     return NULL;
@@ -173,6 +174,7 @@ double gr_ref_image_errors(const ref_accum *acc, int threads, int blocks, ref_er
     }
     w->acc = acc;
     w->blocks = blocks;
+    w->block8_at[0] = w->block8_at[1] = -1;
     atomic_init(&w->next, 0);
     stats_thread th[5];
     int n = threads < 1 ? 1 : threads > 5 ? 5 : threads;
@@ -180,6 +182,9 @@ double gr_ref_image_errors(const ref_accum *acc, int threads, int blocks, ref_er
     double par = gr_beams_run_jobs(stats_job, th, sizeof th[0], n);
     *e = w->q[0];
     memcpy(e->block8, w->block8, sizeof e->block8);
+    e->block8_p99 = w->block8_p99;
+    e->block8_at[0] = w->block8_at[0];
+    e->block8_at[1] = w->block8_at[1];
     *st = GR_OK;
     for (int k = 0; k < 4; k++)
         if (w->st[k] != GR_OK) *st = w->st[k];
@@ -195,12 +200,13 @@ double gr_ref_image_errors(const ref_accum *acc, int threads, int blocks, ref_er
 /* 8 x 8 blocks (issue 30): each block's mean per batch (the mean of its pixels' batch means),
  * its standard error from the spread of those B means (so that what the pixels share, the
  * passes' beam sets, is counted), relative to max(block mean, image mean) per channel, the
- * largest channel's. Its 50th and 95th percentiles and maximum over the whole blocks. */
-static void block_noise(const ref_accum *acc, double q[3])
+ * largest channel's. Its 50th, 95th and 99th percentiles and maximum over the whole blocks,
+ * and where the worst block is (its first pixel). */
+static void block_noise(const ref_accum *acc, double q[3], double *p99, int at[2])
 {
     enum { BS = 8 };
     int bw = acc->W / BS, bh = acc->H / BS, B = acc->B;
-    q[0] = q[1] = q[2] = -1.0;
+    q[0] = q[1] = q[2] = *p99 = -1.0;
     double chm[3] = {0.0, 0.0, 0.0};
     size_t np = (size_t)acc->W * acc->H;
     for (size_t p = 0; p < np; p++) {
@@ -217,6 +223,7 @@ static void block_noise(const ref_accum *acc, double q[3])
     double *rel = malloc((size_t)bw * bh * sizeof *rel), *m = malloc((size_t)B * 3 * sizeof *m);
     if (!rel || !m) { free(rel); free(m); return; }
     size_t nb = 0;
+    double top = -1.0;
     for (int by = 0; by < bh; by++)
         for (int bx = 0; bx < bw; bx++) {
             int ok = 1;
@@ -241,8 +248,14 @@ static void block_noise(const ref_accum *acc, double q[3])
                 if (r > worst) worst = r;
             }
             rel[nb++] = worst;
+            if (worst > top) {
+                top = worst;
+                at[0] = bx * BS;
+                at[1] = by * BS;
+            }
         }
     if (nb) {
+        *p99 = gr_ref_percentile(rel, nb, 0.99);
         q[2] = gr_ref_percentile(rel, nb, 1.0);
         q[1] = gr_ref_percentile(rel, nb, 0.95);
         q[0] = gr_ref_percentile(rel, nb, 0.5);
@@ -345,7 +358,10 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     /* 8 x 8 block noise (block_noise): median, 95th percentile, worst block */
     SET(gr_meta_set_double(m, "godrays:block8_rel_stderr_median", e->block8[0]));
     SET(gr_meta_set_double(m, "godrays:block8_rel_stderr_p95", e->block8[1]));
+    SET(gr_meta_set_double(m, "godrays:block8_rel_stderr_p99", e->block8_p99));
     SET(gr_meta_set_double(m, "godrays:block8_rel_stderr_max", e->block8[2]));
+    SET(gr_meta_set_int(m, "godrays:block8_rel_stderr_max_x", e->block8_at[0]));
+    SET(gr_meta_set_int(m, "godrays:block8_rel_stderr_max_y", e->block8_at[1]));
     SET(gr_meta_set_double(m, "godrays:cutoff_distance_m", r->cutoff_d));
     SET(gr_meta_set_double(m, "godrays:preview_exposure", out->preview_exposure));
     SET(gr_meta_set_double(m, "godrays:queries_per_s", qps));

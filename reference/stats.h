@@ -12,6 +12,8 @@ typedef struct ref_errors {
     double rel_mean, rel_p95, frac_1pct, mean, p95;      /* of the RGB mean */
     double ch_rel_mean[3], ch_rel_p95[3], ch_frac_1pct[3]; /* the same per channel (issue 30) */
     double block8[3]; /* 8 x 8 block noise: median, p95, max of se / max(block mean, image mean), worst channel */
+    double block8_p99;  /* its 99th percentile (steadier than the max of thousands of 7-dof estimates) */
+    int block8_at[2];   /* the worst block's first pixel (x, y); -1 without blocks */
 } ref_errors;
 
 /* The q-quantile of v[0 .. n) (sorts v; linear between ranks). */

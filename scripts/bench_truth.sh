@@ -74,4 +74,4 @@ for p in beams grid pilot march probe stats other; do
     echo "| $p | $(meta "$f" "phase.$p.wall_s") | $(meta "$f" "phase.$p.cpu_s") | $(meta "$f" "phase.$p.serial_s") |"
 done
 echo "| all | $(meta "$f" phases_wall_s) | $(meta "$f" phases_cpu_s) | $(meta "$f" serial_s) |"
-echo "serial fraction (wall with at most one thread busy / wall): $(meta "$f" serial_fraction); 8x8 block noise (max, p95, median): $(meta "$f" block8_rel_stderr_max), $(meta "$f" block8_rel_stderr_p95), $(meta "$f" block8_rel_stderr_median)"
+echo "serial fraction (wall with at most one thread busy / wall): $(meta "$f" serial_fraction); 8x8 block noise (max at pixel x y, p99, p95, median): $(meta "$f" block8_rel_stderr_max) at $(meta "$f" block8_rel_stderr_max_x) $(meta "$f" block8_rel_stderr_max_y), $(meta "$f" block8_rel_stderr_p99), $(meta "$f" block8_rel_stderr_p95), $(meta "$f" block8_rel_stderr_median)"
