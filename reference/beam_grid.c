@@ -1,7 +1,7 @@
 #include "reference/beam_grid.h"
 
 #include <float.h>
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(GR_NO_SIMD)
 #include <emmintrin.h>
 #endif
 #include <pthread.h>
@@ -494,13 +494,13 @@ int gr_beams_lookup(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
     const uint8_t *q = b->cell_q;
     const size_t qs = b->cell_q_stride;
     uint32_t pass[LOOKUP_CHUNK];
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(GR_NO_SIMD)
     const __m128i pv[3] = {_mm_set1_epi8((char)qp[0]), _mm_set1_epi8((char)qp[1]), _mm_set1_epi8((char)qp[2])};
 #endif
     for (uint32_t i0 = b->cell_first[c], e = b->cell_first[c + 1]; i0 < e; i0 += LOOKUP_CHUNK) {
         uint32_t e1 = e - i0 < LOOKUP_CHUNK ? e : i0 + LOOKUP_CHUNK;
         int np = 0;
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(GR_NO_SIMD)
         /* 16 entries at a time: lo <= p as max(lo, p) == p, p <= hi as min(hi, p) == p */
         for (uint32_t i = i0; i < e1; i += 16) {
             __m128i m = _mm_set1_epi8((char)0xff);
