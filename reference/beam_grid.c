@@ -551,9 +551,11 @@ int gr_beams_lookup_brute(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
  * candidate read its box from a primitive array; issue 30 measured 0.7, 1.0 and 1.4: the
  * march the same within the machine's drift, the grid 4.0, 2.7 and 1.9 CPU-s a render, peak
  * memory 440, 386 and 353 MB). Filled in primitive order, so every cell's list is sorted by
- * primitive id. */
+ * primitive id. The cap: 16 entries of 10 bytes per primitive (typically 8), the bytes the
+ * 32 entries of 4 bytes and a 16-bit box per primitive took before, so the memory model
+ * (reference/memory.h) holds as it did. */
 #define GRID_CELL_BOX 1.0
-#define GRID_ENTRIES_PER_PRIM 32.0
+#define GRID_ENTRIES_PER_PRIM 16.0
 
 static void grid_range(const gr_beams *b, const float *bx, int lo[3], int hi[3])
 {

@@ -14,7 +14,7 @@
  * batch sums (3 doubles) and counts (uint32) of every batch, the two AOVs and the 8-channel
  * float image; per surface cell two beam triangles (128 B + 4 B drift each), a vertex (24 B
  * position, 40 B beam vertex, 16 B Jacobian) and up to two beam primitives with their lookup
- * grid (box, id, at most 32 grid entries: 160 B each, at most the budget of 2^24), for the
+ * grid (box, id, at most 16 grid entries of 10 B: 160 B each, at most the budget of 2^24), for the
  * plain grid and, with local refinement, the camera cone's set. */
 double gr_ref_memory_estimate(const gr_scene *scene, const gr_ref_info *info);
 
