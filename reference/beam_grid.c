@@ -557,13 +557,17 @@ int gr_beams_lookup_brute(const gr_beams *b, gr_vec3 p, gr_beam_hits *out)
 #define GRID_CELL_BOX 1.0
 #define GRID_ENTRIES_PER_PRIM 16.0
 
-static void grid_range(const gr_beams *b, const float *bx, int lo[3], int hi[3])
+/* Box bx's cell range (lower u, y, w then upper, clamped to the grid) into r and its ends in
+ * cell units (grid_qcoord, the entries' bytes) into g, from one grid coordinate per end. */
+static void grid_range(const gr_beams *b, const float *bx, int32_t r[6], int32_t g[6])
 {
     for (int a = 0; a < 3; a++) {
         float f0 = grid_f(b, a, bx[a]), f1 = grid_f(b, a, bx[3 + a]);
         int i0 = f0 > 0.0f ? (int)f0 : 0, i1 = f1 > 0.0f ? (int)f1 : 0;
-        lo[a] = i0 < b->gn[a] ? i0 : b->gn[a] - 1;
-        hi[a] = i1 < b->gn[a] ? i1 : b->gn[a] - 1;
+        r[a] = i0 < b->gn[a] ? i0 : b->gn[a] - 1;
+        r[3 + a] = i1 < b->gn[a] ? i1 : b->gn[a] - 1;
+        g[a] = grid_qcoord(f0);
+        g[3 + a] = grid_qcoord(f1);
     }
 }
 
@@ -666,19 +670,11 @@ static void range_work(void *arg, int chunk, size_t k0, size_t k1)
     uint64_t total = 0;
     (void)chunk;
     for (uint32_t k = (uint32_t)k0; k < (uint32_t)k1; k++) {
-        int l[3], h[3];
-        const float *bx = b->box + 6 * (size_t)k;
-        grid_range(b, bx, l, h);
-        int32_t *r = j->rng + 6 * (size_t)k, *g = j->gq + 6 * (size_t)k;
-        for (int a = 0; a < 3; a++) {
-            r[a] = l[a];
-            r[3 + a] = h[a];
-            g[a] = grid_qcoord(grid_f(b, a, bx[a]));
-            g[3 + a] = grid_qcoord(grid_f(b, a, bx[3 + a]));
-        }
-        uint64_t n = (uint64_t)(h[0] - l[0] + 1) * (uint64_t)(h[1] - l[1] + 1) * (uint64_t)(h[2] - l[2] + 1);
+        int32_t *r = j->rng + 6 * (size_t)k;
+        grid_range(b, b->box + 6 * (size_t)k, r, j->gq + 6 * (size_t)k);
+        uint64_t n = (uint64_t)(r[3] - r[0] + 1) * (uint64_t)(r[4] - r[1] + 1) * (uint64_t)(r[5] - r[2] + 1);
         total += n;
-        j->hist[(int)((int64_t)((l[2] + h[2]) / 2) * j->nbins / gw)] += n;
+        j->hist[(int)((int64_t)((r[2] + r[5]) / 2) * j->nbins / gw)] += n;
     }
     j->total += total;
 }
