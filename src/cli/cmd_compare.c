@@ -107,11 +107,15 @@ static gr_status write_text(const char *path, const char *text, gr_error *err)
 }
 
 /* Reads one input (and what the file says of its pixels, info: may be NULL); any failure is
- * bad input (exit 2) naming the role and the file. */
+ * bad input (exit 2) naming the role and the file, unless no image can be read at all (the
+ * OpenImageIO module missing: exit 1). */
 static gr_status read_input(const char *role, const char *path, int linearize, gr_image **img, gr_oiio_info *info,
                             gr_error *err)
 {
-    gr_status st = gr_oiio_read_info(path, linearize, img, info, err);
+    *img = NULL;
+    gr_status st = gr_oiio_available(err);
+    if (st != GR_OK) return st;
+    st = gr_oiio_read_info(path, linearize, img, info, err);
     if (st == GR_OK) return GR_OK;
     if (st != GR_E_NOMEM) err->status = GR_E_INPUT;
     gr_error_prefix(err, "%s", role);

@@ -1,12 +1,15 @@
-// OpenImageIO 2.4 behind the C interface of oiio.h: the only C++ in the project.
-// Every extern "C" body is wrapped in try/catch(...) so that no exception reaches C code.
+// OpenImageIO 2.4 behind the C interface of oiio.h: the only C++ in the project, built as the
+// module libgodrays_oiio.so that oiio.c loads on first use (oiio_module.h says why). Its one
+// exported function hands oiio.c the table of the functions below; every body is wrapped in
+// try/catch(...) so that no exception reaches C code, and the program is called only through
+// the host table.
 extern "C" {
 #include "common/memlimit.h"
 #include "common/outfile.h"
 #include "common/status.h"
 #include "image/exr.h"
 }
-#include "image/oiio.h"
+#include "image/oiio_module.h"
 
 #include <cerrno>
 #include <cmath>
@@ -25,6 +28,9 @@ extern "C" {
 
 namespace {
 
+// The program's functions (gr_oiio_module_open keeps them).
+const gr_oiio_host *host = nullptr;
+
 // One line: OpenImageIO messages may span several lines.
 std::string one_line(std::string s)
 {
@@ -36,7 +42,7 @@ std::string one_line(std::string s)
 
 gr_status fail(gr_error *err, gr_status st, const char *path, const char *what, const std::string &why)
 {
-    return gr_fail(err, st, "%s: %s: %s", path, what, one_line(why).c_str());
+    return host->fail(err, st, "%s: %s: %s", path, what, one_line(why).c_str());
 }
 
 // sRGB OETF, IEC 61966-2-1 (piecewise: linear toe below 0.0031308, 1/2.4 power above).
@@ -125,7 +131,7 @@ gr_status check_png_chunks(const char *path, gr_error *err, bool *complete = nul
                 for (char &c : type)
                     if (c && (c < 'A' || (c > 'Z' && c < 'a') || c > 'z')) c = '?';
                 if ((long long)len > size - pos - 12) {
-                    st = gr_fail(err, GR_E_INPUT, "%s: PNG chunk '%s' at byte %lld claims %llu bytes, past the end of the "
+                    st = host->fail(err, GR_E_INPUT, "%s: PNG chunk '%s' at byte %lld claims %llu bytes, past the end of the "
                                  "%lld-byte file", path, type, pos, len, size);
                     break;
                 }
@@ -158,7 +164,7 @@ gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::Ty
     auto out = OIIO::ImageOutput::create(path);
     if (!out) return fail(err, GR_E_INPUT, path, "no writer for this file type", OIIO::geterror());
     gr_outfile of;
-    gr_status st = gr_outfile_begin(&of, path, err);
+    gr_status st = host->outfile_begin(&of, path, err);
     if (st != GR_OK) return st;
     const std::string tmp = of.tmp;
     const std::string format = out->format_name();
@@ -177,7 +183,7 @@ gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::Ty
         // truncated file longjmps out of OpenImageIO's reader and leaks)
         gr_error perr;
         if (check_png_chunks(tmp.c_str(), &perr, &png_done) != GR_OK || !png_done)
-            st = gr_fail(err, GR_E_IO, "%s: cannot write: the file written is incomplete (is the disk full?)", path);
+            st = host->fail(err, GR_E_IO, "%s: cannot write: the file written is incomplete (is the disk full?)", path);
         png_done = true;
     }
     if (st == GR_OK && !png_done) {
@@ -187,7 +193,7 @@ gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::Ty
         OIIO::ImageSpec got;
         if (!in || !in->open(tmp, got) || got.width != spec.width || got.height != spec.height ||
             !in->read_image(0, 0, 0, spec.nchannels, spec.format, back.data()))
-            st = gr_fail(err, GR_E_IO, "%s: cannot write: the file written does not read back whole (is the disk full?)",
+            st = host->fail(err, GR_E_IO, "%s: cannot write: the file written does not read back whole (is the disk full?)",
                          path);
         if (in) {
             in->close();
@@ -195,8 +201,8 @@ gr_status write_via_temp(const char *path, const OIIO::ImageSpec &spec, OIIO::Ty
         }
         (void)OIIO::geterror();
     }
-    if (st == GR_OK) return gr_outfile_commit(&of, 1, err);
-    gr_outfile_abort(&of);
+    if (st == GR_OK) return host->outfile_commit(&of, 1, err);
+    host->outfile_abort(&of);
     return st;
 }
 
@@ -211,11 +217,11 @@ gr_status exception_status(gr_error *err, const char *path, const char *what)
     try {
         throw;
     } catch (const std::bad_alloc &) {
-        return gr_fail(err, GR_E_NOMEM, "%s: %s: out of memory", path ? path : "(null)", what);
+        return host->fail(err, GR_E_NOMEM, "%s: %s: out of memory", path ? path : "(null)", what);
     } catch (const std::exception &e) {
-        return gr_fail(err, GR_E_RUNTIME, "%s: %s: %s", path ? path : "(null)", what, one_line(e.what()).c_str());
+        return host->fail(err, GR_E_RUNTIME, "%s: %s: %s", path ? path : "(null)", what, one_line(e.what()).c_str());
     } catch (...) {
-        return gr_fail(err, GR_E_RUNTIME, "%s: %s: unknown exception", path ? path : "(null)", what);
+        return host->fail(err, GR_E_RUNTIME, "%s: %s: unknown exception", path ? path : "(null)", what);
     }
 }
 
@@ -245,19 +251,19 @@ gr_status check_declared_size(const char *path, const OIIO::ImageSpec &spec, gr_
     const double decoded = static_cast<double>(spec.image_bytes());
     struct stat sb;
     if (stat(path, &sb) == 0 && decoded > 4096.0 * static_cast<double>(sb.st_size) + 65536.0)
-        return gr_fail(err, GR_E_INPUT, "%s: declares %d x %d pixels of %d channel%s (%.0f bytes of samples) in a %lld-byte "
+        return host->fail(err, GR_E_INPUT, "%s: declares %d x %d pixels of %d channel%s (%.0f bytes of samples) in a %lld-byte "
                        "file: no image format compresses that much; damaged or forged", path, spec.width, spec.height,
                        spec.nchannels, spec.nchannels == 1 ? "" : "s", decoded, static_cast<long long>(sb.st_size));
     char what[300], detail[160];
     std::snprintf(what, sizeof what, "reading %s", path);
     std::snprintf(detail, sizeof detail, "%d x %d pixels x %d channel(s) as float, and the file's samples", spec.width,
                   spec.height, spec.nchannels);
-    return gr_memlimit_check(what, 4.0 * spec.image_pixels() * spec.nchannels + decoded, detail, err);
+    return host->memlimit_check(what, 4.0 * spec.image_pixels() * spec.nchannels + decoded, detail, err);
 }
 
 } // namespace
 
-extern "C" const char *gr_oiio_version(void)
+static const char *oiio_version(void)
 {
     try {
         // The runtime library's version (not the header's), e.g. 20407 -> "2.4.7".
@@ -269,11 +275,6 @@ extern "C" const char *gr_oiio_version(void)
     } catch (...) {
         return "unknown";
     }
-}
-
-extern "C" gr_status gr_oiio_read(const char *path, int linearize, gr_image **out, gr_error *err)
-{
-    return gr_oiio_read_info(path, linearize, out, nullptr, err);
 }
 
 // Pixels with a channel other than alpha at 1, the top code of an integer file read as
@@ -294,27 +295,27 @@ static long long count_top_code(const gr_image *img, int alpha)
     return top;
 }
 
-extern "C" gr_status gr_oiio_read_info(const char *path, int linearize, gr_image **out, gr_oiio_info *info,
+static gr_status oiio_read_info(const char *path, int linearize, gr_image **out, gr_oiio_info *info,
                                        gr_error *err)
 {
     if (info) std::memset(info, 0, sizeof *info);
     if (out) *out = nullptr;
-    if (!path || !path[0] || !out) return gr_fail(err, GR_E_USAGE, "image read: no input path or output");
+    if (!path || !path[0] || !out) return host->fail(err, GR_E_USAGE, "image read: no input path or output");
     gr_image *img = nullptr;
-    gr_status reg = gr_check_regular_input(path, err); // a FIFO blocks, /dev/zero spins
+    gr_status reg = host->check_regular_input(path, err); // a FIFO blocks, /dev/zero spins
     if (reg != GR_OK) return reg;
     const char *format = read_format(path);
     if (!format) {
         FILE *f = std::fopen(path, "rb"); // a missing file says so first
-        if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
+        if (!f) return host->fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
         std::fclose(f);
-        return gr_fail(err, GR_E_INPUT, "%s: not a supported image file name (the reader takes %s)", path, READ_EXTS);
+        return host->fail(err, GR_E_INPUT, "%s: not a supported image file name (the reader takes %s)", path, READ_EXTS);
     }
     // EXR files pass the project's checks first (image/exr.c: data window and chunk table
     // against the file, before anything is allocated): OpenEXR's C++ reader behind
     // OpenImageIO rebuilt a huge offset table for seconds from a 2.5 KB file.
     if (!std::strcmp(format, "openexr")) {
-        gr_status est = gr_exr_check(path, err);
+        gr_status est = host->exr_check(path, err);
         if (est != GR_OK) return est;
     }
     // libpng prints its own line ("IHDR: CRC error"): kept for the message (PNG only, so
@@ -335,7 +336,7 @@ extern "C" gr_status gr_oiio_read_info(const char *path, int linearize, gr_image
             (void)OIIO::geterror();
             if (why.empty()) why = "not a valid file of this format";
             FILE *f = std::fopen(path, "rb");
-            if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
+            if (!f) return host->fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
             std::fclose(f);
             const std::string lib = cap.take();
             add_lib_text(why, lib);
@@ -347,18 +348,18 @@ extern "C" gr_status gr_oiio_read_info(const char *path, int linearize, gr_image
             add_lib_text(why, lib);
             // A missing or unreadable file is an I/O error; anything else is bad input.
             FILE *f = std::fopen(path, "rb");
-            if (!f) return gr_fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
+            if (!f) return host->fail(err, GR_E_IO, "%s: cannot open: %s", path, std::strerror(errno));
             std::fclose(f);
             return fail(err, GR_E_INPUT, path, "cannot read as an image", why);
         }
         const OIIO::ImageSpec &spec = in->spec();
-        if (spec.deep) return gr_fail(err, GR_E_INPUT, "%s: deep images are not supported", path);
-        if (spec.depth > 1) return gr_fail(err, GR_E_INPUT, "%s: volume images are not supported", path);
+        if (spec.deep) return host->fail(err, GR_E_INPUT, "%s: deep images are not supported", path);
+        if (spec.depth > 1) return host->fail(err, GR_E_INPUT, "%s: volume images are not supported", path);
         const int nc = spec.nchannels;
-        gr_status cst = gr_image_check_size(path, spec.width, spec.height, nc, err);
+        gr_status cst = host->image_check_size(path, spec.width, spec.height, nc, err);
         if (cst != GR_OK) return cst;
         if (nc <= 0 || nc > GR_IMAGE_MAX_CHANNELS)
-            return gr_fail(err, GR_E_INPUT, "%s: %d channels (1 to %d supported)", path, nc, GR_IMAGE_MAX_CHANNELS);
+            return host->fail(err, GR_E_INPUT, "%s: %d channels (1 to %d supported)", path, nc, GR_IMAGE_MAX_CHANNELS);
         cst = check_declared_size(path, spec, err);
         if (cst != GR_OK) return cst;
         static const char *const rgba[4] = {"R", "G", "B", "A"};
@@ -368,12 +369,12 @@ extern "C" gr_status gr_oiio_read_info(const char *path, int linearize, gr_image
             std::string n = c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[static_cast<size_t>(c)] : "";
             if (n.empty()) n = c < 4 ? rgba[c] : "c" + std::to_string(c);
             if (n.size() >= GR_CHANNEL_NAME_MAX)
-                return gr_fail(err, GR_E_INPUT, "%s: channel %d name '%s' is longer than %d characters", path, c, n.c_str(), GR_CHANNEL_NAME_MAX - 1);
+                return host->fail(err, GR_E_INPUT, "%s: channel %d name '%s' is longer than %d characters", path, c, n.c_str(), GR_CHANNEL_NAME_MAX - 1);
             names[static_cast<size_t>(c)] = n;
         }
         for (int c = 0; c < nc; c++) cnames[static_cast<size_t>(c)] = names[static_cast<size_t>(c)].c_str();
-        img = gr_image_create(spec.width, spec.height, nc, cnames.data());
-        if (!img) return gr_fail(err, GR_E_NOMEM, "%s: cannot allocate %d x %d x %d image", path, spec.width, spec.height, nc);
+        img = host->image_create(spec.width, spec.height, nc, cnames.data());
+        if (!img) return host->fail(err, GR_E_NOMEM, "%s: cannot allocate %d x %d x %d image", path, spec.width, spec.height, nc);
         // Scanline files are read in their own sample type and converted here: read_image
         // allocates a 64 MB buffer on every call in OpenImageIO 2.4 (tiled files still use it).
         const bool native = spec.channelformats.empty() && spec.tile_width == 0;
@@ -387,7 +388,7 @@ extern "C" gr_status gr_oiio_read_info(const char *path, int linearize, gr_image
         // scanline" for a strip past the end of the file read as zeros (issue 31)
         std::string late = read_ok ? in->geterror() : std::string();
         if (!late.empty()) {
-            gr_image_destroy(img);
+            host->image_destroy(img);
             return fail(err, GR_E_INPUT, path, "reading pixels (truncated or damaged file)", late);
         }
         if (!read_ok) {
@@ -395,7 +396,7 @@ extern "C" gr_status gr_oiio_read_info(const char *path, int linearize, gr_image
             const std::string lib = cap.take();
             add_lib_text(why, lib);
             gr_status st = fail(err, GR_E_INPUT, path, "reading pixels", why);
-            gr_image_destroy(img);
+            host->image_destroy(img);
             return st;
         }
         in->close();
@@ -419,31 +420,31 @@ extern "C" gr_status gr_oiio_read_info(const char *path, int linearize, gr_image
                         img->pixels[p * static_cast<size_t>(nc) + static_cast<size_t>(c)] =
                             srgb_decode(img->pixels[p * static_cast<size_t>(nc) + static_cast<size_t>(c)]);
         }
-        gr_status st = gr_image_check_finite(img, path, err);
+        gr_status st = host->image_check_finite(img, path, err);
         if (st != GR_OK) {
-            gr_image_destroy(img);
+            host->image_destroy(img);
             if (err) err->status = GR_E_INPUT; // a non-finite sample in a file is bad input
             return GR_E_INPUT;
         }
         *out = img;
         return GR_OK;
     } catch (...) {
-        gr_image_destroy(img);
+        host->image_destroy(img);
         return exception_status(err, path, "reading image");
     }
 }
 
-extern "C" gr_status gr_oiio_write_preview(const char *path, const gr_image *img, const int rgb[3],
+static gr_status oiio_write_preview(const char *path, const gr_image *img, const int rgb[3],
                                            double exposure, gr_error *err)
 {
-    if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "preview: no output path");
-    if (!image_ok(img)) return gr_fail(err, GR_E_INPUT, "%s: no image or bad image size", path);
-    if (!rgb) return gr_fail(err, GR_E_INPUT, "%s: no channels chosen for the preview", path);
+    if (!path || !path[0]) return host->fail(err, GR_E_USAGE, "preview: no output path");
+    if (!image_ok(img)) return host->fail(err, GR_E_INPUT, "%s: no image or bad image size", path);
+    if (!rgb) return host->fail(err, GR_E_INPUT, "%s: no channels chosen for the preview", path);
     for (int k = 0; k < 3; k++)
         if (rgb[k] < 0 || rgb[k] >= img->nchannels)
-            return gr_fail(err, GR_E_INPUT, "%s: preview channel %d is %d, the image has %d channels", path, k, rgb[k], img->nchannels);
+            return host->fail(err, GR_E_INPUT, "%s: preview channel %d is %d, the image has %d channels", path, k, rgb[k], img->nchannels);
     if (!std::isfinite(exposure) || exposure < 0.0)
-        return gr_fail(err, GR_E_INPUT, "%s: preview exposure %g is not a finite value >= 0", path, exposure);
+        return host->fail(err, GR_E_INPUT, "%s: preview exposure %g is not a finite value >= 0", path, exposure);
     try {
         const size_t w = static_cast<size_t>(img->width), h = static_cast<size_t>(img->height);
         const size_t nc = static_cast<size_t>(img->nchannels);
@@ -467,11 +468,11 @@ extern "C" gr_status gr_oiio_write_preview(const char *path, const gr_image *img
     }
 }
 
-extern "C" gr_status gr_oiio_write(const char *path, const gr_image *img, gr_error *err)
+static gr_status oiio_write(const char *path, const gr_image *img, gr_error *err)
 {
-    if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "image write: no output path");
-    if (!image_ok(img)) return gr_fail(err, GR_E_INPUT, "%s: no image or bad image size", path);
-    gr_status st = gr_image_check_finite(img, path, err);
+    if (!path || !path[0]) return host->fail(err, GR_E_USAGE, "image write: no output path");
+    if (!image_ok(img)) return host->fail(err, GR_E_INPUT, "%s: no image or bad image size", path);
+    gr_status st = host->image_check_finite(img, path, err);
     if (st != GR_OK) return st;
     try {
         OIIO::ImageSpec spec(img->width, img->height, img->nchannels, OIIO::TypeDesc::FLOAT);
@@ -490,14 +491,14 @@ extern "C" gr_status gr_oiio_write(const char *path, const gr_image *img, gr_err
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
-extern "C" gr_status gr_oiio_color_map(const gr_image *src, int channel, const char *map, gr_image **out,
+static gr_status oiio_color_map(const gr_image *src, int channel, const char *map, gr_image **out,
                                        gr_error *err)
 {
     if (out) *out = nullptr;
-    if (!out || !image_ok(src)) return gr_fail(err, GR_E_INPUT, "color map: no image or bad image size");
+    if (!out || !image_ok(src)) return host->fail(err, GR_E_INPUT, "color map: no image or bad image size");
     if (channel < 0 || channel >= src->nchannels)
-        return gr_fail(err, GR_E_INPUT, "color map: channel %d, the image has %d", channel, src->nchannels);
-    if (!map || !map[0]) return gr_fail(err, GR_E_INPUT, "color map: no map name");
+        return host->fail(err, GR_E_INPUT, "color map: channel %d, the image has %d", channel, src->nchannels);
+    if (!map || !map[0]) return host->fail(err, GR_E_INPUT, "color map: no map name");
     gr_image *res = nullptr;
     try {
         const size_t n = static_cast<size_t>(src->width) * static_cast<size_t>(src->height);
@@ -509,27 +510,27 @@ extern "C" gr_status gr_oiio_color_map(const gr_image *src, int channel, const c
         }
         OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(in, 0, map);
         if (mapped.has_error() || mapped.nchannels() != 3)
-            return gr_fail(err, GR_E_INPUT, "color map '%s': %s", map, one_line(mapped.geterror()).c_str());
-        res = gr_image_create(src->width, src->height, 3, nullptr);
-        if (!res) return gr_fail(err, GR_E_NOMEM, "color map: cannot allocate %d x %d", src->width, src->height);
+            return host->fail(err, GR_E_INPUT, "color map '%s': %s", map, one_line(mapped.geterror()).c_str());
+        res = host->image_create(src->width, src->height, 3, nullptr);
+        if (!res) return host->fail(err, GR_E_NOMEM, "color map: cannot allocate %d x %d", src->width, src->height);
         if (!mapped.get_pixels(OIIO::ROI(0, src->width, 0, src->height, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT,
                                res->pixels)) {
-            gr_image_destroy(res);
-            return gr_fail(err, GR_E_RUNTIME, "color map '%s': %s", map, one_line(mapped.geterror()).c_str());
+            host->image_destroy(res);
+            return host->fail(err, GR_E_RUNTIME, "color map '%s': %s", map, one_line(mapped.geterror()).c_str());
         }
         *out = res;
         return GR_OK;
     } catch (...) {
-        gr_image_destroy(res);
+        host->image_destroy(res);
         return exception_status(err, map, "color map");
     }
 }
 
-extern "C" gr_status gr_oiio_render_text(gr_image *img, int x, int y, const char *text, int size_px,
+static gr_status oiio_render_text(gr_image *img, int x, int y, const char *text, int size_px,
                                          const float rgb[3], int align, gr_error *err)
 {
     if (!image_ok(img) || !text || !rgb || size_px <= 0)
-        return gr_fail(err, GR_E_INPUT, "text: bad image, text, color or size");
+        return host->fail(err, GR_E_INPUT, "text: bad image, text, color or size");
     try {
         OIIO::ImageSpec spec(img->width, img->height, img->nchannels, OIIO::TypeDesc::FLOAT);
         OIIO::ImageBuf buf(spec, img->pixels); // wraps img's pixels: drawn in place
@@ -545,7 +546,7 @@ extern "C" gr_status gr_oiio_render_text(gr_image *img, int x, int y, const char
                 return GR_OK;
             (void)buf.geterror(); // clear, then try the next font
         }
-        return gr_fail(err, GR_E_RUNTIME, "text '%s': no usable font (DejaVuSans or OpenImageIO's default)", text);
+        return host->fail(err, GR_E_RUNTIME, "text '%s': no usable font (DejaVuSans or OpenImageIO's default)", text);
     } catch (...) {
         return exception_status(err, text, "drawing text");
     }
@@ -553,21 +554,21 @@ extern "C" gr_status gr_oiio_render_text(gr_image *img, int x, int y, const char
 
 // ---- animations for the sequence report (report module) ------------------------------------
 
-extern "C" gr_status gr_oiio_write_animation(const char *path, const gr_image *const *frames, int n, double fps,
+static gr_status oiio_write_animation(const char *path, const gr_image *const *frames, int n, double fps,
                                              gr_error *err)
 {
-    if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "animation write: no output path");
+    if (!path || !path[0]) return host->fail(err, GR_E_USAGE, "animation write: no output path");
     if (!frames || n < 1 || !(fps > 0) || !std::isfinite(fps))
-        return gr_fail(err, GR_E_INPUT, "%s: no frames or a bad frame rate", path);
+        return host->fail(err, GR_E_INPUT, "%s: no frames or a bad frame rate", path);
     for (int i = 0; i < n; i++)
         if (!image_ok(frames[i]) || frames[i]->nchannels < 3 || frames[i]->width != frames[0]->width ||
             frames[i]->height != frames[0]->height)
-            return gr_fail(err, GR_E_INPUT, "%s: frame %d: missing, not RGB, or another size than frame 0", path, i);
+            return host->fail(err, GR_E_INPUT, "%s: frame %d: missing, not RGB, or another size than frame 0", path, i);
     try {
         auto out = OIIO::ImageOutput::create(path);
         if (!out) return fail(err, GR_E_INPUT, path, "no writer for this file type", OIIO::geterror());
         if (!out->supports("multiimage") || !out->supports("appendsubimage"))
-            return gr_fail(err, GR_E_INPUT, "%s: this format holds no animation", path);
+            return host->fail(err, GR_E_INPUT, "%s: this format holds no animation", path);
         const int w = frames[0]->width, h = frames[0]->height;
         OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
         // frames per second as a rational of whole hundredths (the GIF delay unit)
@@ -580,7 +581,7 @@ extern "C" gr_status gr_oiio_write_animation(const char *path, const gr_image *c
         spec.attribute("gif:LoopCount", 0);
         std::vector<OIIO::ImageSpec> specs(static_cast<size_t>(n), spec);
         gr_outfile of;
-        gr_status st = gr_outfile_begin(&of, path, err);
+        gr_status st = host->outfile_begin(&of, path, err);
         if (st != GR_OK) return st;
         const std::string tmp = of.tmp;
         const std::string format = out->format_name();
@@ -620,11 +621,11 @@ extern "C" gr_status gr_oiio_write_animation(const char *path, const gr_image *c
             if (in) (void)in->geterror();
             (void)OIIO::geterror();
             if (count != n)
-                st = gr_fail(err, GR_E_IO, "%s: cannot write: %d of %d frames read back (is the disk full?)", path,
+                st = host->fail(err, GR_E_IO, "%s: cannot write: %d of %d frames read back (is the disk full?)", path,
                              count, n);
         }
-        if (st == GR_OK) return gr_outfile_commit(&of, 1, err);
-        gr_outfile_abort(&of);
+        if (st == GR_OK) return host->outfile_commit(&of, 1, err);
+        host->outfile_abort(&of);
         return st;
     } catch (...) {
         return exception_status(err, path, "writing animation");
@@ -633,11 +634,11 @@ extern "C" gr_status gr_oiio_write_animation(const char *path, const gr_image *c
 
 #include <OpenImageIO/filesystem.h>
 
-extern "C" gr_status gr_oiio_encode_png(const gr_image *img, unsigned char **buf, size_t *len, gr_error *err)
+static gr_status oiio_encode_png(const gr_image *img, unsigned char **buf, size_t *len, gr_error *err)
 {
     *buf = nullptr;
     *len = 0;
-    if (!image_ok(img) || img->nchannels < 3) return gr_fail(err, GR_E_INPUT, "PNG in memory: no image or fewer than 3 channels");
+    if (!image_ok(img) || img->nchannels < 3) return host->fail(err, GR_E_INPUT, "PNG in memory: no image or fewer than 3 channels");
     try {
         const size_t w = static_cast<size_t>(img->width), h = static_cast<size_t>(img->height);
         const size_t nc = static_cast<size_t>(img->nchannels);
@@ -652,15 +653,15 @@ extern "C" gr_status gr_oiio_encode_png(const gr_image *img, unsigned char **buf
         std::vector<unsigned char> bytes;
         OIIO::Filesystem::IOVecOutput vec(bytes);
         auto out = OIIO::ImageOutput::create("png");
-        if (!out) return gr_fail(err, GR_E_RUNTIME, "PNG in memory: no PNG writer (%s)", OIIO::geterror().c_str());
+        if (!out) return host->fail(err, GR_E_RUNTIME, "PNG in memory: no PNG writer (%s)", OIIO::geterror().c_str());
         OIIO::ImageSpec spec(img->width, img->height, 3, OIIO::TypeDesc::UINT8);
         spec.attribute("oiio:ColorSpace", "sRGB");
         if (!out->supports("ioproxy") || !out->set_ioproxy(&vec) || !out->open("mem.png", spec) ||
             !out->write_image(OIIO::TypeDesc::UINT8, codes.data()) || !out->close())
-            return gr_fail(err, GR_E_RUNTIME, "PNG in memory: %s", out->geterror().c_str());
+            return host->fail(err, GR_E_RUNTIME, "PNG in memory: %s", out->geterror().c_str());
         out.reset();
         unsigned char *b = static_cast<unsigned char *>(malloc(bytes.size() ? bytes.size() : 1));
-        if (!b) return gr_fail(err, GR_E_NOMEM, "PNG in memory: out of memory");
+        if (!b) return host->fail(err, GR_E_NOMEM, "PNG in memory: out of memory");
         if (!bytes.empty()) memcpy(b, bytes.data(), bytes.size());
         *buf = b;
         *len = bytes.size();
@@ -668,4 +669,15 @@ extern "C" gr_status gr_oiio_encode_png(const gr_image *img, unsigned char **buf
     } catch (...) {
         return exception_status(err, "PNG in memory", "encoding");
     }
+}
+
+// ---- the module's entry (oiio_module.h) -----------------------------------------------------
+
+extern "C" __attribute__((visibility("default"))) const gr_oiio_api *gr_oiio_module_open(const gr_oiio_host *h, int abi)
+{
+    static const gr_oiio_api api = {oiio_version,     oiio_read_info,   oiio_write_preview, oiio_encode_png,
+                                    oiio_write,       oiio_color_map,   oiio_render_text,   oiio_write_animation};
+    if (abi != GR_OIIO_MODULE_ABI || !h) return nullptr;
+    host = h;
+    return &api;
 }

@@ -9,8 +9,12 @@
 extern "C" {
 #endif
 
-/* OpenImageIO's version string, e.g. "2.4.7". */
+/* OpenImageIO's version string, e.g. "2.4.7" ("not loaded" when the module cannot be). */
 const char *gr_oiio_version(void);
+/* GR_OK when OpenImageIO can be used: its module loads (oiio.c; docs/images.md, "Loading
+ * OpenImageIO"); else GR_E_RUNTIME naming the places tried. Every function below fails the
+ * same way then; a caller that maps read failures to bad input asks this first. */
+gr_status gr_oiio_available(gr_error *err);
 /* Reads any format OpenImageIO reads (EXR, PNG, TIFF, HDR, ...) as float, all channels,
  * channel names as the file gives them (8-bit files are decoded to linear only if
  * linearize is nonzero; otherwise values are code/255). */

@@ -1,0 +1,46 @@
+#!/bin/sh
+# OpenImageIO as a module loaded on first use (docs/images.md, "Loading OpenImageIO"): the
+# binary does not link it; image calls load build/libgodrays_oiio.so; a missing or wrong
+# module is one line naming what was tried and why (exit 1), and EXR-only work never needs it.
+. "$(dirname "$0")/lib.sh"
+command -v oiiotool >/dev/null || { echo "FAIL: oiiotool not found (openimageio-tools)"; exit 1; }
+cd "$dir" || exit 1
+oiiotool --create 32x24 3 --fill:color=0.2,0.4,0.8 32x24 -d float -o ref.exr >/dev/null || exit 1
+oiiotool --create 32x24 3 --fill:color=0.25,0.4,0.8 32x24 -d uint8 -o test.png >/dev/null || exit 1
+
+if ldd "$bin" | grep -q 'libOpenImageIO'; then
+    echo "FAIL: $bin links libOpenImageIO itself:"; ldd "$bin" | grep OpenImageIO; fail=1
+else
+    echo "ok: $bin does not link libOpenImageIO"
+fi
+ck "the module beside the binary" test -f "$(dirname "$bin")/libgodrays_oiio.so"
+
+# loaded on demand: a PNG read and PNG outputs
+"$bin" compare ref.exr test.png --no-linearize -o res >out.txt 2>err.txt
+rc=$?
+ck "compare of a PNG through the module (exit $rc: $(head -c 300 err.txt))" test "$rc" -eq 0
+ck "its diff.png" test -s res/diff.png
+"$bin" info >info.txt 2>&1
+ck "info names OpenImageIO's version" grep -Eq '^OpenImageIO +[0-9]+\.[0-9]+' info.txt
+
+# a module that is not there: one line with the place tried and the loader's reason
+GODRAYS_OIIO_MODULE=$dir/none.so expect 1 "$dir/none.so: " compare ref.exr test.png -o res2
+ck "nothing written by the failed compare" test ! -e res2/metrics.json
+GODRAYS_OIIO_MODULE=$dir/none.so expect 1 "set GODRAYS_OIIO_MODULE to its path" compare ref.exr test.png -o res2
+# a shared library that is not the module
+libm=$(ldd "$bin" | awk '$1 ~ /^libm\.so/ { print $3 }')
+if [ -n "$libm" ]; then
+    GODRAYS_OIIO_MODULE=$libm expect 1 "no gr_oiio_module_open in it" compare ref.exr test.png -o res3
+else
+    echo "FAIL: no libm in ldd's output"; fail=1
+fi
+GODRAYS_OIIO_MODULE=$dir/none.so "$bin" info >info2.txt 2>&1
+ck "info without the module: exit 0, 'not loaded'" grep -Eq '^OpenImageIO +not loaded' info2.txt
+# EXR in and out never load it: a tiny ground truth without a preview
+small_scene scene.json 16 9
+GODRAYS_OIIO_MODULE=$dir/none.so "$bin" reference scene.json -o t.exr --no-preview -q \
+    --set reference.batches=2 --set reference.sun_samples=2 >ref_out.txt 2>&1
+rc=$?
+ck "reference to EXR without the module (exit $rc: $(head -c 300 ref_out.txt))" test "$rc" -eq 0
+ck "its EXR" test -s t.exr
+exit $fail
