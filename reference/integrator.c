@@ -172,6 +172,7 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
     int per_batch = r->passes_per_round / r->batches;
     r->spp_pass = (st->spp + per_batch - 1) / per_batch;
     if (r->spp_pass < 1) r->spp_pass = 1;
+    r->camera_rays = st->camera_rays < 1 ? 1 : st->camera_rays > REF_MAX_RAYS ? REF_MAX_RAYS : st->camera_rays;
     r->threads = st->threads > 0 ? st->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
     if (r->threads < 1) r->threads = 1;
 

@@ -18,16 +18,13 @@ typedef struct ref_job {
     gr_ref_work w;      /* the rows, stop, and per-thread counters summed after the pass */
 } ref_job;
 
-/* Stratum j of n over the pixel: an nx x ny grid of cells (nx the largest divisor of n not
- * above sqrt(n)); the sample is jittered within its cell. */
-static void pixel_stratum(int j, int n, ref_rng *g, double *jx, double *jy)
+/* An nx x ny grid of n cells (nx the largest divisor of n not above sqrt(n)). */
+static void cell_grid(int n, int *nx, int *ny)
 {
-    int nx = 1;
+    *nx = 1;
     for (int d = 1; d * d <= n; d++)
-        if (n % d == 0) nx = d;
-    int ny = n / nx, ix = j % nx, iy = j / nx;
-    *jx = (ix + rng_u(g)) / nx;
-    *jy = (iy + rng_u(g)) / ny;
+        if (n % d == 0) *nx = d;
+    *ny = n / *nx;
 }
 
 void gr_ref_scratch_free(ref_scratch *sc)
@@ -63,14 +60,24 @@ static float ray_end(const gr_ref_renderer *r, const gr_beams *bs, gr_vec3 o, gr
     return D;
 }
 
-int gr_ref_march_ray(const gr_ref_renderer *r, double fx, double fy, int n, const uint16_t *alloc, ref_rng *g, double L[3],
-                     double *trans, double *len, ref_counters *cnt, ref_scratch *sc, double *ck)
+/* One camera ray's geometry: its direction, the beam set it looks up, where it ends and its
+ * march density exp(-lam t) on [0, D] (om: the density's mass, wbase: a stratum's weight). */
+typedef struct ref_ray_geo {
+    gr_vec3 d;
+    const gr_beams *bs;
+    float D;
+    double lam, om, wbase;
+} ref_ray_geo;
+
+/* The ray through the image point (fx, fy) (pixels) for a march of n steps; *trans and *len
+ * get its transmittance (RGB mean) and length to its end. */
+static void ray_geometry(const gr_ref_renderer *r, double fx, double fy, int n, ref_ray_geo *rg, double *trans,
+                         double *len)
 {
     const gr_camera *c = &r->scene.camera;
     double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), aspect = (double)c->width / (double)c->height;
     gr_dvec3 dd = cam_dir(r, (2.0 * fx / c->width - 1.0) * tf * aspect, (1.0 - 2.0 * fy / c->height) * tf);
     gr_vec3 d = gr_d3_to_f(dd), o = r->cam;
-    L[0] = L[1] = L[2] = 0.0;
     /* where the camera ray ends: occluder or seabed, the water surface, the cutoff */
     float De = gr_rtc_intersect(r->geom->ends, o, d, 0.0f, (float)r->cutoff_d, NULL, NULL), D = -1.0f;
     const gr_beams *bs = r->beams;
@@ -90,42 +97,69 @@ int gr_ref_march_ray(const gr_ref_renderer *r, double fx, double fy, int n, cons
     if (!(D > 0.0f)) D = 0.0f;
     *len = D;
     *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
-    if (ck)
-        for (int k = 0; k < 3 * n; k++) ck[k] = 0.0;
-    if (D == 0.0f) return 0;
+    rg->d = d;
+    rg->bs = bs;
+    rg->D = D;
     /* March density ~ exp(-lam t) on [0, D], lam = sig_ref (1 - w_y / mu_t0): the camera
      * ray's extinction times the sunlight's extinction down to the point on flat water, so
      * the flat-water integrand is sampled exactly in proportion (Oracle 1) and the waves
      * only add their caustic modulation. Stratified in the density's CDF, jittered. */
-    double lam = r->sig_ref * (1.0 - (double)d.y / -r->T0.y), lD = lam * D, om, wbase;
+    double lam = r->sig_ref * (1.0 - (double)d.y / -r->T0.y), lD = lam * D;
     if (fabs(lD) > 1e-6) {
-        om = -expm1(-lD);
-        wbase = om / (lam * n);
+        rg->lam = lam;
+        rg->om = -expm1(-lD);
+        rg->wbase = rg->om / (lam * n);
     } else {
-        lam = 0.0;
-        om = 0.0;
-        wbase = (double)D / n;
+        rg->lam = 0.0;
+        rg->om = 0.0;
+        rg->wbase = (double)D / n;
     }
+}
+
+int gr_ref_march_ray(const gr_ref_renderer *r, int nrays, const double *fx, const double *fy, int n, const uint16_t *alloc,
+                     ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt, ref_scratch *sc, double *ck)
+{
+    ref_ray_geo rg[REF_MAX_RAYS];
+    const gr_vec3 o = r->cam;
+    L[0] = L[1] = L[2] = 0.0;
+    *trans = *len = 0.0;
+    int any = 0;
+    for (int i = 0; i < nrays; i++) {
+        double tr, ln;
+        ray_geometry(r, fx[i], fy[i], n, &rg[i], &tr, &ln);
+        *trans += tr / nrays;
+        *len += ln / nrays;
+        any |= rg[i].D > 0.0f;
+    }
+    if (ck)
+        for (int k = 0; k < 3 * n; k++) ck[k] = 0.0;
+    if (!any) return 0;
     const gr_hg hg = gr_hg_make(r->scene.medium.g); /* seed eq. 5.5.4 */
     /* segment sg of the CDF range, [sg, sg + 1) / nseg, holds a >= 1 jittered strata; a point
      * there stands for 1 / (nseg a) of the range (the weight wbase n / (nseg a)); n = the sum
      * of alloc (docs/reference.md 2.5). Without an allotment: one segment of n strata, each
-     * of weight wbase */
+     * of weight wbase. Stratum k is marched on ray k mod nrays (the caller places the rays in
+     * the pixel in a random rotation of its sub-cells, so that every stratum's ray is uniform
+     * over the pixel: docs/reference.md 2.5, "Rays per camera sample") */
     const int nseg = alloc ? SEGMENTS : 1;
     for (int sg = 0, k = 0; sg < nseg; sg++) {
         int a = alloc ? alloc[sg] : n;
-        double ws = alloc ? wbase * n / ((double)SEGMENTS * a) : wbase;
         for (int j = 0; j < a; j++, k++) {
+            const ref_ray_geo *q = &rg[k % nrays];
             double u = (sg + (j + rng_u(g)) / a) / nseg;
-            sc->t[k] = lam != 0.0 ? -log1p(-u * om) / lam : u * D;
+            sc->t[k] = q->lam != 0.0 ? -log1p(-u * q->om) / q->lam : u * q->D;
             sc->tf[k] = (float)sc->t[k];
-            sc->w[k] = ws;
+            sc->w[k] = q->D > 0.0f ? (alloc ? q->wbase * n / ((double)SEGMENTS * a) : q->wbase) : 0.0;
         }
     }
     for (int k = 0; k < n; k++) {
+        if (sc->w[k] == 0.0) continue; /* a ray that ends at once (D = 0) */
+        const ref_ray_geo *q = &rg[k % nrays];
+        const gr_vec3 d = q->d;
+        const double lam = q->lam;
         double t = sc->t[k];
         gr_vec3 x = gr_v3_madd(o, d, sc->tf[k]);
-        int m = light_at(r, bs, x, &sc->lights, &sc->lcap, &sc->hits);
+        int m = light_at(r, q->bs, x, &sc->lights, &sc->lcap, &sc->hits);
         if (m < 0) return -1;
         cnt->queries++;
         if (m > cnt->max_hits) cnt->max_hits = m;
@@ -163,13 +197,26 @@ int gr_ref_march_ray(const gr_ref_renderer *r, double fx, double fy, int n, cons
 }
 
 /* One camera sample of pixel (px, py) with n march steps: stratum j of the n_strata camera
- * samples its batch takes in this round, jittered within it. */
-static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, int n, const uint16_t *alloc,
-                         ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt, ref_scratch *sc)
+ * samples its batch takes in this round (a cell of the pixel), marched on nrays rays, one
+ * jittered in each of the cell's nrays sub-cells, in a random rotation (docs/reference.md
+ * 2.5, "Rays per camera sample"). */
+static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, int nrays, int n,
+                         const uint16_t *alloc, ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt,
+                         ref_scratch *sc)
 {
-    double jx, jy;
-    pixel_stratum(j, n_strata, g, &jx, &jy);
-    return gr_ref_march_ray(r, px + jx, py + jy, n, alloc, g, L, trans, len, cnt, sc, NULL);
+    int nx, ny, kx, ky;
+    cell_grid(n_strata, &nx, &ny);
+    cell_grid(nrays, &kx, &ky);
+    double fx[REF_MAX_RAYS], fy[REF_MAX_RAYS];
+    int rot = nrays > 1 ? (int)(rng_u(g) * nrays) : 0;
+    if (rot >= nrays) rot = nrays - 1;
+    for (int i = 0; i < nrays; i++) {
+        int sub = (i + rot) % nrays;
+        double ux = rng_u(g), uy = rng_u(g);
+        fx[i] = px + ((j % nx) + ((sub % kx) + ux) / kx) / nx;
+        fy[i] = py + ((j / nx) + ((sub / kx) + uy) / ky) / ny;
+    }
+    return gr_ref_march_ray(r, nrays, fx, fy, n, alloc, g, L, trans, len, cnt, sc, NULL);
 }
 
 static void *worker(void *arg)
@@ -221,7 +268,7 @@ static void *worker(void *arg)
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
-                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, n, alloc, &g, L, &tr, &len,
+                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, r->camera_rays, n, alloc, &g, L, &tr, &len,
                                   &cnt, &sc) != 0) {
                     oom = 1;
                     break;

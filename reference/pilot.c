@@ -55,7 +55,7 @@ static void *pilot_worker(void *arg)
             int bh = H - j * PILOT_STRIDE < PILOT_STRIDE ? H - j * PILOT_STRIDE : PILOT_STRIDE;
             double fx = i * PILOT_STRIDE + bw * rng_u(&g), fy = j * PILOT_STRIDE + bh * rng_u(&g);
             double L[3], tr, len;
-            if (gr_ref_march_ray(r, fx, fy, n0, NULL, &g, L, &tr, &len, &cnt, &sc, ck) != 0) { oom = 1; break; }
+            if (gr_ref_march_ray(r, 1, &fx, &fy, n0, NULL, &g, L, &tr, &len, &cnt, &sc, ck) != 0) { oom = 1; break; }
             /* collapsed strata: the strata 2i and 2i + 1 merged into one holding two samples,
              * whose variance (c_2i - c_2i+1)^2 estimates without bias and that of the stratified
              * pair at most (docs/reference.md 2.5) */

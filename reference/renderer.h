@@ -42,6 +42,8 @@ enum { PILOT_STRIDE = 2, PILOT_RADIUS = 2, PILOT_MEAN_STRIDE = 4 };
  * [0, 1) is cut into SEGMENTS equal parts, each with its own number of jittered strata (at
  * least one), allotted from the pilot's step noise in that part. */
 enum { SEGMENTS = 8 };
+/* at most this many camera rays share one camera sample's march (reference.camera_rays) */
+enum { REF_MAX_RAYS = 16 };
 #define ALLOT_FLOOR 0.25
 /* the march's unit of work: bands of MARCH_TILE rows, walked in square tiles (worker; the
  * pilot's of MARCH_TILE / PILOT_STRIDE pilot pixels: the same image area) */
@@ -82,6 +84,7 @@ struct gr_ref_renderer {
     gr_beam_region region;
     double pad;
     int passes_per_round, spp_pass, batches, threads;
+    int camera_rays;          /* rays per camera sample in the main passes (1..REF_MAX_RAYS) */
     double sig_t[3], sig_s[3], E[3];
     double sig_ref;           /* min_c sigma_t: the march's importance density */
     /* current pass */

@@ -18,6 +18,8 @@ static const char *const sun_disc_names[] = {"convolve", "sample", NULL};
 static const gr_param reference_params[] = {
     {.name = "spp", .type = GR_PT_INT, .offset = REF(spp), .min = 1, .max = 1 << 20, .def = 1,
      .unit = "", .doc = "camera samples per pixel in each batch"},
+    {.name = "camera_rays", .type = GR_PT_INT, .offset = REF(camera_rays), .min = 1, .max = 16, .def = 4,
+     .unit = "", .doc = "camera rays sharing each camera sample's march steps, one in each sub-cell of its pixel cell (round robin over the steps): the pixel's footprint sampled more finely at the same steps"},
     {.name = "steps", .type = GR_PT_INT, .offset = REF(steps), .min = 1, .max = 1 << 16, .def = 64,
      .unit = "", .doc = "stratified, jittered march steps along each camera ray (with adaptive_steps: the most a pixel takes)"},
     {.name = "surface_res", .type = GR_PT_INT, .offset = REF(surface_res), .min = 2, .max = 16384,

@@ -10,6 +10,7 @@
 /* Ground-truth integrator (reference/). */
 typedef struct gr_reference_settings {
     int spp;                      /* camera samples per pixel (per batch group, see batches) */
+    int camera_rays;              /* rays per camera sample, sharing its march steps */
     int steps;                    /* stratified, jittered march steps along each camera ray;
                                      with adaptive_steps the most any pixel takes */
     int surface_res;              /* surface tessellation: cells along each axis of the lit patch */
