@@ -61,24 +61,11 @@ static gr_scene *wavy(int w, int h, double fov, int steps, int adaptive, int see
 enum { NBX = 4, NBY = 4, NB = NBX * NBY };
 static void batch_means(const gr_ref_sums *s, double *m)
 {
-    int B = s->B;
     for (int k = 0; k <= NB; k++)
-        for (int b = 0; b < B; b++) {
-            int x0 = 0, x1 = s->W, y0 = 0, y1 = s->H;
-            if (k < NB) {
-                x0 = (k % NBX) * s->W / NBX; x1 = (k % NBX + 1) * s->W / NBX;
-                y0 = (k / NBX) * s->H / NBY; y1 = (k / NBX + 1) * s->H / NBY;
-            }
-            double v = 0.0;
-            int n = 0;
-            for (int y = y0; y < y1; y++)
-                for (int x = x0; x < x1; x++, n++) {
-                    size_t p = (size_t)y * s->W + x;
-                    const double *q = s->sum + (p * B + b) * 3;
-                    v += (q[0] + q[1] + q[2]) / (3.0 * s->count[p * B + b]);
-                }
-            m[k * B + b] = v / n;
-        }
+        for (int b = 0; b < s->B; b++)
+            m[k * s->B + b] = k < NB ? ref_batch_region_mean(s, b, (k % NBX) * s->W / NBX, (k % NBX + 1) * s->W / NBX,
+                                                            (k / NBX) * s->H / NBY, (k / NBX + 1) * s->H / NBY)
+                                     : ref_batch_region_mean(s, b, 0, s->W, 0, s->H);
 }
 
 /* (a) The same seed for both renders: their batches share the passes' grid offsets and the
@@ -105,16 +92,7 @@ static void test_unbiased(int reduced)
     batch_means(rf.sums, mf);
     double worst = 0.0;
     for (int k = 0; k <= NB; k++) {
-        double a = 0.0, a2 = 0.0, f = 0.0;
-        for (int b = 0; b < B; b++) {
-            double d = ma[k * B + b] - mf[k * B + b];
-            a += d;
-            a2 += d * d;
-            f += mf[k * B + b];
-        }
-        a /= B;
-        f /= B;
-        double se = sqrt(fmax(0.0, (a2 - B * a * a) / (B - 1)) / B), t = se > 0.0 ? a / se : (a == 0.0 ? 0.0 : INFINITY);
+        double a, se, f, t = ref_paired_t(ma + k * B, mf + k * B, B, &a, &se, &f);
         if (k == NB)
             printf("(a) image mean: fixed 96 steps %.6f, adaptive (%.1f steps) - fixed %+.2e +- %.1e (t = %.2f)\n", f,
                    ra.steps_mean, a, se, t);

@@ -60,27 +60,15 @@ static double px(const gr_image *im, int x, int y, int c)
 }
 
 /* Per 8 x 8 block k (k < nb; k = nb: the image) and batch b, the RGB mean of the batch's
- * pixel estimates: m[k * B + b]. */
+ * pixel estimates: m[k * B + b] (m may be NULL). Returns nb. */
 static int block_means(const gr_ref_sums *s, double *m)
 {
-    int B = s->B, bw = s->W / 8, nb = bw * (s->H / 8);
-    for (int k = 0; k <= nb; k++)
-        for (int b = 0; b < B; b++) {
-            int x0 = 0, x1 = s->W, y0 = 0, y1 = s->H;
-            if (k < nb) {
-                x0 = (k % bw) * 8; x1 = x0 + 8;
-                y0 = (k / bw) * 8; y1 = y0 + 8;
-            }
-            double v = 0.0;
-            int n = 0;
-            for (int y = y0; y < y1; y++)
-                for (int x = x0; x < x1; x++, n++) {
-                    size_t p = (size_t)y * s->W + x;
-                    const double *q = s->sum + (p * B + b) * 3;
-                    v += (q[0] + q[1] + q[2]) / (3.0 * s->count[p * B + b]);
-                }
-            if (m) m[k * B + b] = v / n;
-        }
+    int bw = s->W / 8, nb = bw * (s->H / 8);
+    for (int k = 0; m && k <= nb; k++)
+        for (int b = 0; b < s->B; b++)
+            m[k * s->B + b] = k < nb ? ref_batch_region_mean(s, b, (k % bw) * 8, (k % bw) * 8 + 8, (k / bw) * 8,
+                                                            (k / bw) * 8 + 8)
+                                     : ref_batch_region_mean(s, b, 0, s->W, 0, s->H);
     return nb;
 }
 
@@ -106,16 +94,7 @@ int main(void)
     block_means(b.sums, mb);
     double worst = 0.0;
     for (int k = 0; k <= nb; k++) {
-        double m = 0.0, m2 = 0.0, f = 0.0;
-        for (int j = 0; j < B; j++) {
-            double d = ma[k * B + j] - mb[k * B + j];
-            m += d;
-            m2 += d * d;
-            f += mb[k * B + j];
-        }
-        m /= B;
-        f /= B;
-        double se = sqrt(fmax(0.0, (m2 - B * m * m) / (B - 1)) / B), t = se > 0.0 ? m / se : (m == 0.0 ? 0.0 : INFINITY);
+        double m, se, f, t = ref_paired_t(ma + k * B, mb + k * B, B, &m, &se, &f);
         if (k == nb)
             printf("(a) image mean: 1 ray %.6f, 4 rays - 1 ray %+.2e +- %.1e (t = %.2f)\n", f, m, se, t);
         else if (fabs(t) > fabs(worst))

@@ -2,11 +2,13 @@
  * text, one-call renders, and the reduced-run switch. */
 #ifndef GR_TEST_REF_UTIL_H
 #define GR_TEST_REF_UTIL_H
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "reference/integrator.h"
+#include "reference/sums.h"
 #include "scene/scene.h"
 
 /* CI sets GODRAYS_TEST_REDUCED=1 for slow tests: a smaller variant that checks the same
@@ -52,5 +54,37 @@ static inline void ref_render(const gr_scene *s, const gr_ref_options *o, gr_ref
         exit(1);
     }
     gr_ref_destroy(r);
+}
+/* The RGB mean of batch b's pixel estimates over [x0, x1) x [y0, y1) (with keep_sums). */
+static inline double ref_batch_region_mean(const gr_ref_sums *s, int b, int x0, int x1, int y0, int y1)
+{
+    double v = 0.0;
+    int n = 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++, n++) {
+            size_t p = (size_t)y * s->W + x;
+            const double *q = s->sum + (p * s->B + b) * 3;
+            v += (q[0] + q[1] + q[2]) / (3.0 * s->count[p * s->B + b]);
+        }
+    return n ? v / n : 0.0;
+}
+
+/* Two renders' batch values a[b], c[b] (b < B) paired: the mean of d_b = a_b - c_b in *mean,
+ * its standard error in *se (batches independent: sd(d) / sqrt(B)), c's mean in *mean_c;
+ * returns mean / se, Student t with B - 1 degrees of freedom when the two agree on average. */
+static inline double ref_paired_t(const double *a, const double *c, int B, double *mean, double *se, double *mean_c)
+{
+    double m = 0.0, m2 = 0.0, f = 0.0;
+    for (int b = 0; b < B; b++) {
+        double d = a[b] - c[b];
+        m += d;
+        m2 += d * d;
+        f += c[b];
+    }
+    m /= B;
+    *mean = m;
+    *mean_c = f / B;
+    *se = sqrt(fmax(0.0, (m2 - B * m * m) / (B - 1)) / B);
+    return *se > 0.0 ? m / *se : (m == 0.0 ? 0.0 : INFINITY);
 }
 #endif
