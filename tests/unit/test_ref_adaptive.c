@@ -18,17 +18,6 @@
 #include "core/optics.h"
 #include "test_ref_util.h"
 
-/* the default scene's waves, sun, water and camera (data/scenes/default.json) */
-#define WAVES                                                                                                         \
-    "\"water\":{\"waves\":[{\"amplitude_m\":0.115,\"wavelength_m\":12,\"direction_deg\":40},"                         \
-    "{\"amplitude_m\":0.079,\"wavelength_m\":9,\"direction_deg\":25,\"phase_rad\":1.3},"                              \
-    "{\"amplitude_m\":0.056,\"wavelength_m\":7,\"direction_deg\":58,\"phase_rad\":2.9},"                              \
-    "{\"amplitude_m\":0.044,\"wavelength_m\":5.5,\"direction_deg\":32,\"phase_rad\":4.4},"                            \
-    "{\"amplitude_m\":0.029,\"wavelength_m\":4,\"direction_deg\":70,\"phase_rad\":0.7},"                              \
-    "{\"amplitude_m\":0.028,\"wavelength_m\":2.4,\"direction_deg\":12,\"phase_rad\":3.6},"                            \
-    "{\"amplitude_m\":0.019,\"wavelength_m\":1.6,\"direction_deg\":50,\"phase_rad\":5.5},"                            \
-    "{\"amplitude_m\":0.012,\"wavelength_m\":1.0,\"direction_deg\":85,\"phase_rad\":2.2}]}"
-#define MEDIUM "\"medium\":{\"absorption_per_m\":[0.342,0.0585,0.0212],\"scattering_per_m\":[0.041,0.049,0.062],\"g\":0.9}"
 
 /* Student's t, 7 degrees of freedom, two-sided 99.8 % (P(|T| <= t) = 0.998; standard table):
  * the family of 17 comparisons in (a) then fails by chance with probability below 4 %. */
@@ -43,7 +32,7 @@ static double meta(const gr_ref_result *r, const char *key)
 static gr_scene *wavy_along(int w, int h, double fov, int steps, int adaptive, int seed, int surface_res,
                             double step_error, int along)
 {
-    return ref_scene("{" WAVES ",\"sun\":{\"elevation_deg\":60,\"azimuth_deg\":30}," MEDIUM ","
+    return ref_scene("{" REF_DEFAULT_WAVES ",\"sun\":{\"elevation_deg\":60,\"azimuth_deg\":30}," REF_DEFAULT_MEDIUM ","
                      "\"camera\":{\"position_m\":[0,-8,0],\"yaw_deg\":30,\"pitch_deg\":60,\"fov_deg\":%g,"
                      "\"width\":%d,\"height\":%d},\"seabed\":{\"depth_m\":25},"
                      "\"reference\":{\"steps\":%d,\"adaptive_steps\":%s,\"seed\":%d,\"surface_res\":%d,"
@@ -171,7 +160,7 @@ static void test_along_ray(void)
  * ask for steps (the target holds per channel), and the image is Oracle 1's closed form (as in unit.ref_flat, written here for one ray). */
 static void test_flat(void)
 {
-    gr_scene *s = ref_scene("{\"sun\":{\"elevation_deg\":60,\"azimuth_deg\":30,\"angular_diameter_deg\":0}," MEDIUM ","
+    gr_scene *s = ref_scene("{\"sun\":{\"elevation_deg\":60,\"azimuth_deg\":30,\"angular_diameter_deg\":0}," REF_DEFAULT_MEDIUM ","
                             "\"camera\":{\"position_m\":[0,-8,0],\"yaw_deg\":30,\"pitch_deg\":-60,\"fov_deg\":0.01,"
                             "\"width\":3,\"height\":3},"
                             "\"reference\":{\"steps\":96,\"bias_probe\":false,\"sun_samples\":8,\"batches\":8}}");

@@ -11,6 +11,18 @@
 #include "reference/sums.h"
 #include "scene/scene.h"
 
+/* the default scene's waves and water (data/scenes/default.json), as JSON members */
+#define REF_DEFAULT_WAVES                                                                                                         \
+    "\"water\":{\"waves\":[{\"amplitude_m\":0.115,\"wavelength_m\":12,\"direction_deg\":40},"                         \
+    "{\"amplitude_m\":0.079,\"wavelength_m\":9,\"direction_deg\":25,\"phase_rad\":1.3},"                              \
+    "{\"amplitude_m\":0.056,\"wavelength_m\":7,\"direction_deg\":58,\"phase_rad\":2.9},"                              \
+    "{\"amplitude_m\":0.044,\"wavelength_m\":5.5,\"direction_deg\":32,\"phase_rad\":4.4},"                            \
+    "{\"amplitude_m\":0.029,\"wavelength_m\":4,\"direction_deg\":70,\"phase_rad\":0.7},"                              \
+    "{\"amplitude_m\":0.028,\"wavelength_m\":2.4,\"direction_deg\":12,\"phase_rad\":3.6},"                            \
+    "{\"amplitude_m\":0.019,\"wavelength_m\":1.6,\"direction_deg\":50,\"phase_rad\":5.5},"                            \
+    "{\"amplitude_m\":0.012,\"wavelength_m\":1.0,\"direction_deg\":85,\"phase_rad\":2.2}]}"
+#define REF_DEFAULT_MEDIUM "\"medium\":{\"absorption_per_m\":[0.342,0.0585,0.0212],\"scattering_per_m\":[0.041,0.049,0.062],\"g\":0.9}"
+
 /* CI sets GODRAYS_TEST_REDUCED=1 for slow tests: a smaller variant that checks the same
  * property. GODRAYS_TEST_FULL=1 forces the full variant. */
 static inline int ref_reduced(void)
