@@ -12,6 +12,9 @@
 # space-separated subset; default: every technique), QUICK=1 (only the ladders' quick points),
 # DEFAULTS_ONLY=1 (only the scene defaults), BASE=BINARY (also render each technique's defaults
 # with BINARY in the same run, alternating, and print the wall-time ratio new / base).
+# On a machine without Debian's libraries (../shared/tools/carry-build packs build/godrays with
+# its own library closure): build with `cmake -DGODRAYS_OIIO_MODULE=OFF` first, so that
+# OpenImageIO is in that closure rather than in the module loaded on demand (docs/images.md).
 set -eu
 here=$(cd "$(dirname "$0")/.." && pwd)
 bin=${1:-$here/build/godrays}
