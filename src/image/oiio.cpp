@@ -679,9 +679,5 @@ extern "C" __attribute__((visibility("default"))) const gr_oiio_api *gr_oiio_mod
                                     oiio_write,       oiio_color_map,   oiio_render_text,   oiio_write_animation};
     if (abi != GR_OIIO_MODULE_ABI || !h) return nullptr;
     host = h;
-    // No worker pool: its threads, started inside a dlopen'ed library, crashed LeakSanitizer's
-    // tracer at exit (the ASan build's unit.metric_registry, cli.sweep); the images this
-    // module handles (previews, maps, inputs of compare) are small.
-    OIIO::attribute("threads", 1);
     return &api;
 }
