@@ -196,25 +196,28 @@ int gr_ref_march_ray(const gr_ref_renderer *r, int nrays, const double *fx, cons
     return 0;
 }
 
-/* One camera sample of pixel (px, py) with n march steps: stratum j of the n_strata camera
- * samples its batch takes in this round (a cell of the pixel), marched on nrays rays, one
- * jittered in each of the cell's nrays sub-cells, in a random rotation (docs/reference.md
- * 2.5, "Rays per camera sample"). */
-static int render_sample(const gr_ref_renderer *r, int px, int py, int j, int n_strata, int nrays, int n,
+/* Where a pixel's camera samples and their rays go: the samples' strata an nx x ny grid of
+ * cells of the pixel, each cell's rays a kx x ky grid of sub-cells (cell_grid; fixed for a
+ * render, set once per worker). */
+typedef struct ref_sample_grid { int nx, ny, kx, ky; } ref_sample_grid;
+
+/* One camera sample of pixel (px, py) with n march steps: stratum j of the camera samples its
+ * batch takes in this round (a cell of the pixel), marched on the kx ky rays, one jittered in
+ * each of the cell's sub-cells, in a random rotation (docs/reference.md 2.5, "Rays per
+ * camera sample"). */
+static int render_sample(const gr_ref_renderer *r, int px, int py, int j, const ref_sample_grid *sg, int n,
                          const uint16_t *alloc, ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt,
                          ref_scratch *sc)
 {
-    int nx, ny, kx, ky;
-    cell_grid(n_strata, &nx, &ny);
-    cell_grid(nrays, &kx, &ky);
+    const int nrays = sg->kx * sg->ky;
     double fx[REF_MAX_RAYS], fy[REF_MAX_RAYS];
     int rot = nrays > 1 ? (int)(rng_u(g) * nrays) : 0;
     if (rot >= nrays) rot = nrays - 1;
     for (int i = 0; i < nrays; i++) {
         int sub = (i + rot) % nrays;
         double ux = rng_u(g), uy = rng_u(g);
-        fx[i] = px + ((j % nx) + ((sub % kx) + ux) / kx) / nx;
-        fy[i] = py + ((j / nx) + ((sub / kx) + uy) / ky) / ny;
+        fx[i] = px + ((j % sg->nx) + ((sub % sg->kx) + ux) / sg->kx) / sg->nx;
+        fy[i] = py + ((j / sg->nx) + ((sub / sg->kx) + uy) / sg->ky) / sg->ny;
     }
     return gr_ref_march_ray(r, nrays, fx, fy, n, alloc, g, L, trans, len, cnt, sc, NULL);
 }
@@ -230,6 +233,9 @@ static void *worker(void *arg)
     /* camera samples are stratified over the pixel within a batch (like the passes' strata):
      * this pass is the k-th of its batch in the round */
     int per_batch = r->passes_per_round / r->batches, k_in_batch = (job->pass % r->passes_per_round) / r->batches;
+    ref_sample_grid sgrid;
+    cell_grid(per_batch * r->spp_pass, &sgrid.nx, &sgrid.ny);
+    cell_grid(r->camera_rays, &sgrid.kx, &sgrid.ky);
     if (gr_ref_scratch_alloc(&sc, r->set.steps) != 0) {
         atomic_store(&job->w.stop, 2);
         return NULL;
@@ -268,7 +274,7 @@ static void *worker(void *arg)
                 uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
-                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, per_batch * r->spp_pass, r->camera_rays, n, alloc, &g, L, &tr, &len,
+                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, &sgrid, n, alloc, &g, L, &tr, &len,
                                   &cnt, &sc) != 0) {
                     oom = 1;
                     break;
