@@ -284,10 +284,19 @@ static void *destroy_job(void *arg)
 gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
 {
     r->Ip = gr_ref_pass_sun_dir(r, pass);
-    ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)pass);
+    /* the grid's offset: the pass's own; with reference.antithetic, the (2m + 1)-th pass of a
+     * batch in a round takes the (2m)-th's moved by half a cell in both directions (a batch
+     * then holds antithetic pairs, the batches stay independent: docs/reference.md 2.5) */
+    int per_batch = r->passes_per_round / r->batches, k = (pass % r->passes_per_round) / r->batches;
+    int half = r->set.antithetic && (k & 1) && k < (per_batch & ~1);
+    ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)(pass - half * r->batches));
     (void)rng_u(&g);
     (void)rng_u(&g);
     double jit[2] = {rng_u(&g), rng_u(&g)};
+    if (half) {
+        jit[0] = jit[0] < 0.5 ? jit[0] + 0.5 : jit[0] - 0.5;
+        jit[1] = jit[1] < 0.5 ? jit[1] + 0.5 : jit[1] - 0.5;
+    }
     if (r->opt.fixed_grid) jit[0] = jit[1] = 0.5;
     /* Oracle 1: flat refraction, E_w / E_sun = F_t cos(theta_i) / cos(theta_t) */
     gr_dvec3 T = gr_refract_d(r->Ip, gr_d3(0, 1, 0), 1.0 / r->scene.medium.ior);

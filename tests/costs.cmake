@@ -31,6 +31,7 @@ set(GR_TEST_COSTS
   cli.compare_fit 13 19
   cli.rel_signals 10 0
   unit.ref_convergence 9 0
+  unit.ref_antithetic 9 13
   integration.volume_flat 9 21
   cli.report_browser 9 16
   unit.ref_focus 8 0

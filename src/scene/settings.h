@@ -11,6 +11,8 @@
 typedef struct gr_reference_settings {
     int spp;                      /* camera samples per pixel (per batch group, see batches) */
     int camera_rays;              /* rays per camera sample, sharing its march steps */
+    int antithetic;               /* 1: a batch's passes in pairs whose surface grids are offset by
+                                     half a cell (docs/reference.md 2.5, "Antithetic pairs") */
     int steps;                    /* stratified, jittered march steps along each camera ray;
                                      with adaptive_steps the most any pixel takes */
     int surface_res;              /* surface tessellation: cells along each axis of the lit patch */
