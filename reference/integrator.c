@@ -257,8 +257,7 @@ gr_dvec3 gr_ref_pass_sun_dir(const gr_ref_renderer *r, int pass)
      * of a round, the k-th of them stratum k of P / B. Every batch is then a stratified
      * estimator of its own, independent of the others, so the spread of the batch means is
      * an honest error bar (strata spread across batches would inflate it). */
-    int per_batch = r->passes_per_round / r->batches;
-    int k = (pass % r->passes_per_round) / r->batches;
+    int per_batch, k = pass_in_batch(r, pass, &per_batch);
     double u = (k + rng_u(&g)) / per_batch;
     double phi = 2.0 * GR_PI * rng_u(&g);
     double cr = 1.0 - u * (1.0 - cos(r->sun_radius)), sr = sqrt(fmax(0.0, 1.0 - cr * cr));
@@ -287,7 +286,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     /* the grid's offset: the pass's own; with reference.antithetic, the (2m + 1)-th pass of a
      * batch in a round takes the (2m)-th's moved by half a cell in both directions (a batch
      * then holds antithetic pairs, the batches stay independent: docs/reference.md 2.5) */
-    int per_batch = r->passes_per_round / r->batches, k = (pass % r->passes_per_round) / r->batches;
+    int per_batch, k = pass_in_batch(r, pass, &per_batch);
     int half = r->set.antithetic && (k & 1) && k < (per_batch & ~1);
     ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)(pass - half * r->batches));
     (void)rng_u(&g);

@@ -232,7 +232,7 @@ static void *worker(void *arg)
     int oom = 0;
     /* camera samples are stratified over the pixel within a batch (like the passes' strata):
      * this pass is the k-th of its batch in the round */
-    int per_batch = r->passes_per_round / r->batches, k_in_batch = (job->pass % r->passes_per_round) / r->batches;
+    int per_batch, k_in_batch = pass_in_batch(r, job->pass, &per_batch);
     ref_sample_grid sgrid;
     cell_grid(per_batch * r->spp_pass, &sgrid.nx, &sgrid.ny);
     cell_grid(r->camera_rays, &sgrid.kx, &sgrid.ky);

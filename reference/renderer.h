@@ -134,6 +134,15 @@ typedef struct ref_accum {
     double *aov;        /* [pixel * 2 + {transmittance, ray length}] */
 } ref_accum;
 
+/* Pass `pass` feeds batch pass mod B and is the k-th (returned) of the *per_batch passes that
+ * batch takes in a round (docs/reference.md 2.6): the index of its strata (sun directions,
+ * camera samples) and of its antithetic pair. */
+static inline int pass_in_batch(const gr_ref_renderer *r, int pass, int *per_batch)
+{
+    *per_batch = r->passes_per_round / r->batches;
+    return (pass % r->passes_per_round) / r->batches;
+}
+
 static inline gr_dvec3 cam_dir(const gr_ref_renderer *r, double ndx, double ndy)
 {
     const gr_camera *c = &r->scene.camera;
