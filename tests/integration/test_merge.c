@@ -102,7 +102,7 @@ static void same_image(const char *a, const char *b, int expect_probe)
         /* adaptive steps (the default): the parts' pilots must agree; under waves the steps vary,
          * flat water takes the fewest everywhere (docs/reference.md 2.5) */
         if (expect_probe) CHECK(meta_num(&ma, "godrays:steps_min") < meta_num(&ma, "godrays:steps_max"));
-        else CHECK(meta_num(&ma, "godrays:steps_max") == 8.0);
+        else CHECK(meta_num(&ma, "godrays:steps_max") == meta_num(&ma, "godrays:reference.min_steps"));
         /* the local refinement's summary (under waves, on by default) travels with the parts */
         const gr_meta_item *ra = gr_meta_get(&ma, "godrays:surface_refine"), *rb = gr_meta_get(&mb, "godrays:surface_refine");
         CHECK_MSG((ra != NULL) == (rb != NULL), "godrays:surface_refine: single %s, merged %s", ra ? "set" : "unset",
