@@ -34,12 +34,7 @@ static gr_ref_result render(const char *path, int res, int spp, int refine)
      * which more rays per sample (docs/reference.md 2.5) would mostly take away beforehand */
     const char *ov[] = {"camera.width=64", "camera.height=36", "reference.sun_samples=4", "reference.batches=4",
                         "reference.camera_rays=1", r_, s_, "reference.refine_factor=1"};
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err = {GR_OK, ""};
-    if (!s || gr_scene_load_file(path, ov, refine ? 7 : 8, s, &err) != GR_OK) {
-        fprintf(stderr, "%s\n", err.msg);
-        exit(1);
-    }
+    gr_scene *s = ref_scene_file(path, ov, refine ? 7 : 8);
     gr_ref_result res_;
     ref_render(s, NULL, &res_);
     free(s);
@@ -55,12 +50,7 @@ static int cone_pixels(const char *path, int W, int H, unsigned char *in)
     snprintf(w_, sizeof w_, "camera.width=%d", W);
     snprintf(h_, sizeof h_, "camera.height=%d", H);
     const char *ov[] = {w_, h_};
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err = {GR_OK, ""};
-    if (!s || gr_scene_load_file(path, ov, 2, s, &err) != GR_OK) {
-        fprintf(stderr, "%s\n", err.msg);
-        exit(1);
-    }
+    gr_scene *s = ref_scene_file(path, ov, 2);
     gr_dvec3 I = gr_d3_norm(gr_d3(s->sun.dir[0], s->sun.dir[1], s->sun.dir[2]));
     gr_dvec3 T = gr_refract_d(I, gr_d3(0, 1, 0), 1.0 / s->medium.ior);
     const gr_camera *c = &s->camera;

@@ -20,12 +20,7 @@ static gr_ref_result render(const char *path, const char *const *extra, int next
     const char *ov[8] = {"camera.width=96", "camera.height=54", "reference.bias_probe=false"};
     int n = 3;
     for (int i = 0; i < nextra && n < 8; i++) ov[n++] = extra[i];
-    gr_scene *s = malloc(sizeof *s);
-    gr_error err = {GR_OK, ""};
-    if (!s || gr_scene_load_file(path, ov, n, s, &err) != GR_OK) {
-        fprintf(stderr, "%s\n", err.msg);
-        exit(1);
-    }
+    gr_scene *s = ref_scene_file(path, ov, n);
     gr_ref_result r;
     ref_render(s, NULL, &r);
     free(s);

@@ -52,6 +52,18 @@ static inline gr_scene *ref_scene(const char *fmt, ...)
     return s;
 }
 
+/* Loads a scene file with "key=value" overrides; exits the test on failure (test code only). */
+static inline gr_scene *ref_scene_file(const char *path, const char *const *ov, int nov)
+{
+    gr_scene *s = malloc(sizeof *s);
+    gr_error err = {GR_OK, ""};
+    if (!s || gr_scene_load_file(path, ov, nov, s, &err) != GR_OK) {
+        fprintf(stderr, "%s: %s\n", path, s ? err.msg : "out of memory");
+        exit(1);
+    }
+    return s;
+}
+
 /* Renders s with options o (NULL = defaults, quiet); exits the test on failure. */
 static inline void ref_render(const gr_scene *s, const gr_ref_options *o, gr_ref_result *res)
 {
