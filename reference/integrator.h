@@ -79,6 +79,8 @@ typedef struct gr_ref_result {
     double bias_block_p95;  /* 95th percentile over 10x10-pixel blocks of |block bias| / max(block
                                mean, image mean) (-1 if not estimated) */
     double steps_mean;      /* march steps per camera ray, mean over the pixels (adaptive steps) */
+    double steps_capped_frac;   /* adaptive steps: the pixels whose pilot asked for more than reference.steps */
+    double steps_wanted_capped; /* the steps those asked for, on average (0: none) */
     int target_met;         /* --target-error: 1 when met (Student t, batches - 1 dof); 1 if off */
     gr_ref_sums *sums;      /* with gr_ref_options.keep_sums: the raw sums (freed with the result) */
     /* Per phase (beams, grid, pilot, march, probe, stats, other: GR_REF_PHASES, the metadata's

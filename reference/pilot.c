@@ -95,9 +95,9 @@ static void *pilot_worker(void *arg)
  * (the model, alpha = 2), and the least total sum n_s for sum V[s] (m[s] / n_s)^2 <= T is
  * n_s = c (V[s] m[s]^2)^(1/3), c = sqrt(sum (V m^2)^(1/3) / T) (Lagrange). Rounded up, at
  * least one stratum per segment (unbiased), the total clamped to [nmin, nmax]. Returns the
- * total. */
+ * total; *wanted gets the total before the cap. */
 static int allot_segments(const double V[SEGMENTS], const int m[SEGMENTS], double T, int nmin, int nmax, double floor_n,
-                          uint16_t n[SEGMENTS])
+                          uint16_t n[SEGMENTS], double *wanted)
 {
     double x[SEGMENTS], sx = 0.0, sc = 0.0;
     for (int k = 0; k < SEGMENTS; k++) {
@@ -113,6 +113,7 @@ static int allot_segments(const double V[SEGMENTS], const int m[SEGMENTS], doubl
         n[k] = (uint16_t)(v > 1.0 ? (v < 65535.0 ? v : 65535.0) : 1.0);
         tot += n[k];
     }
+    *wanted = tot;
     if (tot > nmax) {
         /* over the cap: the same proportions within it (at least one each) */
         double f = sx > 0.0 ? (double)(nmax - SEGMENTS) / sx : 0.0; /* the floors sum to at most nmax / 4 */
@@ -146,6 +147,7 @@ typedef struct map_job {
     double mean[3];
     int y0, y1;                 /* image rows */
     double sum, pixels;         /* the steps' tallies over the rows */
+    double capped, wanted;      /* pixels the cap held back, and the steps they asked for */
     int smin, smax;
 } map_job;
 
@@ -160,7 +162,7 @@ static void *steps_map_rows(void *arg)
     int nmax = r->set.steps, nmin = r->set.min_steps < nmax ? r->set.min_steps : nmax;
     int m[SEGMENTS] = {0}; /* pilot strata per segment (pairs assigned by their first stratum) */
     for (int k = 0; k + 1 < job->n0; k += 2) m[(size_t)k * SEGMENTS / (size_t)job->n0] += 2;
-    mj->sum = mj->pixels = 0.0;
+    mj->sum = mj->pixels = mj->capped = mj->wanted = 0.0;
     mj->smin = INT_MAX;
     mj->smax = 0;
     for (int py = mj->y0; py < mj->y1; py++)
@@ -203,6 +205,7 @@ static void *steps_map_rows(void *arg)
             /* the even spread's steps (its floor below, or the pixel's steps without the allotment) */
             double n = job->n0 * pow(v / (N * tau * tau), 1.0 / PILOT_ALPHA);
             int ni;
+            double want; /* the steps the target asks for, before the cap */
             if (r->alloc_px) {
                 /* the steps along the ray, segment by segment */
                 /* the floor: ALLOT_FLOOR of the uniform allocation's steps per pilot stratum (a part
@@ -210,13 +213,18 @@ static void *steps_map_rows(void *arg)
                  * times what the uniform march would leave there) */
                 double nu = v > 0.0 ? (n < nmax ? n : nmax) : nmin; /* also NaN: the most */
                 ni = allot_segments(V, m, N * tau * tau, nmin, nmax, ALLOT_FLOOR * nu / job->n0,
-                                    r->alloc_px + ((size_t)py * W + px) * SEGMENTS);
+                                    r->alloc_px + ((size_t)py * W + px) * SEGMENTS, &want);
             } else {
+                want = n;
                 if (v == 0.0) ni = nmin;
                 else if (!(n < (double)nmax)) ni = nmax; /* also NaN: the most steps */
                 else ni = n > nmin ? (int)ceil(n) : nmin;
             }
             r->steps_px[(size_t)py * W + px] = ni;
+            if (!(want <= (double)nmax)) { /* also NaN: the target needs more than the cap allows */
+                mj->capped += 1.0;
+                mj->wanted += want < 65536.0 ? ceil(want) : 65536.0;
+            }
             mj->sum += ni;
             mj->pixels += 1.0;
             if (ni < mj->smin) mj->smin = ni;
@@ -247,11 +255,13 @@ static void pilot_steps_map(gr_ref_renderer *r, const pilot_job *job)
         mj[i].y1 = r->opt.row0 + (int)((long)rows * (i + 1) / nt);
     }
     r->phases.par_total += gr_beams_run_jobs(steps_map_rows, mj, sizeof mj[0], nt);
-    r->tally.steps_sum = r->tally.steps_pixels = 0.0;
+    r->tally.steps_sum = r->tally.steps_pixels = r->tally.steps_capped = r->tally.steps_wanted_sum = 0.0;
     r->tally.steps_min = INT_MAX;
     r->tally.steps_max = 0;
     for (int i = 0; i < nt; i++) { /* integers in double: exact, the same sums in any split */
         r->tally.steps_sum += mj[i].sum;
+        r->tally.steps_capped += mj[i].capped;
+        r->tally.steps_wanted_sum += mj[i].wanted;
         r->tally.steps_pixels += mj[i].pixels;
         if (mj[i].smin < r->tally.steps_min) r->tally.steps_min = mj[i].smin;
         if (mj[i].smax > r->tally.steps_max) r->tally.steps_max = mj[i].smax;
@@ -272,6 +282,7 @@ gr_status gr_ref_step_pilot(gr_ref_renderer *r, gr_ref_pool *pool, gr_progress *
     r->tally.steps_min = r->tally.steps_max = r->set.steps;
     r->tally.steps_pixels = (double)W * (r->opt.row1 - r->opt.row0);
     r->tally.steps_sum = r->tally.steps_pixels * r->set.steps;
+    r->tally.steps_capped = r->tally.steps_wanted_sum = 0.0;
     *complete = 1;
     if (!r->set.adaptive_steps || r->set.steps <= r->set.min_steps) return GR_OK;
     double t0 = gr_ref_mono_s();

@@ -413,6 +413,9 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     SET(gr_meta_set_double(m, "godrays:steps_mean", ty->steps_pixels > 0.0 ? ty->steps_sum / ty->steps_pixels : -1.0));
     SET(gr_meta_set_int(m, "godrays:steps_min", ty->steps_min));
     SET(gr_meta_set_int(m, "godrays:steps_max", ty->steps_max));
+    /* where the cap (reference.steps) held the pilot's steps back: those pixels miss step_error */
+    SET(gr_meta_set_double(m, "godrays:steps_capped_frac", ty->steps_pixels > 0.0 ? ty->steps_capped / ty->steps_pixels : 0.0));
+    SET(gr_meta_set_double(m, "godrays:steps_wanted_mean_capped", ty->steps_capped > 0.0 ? ty->steps_wanted_sum / ty->steps_capped : 0.0));
     SET(gr_meta_set_int(m, "godrays:pilot_steps", ty->pilot_steps));
     SET(gr_meta_set_double(m, "godrays:pilot_s", ty->pilot_s));
     SET(gr_meta_set_double(m, "godrays:pilot_share", out->wall_s > 0.0 ? ty->pilot_s / out->wall_s : 0.0));
@@ -496,6 +499,8 @@ gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_marc
     out->beam_build_s = r->tally.beam_build_s;
     out->bias_surface_rel = r->bias_rel;
     out->steps_mean = r->tally.steps_pixels > 0.0 ? r->tally.steps_sum / r->tally.steps_pixels : -1.0;
+    out->steps_capped_frac = r->tally.steps_pixels > 0.0 ? r->tally.steps_capped / r->tally.steps_pixels : 0.0;
+    out->steps_wanted_capped = r->tally.steps_capped > 0.0 ? r->tally.steps_wanted_sum / r->tally.steps_capped : 0.0;
     out->rounds = P > 0 ? (out->passes + P - 1) / P : 0;
     out->max_rounds = r->set.target_error > 0.0 ? r->opt.max_rounds : 1;
     /* preview: the 99th percentile of the brightest channel maps to 0.8 */

@@ -44,6 +44,8 @@ const gr_ref_sums_field gr_ref_sums_fields[] = {
      * the seed and the pixel only): each row range once, from its batch-0 part */
     SCALAR("steps_sum", steps_sum, GR_SUMS_DOUBLE, GR_SUMS_ADD_BATCH0),
     SCALAR("steps_pixels", steps_pixels, GR_SUMS_DOUBLE, GR_SUMS_ADD_BATCH0),
+    SCALAR("steps_capped", steps_capped, GR_SUMS_DOUBLE, GR_SUMS_ADD_BATCH0),
+    SCALAR("steps_wanted_sum", steps_wanted_sum, GR_SUMS_DOUBLE, GR_SUMS_ADD_BATCH0),
     SCALAR("steps_min", steps_min, GR_SUMS_INT, GR_SUMS_MIN_BATCH0),
     SCALAR("steps_max", steps_max, GR_SUMS_INT, GR_SUMS_MAX_BATCH0),
     SCALAR("pilot_steps", pilot_steps, GR_SUMS_INT, GR_SUMS_ANY),

@@ -37,6 +37,9 @@ typedef struct gr_ref_sums {
     /* adaptive steps (docs/reference.md 2.5): the sum of the pixels' march steps over the
      * pixels counted, their extremes, the pilot's steps (0: none) and time */
     double steps_sum, steps_pixels;
+    /* the pixels whose pilot asked for more than the cap (reference.steps: they take the cap and
+     * miss step_error) and the steps those asked for, summed (each at most 65536) */
+    double steps_capped, steps_wanted_sum;
     int steps_min, steps_max, pilot_steps;
     double pilot_s;
 } gr_ref_sums;

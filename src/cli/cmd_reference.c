@@ -80,6 +80,19 @@ static void warn_target(const gr_scene *scene, int passes_per_round, const gr_re
             target, res->passes, rounds, passes_per_round, res->rel_se_mean, res->rel_se_p95);
 }
 
+/* Adaptive steps held back by the cap (reference.steps) in at least 1 % of the pixels: those
+ * miss the step target, and the figures above say how much; the remedy is the cap. */
+static void warn_steps_cap(const gr_scene *scene, const gr_ref_result *res)
+{
+    if (!(res->steps_capped_frac >= 0.01)) return;
+    fprintf(stderr,
+            "godrays reference: warning: in %.1f%% of the pixels the step target (reference.step_error %g) needs "
+            "more than the cap of %d march steps (reference.steps): they were held to the cap where the pilot asked for "
+            "%.0f on average, so their step noise is above the target; raise --steps (or accept a larger "
+            "--step-error)\n",
+            100.0 * res->steps_capped_frac, scene->reference.step_error, scene->reference.steps, res->steps_wanted_capped);
+}
+
 /* "I/N" with 0 <= I < N: 0, else the exit code of the usage error. */
 static int parse_part(const char *flag, const char *v, int *i, int *n)
 {
@@ -170,6 +183,7 @@ static int write_image(const gr_scene *scene, const gr_ref_result *res, const ch
         return 1;
     }
     warn_target(scene, per_round, res);
+    warn_steps_cap(scene, res);
     return 0;
 }
 

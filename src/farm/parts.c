@@ -233,6 +233,7 @@ static gr_status part_check_fields(const cJSON *h, const char *path, gr_error *e
         {"beam_triangles", 0, 9007199254740992.0, 1}, {"beam_build_s", 0, 1e300, 0}, {"march_s", 0, 1e300, 0},
         {"queries", 0, 9007199254740992.0, 1}, {"shadows", 0, 9007199254740992.0, 1},
         {"overflows", 0, 9007199254740992.0, 1}, {"steps_sum", 0, 1e300, 0}, {"steps_pixels", 0, 1e300, 0},
+        {"steps_capped", 0, 1e300, 0}, {"steps_wanted_sum", 0, 1e300, 0},
         {"steps_min", 0, INT_MAX, 1}, {"steps_max", 0, INT_MAX, 1}, {"pilot_steps", 0, INT_MAX, 1},
         {"pilot_s", 0, 1e300, 0}, {"payload_bytes", 0, 9007199254740992.0, 1}};
     for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {

@@ -46,5 +46,27 @@ rc=$?
 ck "reachable target: exit 0" [ "$rc" -eq 0 ]
 ck "reachable target: no warning" [ ! -s err.txt ]
 [ -s err.txt ] && cat err.txt
+# 3. the step cap (docs/reference.md 2.5, "When the cap holds the steps back"): a cap of 17
+# march steps (min_steps is 16) is below what the pilot asks for in most pixels: one warning
+# line (even with --quiet) with the share of the pixels held back and what they asked for,
+# the figures of the EXR's godrays:steps_capped_frac and steps_wanted_mean_capped
+"$bin" reference "$scene" -o cap.exr --size 16x9 --surface-res 32 --steps 17 --quiet >out.txt 2>err.txt
+rc=$?
+cat err.txt
+ck "step cap: exit 0" [ "$rc" -eq 0 ]
+ck "step cap: one stderr line" [ "$(wc -l <err.txt)" -eq 1 ]
+ck "step cap: the warning names the cap" grep -qF "needs more than the cap of 17 march steps (reference.steps)" err.txt
+ck "step cap: the warning says what to raise" grep -qF "raise --steps" err.txt
+if command -v iinfo >/dev/null 2>&1; then
+    iinfo -v cap.exr >meta.txt
+    m() { sed -n "s/^ *godrays:$1: *\([-0-9.eE+]*\).*/\1/p" meta.txt | head -n 1; }
+    frac=$(m steps_capped_frac); want=$(m steps_wanted_mean_capped)
+    echo "metadata: steps_capped_frac $frac, steps_wanted_mean_capped $want"
+    pct=$(awk -v v="$frac" 'BEGIN{printf "%.1f", 100 * v}'); w0=$(awk -v v="$want" 'BEGIN{printf "%.0f", v}')
+    ck "step cap: the warning gives the share held back ($pct%)" grep -qF "in $pct% of the pixels" err.txt
+    ck "step cap: the warning gives what they asked for ($w0)" grep -qF "asked for $w0 on average" err.txt
+    ck "step cap: they asked for more than the cap" awk -v v="$want" 'BEGIN{exit !(v > 17)}'
+fi
+
 [ "$fail" -eq 0 ] && echo "all checks passed"
 exit $fail

@@ -94,7 +94,8 @@ static void same_image(const char *a, const char *b, int expect_probe)
                                            "godrays:rel_stderr_p95", "godrays:frac_pixels_stderr_le_1pct",
                                            "godrays:bias_surface_rel_est", "godrays:spp", "godrays:passes",
                                            "godrays:preview_exposure", "godrays:steps_mean", "godrays:steps_min",
-                                           "godrays:steps_max"};
+                                           "godrays:steps_max", "godrays:steps_capped_frac",
+                                           "godrays:steps_wanted_mean_capped"};
         for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++) {
             double va = meta_num(&ma, keys[k]), vb = meta_num(&mb, keys[k]);
             CHECK_MSG(memcmp(&va, &vb, sizeof va) == 0, "%s: %.17g (single) vs %.17g (merged)", keys[k], va, vb);

@@ -203,6 +203,37 @@ static void test_flat(void)
     free(s);
 }
 
+/* (f) the cap: flat water whose R and G ask for more steps than min_steps (test (c)), under a
+ * cap of min_steps + 1: every pixel is held back and says so (godrays:steps_capped_frac 1, the
+ * steps it asked for above the cap); under the cap of 96 none is, with the steps it asked for
+ * taken */
+static void test_cap(void)
+{
+#define CAP_SCENE                                                                                                             \
+    "{\"sun\":{\"elevation_deg\":60,\"azimuth_deg\":30,\"angular_diameter_deg\":0}," REF_DEFAULT_MEDIUM ","                     \
+    "\"camera\":{\"position_m\":[0,-8,0],\"yaw_deg\":30,\"pitch_deg\":-60,\"fov_deg\":0.01,\"width\":3,\"height\":3},"        \
+    "\"reference\":{\"steps\":%d,\"pilot_steps\":16,\"bias_probe\":false,\"sun_samples\":8,\"batches\":8}}"
+    gr_scene *sc = ref_scene(CAP_SCENE, 17), *sf = ref_scene(CAP_SCENE, 96);
+#undef CAP_SCENE
+    gr_ref_result c, f;
+    ref_render(sc, NULL, &c);
+    ref_render(sf, NULL, &f);
+    printf("(f) the cap: 17 steps: %g of the pixels held back, asking for %g; 96 steps: %g held back, %g to %g taken\n",
+           c.steps_capped_frac, c.steps_wanted_capped, f.steps_capped_frac, meta(&f, "godrays:steps_min"),
+           meta(&f, "godrays:steps_max"));
+    CHECK(c.steps_capped_frac == 1.0 && meta(&c, "godrays:steps_capped_frac") == 1.0);
+    CHECK(meta(&c, "godrays:steps_max") <= 17.0);
+    CHECK_MSG(c.steps_wanted_capped > 17.0, "asked for %g steps, above the cap of 17", c.steps_wanted_capped);
+    /* the same pilot (16 steps in both) and target: the capped render asked for what the free one took */
+    CHECK_MSG(c.steps_wanted_capped == meta(&f, "godrays:steps_max"), "asked for %g under the cap, took %g without",
+              c.steps_wanted_capped, meta(&f, "godrays:steps_max"));
+    CHECK(f.steps_capped_frac == 0.0 && f.steps_wanted_capped == 0.0);
+    gr_ref_result_free(&c);
+    gr_ref_result_free(&f);
+    free(sc);
+    free(sf);
+}
+
 /* (d) the same bytes with 1 and 2 threads (the pilot's rays are keyed per pixel) */
 static void test_threads(void)
 {
@@ -226,6 +257,7 @@ int main(void)
 {
     int reduced = ref_reduced();
     test_flat();
+    test_cap();
     test_threads();
     test_unbiased(reduced);
     test_allocation(reduced);

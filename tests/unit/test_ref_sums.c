@@ -34,7 +34,7 @@ static void test_members(void)
                                        "beam_prims", "beam_refine_factor", "beam_refine_radius_m", "beam_refined_cells",
                                        "beam_transition_cells", "beam_triangles", "beam_build_s", "march_s", "queries",
                                        "shadows", "overflows", "steps_sum", "steps_pixels", "steps_min", "steps_max",
-                                       "pilot_steps", "pilot_s"};
+                                       "pilot_steps", "pilot_s", "steps_capped", "steps_wanted_sum"};
     const size_t nk = sizeof keys / sizeof keys[0];
     for (size_t i = 0; i < nk; i++) set(&s, keys[i], 10.0 + (double)i);
     CHECK(s.W == 10 && s.H == 11 && s.B == 12 && s.passes == 13 && s.probe == 14 && s.probe_levels == 15);
@@ -44,6 +44,7 @@ static void test_members(void)
     CHECK(s.beam_triangles == 28 && s.beam_build_s == 29.0 && s.march_s == 30.0 && s.queries == 31);
     CHECK(s.shadows == 32 && s.overflows == 33 && s.steps_sum == 34.0 && s.steps_pixels == 35.0);
     CHECK(s.steps_min == 36 && s.steps_max == 37 && s.pilot_steps == 38 && s.pilot_s == 39.0);
+    CHECK(s.steps_capped == 40.0 && s.steps_wanted_sum == 41.0);
     /* a 64-bit counter beyond int range survives */
     set(&s, "queries", 6e12);
     CHECK(s.queries == 6000000000000LL);
@@ -95,6 +96,8 @@ static void test_merge(void)
     p[0].steps_sum = 60; p[0].steps_pixels = 6; p[0].steps_min = 8; p[0].steps_max = 12;
     p[1].steps_sum = 90; p[1].steps_pixels = 6; p[1].steps_min = 9; p[1].steps_max = 20;
     p[2].steps_sum = 150; p[2].steps_pixels = 12; p[2].steps_min = 1; p[2].steps_max = 99;
+    p[0].steps_capped = 2; p[1].steps_capped = 3; p[2].steps_capped = 12;
+    p[0].steps_wanted_sum = 200; p[1].steps_wanted_sum = 330; p[2].steps_wanted_sum = 9999;
     p[0].pilot_steps = p[1].pilot_steps = p[2].pilot_steps = 16;
     p[0].pilot_s = 0.5; p[1].pilot_s = 0.25; p[2].pilot_s = 0.125;
     int b0 = 0;
@@ -107,6 +110,7 @@ static void test_merge(void)
     CHECK(m->beam_cell_m == 0.3 && m->beam_prims == 30);
     CHECK(m->march_s == 7.0 && m->queries == 18);
     CHECK(m->steps_sum == 150.0 && m->steps_pixels == 12.0 && m->steps_min == 8 && m->steps_max == 20);
+    CHECK(m->steps_capped == 5.0 && m->steps_wanted_sum == 530.0);
     CHECK(m->pilot_steps == 16 && m->pilot_s == 0.875);
     gr_ref_sums_destroy(m);
 }
