@@ -410,12 +410,12 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     /* adaptive steps (docs/reference.md 2.5): march steps per camera ray over the pixels, the
      * pilot's steps (0: no pilot, the same steps everywhere) and its share of the wall time */
     const gr_ref_sums *ty = &r->tally;
-    SET(gr_meta_set_double(m, "godrays:steps_mean", ty->steps_pixels > 0.0 ? ty->steps_sum / ty->steps_pixels : -1.0));
+    SET(gr_meta_set_double(m, "godrays:steps_mean", out->steps_mean));
     SET(gr_meta_set_int(m, "godrays:steps_min", ty->steps_min));
     SET(gr_meta_set_int(m, "godrays:steps_max", ty->steps_max));
     /* where the cap (reference.steps) held the pilot's steps back: those pixels miss step_error */
-    SET(gr_meta_set_double(m, "godrays:steps_capped_frac", ty->steps_pixels > 0.0 ? ty->steps_capped / ty->steps_pixels : 0.0));
-    SET(gr_meta_set_double(m, "godrays:steps_wanted_mean_capped", ty->steps_capped > 0.0 ? ty->steps_wanted_sum / ty->steps_capped : 0.0));
+    SET(gr_meta_set_double(m, "godrays:steps_capped_frac", out->steps_capped_frac));
+    SET(gr_meta_set_double(m, "godrays:steps_wanted_mean_capped", out->steps_wanted_capped));
     SET(gr_meta_set_int(m, "godrays:pilot_steps", ty->pilot_steps));
     SET(gr_meta_set_double(m, "godrays:pilot_s", ty->pilot_s));
     SET(gr_meta_set_double(m, "godrays:pilot_share", out->wall_s > 0.0 ? ty->pilot_s / out->wall_s : 0.0));
