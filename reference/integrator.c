@@ -286,8 +286,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     /* the grid's offset: the pass's own; with reference.antithetic, the (2m + 1)-th pass of a
      * batch in a round takes the (2m)-th's moved by half a cell in both directions (a batch
      * then holds antithetic pairs, the batches stay independent: docs/reference.md 2.5) */
-    int per_batch, k = pass_in_batch(r, pass, &per_batch);
-    int half = r->set.antithetic && (k & 1) && k < (per_batch & ~1);
+    int half = pass_antithetic(r, pass);
     ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)(pass - half * r->batches));
     (void)rng_u(&g);
     (void)rng_u(&g);

@@ -117,7 +117,8 @@ static void ray_geometry(const gr_ref_renderer *r, double fx, double fy, int n, 
 }
 
 int gr_ref_march_ray(const gr_ref_renderer *r, int nrays, const double *fx, const double *fy, int n, const uint16_t *alloc,
-                     ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt, ref_scratch *sc, double *ck)
+                     int anti, ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt, ref_scratch *sc,
+                     double *ck)
 {
     ref_ray_geo rg[REF_MAX_RAYS];
     const gr_vec3 o = r->cam;
@@ -146,7 +147,9 @@ int gr_ref_march_ray(const gr_ref_renderer *r, int nrays, const double *fx, cons
         int a = alloc ? alloc[sg] : n;
         for (int j = 0; j < a; j++, k++) {
             const ref_ray_geo *q = &rg[k % nrays];
-            double u = (sg + (j + rng_u(g)) / a) / nseg;
+            double xi = rng_u(g);
+            if (anti) xi = xi < 0.5 ? xi + 0.5 : xi - 0.5; /* the pair's other half of the stratum */
+            double u = (sg + (j + xi) / a) / nseg;
             sc->t[k] = q->lam != 0.0 ? -log1p(-u * q->om) / q->lam : u * q->D;
             sc->tf[k] = (float)sc->t[k];
             sc->w[k] = q->D > 0.0f ? (alloc ? q->wbase * n / ((double)SEGMENTS * a) : q->wbase) : 0.0;
@@ -204,9 +207,9 @@ typedef struct ref_sample_grid { int nx, ny, kx, ky; } ref_sample_grid;
 /* One camera sample of pixel (px, py) with n march steps: stratum j of the camera samples its
  * batch takes in this round (a cell of the pixel), marched on the kx ky rays, one jittered in
  * each of the cell's sub-cells, in a random rotation (docs/reference.md 2.5, "Rays per
- * camera sample"). */
+ * camera sample"). anti: the second sample of an antithetic pair, g the first's stream. */
 static int render_sample(const gr_ref_renderer *r, int px, int py, int j, const ref_sample_grid *sg, int n,
-                         const uint16_t *alloc, ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt,
+                         const uint16_t *alloc, int anti, ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt,
                          ref_scratch *sc)
 {
     const int nrays = sg->kx * sg->ky;
@@ -216,10 +219,14 @@ static int render_sample(const gr_ref_renderer *r, int px, int py, int j, const 
     for (int i = 0; i < nrays; i++) {
         int sub = (i + rot) % nrays;
         double ux = rng_u(g), uy = rng_u(g);
+        if (anti) { /* the pair's second sample: the first's place mirrored in its sub-cell */
+            ux = 1.0 - ux;
+            uy = 1.0 - uy;
+        }
         fx[i] = px + ((j % sg->nx) + ((sub % sg->kx) + ux) / sg->kx) / sg->nx;
         fy[i] = py + ((j / sg->nx) + ((sub / sg->kx) + uy) / sg->ky) / sg->ny;
     }
-    return gr_ref_march_ray(r, nrays, fx, fy, n, alloc, g, L, trans, len, cnt, sc, NULL);
+    return gr_ref_march_ray(r, nrays, fx, fy, n, alloc, anti, g, L, trans, len, cnt, sc, NULL);
 }
 
 static void *worker(void *arg)
@@ -233,6 +240,11 @@ static void *worker(void *arg)
     /* camera samples are stratified over the pixel within a batch (like the passes' strata):
      * this pass is the k-th of its batch in the round */
     int per_batch, k_in_batch = pass_in_batch(r, job->pass, &per_batch);
+    /* the second pass of an antithetic pair (docs/reference.md 2.5): the first's random numbers,
+     * its rays' places mirrored in their sub-cells (of its own cell of the pixel), every step
+     * moved by half a stratum */
+    int anti = pass_antithetic(r, job->pass);
+    int rng_pass = job->pass - anti * r->batches;
     ref_sample_grid sgrid;
     cell_grid(per_batch * r->spp_pass, &sgrid.nx, &sgrid.ny);
     cell_grid(r->camera_rays, &sgrid.kx, &sgrid.ky);
@@ -271,10 +283,10 @@ static void *worker(void *arg)
                 /* Ctrl-C within about a second even at thousands of samples per pixel per pass:
                  * a volatile read every 16 samples (the row then stays unfinished: partial) */
                 if ((s & 15) == 15 && r->opt.interrupt && *r->opt.interrupt) break;
-                uint64_t sample = (uint64_t)job->pass * (uint64_t)r->spp_pass + (uint64_t)s;
+                uint64_t sample = (uint64_t)rng_pass * (uint64_t)r->spp_pass + (uint64_t)s;
                 ref_rng g = rng_make(r->set.seed, STREAM_PIXEL0 + pix, sample);
                 double L[3], tr, len;
-                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, &sgrid, n, alloc, &g, L, &tr, &len,
+                if (render_sample(r, px, py, k_in_batch * r->spp_pass + s, &sgrid, n, alloc, anti, &g, L, &tr, &len,
                                   &cnt, &sc) != 0) {
                     oom = 1;
                     break;

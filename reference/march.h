@@ -72,9 +72,12 @@ static inline int light_at(const gr_ref_renderer *r, const gr_beams *bs, gr_vec3
  * (1..REF_MAX_RAYS) camera rays through the image points (fx[i], fy[i]) (pixels), stratum k
  * on ray k mod nrays; *trans and *len are the rays' mean transmittance and length. With ck,
  * ck[3 k + c] receives channel c of march point k's contribution to L (the step pilot).
+ * anti: every stratum's jitter moved by half a stratum (mod one), the second of an antithetic
+ * pair drawing the first's numbers (docs/reference.md 2.5, "Antithetic pairs").
  * Returns 0, or -1 when out of memory (a growing hit list). */
 int gr_ref_march_ray(const gr_ref_renderer *r, int nrays, const double *fx, const double *fy, int n, const uint16_t *alloc,
-                     ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt, ref_scratch *sc, double *ck);
+                     int anti, ref_rng *g, double L[3], double *trans, double *len, ref_counters *cnt, ref_scratch *sc,
+                     double *ck);
 
 typedef struct ref_march_totals { double march_s; long long queries, shadows, max_hits; } ref_march_totals;
 

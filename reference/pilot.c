@@ -55,7 +55,7 @@ static void *pilot_worker(void *arg)
             int bh = H - j * PILOT_STRIDE < PILOT_STRIDE ? H - j * PILOT_STRIDE : PILOT_STRIDE;
             double fx = i * PILOT_STRIDE + bw * rng_u(&g), fy = j * PILOT_STRIDE + bh * rng_u(&g);
             double L[3], tr, len;
-            if (gr_ref_march_ray(r, 1, &fx, &fy, n0, NULL, &g, L, &tr, &len, &cnt, &sc, ck) != 0) { oom = 1; break; }
+            if (gr_ref_march_ray(r, 1, &fx, &fy, n0, NULL, 0, &g, L, &tr, &len, &cnt, &sc, ck) != 0) { oom = 1; break; }
             /* collapsed strata: the strata 2i and 2i + 1 merged into one holding two samples,
              * whose variance (c_2i - c_2i+1)^2 estimates without bias and that of the stratified
              * pair at most (docs/reference.md 2.5) */
@@ -160,6 +160,14 @@ static void *steps_map_rows(void *arg)
     const int W = r->scene.camera.width, pw = job->pw, ph = job->ph;
     double N = (double)r->passes_per_round * r->spp_pass, tau = r->set.step_error;
     int nmax = r->set.steps, nmin = r->set.min_steps < nmax ? r->set.min_steps : nmax;
+    /* antithetic pairs (docs/reference.md 2.5): a pair's two samples with their steps half a
+     * stratum apart act as one sample of 2n strata, whose step noise is a quarter of one of n
+     * (alpha = 2): the mean of P pairs and U unpaired samples has the step noise of N^2 / (P + U)
+     * independent samples. Per batch in a round: P = per_batch / 2 pairs, U = per_batch mod 2. */
+    if (r->set.antithetic) {
+        int per_batch = r->passes_per_round / r->batches, P = per_batch / 2, U = per_batch - 2 * P;
+        N = N * per_batch / (P + U);
+    }
     int m[SEGMENTS] = {0}; /* pilot strata per segment (pairs assigned by their first stratum) */
     for (int k = 0; k + 1 < job->n0; k += 2) m[(size_t)k * SEGMENTS / (size_t)job->n0] += 2;
     mj->sum = mj->pixels = mj->capped = mj->wanted = 0.0;

@@ -143,6 +143,14 @@ static inline int pass_in_batch(const gr_ref_renderer *r, int pass, int *per_bat
     return (pass % r->passes_per_round) / r->batches;
 }
 
+/* 1 when pass `pass` is the second of an antithetic pair (reference.antithetic): the k-th
+ * pass of its batch with k odd and a partner k - 1 (an odd pass count leaves the last alone) */
+static inline int pass_antithetic(const gr_ref_renderer *r, int pass)
+{
+    int per_batch, k = pass_in_batch(r, pass, &per_batch);
+    return r->set.antithetic && pass != PILOT_PASS && (k & 1) && k < (per_batch & ~1);
+}
+
 static inline gr_dvec3 cam_dir(const gr_ref_renderer *r, double ndx, double ndy)
 {
     const gr_camera *c = &r->scene.camera;
