@@ -8,7 +8,9 @@
 # each other, and this tree's per-phase table (godrays:phase.*, serial fraction).
 # Usage: scripts/bench_truth.sh [RUNS (2)] [SIZE (640x360)] [extra godrays reference options]
 # Environment: BASE (commit), BENCH_DIR (where the base is built; kept between runs), BIN (this
-# tree's binary; default build/godrays, built if missing), SCENE.
+# tree's binary; default build/godrays, built if missing), SCENE, THIS_OPTS (options for this
+# tree's renders only, e.g. settings the base does not have: THIS_OPTS="--set
+# reference.batches=4 --set reference.antithetic=true").
 set -eu
 here=$(cd "$(dirname "$0")/.." && pwd)
 runs=${1:-2}
@@ -43,9 +45,11 @@ i=1
 while [ "$i" -le "$runs" ]; do
     for which in main this; do
         b=$dir/build/godrays
-        [ "$which" = this ] && b=$bin
+        extra=
+        [ "$which" = this ] && b=$bin && extra=${THIS_OPTS:-}
+        # shellcheck disable=SC2086 # THIS_OPTS is a list of words
         /usr/bin/time -f "%U %S %e %M" -o "$out/time" "$b" reference "$scene" --size "$size" -q --no-preview \
-            -o "$out/$which$i.exr" "$@" >/dev/null 2>&1
+            -o "$out/$which$i.exr" "$@" $extra >/dev/null 2>&1
         read -r u s e m <"$out/time"
         cpu=$(echo "$u $s" | awk '{ printf "%.2f", $1 + $2 }')
         echo "$cpu" >>"$out/cpu_$which"
@@ -74,4 +78,5 @@ for p in beams grid pilot march probe stats other; do
     echo "| $p | $(meta "$f" "phase.$p.wall_s") | $(meta "$f" "phase.$p.cpu_s") | $(meta "$f" "phase.$p.serial_s") |"
 done
 echo "| all | $(meta "$f" phases_wall_s) | $(meta "$f" phases_cpu_s) | $(meta "$f" serial_s) |"
+echo "this tree's error bars: $(meta "$f" stderr_dof) degrees of freedom${THIS_OPTS:+ (THIS_OPTS: $THIS_OPTS)}"
 echo "serial fraction (wall with at most one thread busy / wall): $(meta "$f" serial_fraction); 8x8 block noise (max at pixel x y, p99, p95, median): $(meta "$f" block8_rel_stderr_max) at $(meta "$f" block8_rel_stderr_max_x) $(meta "$f" block8_rel_stderr_max_y), $(meta "$f" block8_rel_stderr_p99), $(meta "$f" block8_rel_stderr_p95), $(meta "$f" block8_rel_stderr_median)"

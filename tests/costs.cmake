@@ -18,6 +18,7 @@ set(GR_TEST_COSTS
   cli.run_sequence 23 38
   cli.report_links 23 39
   cli.capture_own 23 43
+  unit.ref_antithetic 21 37
   integration.suite_tune 19 0
   cli.tune_pareto 19 0
   unit.ref_photons 17 0
@@ -32,7 +33,6 @@ set(GR_TEST_COSTS
   cli.compare_fit 13 19
   cli.rel_signals 10 0
   unit.ref_convergence 9 0
-  unit.ref_antithetic 9 13
   integration.volume_flat 9 21
   cli.report_browser 9 16
   unit.ref_focus 8 0
