@@ -12,7 +12,7 @@ set(GR_TEST_COSTS
   cli.rel_cache 34 87
   integration.tune_default 31 0
   cli.volume_cli 31 58
-  unit.ref_coverage 25 0
+  unit.ref_coverage 30 0
   unit.ref_adaptive 23 0
   cli.techniques 23 27
   cli.run_sequence 23 38
