@@ -287,7 +287,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
      * batch in a round takes the (2m)-th's moved by half a cell in both directions (a batch
      * then holds antithetic pairs, the batches stay independent: docs/reference.md 2.5) */
     int half = pass_antithetic(r, pass);
-    ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)(pass - half * r->batches));
+    ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)pass_stream(r, pass));
     (void)rng_u(&g);
     (void)rng_u(&g);
     double jit[2] = {rng_u(&g), rng_u(&g)};

@@ -243,8 +243,7 @@ static void *worker(void *arg)
     /* the second pass of an antithetic pair (docs/reference.md 2.5): the first's random numbers,
      * its rays' places mirrored in their sub-cells (of its own cell of the pixel), every step
      * moved by half a stratum */
-    int anti = pass_antithetic(r, job->pass);
-    int rng_pass = job->pass - anti * r->batches;
+    int anti = pass_antithetic(r, job->pass), rng_pass = pass_stream(r, job->pass);
     ref_sample_grid sgrid;
     cell_grid(per_batch * r->spp_pass, &sgrid.nx, &sgrid.ny);
     cell_grid(r->camera_rays, &sgrid.kx, &sgrid.ky);

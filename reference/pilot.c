@@ -164,8 +164,8 @@ static void *steps_map_rows(void *arg)
      * stratum apart act as one sample of 2n strata, whose step noise is a quarter of one of n
      * (alpha = 2): the mean of P pairs and U unpaired samples has the step noise of N^2 / (P + U)
      * independent samples. Per batch in a round: P = per_batch / 2 pairs, U = per_batch mod 2. */
-    if (r->set.antithetic) {
-        int per_batch = r->passes_per_round / r->batches, P = per_batch / 2, U = per_batch - 2 * P;
+    if (antithetic_pairs(r)) {
+        int per_batch = r->passes_per_round / r->batches, P = antithetic_pairs(r), U = per_batch - 2 * P;
         N = N * per_batch / (P + U);
     }
     int m[SEGMENTS] = {0}; /* pilot strata per segment (pairs assigned by their first stratum) */

@@ -143,12 +143,26 @@ static inline int pass_in_batch(const gr_ref_renderer *r, int pass, int *per_bat
     return (pass % r->passes_per_round) / r->batches;
 }
 
-/* 1 when pass `pass` is the second of an antithetic pair (reference.antithetic): the k-th
- * pass of its batch with k odd and a partner k - 1 (an odd pass count leaves the last alone) */
+/* Antithetic pairs (reference.antithetic; docs/reference.md 2.5): the pairs each batch holds
+ * in a round, the passes k = 2m and 2m + 1 of the batch for m < the count (an odd pass count
+ * leaves the last alone); 0 when off. */
+static inline int antithetic_pairs(const gr_ref_renderer *r)
+{
+    return r->set.antithetic ? r->passes_per_round / r->batches / 2 : 0;
+}
+
+/* 1 when pass `pass` is the second of an antithetic pair (the pilot's pass never is) */
 static inline int pass_antithetic(const gr_ref_renderer *r, int pass)
 {
     int per_batch, k = pass_in_batch(r, pass, &per_batch);
-    return r->set.antithetic && pass != PILOT_PASS && (k & 1) && k < (per_batch & ~1);
+    return pass != PILOT_PASS && (k & 1) && k < 2 * antithetic_pairs(r);
+}
+
+/* The pass whose random numbers pass `pass` draws: its pair's first (B passes before it, in
+ * the same batch and round) when it is a pair's second, else itself. */
+static inline int pass_stream(const gr_ref_renderer *r, int pass)
+{
+    return pass - pass_antithetic(r, pass) * r->batches;
 }
 
 static inline gr_dvec3 cam_dir(const gr_ref_renderer *r, double ndx, double ndy)
