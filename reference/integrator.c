@@ -75,6 +75,30 @@ static double max_drift(const gr_ref_renderer *r)
     return best;
 }
 
+/* The least |T_y| over every refracted sunlight direction (normals tilted up to the waves'
+ * largest slope, directions across the sun's disc; the same scan as max_drift): bounds the
+ * integrand's fall along rising camera rays (gr_ref_cutoff_d). Flat water, point sun: T0. */
+static double min_mu(const gr_ref_renderer *r)
+{
+    double Q = gr_gerstner_steepness(&r->scene.water);
+    if (Q >= 0.999) Q = 0.999;
+    double tilt = atan(Q / sqrt(1.0 - Q * Q)) + r->sun_radius, best = -r->T0.y;
+    if (!(tilt > 0.0)) return best;
+    for (int ia = 0; ia < 64; ia++) {
+        double az = 2.0 * GR_PI * ia / 64.0;
+        for (int it = 1; it <= 8; it++) {
+            double a = tilt * it / 8.0;
+            gr_dvec3 n = gr_d3(sin(a) * sin(az), cos(a), sin(a) * cos(az));
+            if (gr_d3_dot(r->I0, n) >= 0.0) return 0.0; /* light from below a facet: no bound */
+            gr_dvec3 T = gr_refract_d(r->I0, n, 1.0 / r->scene.medium.ior);
+            if (-T.y < best) best = -T.y;
+        }
+    }
+    /* the scan's azimuth step (5.6 deg) misses the least value by a second-order amount: a
+     * margin of 1 % keeps the bound on the safe side */
+    return 0.99 * best;
+}
+
 /* The lit region: sheared bounds of the visible volume (camera frustum up to each ray's
  * end), clamped to reference.patch_radius_m around the camera. */
 static void compute_region(gr_ref_renderer *r)
@@ -103,7 +127,7 @@ static void compute_region(gr_ref_renderer *r)
         for (int iy = 0; iy <= NS; iy++)
             for (int ix = 0; ix <= NS; ix++) {
                 gr_dvec3 d = cam_dir(r, (2.0 * ix / NS - 1.0) * tf * aspect, (1.0 - 2.0 * iy / NS) * tf);
-                double D = r->cutoff_d;
+                double D = gr_ref_cutoff_d(r, d.y);
                 if (d.y < 0.0 && s->has_seabed) D = fmin(D, (seabed_y - o.y) / d.y);
                 if (d.y > 0.0) D = fmin(D, (A - o.y) / d.y);
                 double ex = o.x + D * d.x, ey = o.y + D * d.y, ez = o.z + D * d.z;
@@ -195,10 +219,13 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
         if (r->sig_t[c] < smin) smin = r->sig_t[c];
     }
     r->sig_ref = smin > 0.0 ? smin : 0.0;
-    /* camera rays stop where the transmittance of the least attenuated channel falls below
-     * the cutoff, and in any case at reference.max_distance_m */
+    /* camera rays that do not rise stop where the transmittance of the least attenuated
+     * channel falls below the cutoff, rising ones later (gr_ref_cutoff_d), and all at
+     * reference.max_distance_m at the latest */
     r->cutoff_d = st->max_distance_m;
-    if (smin > 0.0 && st->transmittance_cutoff > 0.0) r->cutoff_d = fmin(r->cutoff_d, -log(st->transmittance_cutoff) / smin);
+    r->cutoff_ln = st->transmittance_cutoff > 0.0 && st->transmittance_cutoff < 1.0 ? -log(st->transmittance_cutoff) : 0.0;
+    if (smin > 0.0 && r->cutoff_ln > 0.0) r->cutoff_d = fmin(r->cutoff_d, r->cutoff_ln / smin);
+    r->mu_min = min_mu(r);
     compute_region(r);
     {
         /* the camera cone's radius (docs/reference.md 2.2): the same for every pass */

@@ -79,7 +79,7 @@ static void ray_geometry(const gr_ref_renderer *r, double fx, double fy, int n, 
     gr_dvec3 dd = cam_dir(r, (2.0 * fx / c->width - 1.0) * tf * aspect, (1.0 - 2.0 * fy / c->height) * tf);
     gr_vec3 d = gr_d3_to_f(dd), o = r->cam;
     /* where the camera ray ends: occluder or seabed, the water surface, the cutoff */
-    float De = gr_rtc_intersect(r->geom->ends, o, d, 0.0f, (float)r->cutoff_d, NULL, NULL), D = -1.0f;
+    float De = gr_rtc_intersect(r->geom->ends, o, d, 0.0f, (float)gr_ref_cutoff_d(r, dd.y), NULL, NULL), D = -1.0f;
     const gr_beams *bs = r->beams;
     if (r->cone && fabs(dd.x * r->T0.x + dd.y * r->T0.y + dd.z * r->T0.z) >= r->cone_cos) {
         /* within the cone: its refined set, if the whole ray stays where that set is complete

@@ -80,7 +80,9 @@ struct gr_ref_renderer {
     double sun_radius;        /* angular radius in air (rad) */
     int convolve;             /* 1: the disc by the analytic convolution, passes use I0 */
     int rendering;            /* 1 inside gr_ref_render (beam sets for the march) */
-    double cutoff_d;
+    double cutoff_d;          /* D_cut of rays that do not rise (w_y <= 0); gr_ref_cutoff_d */
+    double cutoff_ln;         /* -ln(transmittance_cutoff) (0: no cutoff) */
+    double mu_min;            /* the least |T_y| of any refracted sunlight (waves, disc) */
     gr_beam_region region;
     double pad;
     int passes_per_round, spp_pass, batches, threads;
@@ -163,6 +165,19 @@ static inline int pass_antithetic(const gr_ref_renderer *r, int pass)
 static inline int pass_stream(const gr_ref_renderer *r, int pass)
 {
     return pass - pass_antithetic(r, pass) * r->batches;
+}
+
+/* Where a camera ray of direction w (unit, w_y its upward part) stops at the latest
+ * (docs/reference.md 1, "Camera ray ends and the cutoff"): on flat water the integrand falls
+ * as exp(-sigma_t k t), k = 1 - w_y / mu_t (Oracle 1), so D_cut = -ln(cutoff) / (sigma_min k)
+ * drops at most the cutoff's fraction of each channel; with waves mu_t >= mu_min bounds k
+ * from below. A ray that rises at least as steeply as the sunlight sinks (k <= 0) sees an
+ * integrand that does not fall: no cutoff but max_distance_m. */
+static inline double gr_ref_cutoff_d(const gr_ref_renderer *r, double wy)
+{
+    if (!(wy > 0.0) || !(r->cutoff_ln > 0.0) || !(r->sig_ref > 0.0)) return r->cutoff_d;
+    double k = 1.0 - wy / r->mu_min, dmax = r->scene.reference.max_distance_m;
+    return k > 0.0 && r->cutoff_ln < k * r->sig_ref * dmax ? r->cutoff_ln / (k * r->sig_ref) : dmax;
 }
 
 static inline gr_dvec3 cam_dir(const gr_ref_renderer *r, double ndx, double ndy)

@@ -425,8 +425,9 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
                            "the measured order, bias_surface_rel_measured_order); bias.* channels and bias_block_p95_rel "
                            "use the measured order; march steps: unbiased (jittered strata; per-pixel counts "
                            "from an independent pilot), noise only; sun disc: convolved to first order, error "
-                           "below 0.3 % L1 (sun_disc = sample: unbiased); cutoff tail <= transmittance_cutoff * "
-                           "S_max / sigma_t (docs/reference.md)"));
+                           "below 0.3 % L1 (sun_disc = sample: unbiased); cutoff: each ray's distance drops at most "
+                           "transmittance_cutoff of each channel on flat water (camera and sun paths' attenuation; "
+                           "docs/reference.md 1)"));
     SET(gr_meta_set_string(m, "godrays:error_bars",
                            r->bias_px ? "stderr.* channels: batch-mean spread (noise only; Student t with stderr_dof "
                                         "degrees of freedom); bias.* channels: the surface bias of the pixel's 5x5 block "

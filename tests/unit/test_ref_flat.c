@@ -1,7 +1,13 @@
 /* Oracle 1 (../shared/notes/physics-oracles.md): flat water, closed form.
  * L = sigma_s p(T.-w) E_w exp(-sigma_t z0 / mu_t) (1 - exp(-sigma_t k D)) / (sigma_t k),
  * k = 1 - w_y / mu_t, E_w = F_t E_sun cos(theta_i) / cos(theta_t), per RGB channel, with
- * D the distance to the ray's end (surface, seabed, or the documented transmittance cutoff).
+ * D the distance to the ray's end (surface, seabed, or reference.max_distance_m): the physical
+ * value, not the renderer's transmittance cutoff, which may drop at most 0.1 % of a channel
+ * (docs/reference.md 1). Until 2026-11-29 the oracle ended its rays at the cutoff as the
+ * renderer did, D_cut = -ln(cutoff) / sigma_t, which hid that a ray rising toward the sun
+ * (k = 0: an integrand that does not fall) lost everything past it: 31 % of the light
+ * looking up the refracted sun from 5 m with sigma_t 2 /m, 8-10 % from 100 m with 0.07 /m.
+ * The deep cases below (camera at 100 m) check that.
  * The oracle is evaluated here from Snell's law, the Fresnel equations and the HG formula
  * written out independently. Each case renders one pixel with a 0.01 deg field of view
  * through the whole pipeline (Embree ends, march, batches), with a point sun. Tolerance
@@ -25,9 +31,9 @@ static double hg(double c, double g)
 
 static int cases = 0, failures_before = 0;
 
-static void one(double elev, int view, double g, double sig_t, int seabed, int beams)
+static void one_at(double elev, int view, double g, double sig_t, int seabed, int beams, double z0)
 {
-    const double deg = 3.14159265358979323846 / 180.0, n = 1.333, z0 = 5.0, H = 20.0, az = 30.0;
+    const double deg = 3.14159265358979323846 / 180.0, n = 1.333, H = z0 + 15.0, az = 30.0;
     const double Esun[3] = {1.0, 0.8, 0.6};
     double sin_t = cos(elev * deg) / n, theta_t = asin(sin_t), mu_t = cos(theta_t);
     double yaw = 0, pitch = 0;
@@ -35,7 +41,8 @@ static void one(double elev, int view, double g, double sig_t, int seabed, int b
     case 0: yaw = 10; pitch = 89; break;                                /* up */
     case 1: yaw = az + 90; pitch = 0; break;                            /* horizontal */
     case 2: yaw = az; pitch = 90.0 - theta_t / deg; break;              /* toward the sun */
-    default: yaw = az + 180; pitch = -(90.0 - theta_t / deg); break;    /* away */
+    case 3: yaw = az + 180; pitch = -(90.0 - theta_t / deg); break;     /* away */
+    default: yaw = az; pitch = 0.5 * (90.0 - theta_t / deg); break;     /* rising, half as steep as the sun */
     }
     char bed[64] = "";
     if (seabed) snprintf(bed, sizeof bed, ",\"seabed\":{\"depth_m\":%g}", H);
@@ -49,7 +56,7 @@ static void one(double elev, int view, double g, double sig_t, int seabed, int b
     double w[3] = {s->camera.forward[0], s->camera.forward[1], s->camera.forward[2]};
     /* refracted sun direction T: horizontal part away from the sun's azimuth */
     double T[3] = {-sin_t * sin(az * deg), -mu_t, -sin_t * cos(az * deg)};
-    double D = fmin(-log(s->reference.transmittance_cutoff) / sig_t, s->reference.max_distance_m);
+    double D = s->reference.max_distance_m;
     if (w[1] > 0.0) D = fmin(D, z0 / w[1]);
     if (seabed && w[1] < 0.0) D = fmin(D, (H - z0) / -w[1]);
     double k = 1.0 - w[1] / mu_t, cos_i = sin(elev * deg);
@@ -70,12 +77,17 @@ static void one(double elev, int view, double g, double sig_t, int seabed, int b
         int before = gr_check_failures;
         CHECK_REL(got, expect, 0.005);
         if (gr_check_failures != before)
-            fprintf(stderr, "  case: elev %g view %d g %g sigma_t %g seabed %d beams %d channel %d (D %g)\n", elev, view,
-                    g, sig_t, seabed, beams, c, D);
+            fprintf(stderr, "  case: elev %g view %d g %g sigma_t %g seabed %d beams %d depth %g channel %d (D %g)\n", elev,
+                    view, g, sig_t, seabed, beams, z0, c, D);
     }
     cases++;
     gr_ref_result_free(&res);
     free(s);
+}
+
+static void one(double elev, int view, double g, double sig_t, int seabed, int beams)
+{
+    one_at(elev, view, g, sig_t, seabed, beams, 5.0);
 }
 
 int main(void)
@@ -92,5 +104,14 @@ int main(void)
     for (int e = 0; e < 4; e++)
         for (int v = 0; v < 4; v++) one(elevs[e], v, 0.5, 0.3, v & 1, 1);
     printf("beam path: %d cases\n", cases);
+    /* deep cameras (100 m) looking toward the sun, rising at half its slope, horizontally:
+     * rays of 100-1000 m whose integrand falls slowly or not at all */
+    for (int e = 1; e < 4; e++)
+        for (int v = 0; v < 3; v++) {
+            static const int views[3] = {2, 4, 1};
+            one_at(elevs[e], views[v], 0.9, 0.07, 0, 0, 100.0);
+            one_at(elevs[e], views[v], 0.5, 0.01, 1, 0, 100.0);
+        }
+    printf("deep cameras: %d cases\n", cases);
     CHECK_DONE();
 }
