@@ -38,7 +38,7 @@ static const gr_param reference_params[] = {
      .flags = HI_X, .def = 0, .unit = "",
      .doc = "0 = off; else refine until the relative standard error is below this"},
     {.name = "transmittance_cutoff", .type = GR_PT_DOUBLE, .offset = REF(transmittance_cutoff),
-     .min = 0, .max = 1, .flags = LO_X | HI_X, .def = 1e-3, .unit = "",
+     .min = 0, .max = 1, .flags = LO_X | HI_X, .def = 1e-4, .unit = "",
      .doc = "camera rays stop where the light they can still gather falls below this fraction (camera and sun paths' attenuation)"},
     {.name = "max_distance_m", .type = GR_PT_DOUBLE, .offset = REF(max_distance_m), .min = 0,
      .max = 1e6, .flags = LO_X, .def = 1000, .unit = "m",

@@ -56,7 +56,7 @@ static void test_defaults(void)
     gr_param_defaults(&gr_reference_param_table, &r);
     gr_param_defaults(&gr_shafts_param_table, &s);
     /* values from the project brief that are not tuning knobs */
-    CHECK(r.seed == 1ull && r.threads == 0 && r.target_error == 0.0 && r.transmittance_cutoff == 1e-3);
+    CHECK(r.seed == 1ull && r.threads == 0 && r.target_error == 0.0 && r.transmittance_cutoff == 1e-4);
     CHECK(s.caps == 1 && s.target_format == GR_TARGET_RGBA8);
     CHECK(isnan(s.extinction[0]) && isnan(s.extinction[1]) && isnan(s.extinction[2]));
     CHECK(s.g == 0.5); /* the seed's g (issue 12), no longer the medium's */

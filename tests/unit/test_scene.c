@@ -47,7 +47,7 @@ static void test_defaults(void)
      * tables, test_scene_doc checks the documented rows); these are fixed by the format */
     CHECK(s->reference.seed == 1ull);
     CHECK(s->reference.threads == 0 && s->reference.target_error == 0.0);
-    CHECK(s->reference.transmittance_cutoff == 1e-3);
+    CHECK(s->reference.transmittance_cutoff == 1e-4);
     CHECK(SHAFTS(s)->caps == 1 && SHAFTS(s)->target_format == GR_TARGET_RGBA8);
     /* FROM_SCENE defaults resolved to the medium */
     for (int k = 0; k < 3; k++) {
