@@ -89,7 +89,7 @@ static double min_mu(const gr_ref_renderer *r)
         for (int it = 1; it <= 8; it++) {
             double a = tilt * it / 8.0;
             gr_dvec3 n = gr_d3(sin(a) * sin(az), cos(a), sin(a) * cos(az));
-            if (gr_d3_dot(r->I0, n) >= 0.0) return 0.0; /* light from below a facet: no bound */
+            if (gr_d3_dot(r->I0, n) >= 0.0) continue; /* a facet facing away from the sun: unlit */
             gr_dvec3 T = gr_refract_d(r->I0, n, 1.0 / r->scene.medium.ior);
             if (-T.y < best) best = -T.y;
         }
