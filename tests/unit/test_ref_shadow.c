@@ -72,10 +72,12 @@ int main(void)
         /* oracle */
         double cos_i = sin(elev * PI / 180.0), sin_t = cos(elev * PI / 180.0) / n, mu = sqrt(1.0 - sin_t * sin_t);
         double T[3] = {0.0, -mu, -sin_t}, w[3] = {s->camera.forward[0], s->camera.forward[1], s->camera.forward[2]};
-        double D = -log(s->reference.transmittance_cutoff) / sig;
+        /* the physical ray, to max_distance_m: not the renderer's cutoff, which may drop at
+         * most the cutoff's fraction (docs/reference.md 1) */
+        double D = s->reference.max_distance_m;
         double Ew = fresnel_t(cos_i, n) * cos_i / mu;
         double ph = (1 - g * g) / (4 * PI * pow(1 + g * g + 2 * g * (T[0] * w[0] + T[1] * w[1] + T[2] * w[2]), 1.5));
-        const int N = 200000;
+        const int N = 2000000; /* 0.5 mm over 1000 m */
         double sum = 0.0, full = 0.0;
         for (int i = 0; i < N; i++) {
             double t = D * (i + 0.5) / N;
