@@ -175,7 +175,8 @@ static void test_flat(void)
               meta(&r, "godrays:steps_max"), s->reference.min_steps);
     /* Oracle 1 along the centre ray (the scene's sun and view directions): the refracted
      * direction T, exact Fresnel, HG phase, the two extinctions, integrated by Simpson's rule
-     * to the cutoff (no seabed) */
+     * along the physical ray (no seabed: to max_distance_m; the renderer's cutoff drops at most
+     * its fraction, 1e-4, and here, looking down, about 1e-8) */
     gr_dvec3 I = gr_d3(s->sun.dir[0], s->sun.dir[1], s->sun.dir[2]);
     gr_dvec3 T = gr_refract_d(I, gr_d3(0, 1, 0), 1.0 / 1.333);
     double ft = 1.0 - gr_fresnel_exact(-I.y, 1.0, 1.333), e_perp = ft * -I.y / -T.y;
@@ -184,8 +185,8 @@ static void test_flat(void)
     double ph = gr_hg_phase(-gr_d3_dot(T, w), 0.9);
     const float *px = gr_image_pixel(r.image, 1, 1);
     for (int c = 0; c < 3; c++) {
-        double st = sa[c] + ss[c], smin = 0.0212 + 0.062, D = -log(1e-3) / smin, L = 0.0;
-        int n = 20000;
+        double st = sa[c] + ss[c], D = s->reference.max_distance_m, L = 0.0;
+        int n = 200000;
         for (int i = 0; i <= n; i++) {
             double t = D * i / n, y = -8.0 + t * w.y;
             double f = ss[c] * ph * e_perp * exp(-st * (-y / -T.y)) * exp(-st * t);
