@@ -50,59 +50,48 @@ static void grow(double b[4], double u, double w)
     if (w > b[3]) b[3] = w;
 }
 
-/* Largest drift |T_xz / T_y - T0_xz / T0_y| of a refracted ray per metre of height, over
- * every normal the waves can have: Gerstner slopes are bounded by tan = Q / sqrt(1 - Q^2)
- * with Q = sum a_i k_i (the slope sin / (1 - Q cos) peaks at cos = Q). */
-static double max_drift(const gr_ref_renderer *r)
+/* Over every refracted sunlight direction T the waves and the sun's disc allow (normals
+ * tilted up to the waves' largest slope, tan = Q / sqrt(1 - Q^2) with Q = sum a_i k_i, where
+ * the Gerstner slope sin / (1 - Q cos) peaks at cos = Q, plus the disc's angular radius;
+ * facets that face away from the sun are unlit and refract nothing), scanned over 64
+ * azimuths x 8 tilts:
+ * - *drift: the largest drift |T_xz / T_y - T0_xz / T0_y| per metre of height (INFINITY once
+ *   a T is within 1e-3 of level), for the rest patch's margin;
+ * - *mu: the least |T_y| (T0's on flat water under a point sun), less 1 % for the scan's
+ *   azimuth step (5.6 deg: it misses the least value by a second-order amount), which
+ *   bounds the integrand's fall along rising camera rays (gr_ref_cutoff_d). */
+static void refraction_range(const gr_ref_renderer *r, double *drift, double *mu)
 {
     double Q = gr_gerstner_steepness(&r->scene.water);
     if (Q >= 0.999) Q = 0.999;
-    double tilt = atan(Q / sqrt(1.0 - Q * Q)) + r->sun_radius;
-    double best = 0.0;
-    for (int ia = 0; ia < 64; ia++) {
+    double tilt = atan(Q / sqrt(1.0 - Q * Q)) + r->sun_radius, best = 0.0, least = -r->T0.y;
+    for (int ia = 0; ia < 64 && tilt > 0.0; ia++) {
         double az = 2.0 * GR_PI * ia / 64.0;
         for (int it = 1; it <= 8; it++) {
             double a = tilt * it / 8.0;
             gr_dvec3 n = gr_d3(sin(a) * sin(az), cos(a), sin(a) * cos(az));
             if (gr_d3_dot(r->I0, n) >= 0.0) continue;
             gr_dvec3 T = gr_refract_d(r->I0, n, 1.0 / r->scene.medium.ior);
-            if (!(T.y < -1e-3)) return INFINITY;
+            if (-T.y < least) least = -T.y;
+            if (!(T.y < -1e-3)) {
+                best = INFINITY;
+                continue;
+            }
             double du = T.x / T.y - r->sx, dw = T.z / T.y - r->sz;
             double d = sqrt(du * du + dw * dw);
             if (d > best) best = d;
         }
     }
-    return best;
-}
-
-/* The least |T_y| over every refracted sunlight direction (normals tilted up to the waves'
- * largest slope, directions across the sun's disc; the same scan as max_drift): bounds the
- * integrand's fall along rising camera rays (gr_ref_cutoff_d). Flat water, point sun: T0. */
-static double min_mu(const gr_ref_renderer *r)
-{
-    double Q = gr_gerstner_steepness(&r->scene.water);
-    if (Q >= 0.999) Q = 0.999;
-    double tilt = atan(Q / sqrt(1.0 - Q * Q)) + r->sun_radius, best = -r->T0.y;
-    if (!(tilt > 0.0)) return best;
-    for (int ia = 0; ia < 64; ia++) {
-        double az = 2.0 * GR_PI * ia / 64.0;
-        for (int it = 1; it <= 8; it++) {
-            double a = tilt * it / 8.0;
-            gr_dvec3 n = gr_d3(sin(a) * sin(az), cos(a), sin(a) * cos(az));
-            if (gr_d3_dot(r->I0, n) >= 0.0) continue; /* a facet facing away from the sun: unlit */
-            gr_dvec3 T = gr_refract_d(r->I0, n, 1.0 / r->scene.medium.ior);
-            if (-T.y < best) best = -T.y;
-        }
-    }
-    /* the scan's azimuth step (5.6 deg) misses the least value by a second-order amount: a
-     * margin of 1 % keeps the bound on the safe side */
-    return 0.99 * best;
+    *drift = best;
+    *mu = tilt > 0.0 ? 0.99 * least : least;
 }
 
 /* The lit region: sheared bounds of the visible volume (camera frustum up to each ray's
  * end), clamped to reference.patch_radius_m around the camera. */
 static void compute_region(gr_ref_renderer *r)
 {
+    double drift;
+    refraction_range(r, &drift, &r->mu_min);
     const gr_scene *s = &r->scene;
     double A = wave_amplitude_sum(&s->water);
     double R = s->reference.patch_radius_m;
@@ -147,7 +136,7 @@ static void compute_region(gr_ref_renderer *r)
     r->region.y_min = ymin;
     /* rest patch margin: horizontal Gerstner displacement plus the largest drift of a beam
      * over the region's depth (rays enter the region from outside it) */
-    double pad = A + fabs(ymin) * max_drift(r) + 0.25;
+    double pad = A + fabs(ymin) * drift + 0.25;
     if (!(pad <= R)) pad = R;
     r->pad = pad;
 }
@@ -225,7 +214,6 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
     r->cutoff_d = st->max_distance_m;
     r->cutoff_ln = st->transmittance_cutoff > 0.0 && st->transmittance_cutoff < 1.0 ? -log(st->transmittance_cutoff) : 0.0;
     if (smin > 0.0 && r->cutoff_ln > 0.0) r->cutoff_d = fmin(r->cutoff_d, r->cutoff_ln / smin);
-    r->mu_min = min_mu(r);
     compute_region(r);
     {
         /* the camera cone's radius (docs/reference.md 2.2): the same for every pass */
