@@ -180,7 +180,7 @@ static gr_status ensure_surface(lr_state *r, int n, gr_error *err)
 
 /* The light's window: the square (in the plane across the sun's direction I, frame e1, e2)
  * that holds the surface points whose refracted rays can reach the visible volume. Points of
- * the volume (rays through a 17 x 17 grid, 9 distances each, to the surface / seabed / cutoff)
+ * the volume (rays through a 17 x 17 grid, 9 distances each, to the surface / seabed / far end)
  * are carried back up the flat refracted sun to the rest plane and projected along I; the
  * waves' displacement and tilt widen it by a margin. All eye-relative. */
 typedef struct lr_window {

@@ -86,11 +86,18 @@ void gr_vol_set(const gr_vol_locs *l, const gr_vol_inputs *in)
     glActiveTexture(GL_TEXTURE0);
 }
 
+/* The volume techniques' far end: where the view's transmittance in the least attenuated
+ * channel falls to 1e-3, as a fog volume's far plane would be set. A constant of these
+ * techniques, not the ground truth's reference.transmittance_cutoff (an accuracy setting of
+ * the truth, which bounds the integrand instead, docs/reference.md 1, and whose default fell
+ * to 1e-4 on 2026-11-29): tightening the truth must not move or slow the techniques. */
+#define VOL_FAR_TRANSMITTANCE 1e-3
+
 double gr_vol_t_max(const gr_scene *scene)
 {
     double smin = fmin(scene->medium.extinction[0], fmin(scene->medium.extinction[1], scene->medium.extinction[2]));
     double t = scene->reference.max_distance_m;
-    if (smin > 0) t = fmin(t, -log(scene->reference.transmittance_cutoff) / smin);
+    if (smin > 0) t = fmin(t, -log(VOL_FAR_TRANSMITTANCE) / smin);
     return t;
 }
 

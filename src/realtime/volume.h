@@ -56,7 +56,7 @@ void gr_vol_set(const gr_vol_locs *l, const gr_vol_inputs *in);
 /* The farthest view depth (along forward) any pixel's ray needs: rays through a 17 x 17 grid
  * to the surface / seabed, at most t_max (m). */
 double gr_vol_far_depth(const gr_scene *scene, const gr_frame *f, double t_max);
-/* Where the reference stops a camera ray in clear water: min(-ln(cutoff) / min sigma_t, max). */
+/* The techniques' far end in clear water: min(-ln(1e-3) / min sigma_t, reference.max_distance_m). */
 double gr_vol_t_max(const gr_scene *scene);
 /* Slab bounds b[0..n] in view depth: b[0] = 0, then linear to far, or geometric from near. */
 void gr_vol_bounds(int n, int exponential, double near_m, double far_m, double *b);

@@ -21,7 +21,7 @@ typedef struct gr_reference_settings {
     unsigned long long seed;      /* RNG seed: same seed, same bytes, any thread count */
     int threads;                  /* 0 = all cores */
     double target_error;          /* 0 = off; else refine until rel. std. error < this */
-    double transmittance_cutoff;  /* camera rays stop where exp(-tau) falls below this */
+    double transmittance_cutoff;  /* camera rays stop where the light left to gather falls below this (docs/reference.md 1) */
     double max_distance_m;        /* camera rays stop here at the latest (clear water) */
     double patch_radius_m;        /* half size of the tessellated surface patch around the
                                      camera; beyond it the waves' mean sunlight is used */
