@@ -9,7 +9,7 @@ set(GR_TEST_COSTS
   cli.run 58 0
   farm.slurm 51 0
   cli.truth_digest 47 0
-  cli.rel_cache 34 87
+  cli.rel_cache 10 16
   integration.tune_default 31 0
   cli.volume_cli 31 58
   unit.ref_coverage 30 0
