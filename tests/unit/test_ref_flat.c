@@ -2,8 +2,8 @@
  * L = sigma_s p(T.-w) E_w exp(-sigma_t z0 / mu_t) (1 - exp(-sigma_t k D)) / (sigma_t k),
  * k = 1 - w_y / mu_t, E_w = F_t E_sun cos(theta_i) / cos(theta_t), per RGB channel, with
  * D the distance to the ray's end (surface, seabed, or reference.max_distance_m): the physical
- * value, not the renderer's transmittance cutoff, which may drop at most 0.1 % of a channel
- * (docs/reference.md 1). Until 2026-11-29 the oracle ended its rays at the cutoff as the
+ * value, not the renderer's transmittance cutoff, which may drop at most its own fraction of
+ * a channel (1e-4 by default; docs/reference.md 1). Until 2026-11-29 the oracle ended its rays at the cutoff as the
  * renderer did, D_cut = -ln(cutoff) / sigma_t, which hid that a ray rising toward the sun
  * (k = 0: an integrand that does not fall) lost everything past it: 31 % of the light
  * looking up the refracted sun from 5 m with sigma_t 2 /m, 8-10 % from 100 m with 0.07 /m.
