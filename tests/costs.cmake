@@ -1,4 +1,4 @@
-# Test times in seconds measured on the 2-core CI VM (2026-11-29, a fresh clone, CI=true: slow
+# Test times in seconds measured on the 2-core CI VM (2026-11-29, ninth session: a fresh clone, CI=true: slow
 # tests reduced): the Werror build's and the sanitizer build's (0: not run there). ctest runs
 # the dearest tests first only when it has timings of its own (Testing/Temporary/CTestCostData.txt),
 # which a fresh clone has not: it then started them in numbering order, and the longest ones
@@ -6,69 +6,72 @@
 # These become each test's COST property, ctest's order when it has no timings. Only tests of
 # 4 s or more; re-measure when the suite changes much (the table need not be exact to help).
 set(GR_TEST_COSTS
-  cli.run 58 0
-  farm.slurm 51 0
-  cli.truth_digest 47 0
-  cli.rel_cache 10 16
-  integration.tune_default 31 0
-  cli.volume_cli 31 58
-  unit.ref_coverage 30 0
-  unit.ref_adaptive 23 0
-  cli.techniques 23 27
-  cli.run_sequence 23 38
-  cli.report_links 23 39
-  cli.capture_own 23 43
-  unit.ref_antithetic 21 37
-  integration.suite_tune 19 0
-  cli.tune_pareto 19 0
+  unit.ref_coverage 60 0
+  farm.slurm 57 0
+  integration.tune_default 37 0
+  cli.capture_own 32 40
+  unit.ref_adaptive 32 0
+  cli.run 28 0
+  cli.techniques 27 33
+  cli.rel_inputs 25 32
+  cli.truth_digest 24 0
+  integration.suite_tune 24 0
+  cli.volume_cli 23 39
+  cli.report_links 22 38
+  unit.ref_antithetic 19 35
+  cli.report_viewer 18 25
+  cli.rel_cache 18 18
+  cli.pareto_suite 18 0
+  cli.tune_pareto 18 0
+  cli.compare_fit 17 24
   unit.ref_photons 17 0
-  integration.ref_cli 17 0
-  cli.rel_inputs 16 30
+  cli.rel_outputs 16 27
+  cli.run_sequence 16 9
+  cli.export_blender 14 12
+  integration.caustics 14 0
+  integration.eevee_flat 14 0
+  integration.ref_cli 14 0
   unit.ref_flux 14 0
-  cli.report_viewer 14 26
-  cli.pareto_suite 14 0
-  integration.eevee_flat 13 0
-  integration.caustics 13 0
-  cli.rel_outputs 13 25
-  cli.compare_fit 13 19
-  cli.rel_signals 10 0
-  unit.ref_convergence 9 0
-  integration.volume_flat 9 21
-  cli.report_browser 9 16
-  unit.ref_focus 8 0
-  cli.usertech_timeout 8 9
-  cli.tune_rgb 8 9
-  cli.rel_tune_trace 8 17
-  cli.export_blender 8 12
-  cli.sweep 7 0
-  cli.run_progress 7 10
-  cli.compare 7 11
-  unit.ref_nocap 6 0
-  integration.merge 6 16
-  cli.rel_readers 6 8
-  integration.tune_starts 5 12
-  integration.tune_identify 5 10
-  cli.watch 5 6
-  cli.reference_target 5 25
-  integration.usertech_identify 4 6
-  integration.ref_hard 4 10
+  integration.volume_flat 13 30
+  cli.report_browser 12 16
+  unit.ref_focus 12 0
+  unit.ref_camera_rays 11 26
+  cli.rel_signals 11 0
+  cli.compare 10 14
+  cli.sweep 10 14
+  unit.ref_convergence 10 0
+  cli.rel_tune_trace 9 15
+  cli.usertech_timeout 8 11
+  cli.run_progress 8 10
+  integration.tune_starts 7 15
+  cli.rel_readers 7 9
+  integration.merge 6 15
+  cli.tune_rgb 6 14
+  cli.reference_target 6 13
+  integration.ref_hard 6 11
+  integration.tune_identify 6 10
+  cli.export_compare 5 10
+  cli.watch 5 7
+  cli.exr_half_rgba 5 6
+  unit.ref_nocap 5 0
+  cli.rel_budget 4 9
+  integration.usertech_identify 4 7
+  cli.oiio_module 4 5
   cli.truth_commands 4 0
-  cli.rel_budget 4 8
-  cli.export_compare 4 8
-  unit.ref_flat 3 7
-  cli.suite 3 4
-  cli.shafts_render 3 4
+  integration.shafts_stable 4 0
   cli.run_verdict 3 7
   cli.run_targets 3 6
-  cli.oiio_module 3 6
-  cli.exr_half_rgba 3 6
+  cli.shafts_render 3 6
+  cli.suite 3 5
+  unit.ref_disc 3 5
+  cli.usertech_glsl 3 4
+  cli.usertech_light 3 4
+  unit.flip 2 7
+  cli.rel_numbers 2 5
   unit.ref_grid_split 2 5
-  unit.ref_disc 2 5
-  unit.flip 2 5
-  cli.usertech_light 2 4
-  cli.rel_numbers 2 4
   cli.preset 2 4
-  integration.tune_objective 1 4
+  cli.radial_blur_cli 2 4
+  unit.ref_flat 2 4
 )
 list(LENGTH GR_TEST_COSTS n)
 math(EXPR last "${n} - 1")

@@ -19,8 +19,11 @@ cd "$out" || exit 1
 scene="$src/data/scenes/default.json"
 small="--size 96x54 --set reference.surface_res=64 --set reference.sun_samples=2 --set reference.batches=2
        --set reference.steps=16"
+# two techniques, a rasterized one and a volume one: the sequence report is the same code for
+# every technique (each technique's frames are cli.techniques' and cli.capture_own's checks)
+two="--techniques shafts,light_rays"
 # shellcheck disable=SC2086
-GODRAYS_CACHE="$out/cache" "$bin" run "$scene" -o rep --frames 0:10:5 --fps 15 $small -q >run.txt 2>&1
+GODRAYS_CACHE="$out/cache" "$bin" run "$scene" -o rep --frames 0:10:5 --fps 15 $small $two -q >run.txt 2>&1
 rc=$?
 ck "godrays run --frames exits 0 (rc $rc)" [ "$rc" -eq 0 ]
 [ "$rc" -eq 0 ] || { cat run.txt; exit 1; }
