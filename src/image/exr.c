@@ -545,6 +545,11 @@ gr_status gr_exr_check(const char *path, gr_error *err)
 
 gr_status gr_exr_read(const char *path, gr_image **out, gr_metadata *meta, gr_error *err)
 {
+    return gr_exr_read_bits(path, out, meta, NULL, err);
+}
+
+gr_status gr_exr_read_bits(const char *path, gr_image **out, gr_metadata *meta, int *bits, gr_error *err)
+{
     if (out) *out = NULL;
     if (!path || !path[0] || !out) return gr_fail(err, GR_E_USAGE, "EXR read: no input path or output");
     gr_status st = gr_check_regular_input(path, err); /* a FIFO would block the open */
@@ -557,6 +562,7 @@ gr_status gr_exr_read(const char *path, gr_image **out, gr_metadata *meta, gr_er
     exr_context_initializer_t init = exr_init_for(1);
     exr_context_t ctx = NULL;
     gr_image *img = NULL;
+    int widest = 0; /* bits of the widest sample */
     gr_metadata attrs;
     gr_meta_init(&attrs);
     exr_result_t rv = exr_start_read(&ctx, path, &init);
@@ -612,6 +618,8 @@ gr_status gr_exr_read(const char *path, gr_image **out, gr_metadata *meta, gr_er
             st = gr_fail(err, GR_E_INPUT, "%s: channel '%s' has unknown pixel type %d", path, e->name.str, (int)e->pixel_type);
             goto done;
         }
+        const int b = e->pixel_type == EXR_PIXEL_HALF ? 16 : 32;
+        if (b > widest) widest = b;
         /* insertion sort into the canonical order */
         int j = i;
         while (j > 0 && channel_before(e->name.str, names[j - 1])) {
@@ -650,5 +658,6 @@ done:
         return st;
     }
     *out = img;
+    if (bits) *bits = widest;
     return GR_OK;
 }

@@ -14,5 +14,7 @@ gr_status gr_exr_write(const char *path, const gr_image *img, const gr_metadata 
  * reading pixels: for readers of EXR files other than gr_exr_read (OpenImageIO's). */
 gr_status gr_exr_check(const char *path, gr_error *err);
 gr_status gr_exr_read(const char *path, gr_image **out, gr_metadata *meta, gr_error *err);
+/* gr_exr_read, and *bits (may be NULL) the file's widest sample: 16 (half) or 32 (float, uint). */
+gr_status gr_exr_read_bits(const char *path, gr_image **out, gr_metadata *meta, int *bits, gr_error *err);
 
 #endif
