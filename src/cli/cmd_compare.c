@@ -109,7 +109,8 @@ static gr_status write_text(const char *path, const char *text, gr_error *err)
 /* Reads one input (and what the file says of its pixels, info: may be NULL); any failure is
  * bad input (exit 2) naming the role and the file, unless no image can be read at all (the
  * OpenImageIO module missing: exit 1). EXR files through the project's reader (image/exr.h),
- * as OpenImageIO reads them (float samples, canonical channel order, "Linear", never decoded),
+ * as OpenImageIO reads them (float samples, canonical channel order, never decoded; its
+ * colour space is "Linear" for every EXR file, whatever the file's attributes say),
  * without loading OpenImageIO (0.4 s of dynamic linking, docs/images.md); the rest through it. */
 static gr_status read_input(const char *role, const char *path, int linearize, gr_image **img, gr_oiio_info *info,
                             gr_error *err)
