@@ -1,7 +1,8 @@
 #!/bin/sh
 # OpenImageIO as a module loaded on first use (docs/images.md, "Loading OpenImageIO"): the
 # binary does not link it; image calls load build/libgodrays_oiio.so; a missing or wrong
-# module is one line naming what was tried and why (exit 1), and EXR-only work never needs it.
+# module is one line naming what was tried and why (exit 1), and EXR-only work (a ground truth
+# without a preview, compare of two EXR files without -o) never needs it.
 # A build with OpenImageIO linked in (-DGODRAYS_OIIO_MODULE=OFF; the sanitizer build's
 # default) is told by ldd and checked for what it promises instead: no module, images work,
 # GODRAYS_OIIO_MODULE is not read.
@@ -52,4 +53,17 @@ GODRAYS_OIIO_MODULE=$dir/none.so "$bin" reference scene.json -o t.exr --no-previ
 rc=$?
 ck "reference to EXR without the module (exit $rc: $(head -c 300 ref_out.txt))" test "$rc" -eq 0
 ck "its EXR" test -s t.exr
+# compare of two EXR files without -o reads them with the project's reader, without the module;
+# its metrics are those of the same float pixels read through OpenImageIO (float TIFF copies)
+oiiotool --create 32x24 3 --fill:color=0.3,0.1,0.05 16x12 -d float -o test.exr >/dev/null || exit 1
+oiiotool ref.exr -d float -o ref.tif >/dev/null && oiiotool test.exr -d float -o test.tif >/dev/null || exit 1
+GODRAYS_OIIO_MODULE=$dir/none.so "$bin" compare ref.exr test.exr --json >exr.json 2>exr.err
+rc=$?
+ck "compare of two EXR files without the module (exit $rc: $(head -c 300 exr.err))" test "$rc" -eq 0
+"$bin" compare ref.tif test.tif --json >tif.json 2>tif.err
+ck "the same metrics as OpenImageIO's reading of the same pixels" python3 - exr.json tif.json <<'PY'
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert a["metrics"] == b["metrics"] and a["metrics"], (a["metrics"], b["metrics"])
+PY
 exit $fail
