@@ -113,15 +113,23 @@ static gr_status write_text(const char *path, const char *text, gr_error *err)
  * colour space is "Linear" for every EXR file, whatever the file's attributes say),
  * without loading OpenImageIO (0.4 s of dynamic linking, docs/images.md); the rest through it. */
 static gr_status read_input(const char *role, const char *path, int linearize, gr_image **img, gr_oiio_info *info,
-                            gr_error *err)
+                            int *dof, gr_error *err)
 {
     *img = NULL;
+    if (dof) *dof = 0;
     gr_status st;
     size_t n = strlen(path);
     if (n > 4 && !strcasecmp(path + n - 4, ".exr")) {
         int bits = 32;
-        st = gr_exr_read_bits(path, img, NULL, &bits, err);
+        gr_metadata meta;
+        gr_meta_init(&meta);
+        st = gr_exr_read_bits(path, img, dof ? &meta : NULL, &bits, err);
         if (st == GR_OK && info) *info = (gr_oiio_info){.bits = bits, .colorspace = "Linear"};
+        /* a ground truth's stderr comes from a few batches: its degrees of freedom (Student's
+         * t), from godrays:stderr_dof when it is one of ours; 0 (unknown) otherwise */
+        const gr_meta_item *it = st == GR_OK && dof ? gr_meta_get(&meta, "godrays:stderr_dof") : NULL;
+        if (it && it->type != GR_META_STRING && it->num >= 1.0) *dof = (int)it->num;
+        gr_meta_free(&meta);
     } else {
         st = gr_oiio_available(err);
         if (st != GR_OK) return st;
@@ -210,6 +218,7 @@ typedef struct compare_state {
     gr_image *ref, *test, *mask, *diff[3];
     gr_image *scaled;             /* TEST as fitted, for FLIP (and the pictures, per channel) */
     gr_oiio_info info[2];         /* what REF's and TEST's files say of their pixels */
+    int ref_dof;                  /* REF's stderr degrees of freedom (0: unknown; read_input) */
     gr_capture_report capture;    /* the capture checks (compare/capture.h) */
     unsigned char *scored;
     float *flipmap, *angles;
@@ -388,9 +397,9 @@ static int parse_args(gr_args *args, compare_opts *o)
  * reference. */
 static gr_status read_inputs(const compare_opts *o, compare_state *s, gr_error *err)
 {
-    gr_status st = read_input("reference", o->paths[0], o->linearize, &s->ref, &s->info[0], err);
-    if (st == GR_OK) st = read_input("test", o->paths[1], o->linearize, &s->test, &s->info[1], err);
-    if (st == GR_OK && o->mask_path) st = read_input("mask", o->mask_path, 0, &s->mask, NULL, err);
+    gr_status st = read_input("reference", o->paths[0], o->linearize, &s->ref, &s->info[0], &s->ref_dof, err);
+    if (st == GR_OK) st = read_input("test", o->paths[1], o->linearize, &s->test, &s->info[1], NULL, err);
+    if (st == GR_OK && o->mask_path) st = read_input("mask", o->mask_path, 0, &s->mask, NULL, NULL, err);
     if (st != GR_OK) return st;
     const gr_image *ref = s->ref, *test = s->test, *mask = s->mask;
     if (ref->width != test->width || ref->height != test->height)
@@ -442,25 +451,6 @@ static gr_status structure_setup(compare_opts *o, compare_state *s, gr_error *er
     s->so.vp_x = o->vp[0], s->so.vp_y = o->vp[1];
     o->opt.structure = &s->so;
     return GR_OK;
-}
-
-/* A ground truth's stderr comes from a few batches: its degrees of freedom (Student's t), from
- * REF's godrays:stderr_dof when it is one of ours; 0 (unknown) otherwise. */
-static int stderr_dof_of(const char *path)
-{
-    gr_metadata meta;
-    gr_meta_init(&meta);
-    gr_image *tmp = NULL;
-    gr_error e2 = {0};
-    int dof = 0;
-    size_t n = strlen(path);
-    if (n > 4 && !strcmp(path + n - 4, ".exr") && gr_exr_read(path, &tmp, &meta, &e2) == GR_OK) {
-        const gr_meta_item *it = gr_meta_get(&meta, "godrays:stderr_dof");
-        if (it && it->type != GR_META_STRING && it->num >= 1.0) dof = (int)it->num;
-    }
-    gr_image_destroy(tmp);
-    gr_meta_free(&meta);
-    return dof;
 }
 
 /* The scored pixels (as the metrics score them), once, for FLIP and the structure details. */
@@ -563,7 +553,7 @@ static gr_status compute_all(compare_opts *o, compare_state *s, gr_error *err)
     if (o->do_struct && (st = structure_setup(o, s, err)) != GR_OK) return st;
     o->opt.mask = s->mask;
     if (!o->do_basic) o->opt.skip_ssim = o->opt.skip_blur = o->opt.skip_extra = 1;
-    o->opt.stderr_dof = stderr_dof_of(o->paths[0]);
+    o->opt.stderr_dof = s->ref_dof;
     const double t0 = now_s();
     st = gr_metrics_compute(s->ref, s->test, &o->opt, &s->m, err);
     s->t_metrics = now_s() - t0;
