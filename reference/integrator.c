@@ -141,30 +141,6 @@ static void compute_region(gr_ref_renderer *r)
     r->pad = pad;
 }
 
-/* The cells' floor (docs/reference.md 2.2, "The cells' floor"): the plain grid's cells,
- * sqrt(patch area) / surface_res, no narrower than hmin = R_min / reference.cells_per_radius,
- * R_min = (1 - Q)^2 / sum a_i k_i^2 the waves' smallest radius of curvature (a Gerstner
- * crest's, (1 - a k)^2 / (a k^2), for one wave): surface_res lowered to fit, never raised,
- * and FLOOR_MIN_RES at least (the bias probe's levels res, res/2, res/4 stay fine). The
- * camera cone's refinement factor stays as set (measured: lowering it too raised the bias
- * there 2-5x in views looking along the beams). */
-#define FLOOR_MIN_RES 64
-static void apply_cell_floor(gr_ref_renderer *r)
-{
-    gr_reference_settings *st = &r->set;
-    double cpr = st->cells_per_radius, C = gr_gerstner_curvature_sum(&r->scene.water);
-    double Q = gr_gerstner_steepness(&r->scene.water);
-    if (r->flat || !(cpr > 0.0) || !(C > 0.0) || !(Q < 1.0)) return;
-    double hmin = (1.0 - Q) * (1.0 - Q) / C / cpr;
-    double eu = r->region.u1 - r->region.u0 + 2.0 * r->pad, ew = r->region.w1 - r->region.w0 + 2.0 * r->pad;
-    double ext = sqrt(eu * ew);
-    if (!(ext > 0.0)) return;
-    if (st->surface_res > FLOOR_MIN_RES && ext / st->surface_res < hmin) {
-        double n = ceil(ext / hmin);
-        st->surface_res = n >= st->surface_res ? st->surface_res : n <= FLOOR_MIN_RES ? FLOOR_MIN_RES : (int)n;
-    }
-}
-
 gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_renderer **out, gr_error *err)
 {
     *out = NULL;
@@ -239,8 +215,6 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
     r->cutoff_ln = st->transmittance_cutoff > 0.0 && st->transmittance_cutoff < 1.0 ? -log(st->transmittance_cutoff) : 0.0;
     if (smin > 0.0 && r->cutoff_ln > 0.0) r->cutoff_d = fmin(r->cutoff_d, r->cutoff_ln / smin);
     compute_region(r);
-    r->res_requested = r->set.surface_res;
-    apply_cell_floor(r);
     {
         /* the camera cone's radius (docs/reference.md 2.2): the same for every pass */
         gr_beam_params bp;
@@ -454,7 +428,6 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
     info->region[0] = r->region.u0; info->region[1] = r->region.u1;
     info->region[2] = r->region.w0; info->region[3] = r->region.w1;
     info->region[4] = r->region.y_min; info->region[5] = r->pad;
-    info->surface_res = r->set.surface_res;
     if (r->beams) {
         info->cell_m = gr_beams_stats(r->beams)->cell_m;
         info->prims = gr_beams_stats(r->beams)->prims;

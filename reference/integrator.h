@@ -126,7 +126,6 @@ typedef struct gr_ref_info {
     size_t prims;           /* beam-slab primitives of the last beam set */
     double cone_cells;      /* estimated surface cells of the camera cone's beam set, its
                                refined sub-cells included (0: none; docs/reference.md 2.2) */
-    int surface_res;        /* the surface_res used: the one set, or lower by the cells' floor */
 } gr_ref_info;
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info);
 /* For the benchmark (reference/bench.c): the displaced surface mesh of the prepared pass

@@ -16,9 +16,7 @@ static const double PRIM_BUDGET = 16777216.0; /* 2^24 */
 double gr_ref_memory_estimate(const gr_scene *scene, const gr_ref_info *info)
 {
     const double px = (double)scene->camera.width * (double)scene->camera.height;
-    /* the resolution the render uses (the cells' floor may lower the one set) */
-    const double B = scene->reference.batches, sr = info->surface_res > 0 ? info->surface_res : scene->reference.surface_res;
-    const double cc = info->cone_cells;
+    const double B = scene->reference.batches, sr = scene->reference.surface_res, cc = info->cone_cells;
     const double cells = sr * sr;
     return px * (PER_PIXEL_BATCH * B + PER_PIXEL_AOV + PER_PIXEL_IMAGE) + (cells + cc) * PER_CELL +
            (fmin(2.0 * cells, PRIM_BUDGET) + fmin(2.0 * cc, PRIM_BUDGET)) * PER_PRIM;
@@ -31,7 +29,6 @@ gr_status gr_ref_memory_check(const gr_scene *scene, const gr_ref_info *info, gr
         snprintf(cone, sizeof cone, ", refine_factor %d (%.0f cells near the camera)", scene->reference.refine_factor,
                  info->cone_cells);
     snprintf(detail, sizeof detail, "%d x %d pixels x %d batches, surface_res %d%s", scene->camera.width,
-             scene->camera.height, scene->reference.batches,
-             info->surface_res > 0 ? info->surface_res : scene->reference.surface_res, cone);
+             scene->camera.height, scene->reference.batches, scene->reference.surface_res, cone);
     return gr_memlimit_check("the ground truth", gr_ref_memory_estimate(scene, info), detail, err);
 }

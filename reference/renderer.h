@@ -85,8 +85,6 @@ struct gr_ref_renderer {
     double mu_min;            /* the least |T_y| of any refracted sunlight (waves, disc) */
     gr_beam_region region;
     double pad;
-    int res_requested;        /* reference.surface_res as set; set.surface_res is the one used,
-                                 after the cells' floor (docs/reference.md 2.2) */
     int passes_per_round, spp_pass, batches, threads;
     int camera_rays;          /* rays per camera sample in the main passes (1..REF_MAX_RAYS) */
     double sig_t[3], sig_s[3], E[3];

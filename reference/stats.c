@@ -326,11 +326,9 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     SET(gr_meta_set_string(m, "godrays:scene", r->scene.source_path[0] ? r->scene.source_path : r->scene.name));
     SET(gr_meta_set_string(m, "godrays:scene_hash", r->scene.hash));
     const gr_param_table *t = &gr_reference_param_table;
-    gr_reference_settings asked = r->set; /* the settings as given; the resolution used below */
-    asked.surface_res = r->res_requested;
     for (size_t i = 0; i < t->count; i++) {
         snprintf(key, sizeof key, "godrays:reference.%s", t->params[i].name);
-        double v = gr_param_get_number(&t->params[i], &asked, 0);
+        double v = gr_param_get_number(&t->params[i], &r->set, 0);
         if (t->params[i].type == GR_PT_DOUBLE) SET(gr_meta_set_double(m, key, v));
         else if (t->params[i].type == GR_PT_ENUM && t->params[i].enum_names) /* the name, as in the scene */
             SET(gr_meta_set_string(m, key, t->params[i].enum_names[(int)v]));
@@ -374,7 +372,6 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     if (r->have_main_beams) {
         const gr_ref_sums *bs = &r->tally;
         SET(gr_meta_set_double(m, "godrays:surface_cell_m", bs->beam_cell_m));
-        SET(gr_meta_set_int(m, "godrays:surface_res_used", r->set.surface_res)); /* after the cells' floor */
         SET(gr_meta_set_int(m, "godrays:beam_prims", bs->beam_prims));
         if (bs->beam_refine_factor > 1) { /* local refinement (docs/reference.md 2.2) */
             snprintf(buf, sizeof buf, "camera rays within %g deg of +-T0: factor %d within %.3f m of P_s, %lld cells refined, "

@@ -78,15 +78,6 @@ double gr_gerstner_steepness(const gr_water *w)
     return s;
 }
 
-double gr_gerstner_curvature_sum(const gr_water *w)
-{
-    double s = 0.0;
-    int n = wave_count(w);
-    for (int i = 0; i < n; i++)
-        s += fabs(w->waves[i].amplitude_m) * w->waves[i].k * w->waves[i].k;
-    return s;
-}
-
 /* Residual r = F(X0) - X of the horizontal map F(X0) = X0 - sum a d sin(phi) and its
  * Jacobian J = I - sum a k d d^T cos(phi) (symmetric: j00, j01 = j10, j11). */
 static void horizontal_residual(const gr_water *w, int n, double x0, double z0, double t,

@@ -18,8 +18,6 @@ void gr_gerstner_frame(const gr_water *w, double x0, double z0, double t,
 
 /* Steepness sum_i a_i k_i; the surface loops (the rest-to-world map folds) iff >= 1. */
 double gr_gerstner_steepness(const gr_water *w);
-/* sum_i a_i k_i^2: the height's largest second derivative over the rest plane (1/m). */
-double gr_gerstner_curvature_sum(const gr_water *w);
 
 /* Height of the surface above the world point (x, z) at time t: finds the rest point
  * (x0, z0) whose displaced horizontal position is (x, z) (a contraction when steepness < 1)

@@ -66,8 +66,6 @@ static const gr_param reference_params[] = {
      .unit = "", .doc = "local refinement: the camera rays that run along the refracted sun's beams look up a tessellation with the surface cells they meet split into F x F (1 = off)"},
     {.name = "refine_angle_deg", .type = GR_PT_DOUBLE, .offset = REF(refine_angle_deg), .min = 0, .max = 30, .def = 12,
      .unit = "deg", .doc = "local refinement: the camera rays within this angle of the refracted sun direction (either way) look up the refined tessellation; the others the plain grid"},
-    {.name = "cells_per_radius", .type = GR_PT_DOUBLE, .offset = REF(cells_per_radius), .min = 0, .max = 1000, .def = 8,
-     .unit = "", .doc = "the surface cells' floor: never narrower than the waves' smallest radius of curvature, (1 - sum a_i k_i)^2 / sum a_i k_i^2, over this (surface_res then lowered for the view, at least 64; a small lit patch otherwise gets cells far finer than the waves need); 0 = no floor"},
 };
 #undef REF
 

@@ -38,8 +38,6 @@ typedef struct gr_reference_settings {
     int refine_factor;            /* surface cells split F x F where camera rays run along the
                                      beams (1 = off; docs/reference.md 2.2) */
     double refine_angle_deg;      /* ...those camera rays: within this angle of the refracted sun */
-    double cells_per_radius;      /* surface cells no narrower than the waves' smallest radius of
-                                     curvature over this (0 = no floor; docs/reference.md 2.2) */
 } gr_reference_settings;
 
 /* reference.sun_disc: the disc average by the analytic convolution of each beam's footprint

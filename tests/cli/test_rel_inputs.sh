@@ -53,7 +53,7 @@ expect 2 "zeros.png: cannot read as an image" compare a.exr zeros.png
 
 # ---- 6 ----
 expect 2 "reference.batches: must be in [2, 1024], got 1" validate "$scene" --set reference.batches=1
-expect 2 "needs about" reference "$scene" --set reference.surface_res=4096 --set reference.cells_per_radius=0 --max-memory 1G -o x.exr
+expect 2 "needs about" reference "$scene" --set reference.surface_res=4096 --max-memory 1G -o x.exr
 GODRAYS_MAX_MEMORY=2G expect 2 "over the memory limit of 2.00 GiB (GODRAYS_MAX_MEMORY)" reference "$scene" --size 16384x16384 -o x.exr
 [ ! -e x.exr ] || bad "x.exr written by a refused render"
 

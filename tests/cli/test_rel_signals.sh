@@ -103,7 +103,7 @@ pid=
 
 # ---- d: a signal while the beams of a fine surface (surface_res 4096) are built ---------------
 rm -f early.exr
-"$bin" reference "$scene" --size 32x18 --set reference.surface_res=4096 --set reference.cells_per_radius=0 -o early.exr >out.txt 2>err.txt &
+"$bin" reference "$scene" --size 32x18 --set reference.surface_res=4096 -o early.exr >out.txt 2>err.txt &
 pid=$!
 wait_cpu "$pid" 1.5 # inside the build of the 4096^2 surface, which takes over 10 s of CPU
 t0=$(now)

@@ -22,7 +22,7 @@ static int run(int res, double elev, const double *depths, int nd, int nz)
         "\"sun\":{\"elevation_deg\":%g,\"azimuth_deg\":0,\"angular_diameter_deg\":0.53},"
         "\"medium\":{\"absorption_per_m\":0,\"scattering_per_m\":0,\"g\":0},"
         "\"camera\":{\"position_m\":[0,-3,0],\"pitch_deg\":80,\"width\":4,\"height\":4},"
-        "\"reference\":{\"surface_res\":%d,\"sun_samples\":2,\"batches\":2,\"cells_per_radius\":0}}", elev, res);
+        "\"reference\":{\"surface_res\":%d,\"sun_samples\":2,\"batches\":2}}", elev, res);
     gr_ref_options o;
     gr_ref_options_default(&o);
     o.progress = 0;
