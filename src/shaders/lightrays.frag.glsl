@@ -51,8 +51,7 @@ void main()
         float mu = -g_t.y, h = t1 - t0, tm = 0.5 * (t0 + t1);
         vec3 kappa = u_sigma_t * (1.0 - w.y / mu);
         vec3 x = abs(0.5 * kappa * h); // sinh(x) / x is even
-        vec3 seg = h * mix(sinh(x) / max(x, vec3(1e-30)), vec3(1.0) + x * x / 6.0, lessThan(x, vec3(1e-3)));
-        vec3 L = u_sigma_s * u_esun * (g_flux * vol_hg(dot(g_t, -w), u_g)) * exp(-u_sigma_t * (g_p0.y / mu) - kappa * tm) * seg;
+        vec3 L = u_sigma_s * u_esun * (g_flux * vol_hg(dot(g_t, -w), u_g)) * vol_slab(-u_sigma_t * (g_p0.y / mu) - kappa * tm, x, h);
         o_color = vec4(L, 1.0);
         return;
     }

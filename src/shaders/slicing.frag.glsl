@@ -28,7 +28,6 @@ void main()
     vec3 p = w * tm;
     vec3 kappa = u_sigma_t * (1.0 - w.y / -u_refr.y);
     vec3 x = abs(0.5 * kappa * h); // sinh(x) / x is even
-    vec3 seg = h * mix(sinh(x) / max(x, vec3(1e-30)), vec3(1.0) + x * x / 6.0, lessThan(x, vec3(1e-3)));
-    vec3 L = vol_inscatter(p, w) * exp(-u_sigma_t * tm) * seg;
+    vec3 L = vol_inscatter_slab(p, w, tm, x, h);
     o_color = vec4(L, 1.0);
 }

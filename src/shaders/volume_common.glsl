@@ -30,11 +30,28 @@ float vol_shadow(vec3 p)
     return (d >= 1.0 || s.z <= d + 1e-3) ? 1.0 : 0.0;
 }
 
-// Henyey-Greenstein, normalized over the sphere (seed 000 eq. 5.5.4 / 4 pi).
+// Henyey-Greenstein, normalized over the sphere (seed 000 eq. 5.5.4 / 4 pi). Its denominator
+// 1 + g^2 - 2 g cos written (1 - |g|)^2 + 2 |g| (1 - sign(g) cos), the same number: in float
+// the first form cancels to 0 at cos = 1 for g >= 0.9999 (the peak an Inf) and keeps no digit
+// near it; the second is >= (1 - |g|)^2 > 0 to full precision (docs/volume-techniques.md,
+// "Floating point").
 float vol_hg(float cos_t, float g)
 {
-    float d = 1.0 + g * g - 2.0 * g * cos_t;
+    float ag = abs(g), c = g < 0.0 ? -cos_t : cos_t;
+    float d = (1.0 - ag) * (1.0 - ag) + 2.0 * ag * max(1.0 - c, 0.0);
     return (1.0 - g * g) / (4.0 * PI * d * sqrt(d));
+}
+
+// h exp(e) sinh(x) / x: a slab's weight (the exact integral of the two paths' extinction over
+// its length h, x = |kappa h / 2|) times the attenuation exp(e) at its middle, written
+// h (exp(e + x) - exp(e - x)) / (2 x): its exponents are those at the slab's two ends (<= 0),
+// where sinh(x) alone overflows to Inf past x = 89 (a long slab in murky water) and Inf times
+// the middle's exp(e) = 0 makes NaN (docs/volume-techniques.md, "Floating point").
+vec3 vol_slab(vec3 e, vec3 x, float h)
+{
+    vec3 big = h * (exp(e + x) - exp(e - x)) / (2.0 * max(x, vec3(1e-30)));
+    vec3 small = h * exp(e) * (vec3(1.0) + x * x / 6.0);
+    return mix(big, small, lessThan(x, vec3(1e-3)));
 }
 
 // In-scattered radiance per metre at p toward the eye (view direction w, away from the eye):
@@ -49,3 +66,13 @@ vec3 vol_inscatter_nophase(vec3 p)
     return u_sigma_s * u_esun * e * exp(-u_sigma_t * (depth / mu)) * vol_shadow(p);
 }
 vec3 vol_inscatter(vec3 p, vec3 w) { return vol_inscatter_nophase(p) * vol_hg(dot(u_refr, -w), u_g); }
+// A slab of view ray around p (at view distance tm, length h, x = |kappa h / 2|):
+// vol_inscatter(p, w) exp(-sigma_t tm) h sinh(x) / x, the exponentials taken together (vol_slab).
+vec3 vol_inscatter_slab(vec3 p, vec3 w, float tm, vec3 x, float h)
+{
+    float depth = u_rest - p.y;
+    if (depth <= 0.0) return vec3(0.0);
+    float mu = -u_refr.y;
+    float e = vol_caustic(p, depth) / mu * vol_shadow(p) * vol_hg(dot(u_refr, -w), u_g);
+    return u_sigma_s * u_esun * e * vol_slab(-u_sigma_t * (depth / mu + tm), x, h);
+}
