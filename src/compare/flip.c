@@ -2,6 +2,7 @@
 #include "compare/flip.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -373,6 +374,30 @@ gr_status gr_flip_exposures(const gr_image *ref, gr_flip_tonemapper tm, double *
     const int k = (int)ceil(*stop - *start);
     *count = k < 2 ? 2 : k;
     return GR_OK;
+}
+
+gr_status gr_flip_compute_defined(const gr_image *ref, const gr_image *test, const gr_flip_options *opt, float *map,
+                                  gr_flip_result *res, int *undefined, char *why, size_t why_n, gr_error *err)
+{
+    *undefined = 0;
+    if (!ref || !opt || !res || opt->mode != GR_FLIP_HDR || opt->exposures_given)
+        return gr_flip_compute(ref, test, opt, map, res, err);
+    gr_flip_options o = *opt;
+    gr_error e = {GR_OK, ""};
+    gr_status st = gr_flip_exposures(ref, o.tonemapper, &o.start_exposure, &o.stop_exposure, &o.n_exposures, &e);
+    if (st == GR_E_INPUT) {
+        memset(res, 0, sizeof *res);
+        res->mode = o.mode;
+        res->tonemapper = o.tonemapper;
+        res->mean = res->min = res->max = res->median = res->q1 = res->q3 = NAN;
+        if (map) memset(map, 0, (size_t)ref->width * (size_t)ref->height * sizeof *map);
+        if (why && why_n) snprintf(why, why_n, "%s", e.msg);
+        *undefined = 1;
+        return GR_OK;
+    }
+    if (st != GR_OK) return gr_fail(err, st, "%s", e.msg);
+    o.exposures_given = 1; /* the same range gr_flip_compute would derive */
+    return gr_flip_compute(ref, test, &o, map, res, err);
 }
 
 static gr_status check_image(const gr_image *img, const char *role, gr_error *err)

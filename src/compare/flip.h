@@ -60,6 +60,12 @@ gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_fl
 gr_status gr_flip_exposures(const gr_image *ref, gr_flip_tonemapper tm, double *start, double *stop, int *count,
                             gr_error *err);
 
+/* gr_flip_compute, except that a reference that HDR-FLIP derives no exposure range from (all
+ * zero, or a zero median: a black ground truth) is not an error: *undefined = 1, res's
+ * statistics NaN (n_pooled 0), map zeros, the reason in why (may be NULL). */
+gr_status gr_flip_compute_defined(const gr_image *ref, const gr_image *test, const gr_flip_options *opt, float *map,
+                                  gr_flip_result *res, int *undefined, char *why, size_t why_n, gr_error *err);
+
 /* The heat map: per-pixel FLIP values (clamped to [0, 1]) through the magma colour map, as a
  * new 3-channel display-encoded image (write it with gr_oiio_write). */
 gr_status gr_flip_heatmap(const float *map, int width, int height, gr_image **out, gr_error *err);

@@ -286,9 +286,12 @@ static gr_status compute_set(const ctx *cx, const int rr[3], const int tr[3], do
     if (cx->opt->flip) {
         gr_flip_options fo = *cx->opt->flip;
         fo.scored = cx->scored, fo.test_scale = scale;
-        gr_status st = gr_flip_compute(ref, test, &fo, NULL, &set->flip, err);
+        /* a black reference (all zero, or a zero median) gives HDR-FLIP no exposure range: FLIP
+         * is left out (have_flip 0: NaN), as compare does, instead of failing every metric */
+        int undefined = 0;
+        gr_status st = gr_flip_compute_defined(ref, test, &fo, NULL, &set->flip, &undefined, NULL, 0, err);
         if (st != GR_OK) return st;
-        set->have_flip = 1;
+        set->have_flip = !undefined;
     }
     return own_metrics(cx, rr, tr, scale, set, err);
 }

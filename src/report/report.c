@@ -732,6 +732,8 @@ typedef struct tctx {
     gr_image *disp_targets;        /* t->targets for display (NULL: none) */
     double exposure_targets;
     gr_flip_result flip;
+    int flip_undefined;            /* 1: a black ground truth gives HDR-FLIP no exposure range */
+    char flip_why[160];
     char lines[3][512];            /* its summary lines */
 } tctx;
 
@@ -1425,10 +1427,14 @@ static void html_technique(ctx *c, gr_strbuf *b, int k)
     snprintf(cap, sizeof cap, "%s as rendered (a = 1), own exposure %s.", t->name,
              fmt(tc->exposure_raw, tt[0], sizeof tt[0]));
     html_figure(b, f[3], tc->disp_raw, "technique as rendered", cap);
-    snprintf(cap, sizeof cap,
-             "HDR-FLIP per pixel of a x %s against the ground truth (Andersson et al. 2020, 2021; docs/metrics.md): "
-             "magma from 0 (black, no visible difference) to 1 (pale yellow); mean %.4f, median %.4f.",
-             t->name, tc->flip.mean, tc->flip.median);
+    if (tc->flip_undefined)
+        snprintf(cap, sizeof cap, "HDR-FLIP of a x %s against the ground truth: not computed (%s); the map is left black.",
+                 t->name, tc->flip_why);
+    else
+        snprintf(cap, sizeof cap,
+                 "HDR-FLIP per pixel of a x %s against the ground truth (Andersson et al. 2020, 2021; docs/metrics.md): "
+                 "magma from 0 (black, no visible difference) to 1 (pale yellow); mean %.4f, median %.4f.",
+                 t->name, tc->flip.mean, tc->flip.median);
     html_figure(b, f[4], tc->flip_map, "FLIP map", cap);
     gr_sb_puts(b, "</div>\n");
     if (tc->disp_targets) { /* run --save-targets */
@@ -1753,10 +1759,12 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
             if (st != GR_OK) goto done;
         }
         {
-            /* HDR-FLIP of a * test over every pixel, and its magma picture */
+            /* HDR-FLIP of a * test over every pixel, and its magma picture (none, said in the
+             * caption, when a black ground truth gives it no exposure range) */
             float *fm = malloc((size_t)in->ref->width * (size_t)in->ref->height * sizeof(float));
             gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = tc->a};
-            st = fm ? gr_flip_compute(in->ref, tc->t->test, &fo, fm, &tc->flip, err)
+            st = fm ? gr_flip_compute_defined(in->ref, tc->t->test, &fo, fm, &tc->flip, &tc->flip_undefined, tc->flip_why,
+                                              sizeof tc->flip_why, err)
                     : gr_fail(err, GR_E_NOMEM, "report: out of memory for the FLIP map");
             if (st == GR_OK) st = gr_flip_heatmap(fm, in->ref->width, in->ref->height, &tc->flip_map, err);
             free(fm);

@@ -147,7 +147,9 @@ static gr_status make_images(watch_ctx *c, const outcome *out, gr_watch_blob *b,
         float *fm = malloc((size_t)truth->width * (size_t)truth->height * sizeof(float));
         gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = a};
         gr_flip_result fres;
-        st = fm ? gr_flip_compute(truth, out->img, &fo, fm, &fres, err) : gr_fail(err, GR_E_NOMEM, "watch: out of memory for FLIP");
+        int undefined = 0; /* a black truth: no FLIP, a black map */
+        st = fm ? gr_flip_compute_defined(truth, out->img, &fo, fm, &fres, &undefined, NULL, 0, err)
+                : gr_fail(err, GR_E_NOMEM, "watch: out of memory for FLIP");
         if (st == GR_OK && (st = gr_flip_heatmap(fm, truth->width, truth->height, &d, err)) == GR_OK)
             st = to_png(d, "flip", &b[(*n)++], err);
         free(fm);
