@@ -7,13 +7,9 @@
 # the run writes its report and warns that the truth is zero, and exits 3 for the techniques
 # that rendered black, as for any failed technique. compare still refuses a black reference.
 set -u
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
-src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/lib.sh"
 cd "$dir" || exit 1
 export GODRAYS_CACHE="$dir/cache"
-fail=0
 "$bin" run "$src/data/scenes/default.json" -o r --techniques shafts,slicing --size 32x18 \
   --set "medium.absorption_per_m=[15,15,15]" -q >out.txt 2>err.txt
 rc=$?

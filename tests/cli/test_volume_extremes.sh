@@ -7,12 +7,8 @@
 # exit 0 (`render` refuses an image with a non-finite value: exit 1, naming the pixel), and
 # the long slab's view must not be black (it sees the glow of the sun in blue water).
 set -u
-bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
-src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/lib.sh"
 cd "$dir" || exit 1
-fail=0
 for sc in volume_long_slab volume_deep_g9999; do
   for t in slicing light_rays froxel; do
     if "$bin" render "$t" "$src/tests/scenes/$sc.json" -o "$t-$sc.exr" -q >out.txt 2>err.txt; then
