@@ -1552,8 +1552,15 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     gr_sb_puts(b, "</div>\n");
     /* Warnings a reader must not miss. */
     const int no_stderr = gr_image_channel(in->ref, "stderr.R") < 0;
-    if (no_stderr || in->ref_cache_note || meta_num(in->ref_meta, "godrays:partial") > 0 || in->n_failed > 0) {
+    int black = 1; /* the ground truth zero in R, G and B everywhere (the terminal says it too) */
+    for (size_t i = 0, n = (size_t)in->ref->width * (size_t)in->ref->height; i < n && black; i++)
+        for (int ch = 0; ch < 3 && ch < in->ref->nchannels; ch++)
+            if (in->ref->pixels[i * (size_t)in->ref->nchannels + (size_t)ch] != 0.0f) black = 0;
+    if (no_stderr || in->ref_cache_note || meta_num(in->ref_meta, "godrays:partial") > 0 || in->n_failed > 0 || black) {
         gr_sb_puts(b, "<div class=\"box warn\">\n");
+        if (black)
+            gr_sb_html(b, " The ground truth is zero everywhere: the metrics below say nothing (camera inside an occluder, "
+                          "no scattering, or no light left in float range: the medium's extinction times the depth).");
         if (in->n_failed > 0)
             gr_sb_htmlf(b, " %d technique%s FAILED (no image to score): see the leaderboard's failed rows.",
                         in->n_failed, in->n_failed == 1 ? "" : "s");

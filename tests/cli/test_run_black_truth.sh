@@ -18,6 +18,7 @@ grep -q "FLIP exposures" err.txt && { echo "FAIL: FLIP's exposures failed the ru
 grep -q "the ground truth is zero everywhere scored" err.txt || { echo "FAIL: no warning that the truth is zero"; fail=1; }
 grep -q "slicing FAILED: rendered a black image" err.txt || { echo "FAIL: slicing not failed as black"; fail=1; }
 [ -s r/index.html ] && [ -s r/metrics.json ] && [ -s r/shafts_flip.png ] || { echo "FAIL: no report"; ls r; fail=1; }
+grep -q "The ground truth is zero everywhere" r/index.html || { echo "FAIL: the report does not warn that the truth is zero"; fail=1; }
 grep -q "HDR-FLIP of a x shafts against the ground truth: not computed" r/index.html || {
   echo "FAIL: the report does not say that FLIP was not computed"; fail=1; }
 python3 -c "
