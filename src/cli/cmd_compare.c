@@ -490,18 +490,12 @@ static gr_status compute_flip(compare_opts *o, compare_state *s, gr_error *err)
     }
     const gr_image *ft = s->scaled ? s->scaled : test;
     const double t1 = now_s();
-    gr_error ferr = {GR_OK, ""};
-    double e0, e1;
-    int ne;
-    if (o->fopt.mode == GR_FLIP_HDR && !o->fopt.exposures_given &&
-        gr_flip_exposures(ref, o->fopt.tonemapper, &e0, &e1, &ne, &ferr) != GR_OK) {
-        /* a black reference (all-zero, or a zero median) gives HDR-FLIP no exposure range:
-         * FLIP is left out, said so, instead of failing the whole comparison */
-        snprintf(s->flip_skipped, sizeof s->flip_skipped, "%s", ferr.msg);
-        o->do_flip = 0;
-    } else {
-        st = gr_flip_compute(ref, ft, &o->fopt, s->flipmap, &s->fres, err);
-    }
+    /* a black reference (all-zero, or a zero median) gives HDR-FLIP no exposure range: FLIP
+     * is left out, said so, instead of failing the whole comparison */
+    int undefined = 0;
+    st = gr_flip_compute_defined(ref, ft, &o->fopt, s->flipmap, &s->fres, &undefined, s->flip_skipped,
+                                 sizeof s->flip_skipped, err);
+    if (undefined) o->do_flip = 0;
     s->t_flip = now_s() - t1;
     return st;
 }

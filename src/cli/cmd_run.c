@@ -275,8 +275,7 @@ static void print_summary(const char *dir, const gr_report_input *in, const gr_l
     if (in->n_failed > 0)
         printf("%d technique%s FAILED (rows above; exit code 3)\n", in->n_failed, in->n_failed == 1 ? "" : "s");
     printf("report: %s/index.html (also %smetrics.json)\n", dir, in->n_techniques > 0 ? "summary.png, " : "");
-    const gr_metrics *m0 = in->baselines ? &in->baselines->m[0] : in->n_techniques > 0 ? in->techniques[0].metrics : NULL;
-    if (m0 && m0->raw.ch[GR_MCH_Y].ref_mean == 0.0) /* the ground truth is >= 0: zero mean = zero everywhere scored */
+    if (gr_report_truth_zero(in))
         fprintf(stderr, "godrays run: warning: the ground truth is zero everywhere scored: the metrics say nothing "
                 "(camera inside an occluder, no scattering, or no light reaching the view?)\n");
 }

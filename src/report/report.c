@@ -1552,10 +1552,7 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     gr_sb_puts(b, "</div>\n");
     /* Warnings a reader must not miss. */
     const int no_stderr = gr_image_channel(in->ref, "stderr.R") < 0;
-    int black = 1; /* the ground truth zero in R, G and B everywhere (the terminal says it too) */
-    for (size_t i = 0, n = (size_t)in->ref->width * (size_t)in->ref->height; i < n && black; i++)
-        for (int ch = 0; ch < 3 && ch < in->ref->nchannels; ch++)
-            if (in->ref->pixels[i * (size_t)in->ref->nchannels + (size_t)ch] != 0.0f) black = 0;
+    const int black = gr_report_truth_zero(in); /* the terminal says it too (cmd_run) */
     if (no_stderr || in->ref_cache_note || meta_num(in->ref_meta, "godrays:partial") > 0 || in->n_failed > 0 || black) {
         gr_sb_puts(b, "<div class=\"box warn\">\n");
         if (black)
@@ -1713,6 +1710,12 @@ static gr_image *stack_rows(gr_image *const *rows, int n)
         y0 += rows[i]->height;
     }
     return s;
+}
+
+int gr_report_truth_zero(const gr_report_input *in)
+{
+    const gr_metrics *m0 = in->baselines ? &in->baselines->m[0] : in->n_techniques > 0 ? in->techniques[0].metrics : NULL;
+    return m0 && m0->raw.ch[GR_MCH_Y].ref_mean == 0.0;
 }
 
 gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_result *res, gr_error *err)

@@ -95,6 +95,11 @@ typedef struct gr_report_result {
  * (report/leaderboard.h). */
 gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_result *res, gr_error *err);
 
+/* 1 when the ground truth is zero everywhere scored (its luminance mean over the scored pixels,
+ * from the first baseline's or technique's metrics, is 0; the truth is >= 0): every metric then
+ * says nothing, which the page and `run`'s terminal both say. */
+int gr_report_truth_zero(const gr_report_input *in);
+
 /* Technique name's file stem in the report: its name, or "rt_NAME" for one of the report's own
  * names (reference, summary, metrics, index, radial_profile). */
 void gr_report_tech_stem(const char *name, char *buf, size_t n);

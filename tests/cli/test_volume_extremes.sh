@@ -2,8 +2,8 @@
 # The volume techniques on two views where they rendered NaN (found by 48 random views,
 # 2026-11-30; docs/volume-techniques.md, "Floating point"): slicing's slab weight h sinh(x) / x
 # overflowed to Inf past x = 89 (a long slab in water of sigma_t 9.6 /m) and Inf times the
-# middle's attenuation 0 made NaN; the shared Henyey-Greenstein denominator 1 + g^2 - 2 g cos
-# cancels to 0 or below in float for g = 0.9999. Each technique must render both views with
+# middle's attenuation 0 made NaN (the shared Henyey-Greenstein denominator, 1 + g^2 - 2 g cos,
+# 0 in float at cos = 1 for g >= 0.9999, was rewritten beside it). Each technique must render both views with
 # exit 0 (`render` refuses an image with a non-finite value: exit 1, naming the pixel), and
 # the long slab's view must not be black (it sees the glow of the sun in blue water).
 set -u
