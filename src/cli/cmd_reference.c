@@ -4,6 +4,7 @@
 #include "cli/cli.h"
 #include "cli/args.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -91,6 +92,28 @@ static void warn_steps_cap(const gr_scene *scene, const gr_ref_result *res)
             "%.0f on average, so their step noise is above the target; raise --steps (or accept a larger "
             "--step-error)\n",
             100.0 * res->steps_capped_frac, scene->reference.step_error, scene->reference.steps, res->steps_wanted_capped);
+}
+
+/* The surface tessellation's estimated bias above 1 % of the image mean (issue 30's quality
+ * line): the cells are 1/surface_res of the lit region, so views with a wide lit region (a deep
+ * camera, a low sun) get coarse cells. Bias ~ h^p with the order p measured by the probe
+ * (docs/reference.md 4, "Views with a wide lit region"), so each doubling of surface_res divides
+ * it by 2^p. Not under --quiet (the summary line gives the figure, this the remedy), nor where
+ * twice the cells would pass the setting's maximum (16384). */
+static void warn_bias(const gr_scene *scene, const gr_ref_result *res, int quiet)
+{
+    const double est = res->bias_surface_rel;
+    if (quiet || !(est > 0.01) || !isfinite(est) || scene->reference.surface_res > 8192) return;
+    const gr_meta_item *mo = gr_meta_get(&res->meta, "godrays:bias_surface_rel_measured_order");
+    const gr_meta_item *po = gr_meta_get(&res->meta, "godrays:bias_surface_order");
+    const double p = po && po->num >= 1.0 && po->num <= 2.0 ? po->num : 1.0;
+    char with[96] = "";
+    if (mo && mo->num > est) snprintf(with, sizeof with, ", %.2g%% with the measured order %.2g", 100.0 * mo->num, p);
+    fprintf(stderr,
+            "godrays reference: warning: the surface tessellation's bias is about %.2g%% of the image mean%s "
+            "(godrays:bias_surface_rel_est): the surface cells, 1/%d of the lit region (godrays:lit_region), are coarse "
+            "for this view; --surface-res %d should divide it by %.2g to 4 (the beam builds' time and memory grow 4x)\n",
+            100.0 * est, with, scene->reference.surface_res, 2 * scene->reference.surface_res, pow(2.0, p));
 }
 
 /* "I/N" with 0 <= I < N: 0, else the exit code of the usage error. */
@@ -184,6 +207,7 @@ static int write_image(const gr_scene *scene, const gr_ref_result *res, const ch
     }
     warn_target(scene, per_round, res);
     warn_steps_cap(scene, res);
+    warn_bias(scene, res, quiet);
     return 0;
 }
 

@@ -4,7 +4,8 @@
 # with the figures (even with --quiet), the image is still written and the exit code is 0;
 # the figures are those of the EXR's metadata (godrays:rel_stderr_mean, godrays:rel_stderr_p95,
 # godrays:passes). A target that is met prints nothing under --quiet. A 16x9 image with a
-# coarse surface and 8 march steps: 64 rounds of 8 passes take about 3 s on 2 cores.
+# coarse surface and 8 march steps: 64 rounds of 8 passes take about 3 s on 2 cores. And the
+# warning that the surface tessellation's bias is above 1 % of the image mean (case 4).
 set -u
 . "$(dirname "$0")/lib.sh"
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
@@ -66,6 +67,22 @@ if command -v iinfo >/dev/null 2>&1; then
     ck "step cap: the warning gives the share held back ($pct%)" grep -qF "in $pct% of the pixels" err.txt
     ck "step cap: the warning gives what they asked for ($w0)" grep -qF "asked for $w0 on average" err.txt
     ck "step cap: they asked for more than the cap" awk -v v="$want" 'BEGIN{exit !(v > 17)}'
+fi
+
+# 4. the surface tessellation's bias above 1 % of the image mean (docs/reference.md 4, "Views
+# with a wide lit region"): without --quiet one warning gives godrays:bias_surface_rel_est and
+# the remedy, twice the surface_res; under --quiet (cases 2 and 3, the same 32 cells) nothing
+"$bin" reference "$scene" -o bias.exr --size 16x9 --surface-res 32 --steps 17 --no-preview >out.txt 2>err.txt
+rc=$?
+grep "tessellation" err.txt
+ck "bias: exit 0" [ "$rc" -eq 0 ]
+ck "bias: one warning naming the remedy" [ "$(grep -c "warning: the surface tessellation's bias is about .*--surface-res 64 should" err.txt)" -eq 1 ]
+if command -v iinfo >/dev/null 2>&1; then
+    iinfo -v bias.exr >meta.txt
+    est=$(sed -n "s/^ *godrays:bias_surface_rel_est: *\([-0-9.eE+]*\).*/\1/p" meta.txt | head -n 1)
+    pct=$(awk -v v="$est" 'BEGIN{printf "%.2g", 100 * v}')
+    ck "bias: the warning gives godrays:bias_surface_rel_est ($pct%)" grep -qF "bias is about $pct% of the image mean" err.txt
+    ck "bias: above the 1 % line" awk -v v="$est" 'BEGIN{exit !(v > 0.01)}'
 fi
 
 [ "$fail" -eq 0 ] && echo "all checks passed"
