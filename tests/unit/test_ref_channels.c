@@ -19,8 +19,12 @@
  *     pixel (16 x 16 points: wide pixels are not their centres): in every channel the worst
  *     pixel's standard error within 1.5 x step_error of max(pixel, image mean) (the target's
  *     normalization, docs/reference.md 2.5) and its error within 1.5 t of that; the 95 %
- *     intervals cover 91-99 % of the noisy values. Values below 1e-30 (an extinction of
- *     tens per metre over metres: 0 in float) are left out. */
+ *     intervals, widened by the cutoff's bound (1e-4 of the value, docs/reference.md 1), cover
+ *     91-99 % of the noisy values. Values below 1e-30 (an extinction of tens per metre over
+ *     metres: 0 in float) are left out. A scene where the cap held pixels back (the render
+ *     warns) misses its targets by design and its error bars run low (too few strata for
+ *     light packed into the ray's first metre: skewed batch means, docs/reference.md 2.5,
+ *     "The floor"): it is printed, not checked. */
 #include <math.h>
 #include "check.h"
 #include "core/optics.h"
@@ -32,14 +36,14 @@ static double SA[3] = {1.5, 0.06, 0.02}, SS[3] = {0.02, 0.03, 0.05}, G = 0.8;
 
 /* Oracle 1 along the unit direction w from the camera at depth z0 (ray ending on the surface,
  * w_y > 0): sigma_s p E_w exp(-sigma_t z0 / mu) (1 - exp(-sigma_t k D)) / (sigma_t k),
- * k = 1 - w_y / mu, D = z0 / w_y. */
+ * k = 1 - w_y / mu, D = z0 / w_y (infinite for a ray level or looking down: no seabed). SA, SS, G:
+ * the medium of the scene being checked. */
 static double closed_form(const gr_scene *s, gr_dvec3 w, double z0, int c)
 {
-    /* the medium's g: the one of the scene (the test's media set SA, SS and G) */
     gr_dvec3 I = gr_d3(s->sun.dir[0], s->sun.dir[1], s->sun.dir[2]);
     gr_dvec3 T = gr_refract_d(I, gr_d3(0, 1, 0), 1.0 / 1.333);
     double mu = -T.y, ft = 1.0 - gr_fresnel_exact(-I.y, 1.0, 1.333), e_w = ft * -I.y / mu;
-    double st = SA[c] + SS[c], k = 1.0 - w.y / mu, D = z0 / w.y;
+    double st = SA[c] + SS[c], k = 1.0 - w.y / mu, D = w.y > 0.0 ? z0 / w.y : INFINITY; /* no seabed: down to infinity */
     return SS[c] * gr_hg_phase(-gr_d3_dot(T, w), G) * e_w * exp(-st * z0 / mu) * -expm1(-st * k * D) / (st * k);
 }
 
@@ -132,6 +136,7 @@ static double draw(unsigned *st)
 
 static void test_random(void)
 {
+    const double CUT = 1e-4; /* the cutoff's bound: a ray drops at most this much of a channel (docs/reference.md 1) */
     const int W = 96, SUB = 8, NP = W / SUB;
     unsigned st = 12345u;
     long n = 0, in = 0;
@@ -160,6 +165,7 @@ static void test_random(void)
          * warns: docs/reference.md 2.5, "When the cap holds the steps back"): the targets are
          * checked where no pixel was held back, the coverage everywhere */
         const int capped = r.steps_capped_frac > 0.0;
+        int sn = 0, sin = 0;
         for (int c = 0; c < 3; c++) {
             double mean = 0.0, worst_se = 0.0, worst_err = 0.0;
             for (int y = 0; y < NP; y++)
@@ -179,8 +185,8 @@ static void test_random(void)
                     if (se > worst_se) worst_se = se;
                     if (err > worst_err) worst_err = err;
                     if (!(px[3 + c] > 1e-5 * L)) continue; /* no noise: sampled in proportion */
-                    n++;
-                    in += fabs(px[c] - L) <= t * px[3 + c];
+                    sn++;
+                    sin += fabs(px[c] - L) <= t * px[3 + c] + CUT * L;
                 }
             if (!used) continue;
             printf("    channel %d: worst stderr %.3f %%, worst |error| %.3f %% of max(pixel, image mean)\n", c, 100.0 * worst_se,
@@ -191,6 +197,11 @@ static void test_random(void)
                       worst_se);
             CHECK_MSG(worst_err <= 1.5 * t * tau, "(c) scene %d channel %d: error %.4f of max(pixel, mean) over %.4f", it, c,
                       worst_err, 1.5 * t * tau);
+        }
+        printf("    %d of %d noisy values covered%s\n", sin, sn, capped ? " (held to the cap: not counted)" : "");
+        if (!capped) {
+            n += sn;
+            in += sin;
         }
         gr_ref_result_free(&r);
         free(s);
