@@ -278,6 +278,8 @@ static void print_summary(const char *dir, const gr_report_input *in, const gr_l
     if (gr_report_truth_zero(in))
         fprintf(stderr, "godrays run: warning: the ground truth is zero everywhere scored: the metrics say nothing "
                 "(camera inside an occluder, no scattering, or no light reaching the view?)\n");
+    char coarse[512];
+    if (gr_report_truth_coarse(in, coarse, sizeof coarse)) fprintf(stderr, "godrays run: warning: %s\n", coarse);
 }
 
 /* What the command line asks for. */

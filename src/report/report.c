@@ -787,11 +787,19 @@ static void summary_lines(ctx *c)
              in->scene->name, in->scene->hash, in->ref->width, in->ref->height, GR_VERSION,
              in->n_techniques + in->n_failed, in->n_techniques + in->n_failed == 1 ? "" : "s", failed);
     const double wall = meta_num(in->ref_meta, "godrays:wall_s");
+    /* the truth's own error: its noise and its surface tessellation's bias (docs/reference.md 4) */
+    char bias[160] = "";
+    const double be = meta_num(in->ref_meta, "godrays:bias_surface_rel_est"),
+                 bm = meta_num(in->ref_meta, "godrays:bias_surface_rel_measured_order");
+    if (be >= 0.0)
+        snprintf(bias, sizeof bias, ", surface bias ~%s %%%s%s%s", fmt(100.0 * be, t[3], sizeof t[3]),
+                 bm >= 0.0 ? " (" : "", bm >= 0.0 ? fmt(100.0 * bm, t[4], sizeof t[4]) : "",
+                 bm >= 0.0 ? " % with the measured order)" : "");
     snprintf(c->lines[1], sizeof c->lines[1],
-             "reference: %s s render%s, %s spp, rel. std. error of the image mean %s %%",
+             "reference: %s s render%s, %s spp, rel. std. error of the image mean %s %%%s",
              fmt(wall, t[0], sizeof t[0]), in->ref_cached ? " (read from the cache)" : "",
              fmt(meta_num(in->ref_meta, "godrays:spp"), t[1], sizeof t[1]),
-             fmt(100.0 * meta_num(in->ref_meta, "godrays:rel_stderr_mean"), t[2], sizeof t[2]));
+             fmt(100.0 * meta_num(in->ref_meta, "godrays:rel_stderr_mean"), t[2], sizeof t[2]), bias);
     for (int k = 0; k < in->n_techniques; k++) {
         tctx *tc = &c->t[k];
         const gr_metrics *m = tc->t->metrics;
@@ -1553,7 +1561,10 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     /* Warnings a reader must not miss. */
     const int no_stderr = gr_image_channel(in->ref, "stderr.R") < 0;
     const int black = gr_report_truth_zero(in); /* the terminal says it too (cmd_run) */
-    if (no_stderr || in->ref_cache_note || meta_num(in->ref_meta, "godrays:partial") > 0 || in->n_failed > 0 || black) {
+    char coarse_msg[512];
+    const int coarse = gr_report_truth_coarse(in, coarse_msg, sizeof coarse_msg); /* cmd_run says it too */
+    if (no_stderr || in->ref_cache_note || meta_num(in->ref_meta, "godrays:partial") > 0 || in->n_failed > 0 || black ||
+        coarse) {
         gr_sb_puts(b, "<div class=\"box warn\">\n");
         if (black)
             gr_sb_html(b, " The ground truth is zero everywhere: the metrics below say nothing (camera inside an occluder, "
@@ -1562,6 +1573,11 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
             gr_sb_htmlf(b, " %d technique%s FAILED (no image to score): see the leaderboard's failed rows.",
                         in->n_failed, in->n_failed == 1 ? "" : "s");
         if (no_stderr) gr_sb_html(b, " The reference carries no standard-error channels: no significance test.");
+        if (coarse) {
+            /* the message starts lower-case for the terminal's "warning: " */
+            gr_sb_html(b, " The");
+            gr_sb_html(b, coarse_msg + 3);
+        }
         if (meta_num(in->ref_meta, "godrays:partial") > 0)
             gr_sb_html(b, " The reference is a PARTIAL (interrupted) render.");
         if (in->ref_cache_note) {
@@ -1620,6 +1636,9 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
     kv_num(b, "rel. std. error of the image mean", meta_num(rm, "godrays:rel_stderr_mean"), 100.0, "%");
     kv_num(b, "rel. std. error of the p95 pixel", meta_num(rm, "godrays:rel_stderr_p95"), 100.0, "%");
     kv_num(b, "pixels with std. error <= 1%", meta_num(rm, "godrays:frac_pixels_stderr_le_1pct"), 100.0, "%");
+    kv_num(b, "surface bias, estimate (order 2)", meta_num(rm, "godrays:bias_surface_rel_est"), 100.0, "%");
+    kv_num(b, "surface bias, with the measured order", meta_num(rm, "godrays:bias_surface_rel_measured_order"), 100.0, "%");
+    kv_num(b, "surface bias, 95th-percentile 10x10 block", meta_num(rm, "godrays:bias_block_p95_rel"), 100.0, "%");
     kv_num(b, "RMS std. error of Y (noise)", c->noise_y, 1.0, "");
     kv_num(b, "beam lookups per second", meta_num(rm, "godrays:queries_per_s"), 1.0, "");
     kv_num(b, "beam build time", meta_num(rm, "godrays:beam_build_s"), 1.0, "s");
@@ -1710,6 +1729,29 @@ static gr_image *stack_rows(gr_image *const *rows, int n)
         y0 += rows[i]->height;
     }
     return s;
+}
+
+int gr_report_truth_coarse(const gr_report_input *in, char *msg, size_t n)
+{
+    const double est = meta_num(in->ref_meta, "godrays:bias_surface_rel_est");
+    if (!(est > 0.01) || !isfinite(est)) return 0;
+    if (msg && n > 0) {
+        const double bm = meta_num(in->ref_meta, "godrays:bias_surface_rel_measured_order"),
+                     bp = meta_num(in->ref_meta, "godrays:bias_block_p95_rel"),
+                     res = meta_num(in->ref_meta, "godrays:reference.surface_res");
+        char more[160] = "", fix[96] = "";
+        if (bm > est && bp > 0.0)
+            snprintf(more, sizeof more, " (%.2g %% with the measured order; 95th-percentile block %.2g %%)", 100.0 * bm,
+                     100.0 * bp);
+        else if (bm > est) snprintf(more, sizeof more, " (%.2g %% with the measured order)", 100.0 * bm);
+        if (res > 0.0) snprintf(fix, sizeof fix, " A finer truth: reference.surface_res %.0f.", 2.0 * res);
+        snprintf(msg, n,
+                 "the ground truth's surface tessellation is coarse for this view: its bias is about %.2g %% of the image "
+                 "mean%s, so differences of that size are not the techniques' (docs/reference.md 4, \"Views with a wide "
+                 "lit region\").%s",
+                 100.0 * est, more, fix);
+    }
+    return 1;
 }
 
 int gr_report_truth_zero(const gr_report_input *in)

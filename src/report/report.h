@@ -100,6 +100,13 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
  * says nothing, which the page and `run`'s terminal both say. */
 int gr_report_truth_zero(const gr_report_input *in);
 
+/* 1 when the ground truth's surface tessellation bias (its metadata godrays:bias_surface_rel_est,
+ * order 2) is above 1 % of the image mean, as `godrays reference` warns (docs/reference.md 4,
+ * "Views with a wide lit region"); msg (if not NULL) gets one line saying so, with the
+ * measured-order and 95th-percentile block figures and the remedy, for the page and `run`'s
+ * terminal. */
+int gr_report_truth_coarse(const gr_report_input *in, char *msg, size_t n);
+
 /* Technique name's file stem in the report: its name, or "rt_NAME" for one of the report's own
  * names (reference, summary, metrics, index, radial_profile). */
 void gr_report_tech_stem(const char *name, char *buf, size_t n);
