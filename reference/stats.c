@@ -420,7 +420,7 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     SET(gr_meta_set_double(m, "godrays:pilot_s", ty->pilot_s));
     SET(gr_meta_set_double(m, "godrays:pilot_share", out->wall_s > 0.0 ? ty->pilot_s / out->wall_s : 0.0));
     SET(gr_meta_set_string(m, "godrays:bias_note",
-                           "bias_surface_rel_est = mean |pixel bias| / image mean from the surface tessellation "
+                           "bias_surface_rel_est = mean |pixel bias| / image mean, in the worst channel, from the surface tessellation "
                            "(measured here with order 2, see bias_surface_probe; bound = max(2x the estimate, the figure with "
                            "the measured order, bias_surface_rel_measured_order); bias.* channels and bias_block_p95_rel "
                            "use the measured order; march steps: unbiased (jittered strata; per-pixel counts "
