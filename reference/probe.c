@@ -156,30 +156,47 @@ gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *cap
     return st;
 }
 
-void gr_ref_block_bias(gr_ref_renderer *r, const gr_image *img, double image_mean)
+void gr_ref_block_bias(gr_ref_renderer *r, const gr_image *img)
 {
     r->bias_block_p95 = -1.0;
     r->bias_blocks = 0;
     if (!r->bias_px || !img) return;
+    /* the image's mean per channel; channels below 1e-3 of the brightest are left out (as in
+     * gr_ref_probe_stats) */
+    double im[3] = {0.0, 0.0, 0.0};
+    for (int y = 0; y < img->height; y++)
+        for (int x = 0; x < img->width; x++) {
+            const float *px = gr_image_pixel((gr_image *)img, x, y);
+            for (int c = 0; c < 3; c++) im[c] += px[c];
+        }
+    for (int c = 0; c < 3; c++) im[c] /= (double)img->width * img->height;
+    const double imax = fmax(im[0], fmax(im[1], im[2]));
     int bw = (r->bias_pw + 1) / 2, bh = (r->bias_ph + 1) / 2, bs = 2 * PROBE_STRIDE;
     double *v = malloc((size_t)bw * bh * sizeof *v);
     if (!v) return;
     size_t n = 0;
     for (int J = 0; J < bh; J++)
         for (int I = 0; I < bw; I++) {
-            double b = 0.0, m = 0.0;
+            double b[3] = {0.0, 0.0, 0.0}, m[3] = {0.0, 0.0, 0.0};
             int nb = 0, nm = 0;
             for (int j = 2 * J; j < 2 * J + 2 && j < r->bias_ph; j++)
                 for (int i = 2 * I; i < 2 * I + 2 && i < r->bias_pw; i++, nb++)
-                    for (int c = 0; c < 3; c++) b += r->bias_px[((size_t)j * r->bias_pw + (size_t)i) * 3 + c] / 3.0;
+                    for (int c = 0; c < 3; c++) b[c] += r->bias_px[((size_t)j * r->bias_pw + (size_t)i) * 3 + c];
             for (int y = J * bs; y < (J + 1) * bs && y < img->height; y++)
                 for (int x = I * bs; x < (I + 1) * bs && x < img->width; x++, nm++) {
                     const float *px = gr_image_pixel((gr_image *)img, x, y);
-                    m += (px[0] + px[1] + px[2]) / 3.0;
+                    for (int c = 0; c < 3; c++) m[c] += px[c];
                 }
             if (!nb || !nm) continue;
-            double den = fmax(m / nm, image_mean);
-            if (den > 0.0) v[n++] = fabs(b / nb) / den;
+            /* the worst channel's |block bias| / max(block mean, image mean) */
+            double w = -1.0;
+            for (int c = 0; c < 3; c++) {
+                double den = fmax(m[c] / nm, im[c]);
+                if (!(den > 0.0) || !(im[c] > 1e-3 * imax)) continue;
+                double q = fabs(b[c] / nb) / den;
+                if (q > w) w = q;
+            }
+            if (w >= 0.0) v[n++] = w;
         }
     if (n) {
         r->bias_block_p95 = gr_ref_percentile(v, n, 0.95);

@@ -41,9 +41,10 @@ static inline float bias_at(const gr_ref_renderer *r, int x, int y, int c)
 }
 
 /* Block bias: over blocks of 2 x 2 probe pixels (10 x 10 image pixels), the mean of the probe
- * pixels' signed estimates (RGB mean) relative to max(block mean, image mean) (the same
- * normalization as the 1 % standard-error figure); the 95th percentile of its magnitude. The
- * probe's residual noise enters the magnitude: an overestimate, not an underestimate. */
-void gr_ref_block_bias(gr_ref_renderer *r, const gr_image *img, double image_mean);
+ * pixels' signed estimates relative to max(block mean, image mean) (the same normalization as
+ * the 1 % standard-error figure), in the block's worst channel (channels with less than 1e-3
+ * of the brightest one's light left out); the 95th percentile of its magnitude. The probe's
+ * residual noise enters the magnitude: an overestimate, not an underestimate. */
+void gr_ref_block_bias(gr_ref_renderer *r, const gr_image *img);
 
 #endif

@@ -487,7 +487,7 @@ gr_status gr_ref_finish(gr_ref_renderer *r, const ref_accum *acc, const ref_marc
     if (est != GR_OK) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory");
     if (st == GR_OK) st = build_image(r, acc, out, err);
     if (st != GR_OK) return st;
-    gr_ref_block_bias(r, out->image, e.mean);
+    gr_ref_block_bias(r, out->image);
     out->bias_block_p95 = r->bias_block_p95;
     out->target_met = r->set.target_error > 0.0 ? gr_ref_target_met(&e, acc->B, r->set.target_error) : 1;
     out->wall_s = wall_s;

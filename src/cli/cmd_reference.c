@@ -110,7 +110,7 @@ static void warn_bias(const gr_scene *scene, const gr_ref_result *res, int quiet
     char with[96] = "";
     if (mo && mo->num > est) snprintf(with, sizeof with, ", %.2g%% with the measured order %.2g", 100.0 * mo->num, p);
     fprintf(stderr,
-            "godrays reference: warning: the surface tessellation's bias is about %.2g%% of the image mean%s "
+            "godrays reference: warning: the surface tessellation's bias is about %.2g%% of the image mean in the worst channel%s "
             "(godrays:bias_surface_rel_est): the surface cells, 1/%d of the lit region (godrays:lit_region), are coarse "
             "for this view; --surface-res %d should divide it by %.2g to 4 (the beam builds' time and memory grow 4x)\n",
             100.0 * est, with, scene->reference.surface_res, 2 * scene->reference.surface_res, pow(2.0, p));

@@ -257,7 +257,7 @@ static void print_leaderboard(const gr_report_input *in, const gr_leaderboard *l
 }
 
 static void print_summary(const char *dir, const gr_report_input *in, const gr_leaderboard *lb, const ref_out *ro,
-                          double t_ref)
+                          double t_ref, int quiet)
 {
     const gr_scene *scene = in->scene;
     const int nt = in->n_techniques + in->n_failed;
@@ -278,8 +278,9 @@ static void print_summary(const char *dir, const gr_report_input *in, const gr_l
     if (gr_report_truth_zero(in))
         fprintf(stderr, "godrays run: warning: the ground truth is zero everywhere scored: the metrics say nothing "
                 "(camera inside an occluder, no scattering, or no light reaching the view?)\n");
+    /* as `reference` warns: not under -q (the page says it in every case) */
     char coarse[512];
-    if (gr_report_truth_coarse(in, coarse, sizeof coarse)) fprintf(stderr, "godrays run: warning: %s\n", coarse);
+    if (!quiet && gr_report_truth_coarse(in, coarse, sizeof coarse)) fprintf(stderr, "godrays run: warning: %s\n", coarse);
 }
 
 /* What the command line asks for. */
@@ -756,7 +757,7 @@ static int run_scene(gr_args *args, run_opts *o, run_state *rs)
         gr_sb_status(&rs->words, "the command line", &err) != GR_OK)
         return gr_cli_report(cmd, &err);
     if ((rc = run_case(o, rs, outdir)) != 0) return rc;
-    print_summary(outdir, &rs->in, &rs->lb, &rs->ro, rs->t_ref);
+    print_summary(outdir, &rs->in, &rs->lb, &rs->ro, rs->t_ref, o->quiet);
     if (o->nf > 1 && rs->n_failed < o->nt) print_sequence(o, rs, outdir);
     return rs->n_failed > 0 ? 3 : 0; /* the report is complete; some technique failed (docs/report.md) */
 }

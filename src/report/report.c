@@ -1747,7 +1747,7 @@ int gr_report_truth_coarse(const gr_report_input *in, char *msg, size_t n)
         if (res > 0.0) snprintf(fix, sizeof fix, " A finer truth: reference.surface_res %.0f.", 2.0 * res);
         snprintf(msg, n,
                  "the ground truth's surface tessellation is coarse for this view: its bias is about %.2g %% of the image "
-                 "mean%s, so differences of that size are not the techniques' (docs/reference.md 4, \"Views with a wide "
+                 "mean in the worst channel%s, so differences of that size are not the techniques' (docs/reference.md 4, \"Views with a wide "
                  "lit region\").%s",
                  100.0 * est, more, fix);
     }

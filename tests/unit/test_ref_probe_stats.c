@@ -11,10 +11,16 @@
  * Then R's light is cut to 1e-4 of G's (R = 1e-4 x the above): below 1e-3 of the brightest
  * channel, it is left out of the worst, and the figures are the mean's: d1 / v with the mean
  * now (1e-4 x 0.01) / (2 + 0.5e-4) per pixel; the order stays 2 (both differences scale).
- * The signed per-pixel estimates (bias channels): (L_2h - L_h) / 3 per channel. */
+ * The signed per-pixel estimates (bias channels): (L_2h - L_h) / 3 per channel.
+ * The block figure (gr_ref_block_bias): the 2 x 2 probe pixels make one block of 2 PROBE_STRIDE
+ * image pixels a side; on an image with R = 0.5, G = B = 1 everywhere, the block's R estimate
+ * (0.01 / 3) over max(block mean, image mean) = 0.5 is 0.02 / 3 (the RGB mean's, the code
+ * before: (0.01 / 9) / (2.5 / 3), five times lower); with R at 1e-4 of G (image and sums),
+ * R is left out and G, B have no bias: 0. */
 #include <math.h>
 #include <stdlib.h>
 #include "check.h"
+#include "image/image.h"
 #include "reference/probe.h"
 #include "reference/renderer.h"
 
@@ -52,6 +58,19 @@ int main(void)
     CHECK_MSG(fabs(r->bias_rel - 0.02 / 3.0) < 1e-12, "estimate %.12g, expected the worst channel's %.12g (the mean's: %.12g)",
               r->bias_rel, 0.02 / 3.0, 0.004 / 3.0);
     CHECK_MSG(fabs(r->bias_rel_cons - 0.02 / 3.0) < 1e-12, "measured-order figure %.12g", r->bias_rel_cons);
+    const int side = 2 * PROBE_STRIDE;
+    gr_image *img = gr_image_create(side, side, 3, NULL);
+    if (!img) return 1;
+    for (int y = 0; y < side; y++)
+        for (int x = 0; x < side; x++) {
+            float *px = gr_image_pixel(img, x, y);
+            px[0] = 0.5f;
+            px[1] = px[2] = 1.0f;
+        }
+    gr_ref_block_bias(r, img);
+    printf("block figure %.9g (expected %.9g)\n", r->bias_block_p95, 0.02 / 3.0);
+    CHECK_MSG(r->bias_blocks == 1 && fabs(r->bias_block_p95 - 0.02 / 3.0) < 1e-7, "block figure %.9g over %d blocks",
+              r->bias_block_p95, r->bias_blocks);
     CHECK(r->bias_px != NULL);
     for (int i = 0; i < NP && r->bias_px; i++) {
         CHECK_MSG(fabs(r->bias_px[i * 3] - 0.01f / 3.0f) < 1e-7, "pixel %d: R's signed estimate %.9g", i, r->bias_px[i * 3]);
@@ -64,6 +83,11 @@ int main(void)
     printf("R at 1e-4 of G: estimate %.9g (expected the mean's %.9g)\n", r->bias_rel, mean_rel / 3.0);
     CHECK_MSG(fabs(r->bias_rel - mean_rel / 3.0) < 1e-15, "estimate %.12g, expected %.12g", r->bias_rel, mean_rel / 3.0);
     CHECK_MSG(fabs(r->bias_order - 2.0) < 1e-6, "order %.9g, expected 2", r->bias_order);
+    for (int y = 0; y < side; y++)
+        for (int x = 0; x < side; x++) gr_image_pixel(img, x, y)[0] = 0.5e-4f;
+    gr_ref_block_bias(r, img);
+    CHECK_MSG(r->bias_blocks == 1 && r->bias_block_p95 == 0.0, "R at 1e-4: block figure %.9g, expected 0", r->bias_block_p95);
+    gr_image_destroy(img);
 
     free(r->bias_px);
     free(r);
