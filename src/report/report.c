@@ -3,6 +3,7 @@
 #include "common/outfile.h"
 
 #include <errno.h>
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -1574,9 +1575,9 @@ static gr_status build_html(ctx *c, gr_strbuf *b, gr_error *err)
                         in->n_failed, in->n_failed == 1 ? "" : "s");
         if (no_stderr) gr_sb_html(b, " The reference carries no standard-error channels: no significance test.");
         if (coarse) {
-            /* the message starts lower-case for the terminal's "warning: " */
-            gr_sb_html(b, " The");
-            gr_sb_html(b, coarse_msg + 3);
+            coarse_msg[0] = (char)toupper((unsigned char)coarse_msg[0]); /* lower-case for the terminal's "warning: " */
+            gr_sb_html(b, " ");
+            gr_sb_html(b, coarse_msg);
         }
         if (meta_num(in->ref_meta, "godrays:partial") > 0)
             gr_sb_html(b, " The reference is a PARTIAL (interrupted) render.");
@@ -1747,8 +1748,8 @@ int gr_report_truth_coarse(const gr_report_input *in, char *msg, size_t n)
         if (res > 0.0) snprintf(fix, sizeof fix, " A finer truth: reference.surface_res %.0f.", 2.0 * res);
         snprintf(msg, n,
                  "the ground truth's surface tessellation is coarse for this view: its bias is about %.2g %% of the image "
-                 "mean in the worst channel%s, so differences of that size are not the techniques' (docs/reference.md 4, \"Views with a wide "
-                 "lit region\").%s",
+                 "mean in the worst channel%s, so differences of that size are not the techniques' (docs/reference.md "
+                 "4, \"Views with a wide lit region\").%s",
                  100.0 * est, more, fix);
     }
     return 1;
