@@ -2,8 +2,8 @@
 #include "report/report.h"
 #include "common/outfile.h"
 
-#include <errno.h>
 #include <ctype.h>
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
