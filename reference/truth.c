@@ -1,6 +1,7 @@
 /* The ground-truth provider (truth.h). */
 #include "reference/truth.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -60,6 +61,13 @@ static gr_status render(const gr_scene *scene, const gr_ref_options *opt, gr_ref
     return st;
 }
 
+/* The truth's surface-bias estimate from its metadata (-1 when absent or not a number). */
+static double bias_of(const gr_metadata *m)
+{
+    const gr_meta_item *it = gr_meta_get(m, "godrays:bias_surface_rel_est");
+    return it && it->type != GR_META_STRING && isfinite(it->num) ? it->num : -1.0;
+}
+
 /* The cache's part of gr_truth_get: *hit = 1 with res filled from a valid entry; else
  * info->cache_on, info->path, *key and *dir ready for the store, info->note set when the cache
  * is off or an entry was ignored. Only allocation failures and overlong names are errors. */
@@ -101,6 +109,7 @@ gr_status gr_truth_get(const gr_scene *scene, const gr_truth_options *o, gr_ref_
         if (hit) {
             info->cached = 1;
             info->seconds = now_s() - t0;
+            info->bias_rel_est = bias_of(&res->meta);
             return GR_OK;
         }
     }
@@ -126,6 +135,7 @@ gr_status gr_truth_get(const gr_scene *scene, const gr_truth_options *o, gr_ref_
         }
     }
     info->seconds = now_s() - t0;
+    info->bias_rel_est = bias_of(&res->meta);
     return GR_OK;
 }
 

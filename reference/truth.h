@@ -27,6 +27,8 @@ typedef struct gr_truth_info {
     char path[4200];       /* the cache file ("" when the cache is off) */
     char note[1400];       /* why the cache was not used, if it was not: "cache off: ...",
                               "cache entry PATH: ignored: ..." or "not cached: ..." ("" if none) */
+    double bias_rel_est;   /* its godrays:bias_surface_rel_est (worst channel, order 2; -1: not
+                              estimated), rendered or read from the cache: docs/reference.md 4 */
 } gr_truth_info;
 
 typedef struct gr_truth_options {
