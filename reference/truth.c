@@ -139,6 +139,17 @@ gr_status gr_truth_get(const gr_scene *scene, const gr_truth_options *o, gr_ref_
     return GR_OK;
 }
 
+int gr_truth_coarse(const gr_truth_info *info, const gr_scene *scene, char *msg, size_t n)
+{
+    if (!(info->bias_rel_est > 0.01)) return 0;
+    if (msg && n > 0)
+        snprintf(msg, n,
+                 "its surface tessellation's bias is about %.2g %% of the image mean in the worst channel, so errors of "
+                 "that size are not the technique's; a finer truth: reference.surface_res %d",
+                 100.0 * info->bias_rel_est, 2 * scene->reference.surface_res);
+    return 1;
+}
+
 gr_status gr_truth_image(const gr_scene *scene, const gr_truth_options *o, gr_image **img, gr_truth_info *info,
                          gr_error *err)
 {

@@ -31,6 +31,11 @@ typedef struct gr_truth_info {
                               estimated), rendered or read from the cache: docs/reference.md 4 */
 } gr_truth_info;
 
+/* 1 when the truth's surface bias estimate (info->bias_rel_est) is above 1 % of its image mean
+ * (docs/reference.md 4, "Views with a wide lit region"); msg (if not NULL) gets one line saying
+ * so with the remedy (twice scene's surface_res), for the commands' warnings. */
+int gr_truth_coarse(const gr_truth_info *info, const gr_scene *scene, char *msg, size_t n);
+
 typedef struct gr_truth_options {
     int use_cache;         /* 1: read the cache first, store a complete render (the renderer's
                               options must then be the defaults but progress: GR_E_USAGE) */

@@ -303,6 +303,9 @@ static gr_status reference_points(const pareto_opts *o, const gr_scene *scene, g
     to.ref.progress = !o->quiet;
     if ((st = gr_truth_image(work, &to, truth, ti, err)) != GR_OK) return st;
     if (!o->quiet && ti->cached) fprintf(stderr, "godrays pareto:   from the cache %s\n", ti->path);
+    char coarse[320]; /* docs/reference.md 4, "Views with a wide lit region" */
+    if (!o->quiet && gr_truth_coarse(ti, scene, coarse, sizeof coarse)) /* the remedy in the scene's setting */
+        fprintf(stderr, "godrays pareto: warning: the high-quality ground truth: %s\n", coarse);
     to.use_cache = 0; /* each level is timed: rendered, never cached */
     const int n_levels = o->quick ? 2 : N_LEVELS;
     for (int l = 0; l < n_levels; l++) {

@@ -77,6 +77,9 @@ static gr_status truths(const gr_ps_opts *o, ps_run *r, gr_error *err)
         if (!o->quiet) fprintf(stderr, "godrays pareto: ground truth of case %s (%s)...\n", c->name, gr_split_name(c->split));
         gr_status st = gr_truth_image(&c->scene, &to, &r->truths[i], &ti, err);
         if (st != GR_OK) return gr_error_prefix(err, "%s: case %s", r->suite->path, c->name);
+        char coarse[320]; /* docs/reference.md 4, "Views with a wide lit region" */
+        if (!o->quiet && gr_truth_coarse(&ti, &c->scene, coarse, sizeof coarse))
+            fprintf(stderr, "godrays pareto: warning: the ground truth of case %s: %s\n", c->name, coarse);
         r->cases[i] = (gr_st_case){&c->scene, r->truths[i], c->split};
         if (first_train < 0 && c->split == GR_SPLIT_TRAIN) first_train = i;
         if (c->split == GR_SPLIT_TEST && r->suite->cases[r->thumb_case].split != GR_SPLIT_TEST) r->thumb_case = i;

@@ -149,13 +149,9 @@ gr_status gr_tune_session_open(const gr_tune_session_options *o, gr_tune_session
         if (o->progress && s->truth[i].note[0]) fprintf(stderr, "%s:   note: %s\n", label, s->truth[i].note);
         /* a coarse truth (docs/reference.md 4, "Views with a wide lit region"), as run's page says; not
          * under -q, as reference and run */
-        if (o->progress && s->truth[i].bias_rel_est > 0.01)
-            fprintf(stderr,
-                    "%s: warning: ground truth %d/%d (%s): its surface tessellation's bias is about %.2g %% of the image "
-                    "mean in the worst channel, so errors of that size in this case are not the technique's; a finer "
-                    "truth: reference.surface_res %d\n",
-                    label, i + 1, s->n_cases, s->labels[i], 100.0 * s->truth[i].bias_rel_est,
-                    2 * s->cases[i].reference.surface_res);
+        char coarse[320];
+        if (o->progress && gr_truth_coarse(&s->truth[i], &s->cases[i], coarse, sizeof coarse))
+            fprintf(stderr, "%s: warning: ground truth %d/%d (%s): %s\n", label, i + 1, s->n_cases, s->labels[i], coarse);
     }
     return GR_OK;
 }

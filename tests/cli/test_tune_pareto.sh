@@ -4,7 +4,8 @@
 # the quick levels of its ladder, or one point at the scene's settings without a ladder; for
 # the shafts 2 N x 2 target scales x 2 formats = 8), times and errors positive and finite,
 # each family with at least one point on its front, and the lowest time and the lowest error
-# of each family on its front (a property of any Pareto front).
+# of each family on its front (a property of any Pareto front); and the warning about a coarse
+# high-quality ground truth (its surface bias estimate above 1 %).
 # The folder's parent holds the files of a `godrays run` report (index.html, metrics.json;
 # stand-ins here), so the page links back to it (cli.report_links checks the rest).
 bin=${GODRAYS_BINARY:?GODRAYS_BINARY is not set (run through ctest)}
@@ -51,3 +52,16 @@ for fam, n in want:
     assert any(float(r["error"]) == emin for r in front), (fam, "most accurate not on front")
 print("pareto.csv ok")
 PY
+rc_csv=$?
+# a coarse high-quality ground truth (the scene's 32 cells, 48 in the high-quality truth: its
+# surface bias estimate above 1 %; docs/reference.md 4, "Views with a wide lit region"): one
+# warning line with the remedy in the scene's own setting (twice its 32); none under -q (above)
+src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
+"$bin" pareto "$src/data/scenes/default.json" --quick --technique shafts --repeat 1 --size 32x18 \
+  --set reference.surface_res=32 -o "$dir/pc" >"$dir/out_c" 2>"$dir/err_c" || { echo "FAIL: coarse pareto exit $?"; exit 1; }
+grep "tessellation" "$dir/err_c"
+[ "$(grep -c "godrays pareto: warning: the high-quality ground truth: its surface tessellation's bias is about .* reference.surface_res 64$" "$dir/err_c")" = 1 ] ||
+  { echo "FAIL: no single coarse-truth warning naming reference.surface_res 64"; exit 1; }
+grep -q "tessellation" "$dir/err" && { echo "FAIL: a coarse-truth warning under -q"; exit 1; }
+echo "ok: a coarse high-quality truth warned about, with the remedy"
+exit $rc_csv
