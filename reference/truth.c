@@ -141,7 +141,7 @@ gr_status gr_truth_get(const gr_scene *scene, const gr_truth_options *o, gr_ref_
 
 int gr_truth_coarse(const gr_truth_info *info, const gr_scene *scene, char *msg, size_t n)
 {
-    if (!(info->bias_rel_est > 0.01)) return 0;
+    if (!(info->bias_rel_est > GR_TRUTH_COARSE_BIAS)) return 0;
     if (msg && n > 0)
         snprintf(msg, n,
                  "its surface tessellation's bias is about %.2g %% of the image mean in the worst channel, so errors of "

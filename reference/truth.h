@@ -31,7 +31,11 @@ typedef struct gr_truth_info {
                               estimated), rendered or read from the cache: docs/reference.md 4 */
 } gr_truth_info;
 
-/* 1 when the truth's surface bias estimate (info->bias_rel_est) is above 1 % of its image mean
+/* The line above which the commands call a truth coarse: its surface bias estimate (worst
+ * channel, order 2) above 1 % of its image mean (issue 30's quality line) */
+#define GR_TRUTH_COARSE_BIAS 0.01
+
+/* 1 when the truth's surface bias estimate (info->bias_rel_est) is above GR_TRUTH_COARSE_BIAS
  * (docs/reference.md 4, "Views with a wide lit region"); msg (if not NULL) gets one line saying
  * so with the remedy (twice scene's surface_res), for the commands' warnings. */
 int gr_truth_coarse(const gr_truth_info *info, const gr_scene *scene, char *msg, size_t n);

@@ -103,7 +103,7 @@ static void warn_steps_cap(const gr_scene *scene, const gr_ref_result *res)
 static void warn_bias(const gr_scene *scene, const gr_ref_result *res, int quiet)
 {
     const double est = res->bias_surface_rel;
-    if (quiet || !(est > 0.01) || !isfinite(est) || scene->reference.surface_res > 8192) return;
+    if (quiet || !(est > GR_TRUTH_COARSE_BIAS) || !isfinite(est) || scene->reference.surface_res > 8192) return;
     const gr_meta_item *mo = gr_meta_get(&res->meta, "godrays:bias_surface_rel_measured_order");
     const gr_meta_item *po = gr_meta_get(&res->meta, "godrays:bias_surface_order");
     const double p = po && po->num >= 1.0 && po->num <= 2.0 ? po->num : 1.0;

@@ -1735,6 +1735,7 @@ static gr_image *stack_rows(gr_image *const *rows, int n)
 int gr_report_truth_coarse(const gr_report_input *in, char *msg, size_t n)
 {
     const double est = meta_num(in->ref_meta, "godrays:bias_surface_rel_est");
+    /* the line of GR_TRUTH_COARSE_BIAS (reference/truth.h; src/report does not include reference/) */
     if (!(est > 0.01) || !isfinite(est)) return 0;
     if (msg && n > 0) {
         const double bm = meta_num(in->ref_meta, "godrays:bias_surface_rel_measured_order"),
