@@ -792,10 +792,11 @@ static void summary_lines(ctx *c)
     char bias[160] = "";
     const double be = meta_num(in->ref_meta, "godrays:bias_surface_rel_est"),
                  bm = meta_num(in->ref_meta, "godrays:bias_surface_rel_measured_order");
-    if (be >= 0.0)
-        snprintf(bias, sizeof bias, ", surface bias ~%s %%%s%s%s", fmt(100.0 * be, t[3], sizeof t[3]),
-                 bm >= 0.0 ? " (" : "", bm >= 0.0 ? fmt(100.0 * bm, t[4], sizeof t[4]) : "",
-                 bm >= 0.0 ? " % with the measured order)" : "");
+    if (be >= 0.0 && bm >= 0.0)
+        snprintf(bias, sizeof bias, ", surface bias ~%s %% (%s %% with the measured order)", fmt(100.0 * be, t[3], sizeof t[3]),
+                 fmt(100.0 * bm, t[4], sizeof t[4]));
+    else if (be >= 0.0)
+        snprintf(bias, sizeof bias, ", surface bias ~%s %%", fmt(100.0 * be, t[3], sizeof t[3]));
     snprintf(c->lines[1], sizeof c->lines[1],
              "reference: %s s render%s, %s spp, rel. std. error of the image mean %s %%%s",
              fmt(wall, t[0], sizeof t[0]), in->ref_cached ? " (read from the cache)" : "",
