@@ -462,7 +462,7 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     }
     tp.h = h;
     tp.nv0 = (size_t)(b->nu + 1) * (size_t)(b->nw + 1);
-    double rho = tp.F > 1 ? gr_beam_refine_radius(p) : -1.0;
+    double rho = tp.F > 1 ? (p->refine_radius_m > 0.0 ? p->refine_radius_m : gr_beam_refine_radius(p)) : -1.0;
     uint8_t *ref = NULL;
     size_t nref = 0, ntrans = 0;
     if (rho >= 0.0) {

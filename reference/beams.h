@@ -71,6 +71,7 @@ typedef struct gr_beam_params {
      * the cell size (res and jitter are then unused) and the grid's lines pass through
      * (anchor_u, anchor_w), that set's gr_beam_stats.grid_u0, grid_w0. 0: from res. */
     double cell_m, anchor_u, anchor_w;
+    double refine_radius_m; /* > 0: refine within this radius of P_s instead of gr_beam_refine_radius */
 } gr_beam_params;
 
 /* The radius (m, horizontal, in sheared coordinates at the rest plane) around P_s of the

@@ -86,6 +86,41 @@ static void refraction_range(const gr_ref_renderer *r, double *drift, double *mu
     *mu = tilt > 0.0 ? 0.99 * least : least;
 }
 
+/* Refinement near the camera (docs/reference.md 2.2, "Near the camera"): when the plain grid
+ * (surface_res cells across the lit region) has fewer than near_cells_per_wavelength cells
+ * across the shortest wave, the cells within near_radius_cells of them around P_s are split
+ * by the odd factor at or just above the one that brings them nearest to it (at most
+ * near_max_factor). Computed once from the full surface_res: the probe's coarser levels keep
+ * the same factor and disc in metres. */
+static void near_refinement(gr_ref_renderer *r)
+{
+    const gr_reference_settings *st = &r->scene.reference;
+    r->near_F = 1;
+    r->near_D = r->near_cpw = r->near_lambda = 0.0;
+    double lam = INFINITY;
+    for (int i = 0; i < r->scene.water.n_waves; i++)
+        if (r->scene.water.waves[i].amplitude_m != 0.0) lam = fmin(lam, r->scene.water.waves[i].wavelength_m);
+    double eu = r->region.u1 - r->region.u0 + 2.0 * r->pad, ew = r->region.w1 - r->region.w0 + 2.0 * r->pad;
+    if (r->flat || !isfinite(lam) || !(eu > 0.0 && ew > 0.0) || st->surface_res < 1) return;
+    double h = sqrt(eu * ew) / st->surface_res; /* the plain grid's cell (gr_beams_build) */
+    r->near_lambda = lam;
+    r->near_cpw = lam / h;
+    if (!(st->near_cells_per_wavelength > 0.0)) return;
+    /* the factor nearest the target, made odd: half a plain cell is then half a fine one too
+     * (the antithetic passes' shift, docs/reference.md 2.5); at most near_max_factor's odd part */
+    double f = floor(st->near_cells_per_wavelength / r->near_cpw + 0.5);
+    int cap = st->near_max_factor % 2 ? st->near_max_factor : st->near_max_factor - 1;
+    int F = f < 1.5 ? 1 : f > cap ? cap : (int)f | 1;
+    if (F > cap) F = cap;
+    if (F <= 1) return;
+    r->near_F = F;
+    r->near_D = st->near_radius_cells * h;
+    /* the set covers the disc and the waves' horizontal displacement around P_s */
+    double R = r->near_D + wave_amplitude_sum(&r->scene.water), pu = r->cam.x - r->sx * r->cam.y, pw = r->cam.z - r->sz * r->cam.y;
+    r->near_box[0] = pu - R; r->near_box[1] = pu + R;
+    r->near_box[2] = pw - R; r->near_box[3] = pw + R;
+}
+
 /* The lit region: sheared bounds of the visible volume (camera frustum up to each ray's
  * end), clamped to reference.patch_radius_m around the camera. */
 static void compute_region(gr_ref_renderer *r)
@@ -215,6 +250,7 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
     r->cutoff_ln = st->transmittance_cutoff > 0.0 && st->transmittance_cutoff < 1.0 ? -log(st->transmittance_cutoff) : 0.0;
     if (smin > 0.0 && r->cutoff_ln > 0.0) r->cutoff_d = fmin(r->cutoff_d, r->cutoff_ln / smin);
     compute_region(r);
+    near_refinement(r);
     {
         /* the camera cone's radius (docs/reference.md 2.2): the same for every pass */
         gr_beam_params bp;
@@ -234,6 +270,8 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
             r->cone_box[0] = pu - R; r->cone_box[1] = pu + R;
             r->cone_box[2] = pw - R; r->cone_box[3] = pw + R;
             r->cone_cos = cos(bp.refine_angle);
+            /* the near disc covers the cone's at least as finely: every ray looks up the plain set */
+            if (r->near_F >= st->refine_factor && r->near_D >= rho) r->cone_on = 0;
         }
     }
 
@@ -253,6 +291,7 @@ void gr_ref_destroy(gr_ref_renderer *r)
     if (!r) return;
     gr_beams_destroy(r->beams);
     gr_beams_destroy(r->cone);
+    gr_beams_destroy(r->near);
     free(r->bias_px);
     free(r->steps_px);
     free(r->alloc_px);
@@ -320,14 +359,15 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     r->flat_eperp = (float)(ft * cos_i / -T.y);
     if (r->flat || r->beams_pass == pass) return GR_OK;
     /* the last pass's two sets freed side by side (their pages go back: issue 30's serial part) */
-    gr_beams *old[2] = {r->beams, r->cone};
-    if (old[0] && old[1] && r->threads > 1)
-        r->phases.par_total += gr_beams_run_jobs(destroy_job, old, sizeof old[0], 2);
-    else {
-        gr_beams_destroy(old[0]);
-        gr_beams_destroy(old[1]);
-    }
-    r->beams = r->cone = NULL;
+    gr_beams *old[3] = {r->beams, r->cone, r->near};
+    int nold = 0;
+    for (int i = 0; i < 3; i++)
+        if (old[i]) old[nold++] = old[i];
+    if (nold > 1 && r->threads > 1)
+        r->phases.par_total += gr_beams_run_jobs(destroy_job, old, sizeof old[0], nold);
+    else
+        for (int i = 0; i < nold; i++) gr_beams_destroy(old[i]);
+    r->beams = r->cone = r->near = NULL;
     r->beams_pass = -1;
     gr_beam_params bp;
     memset(&bp, 0, sizeof bp);
@@ -389,6 +429,27 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
             r->tally.beam_build_s += gr_beams_stats(r->cone)->build_s;
         }
     }
+    if (r->near_F > 1 && st == GR_OK) {
+        /* near the camera (docs/reference.md 2.2): near_box on the plain grid's lines, the
+         * disc of radius near_D around P_s split near_F x near_F */
+        const gr_beam_stats *bs = gr_beams_stats(r->beams);
+        bp.region.u0 = r->near_box[0];
+        bp.region.u1 = r->near_box[1];
+        bp.region.w0 = r->near_box[2];
+        bp.region.w1 = r->near_box[3];
+        bp.refine_factor = r->near_F;
+        bp.refine_radius_m = r->near_D;
+        bp.cell_m = bs->cell_m;
+        bp.anchor_u = bs->grid_u0;
+        bp.anchor_w = bs->grid_w0;
+        bp.surface_mesh = 1;
+        bp.slab_cells = r->rendering ? 0.5 : 1.0;
+        st = gr_beams_build(r->rtc, &bp, &r->near, err);
+        if (st == GR_OK) {
+            account_build(r, r->near);
+            r->tally.beam_build_s += gr_beams_stats(r->near)->build_s;
+        }
+    }
     gr_ref_phases_switch(&r->phases, prev);
     if (st != GR_OK) return st;
     r->beams_pass = pass;
@@ -431,6 +492,17 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
     if (r->beams) {
         info->cell_m = gr_beams_stats(r->beams)->cell_m;
         info->prims = gr_beams_stats(r->beams)->prims;
+    }
+    info->near_factor = r->near_F;
+    info->near_radius_m = r->near_D;
+    info->cells_per_wave = r->near_cpw;
+    if (r->near_F > 1) {
+        /* the near set (prepare_pass): near_box (half side R) padded, on the plain grid's cells
+         * h, those within near_D + h of P_s split F x F */
+        double eu = r->region.u1 - r->region.u0 + 2.0 * r->pad, ew = r->region.w1 - r->region.w0 + 2.0 * r->pad;
+        double h = sqrt(eu * ew) / r->set.surface_res, R = 0.5 * (r->near_box[1] - r->near_box[0]);
+        double side = 2.0 * (R + r->pad) / h + 2.0, F = r->near_F, disc = GR_PI * (r->near_D / h + 1.0) * (r->near_D / h + 1.0);
+        info->near_cells = side * side + disc * (F * F - 1.0);
     }
     if (r->cone_on && r->set.surface_res > 0) {
         /* the camera cone's set (prepare_pass): cone_box (half side R) padded, on the plain
@@ -532,16 +604,30 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     t->beam_cell_m = t->beam_refine_radius_m = 0.0;
     t->beam_prims = t->beam_refined_cells = t->beam_transition_cells = t->beam_triangles = 0;
     t->beam_refine_factor = 0;
+    t->beam_near_factor = 1;
+    t->beam_near_radius_m = 0.0;
+    t->beam_near_cells = t->beam_near_transition_cells = t->beam_near_triangles = 0;
     if (r->beams) {
-        /* the refinement is the camera cone's set's (docs/reference.md 2.2) */
-        const gr_beam_stats *bs = gr_beams_stats(r->beams), *rs = r->cone ? gr_beams_stats(r->cone) : bs;
+        /* the refinements of the camera cone's set and of the set near the camera
+         * (docs/reference.md 2.2) */
+        const gr_beam_stats *bs = gr_beams_stats(r->beams), *rs = r->cone ? gr_beams_stats(r->cone) : NULL;
         t->beam_cell_m = bs->cell_m;
         t->beam_prims = (long long)bs->prims;
-        t->beam_refine_factor = rs->refine_factor;
-        t->beam_refine_radius_m = rs->refine_radius_m;
-        t->beam_refined_cells = (long long)rs->refined_cells;
-        t->beam_transition_cells = (long long)rs->transition_cells;
-        t->beam_triangles = (long long)rs->triangles;
+        t->beam_refine_factor = rs ? rs->refine_factor : 1;
+        if (rs) {
+            t->beam_refine_radius_m = rs->refine_radius_m;
+            t->beam_refined_cells = (long long)rs->refined_cells;
+            t->beam_transition_cells = (long long)rs->transition_cells;
+            t->beam_triangles = (long long)rs->triangles;
+        }
+        if (r->near) {
+            const gr_beam_stats *ns = gr_beams_stats(r->near);
+            t->beam_near_factor = ns->refine_factor;
+            t->beam_near_radius_m = ns->refine_radius_m;
+            t->beam_near_cells = (long long)ns->refined_cells;
+            t->beam_near_transition_cells = (long long)ns->transition_cells;
+            t->beam_near_triangles = (long long)ns->triangles;
+        }
     }
     ref_march_totals ptot = {0.0, 0, 0, 0};
     if (st == GR_OK && probe && !out->partial) {

@@ -126,6 +126,10 @@ typedef struct gr_ref_info {
     size_t prims;           /* beam-slab primitives of the last beam set */
     double cone_cells;      /* estimated surface cells of the camera cone's beam set, its
                                refined sub-cells included (0: none; docs/reference.md 2.2) */
+    int near_factor;        /* refinement near the camera (docs/reference.md 2.2): the factor (1: none), */
+    double near_radius_m;   /* its radius around P_s (sheared, m), */
+    double near_cells;      /* estimated surface cells of its beam set, the refined sub-cells included */
+    double cells_per_wave;  /* the plain grid's cells across the shortest wave (0: flat water) */
 } gr_ref_info;
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info);
 /* For the benchmark (reference/bench.c): the displaced surface mesh of the prepared pass

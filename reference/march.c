@@ -60,6 +60,15 @@ static float ray_end(const gr_ref_renderer *r, const gr_beams *bs, gr_vec3 o, gr
     return D;
 }
 
+/* Whether the local point p lies in the box of the set near the camera (sheared coordinates;
+ * docs/reference.md 2.2, "Near the camera"). */
+static int in_near(const gr_ref_renderer *r, gr_vec3 p)
+{
+    float u = p.x - (float)r->sx * p.y, w = p.z - (float)r->sz * p.y;
+    const double *b = r->near_box;
+    return u >= b[0] && u <= b[1] && w >= b[2] && w <= b[3];
+}
+
 /* One camera ray's geometry: its direction, the beam set it looks up, where it ends and its
  * march density exp(-lam t) on [0, D] (om: the density's mass, wbase: a stratum's weight). */
 typedef struct ref_ray_geo {
@@ -93,7 +102,11 @@ static void ray_geometry(const gr_ref_renderer *r, double fx, double fy, int n, 
         if (u0 >= cb[0] && u0 <= cb[1] && u1 >= cb[0] && u1 <= cb[1] && w0 >= cb[2] && w0 <= cb[3] && w1 >= cb[2] && w1 <= cb[3])
             bs = r->cone;
     }
-    if (bs == r->beams) D = ray_end(r, r->beams, o, d, De);
+    if (bs == r->beams) {
+        D = ray_end(r, r->beams, o, d, De);
+        /* where it ends near the camera, on that set's finer surface */
+        if (r->near && D > 0.0f && in_near(r, gr_v3_madd(o, d, D))) D = ray_end(r, r->near, o, d, De);
+    }
     if (!(D > 0.0f)) D = 0.0f;
     *len = D;
     *trans = (exp(-r->sig_t[0] * D) + exp(-r->sig_t[1] * D) + exp(-r->sig_t[2] * D)) / 3.0;
@@ -162,7 +175,9 @@ int gr_ref_march_ray(const gr_ref_renderer *r, int nrays, const double *fx, cons
         const double lam = q->lam;
         double t = sc->t[k];
         gr_vec3 x = gr_v3_madd(o, d, sc->tf[k]);
-        int m = light_at(r, q->bs, x, &sc->lights, &sc->lcap, &sc->hits);
+        /* a point of a plain-set ray near the camera looks up the finer set there */
+        const gr_beams *bs = q->bs == r->beams && r->near && in_near(r, x) ? r->near : q->bs;
+        int m = light_at(r, bs, x, &sc->lights, &sc->lcap, &sc->hits);
         if (m < 0) return -1;
         cnt->queries++;
         if (m > cnt->max_hits) cnt->max_hits = m;

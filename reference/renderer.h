@@ -70,6 +70,14 @@ struct gr_ref_renderer {
      * `beams`, the plain grid. NULL: no refinement (factor 1, or no camera ray that close) */
     gr_beams *cone;
     int cone_on;              /* 1: a cone (set by gr_ref_create, the same for every pass) */
+    /* Refinement near the camera (docs/reference.md 2.2, "Near the camera"): the set `near`
+     * covers near_box (sheared u0 u1 w0 w1) on the plain grid's lines, its cells within near_D
+     * (m, sheared) of P_s split near_F x near_F (1: none, near NULL); every march point of a
+     * ray on the plain set that lies in near_box looks it up instead. near_cpw: the plain
+     * grid's cells across the shortest wave, near_lambda (m) */
+    gr_beams *near;
+    int near_F;
+    double near_D, near_cpw, near_lambda, near_box[4];
     double cone_box[4], cone_cos;
     int beams_pass;
     int flat;

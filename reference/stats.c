@@ -380,6 +380,17 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
                      bs->beam_transition_cells, bs->beam_triangles);
             SET(gr_meta_set_string(m, "godrays:surface_refine", buf));
         }
+        /* the plain grid's cells across the shortest wave, and the refinement near the camera
+         * they call for (docs/reference.md 2.2, "Near the camera") */
+        if (r->near_cpw > 0.0) SET(gr_meta_set_double(m, "godrays:surface_cells_per_wave", r->near_cpw));
+        if (bs->beam_near_factor > 1) {
+            snprintf(buf, sizeof buf, "plain grid %.2f cells across the shortest wave (%g m), under %g: factor %d within %.3f m of "
+                     "P_s (%g cells), %lld cells refined, %lld transition cells, %lld triangles",
+                     r->near_cpw, r->near_lambda, r->set.near_cells_per_wavelength, bs->beam_near_factor,
+                     bs->beam_near_radius_m, r->set.near_radius_cells, bs->beam_near_cells, bs->beam_near_transition_cells,
+                     bs->beam_near_triangles);
+            SET(gr_meta_set_string(m, "godrays:surface_refine_near", buf));
+        }
     }
     /* bias next to the noise (docs/reference.md section 4): the surface tessellation is the
      * only discretization bias; measured on this scene by the probe (gr_ref_probe_run, probe.c) */

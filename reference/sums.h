@@ -32,6 +32,10 @@ typedef struct gr_ref_sums {
     int beam_refine_factor;
     double beam_refine_radius_m;
     long long beam_refined_cells, beam_transition_cells, beam_triangles;
+    /* the plain set's refinement near the camera (docs/reference.md 2.2; factor 1: none) */
+    int beam_near_factor;
+    double beam_near_radius_m;
+    long long beam_near_cells, beam_near_transition_cells, beam_near_triangles;
     double beam_build_s, march_s;
     long long queries, shadows, overflows;
     /* adaptive steps (docs/reference.md 2.5): the sum of the pixels' march steps over the

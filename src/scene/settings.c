@@ -66,6 +66,13 @@ static const gr_param reference_params[] = {
      .unit = "", .doc = "local refinement: the camera rays that run along the refracted sun's beams look up a tessellation with the surface cells they meet split into F x F (1 = off)"},
     {.name = "refine_angle_deg", .type = GR_PT_DOUBLE, .offset = REF(refine_angle_deg), .min = 0, .max = 30, .def = 12,
      .unit = "deg", .doc = "local refinement: the camera rays within this angle of the refracted sun direction (either way) look up the refined tessellation; the others the plain grid"},
+    {.name = "near_cells_per_wavelength", .type = GR_PT_DOUBLE, .offset = REF(near_cells_per_wavelength), .min = 0, .max = 64,
+     .def = 8, .unit = "",
+     .doc = "refinement near the camera: where the plain grid has fewer cells than this across the shortest wave (a wide lit region: a level or deep view), the cells near the camera are split by the odd factor at or just above the one that brings them nearest to it (0 = off)"},
+    {.name = "near_radius_cells", .type = GR_PT_DOUBLE, .offset = REF(near_radius_cells), .min = 0, .max = 4096, .flags = LO_X,
+     .def = 24, .unit = "cells", .doc = "refinement near the camera: the cells within this many plain cells of the camera's position sheared along the refracted sun"},
+    {.name = "near_max_factor", .type = GR_PT_INT, .offset = REF(near_max_factor), .min = 1, .max = 15, .def = 3,
+     .unit = "", .doc = "refinement near the camera: the largest split factor (odd: an even value counts as the odd one below it; the cost grows with its square)"},
 };
 #undef REF
 

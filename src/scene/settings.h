@@ -38,6 +38,12 @@ typedef struct gr_reference_settings {
     int refine_factor;            /* surface cells split F x F where camera rays run along the
                                      beams (1 = off; docs/reference.md 2.2) */
     double refine_angle_deg;      /* ...those camera rays: within this angle of the refracted sun */
+    double near_cells_per_wavelength; /* refinement near the camera: where the plain grid has fewer
+                                     cells across the shortest wave, those near the camera are
+                                     split by an odd factor to come near it (0 = off;
+                                     docs/reference.md 2.2) */
+    double near_radius_cells;     /* ...within this many plain cells of the camera (sheared) */
+    int near_max_factor;          /* ...by at most this factor (its odd part) */
 } gr_reference_settings;
 
 /* reference.sun_disc: the disc average by the analytic convolution of each beam's footprint

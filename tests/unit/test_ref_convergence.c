@@ -33,8 +33,9 @@ static gr_ref_result render(const char *path, int res, int spp, int refine)
      * allotted, which the surface resolution changes; and its spp law is the camera sample's,
      * which more rays per sample (docs/reference.md 2.5) would mostly take away beforehand */
     const char *ov[] = {"camera.width=64", "camera.height=36", "reference.sun_samples=4", "reference.batches=4",
-                        "reference.camera_rays=1", r_, s_, "reference.refine_factor=1"};
-    gr_scene *s = ref_scene_file(path, ov, refine ? 7 : 8);
+                        "reference.camera_rays=1", "reference.near_cells_per_wavelength=0", r_, s_,
+                        "reference.refine_factor=1"};
+    gr_scene *s = ref_scene_file(path, ov, refine ? 8 : 9);
     gr_ref_result res_;
     ref_render(s, NULL, &res_);
     free(s);
