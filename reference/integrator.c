@@ -89,8 +89,7 @@ static void refraction_range(const gr_ref_renderer *r, double *drift, double *mu
 /* Refinement near the camera (docs/reference.md 2.2, "Near the camera"): when the plain grid
  * (surface_res cells across the lit region) has fewer than near_cells_per_wavelength cells
  * across the shortest wave, the cells within near_radius_cells of them around P_s are split
- * by the odd factor at or just above the one that brings them nearest to it (at most
- * near_max_factor). Computed once from the full surface_res: the probe's coarser levels keep
+ * by the smallest odd factor that brings them to it (at most near_max_factor). Computed once from the full surface_res: the probe's coarser levels keep
  * the same factor and disc in metres. */
 static void near_refinement(gr_ref_renderer *r)
 {
@@ -106,13 +105,15 @@ static void near_refinement(gr_ref_renderer *r)
     r->near_lambda = lam;
     r->near_cpw = lam / h;
     if (!(st->near_cells_per_wavelength > 0.0)) return;
-    /* the factor nearest the target, made odd: half a plain cell is then half a fine one too
-     * (the antithetic passes' shift, docs/reference.md 2.5); at most near_max_factor's odd part */
-    double f = floor(st->near_cells_per_wavelength / r->near_cpw + 0.5);
+    /* the smallest odd factor that brings the cells to the target (odd: half a plain cell is
+     * then half a fine one too, the antithetic passes' shift, docs/reference.md 2.5), at most
+     * near_max_factor's odd part; a finer plain grid never gets coarser cells near the camera */
+    double ratio = st->near_cells_per_wavelength / r->near_cpw;
     int cap = st->near_max_factor % 2 ? st->near_max_factor : st->near_max_factor - 1;
-    int F = f < 1.5 ? 1 : f > cap ? cap : (int)f | 1;
+    if (!(ratio > 1.0) || cap <= 1) return;
+    int F = ratio >= cap ? cap : (int)ceil(ratio);
+    if (F % 2 == 0) F++;
     if (F > cap) F = cap;
-    if (F <= 1) return;
     r->near_F = F;
     r->near_D = st->near_radius_cells * h;
     /* the set covers the disc and the waves' horizontal displacement around P_s */
@@ -443,7 +444,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
         bp.anchor_u = bs->grid_u0;
         bp.anchor_w = bs->grid_w0;
         bp.surface_mesh = 1;
-        bp.slab_cells = r->rendering ? 0.5 : 1.0;
+        bp.slab_cells = r->rendering ? 0.5 : 1.0; /* as the plain set's (measured: 1.0 and 2.0 cost more) */
         st = gr_beams_build(r->rtc, &bp, &r->near, err);
         if (st == GR_OK) {
             account_build(r, r->near);

@@ -230,7 +230,10 @@ static gr_status part_check_fields(const cJSON *h, const char *path, gr_error *e
         {"probe_s", 0, 1e300, 0}, {"beam_cell_m", 0, 1e300, 0}, {"beam_prims", 0, 9007199254740992.0, 1},
         {"beam_refine_factor", 0, INT_MAX, 1}, {"beam_refine_radius_m", -1, 1e300, 0}, /* -1: no cone (beams.h) */
         {"beam_refined_cells", 0, 9007199254740992.0, 1}, {"beam_transition_cells", 0, 9007199254740992.0, 1},
-        {"beam_triangles", 0, 9007199254740992.0, 1}, {"beam_build_s", 0, 1e300, 0}, {"march_s", 0, 1e300, 0},
+        {"beam_triangles", 0, 9007199254740992.0, 1}, {"beam_near_factor", 0, INT_MAX, 1},
+        {"beam_near_radius_m", 0, 1e300, 0}, {"beam_near_cells", 0, 9007199254740992.0, 1},
+        {"beam_near_transition_cells", 0, 9007199254740992.0, 1}, {"beam_near_triangles", 0, 9007199254740992.0, 1},
+        {"beam_build_s", 0, 1e300, 0}, {"march_s", 0, 1e300, 0},
         {"queries", 0, 9007199254740992.0, 1}, {"shadows", 0, 9007199254740992.0, 1},
         {"overflows", 0, 9007199254740992.0, 1}, {"steps_sum", 0, 1e300, 0}, {"steps_pixels", 0, 1e300, 0},
         {"steps_capped", 0, 1e300, 0}, {"steps_wanted_sum", 0, 1e300, 0},

@@ -40,8 +40,8 @@ typedef struct gr_reference_settings {
     double refine_angle_deg;      /* ...those camera rays: within this angle of the refracted sun */
     double near_cells_per_wavelength; /* refinement near the camera: where the plain grid has fewer
                                      cells across the shortest wave, those near the camera are
-                                     split by an odd factor to come near it (0 = off;
-                                     docs/reference.md 2.2) */
+                                     split by the smallest odd factor that brings them to it
+                                     (0 = off; docs/reference.md 2.2) */
     double near_radius_cells;     /* ...within this many plain cells of the camera (sheared) */
     int near_max_factor;          /* ...by at most this factor (its odd part) */
 } gr_reference_settings;

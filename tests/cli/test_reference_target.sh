@@ -11,7 +11,7 @@ set -u
 src=${GODRAYS_SOURCE_DIR:?GODRAYS_SOURCE_DIR is not set (run through ctest)}
 cd "$dir" || exit 1
 scene="$src/data/scenes/default.json"
-tiny="--size 16x9 --surface-res 32 --steps 8 --quiet"
+tiny="--size 16x9 --surface-res 32 --steps 8 --set reference.near_cells_per_wavelength=0 --quiet"
 
 # 1. unreachable: 1e-6
 # shellcheck disable=SC2086

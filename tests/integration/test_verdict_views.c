@@ -97,8 +97,9 @@ static void add_noise(const gr_image *truth, const gr_image *noise, double k, gr
 static void view(int w, int h, int side)
 {
     gr_error err = {GR_OK, ""};
-    const char *sets[2] = {"camera.yaw_deg=120", "camera.pitch_deg=20"};
-    gr_scene *s = test_data_scene("default.json", w, h, sets, side ? 2 : 0);
+    /* the side view on the plain grid, as integration.structure_views (the same cached truth) */
+    const char *sets[3] = {"camera.yaw_deg=120", "camera.pitch_deg=20", "reference.near_cells_per_wavelength=0"};
+    gr_scene *s = test_data_scene("default.json", w, h, sets, side ? 3 : 0);
     gr_image *truth = NULL;
     gr_truth_info info;
     CHECK_OK(gr_truth_image(s, NULL, &truth, &info, &err), err);

@@ -28,13 +28,16 @@
  * error of 0.30) */
 #define T7_9995 5.408
 
+/* the plain grid alone (4.2 cells per wave here: by default a set near the camera, docs/reference.md
+ * 2.2, which is not what this test is about and doubles its time) */
 static gr_scene *scene(int rays, int seed, int threads)
 {
     return ref_scene("{\"name\":\"rays\"," REF_DEFAULT_WAVES "," REF_DEFAULT_MEDIUM ","
                      "\"sun\":{\"elevation_deg\":55,\"azimuth_deg\":20},"
                      "\"camera\":{\"position_m\":[0,-3,0],\"yaw_deg\":20,\"pitch_deg\":35,\"fov_deg\":60,"
                      "\"width\":96,\"height\":54},"
-                     "\"reference\":{\"camera_rays\":%d,\"seed\":%d,\"threads\":%d,\"bias_probe\":false}}",
+                     "\"reference\":{\"camera_rays\":%d,\"seed\":%d,\"threads\":%d,\"bias_probe\":false,"
+                     "\"near_cells_per_wavelength\":0}}",
                      rays, seed, threads);
 }
 

@@ -34,7 +34,9 @@ static void test_members(void)
                                        "beam_prims", "beam_refine_factor", "beam_refine_radius_m", "beam_refined_cells",
                                        "beam_transition_cells", "beam_triangles", "beam_build_s", "march_s", "queries",
                                        "shadows", "overflows", "steps_sum", "steps_pixels", "steps_min", "steps_max",
-                                       "pilot_steps", "pilot_s", "steps_capped", "steps_wanted_sum"};
+                                       "pilot_steps", "pilot_s", "steps_capped", "steps_wanted_sum", "beam_near_factor",
+                                       "beam_near_radius_m", "beam_near_cells", "beam_near_transition_cells",
+                                       "beam_near_triangles"};
     const size_t nk = sizeof keys / sizeof keys[0];
     for (size_t i = 0; i < nk; i++) set(&s, keys[i], 10.0 + (double)i);
     CHECK(s.W == 10 && s.H == 11 && s.B == 12 && s.passes == 13 && s.probe == 14 && s.probe_levels == 15);
@@ -45,6 +47,8 @@ static void test_members(void)
     CHECK(s.shadows == 32 && s.overflows == 33 && s.steps_sum == 34.0 && s.steps_pixels == 35.0);
     CHECK(s.steps_min == 36 && s.steps_max == 37 && s.pilot_steps == 38 && s.pilot_s == 39.0);
     CHECK(s.steps_capped == 40.0 && s.steps_wanted_sum == 41.0);
+    CHECK(s.beam_near_factor == 42 && s.beam_near_radius_m == 43.0 && s.beam_near_cells == 44);
+    CHECK(s.beam_near_transition_cells == 45 && s.beam_near_triangles == 46);
     /* a 64-bit counter beyond int range survives */
     set(&s, "queries", 6e12);
     CHECK(s.queries == 6000000000000LL);
