@@ -89,8 +89,9 @@ static void refraction_range(const gr_ref_renderer *r, double *drift, double *mu
 /* Refinement near the camera (docs/reference.md 2.2, "Near the camera"): when the plain grid
  * (surface_res cells across the lit region) has fewer than near_cells_per_wavelength cells
  * across the shortest wave, the cells within near_radius_cells of them around P_s are split
- * by the smallest odd factor that brings them to it (at most near_max_factor). Computed once from the full surface_res: the probe's coarser levels keep
- * the same factor and disc in metres. */
+ * by the smallest odd factor that brings them to it (at most near_max_factor). Computed once
+ * from the full surface_res: the probe's coarser levels keep the same factor and disc in
+ * metres. */
 static void near_refinement(gr_ref_renderer *r)
 {
     const gr_reference_settings *st = &r->scene.reference;
@@ -271,7 +272,8 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
             r->cone_box[0] = pu - R; r->cone_box[1] = pu + R;
             r->cone_box[2] = pw - R; r->cone_box[3] = pw + R;
             r->cone_cos = cos(bp.refine_angle);
-            /* the near disc covers the cone's at least as finely: every ray looks up the plain set */
+            /* the near set covers the cone's disc at least as finely: no cone set, its rays'
+             * points look up the near set (march.c) */
             if (r->near_F >= st->refine_factor && r->near_D >= rho) r->cone_on = 0;
         }
     }
@@ -359,7 +361,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     r->mu_t = (float)(-T.y);
     r->flat_eperp = (float)(ft * cos_i / -T.y);
     if (r->flat || r->beams_pass == pass) return GR_OK;
-    /* the last pass's two sets freed side by side (their pages go back: issue 30's serial part) */
+    /* the last pass's sets freed side by side (their pages go back: issue 30's serial part) */
     gr_beams *old[3] = {r->beams, r->cone, r->near};
     int nold = 0;
     for (int i = 0; i < 3; i++)

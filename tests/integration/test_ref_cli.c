@@ -61,7 +61,7 @@ int main(void)
     unlink(exr);
     unlink(png);
     {
-        char *argv[] = {(char *)bin, w(0, "reference"), scene, w(1, "-o"), exr, w(2, "--size"), w(3, "48x27"), w(4, "--surface-res"), w(5, "64"), w(6, "--quiet"), w(7, "--aov"), NULL};
+        char *argv[] = {(char *)bin, w(0, "reference"), scene, w(1, "-o"), exr, w(2, "--size"), w(3, "48x27"), w(4, "--surface-res"), w(5, "64"), w(6, "--quiet"), w(7, "--aov"), w(8, "--set"), w(9, "reference.near_cells_per_wavelength=0"), NULL};
         CHECK(run(argv, 0.0) == 0);
         struct stat st;
         CHECK_MSG(stat(png, &st) == 0 && st.st_size > 0, "PNG preview missing: %s", png);
@@ -96,7 +96,7 @@ int main(void)
         gr_meta_free(&m);
     }
     {
-        char *argv[] = {(char *)bin, w(0, "reference"), scene, w(1, "-o"), exr, w(2, "--size"), w(3, "32x18"), w(4, "--surface-res"), w(5, "64"), w(6, "--steps"), w(7, "16"), w(8, "--target-error"), w(9, "0.02"), w(10, "--quiet"), NULL};
+        char *argv[] = {(char *)bin, w(0, "reference"), scene, w(1, "-o"), exr, w(2, "--size"), w(3, "32x18"), w(4, "--surface-res"), w(5, "64"), w(6, "--steps"), w(7, "16"), w(8, "--target-error"), w(9, "0.02"), w(10, "--quiet"), w(11, "--set"), w(12, "reference.near_cells_per_wavelength=0"), NULL};
         CHECK(run(argv, 0.0) == 0);
         gr_image *img = NULL;
         gr_metadata m;
