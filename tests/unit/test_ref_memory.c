@@ -44,6 +44,17 @@ int main(void)
     CHECK_MSG(strstr(err.msg, "the ground truth needs about") && strstr(err.msg, "4 x 2 pixels x 3 batches, surface_res 10") &&
                   strstr(err.msg, "refine_factor 3 (50 cells near the camera)") && strstr(err.msg, "--max-memory"),
               "message: %s", err.msg);
+    /* the set near the camera (docs/reference.md 2.2): its cells count like the others, and
+     * the message names it */
+    gr_memlimit_set(1e12);
+    info.cone_cells = 0.0;
+    info.near_cells = 70.0;
+    info.near_factor = 3;
+    info.near_radius_m = 8.5;
+    CHECK_NEAR(gr_ref_memory_estimate(s, &info), 67456.0 + 70.0 * (344.0 + 320.0), 0.0);
+    gr_memlimit_set(1000.0);
+    CHECK(gr_ref_memory_check(s, &info, &err) == GR_E_INPUT);
+    CHECK_MSG(strstr(err.msg, "surface_res 10, near_factor 3 within 8.5 m of the camera (70 cells)"), "message: %s", err.msg);
     free(s);
     free(big);
     CHECK_DONE();

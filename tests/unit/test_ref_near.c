@@ -76,9 +76,10 @@ int main(void)
         CHECK_MSG(b <= 0.02, "channel %c: refined near the camera, within 2 %% of the 3x finer surface (%.2f %%)",
                   "RGB"[c], 100.0 * b);
     }
-    CHECK_MSG(eo > 0.03, "the unrefined render is off by more than 3 %% in some channel (%.2f %%): the case needs it", 100.0 * eo);
+    CHECK_MSG(eo > 0.03, "the unrefined render is off by more than 3 %% in some channel (%.2f %%): the case needs it",
+              100.0 * eo);
     CHECK_MSG(en <= eo / 3.0, "the refinement takes the worst channel's error to a third or less (%.2f %% -> %.2f %%)",
-          100.0 * eo, 100.0 * en);
+              100.0 * eo, 100.0 * en);
     const char *near = meta_string(&on, "godrays:surface_refine_near");
     CHECK_MSG(near && strstr(near, "factor 3 within"), "the metadata states the refinement: %s", near ? near : "(none)");
     if (near) printf("%s\n", near);
@@ -87,7 +88,6 @@ int main(void)
     double cpw = meta_num(&on, "godrays:surface_cells_per_wave"), cell = meta_num(&on, "godrays:surface_cell_m");
     printf("plain grid: %.4g m cells, %.4g across the shortest wave\n", cell, cpw);
     CHECK_REL(cpw, 1.0 / cell, 1e-6);
-    CHECK(cpw < 8.0 / 2.5);
     gr_ref_result_free(&off);
     gr_ref_result_free(&on);
     gr_ref_result_free(&fine);
