@@ -109,11 +109,17 @@ static void warn_bias(const gr_scene *scene, const gr_ref_result *res, int quiet
     const double p = po && po->num >= 1.0 && po->num <= 2.0 ? po->num : 1.0;
     char with[96] = "";
     if (mo && mo->num > est) snprintf(with, sizeof with, ", %.2g%% with the measured order %.2g", 100.0 * mo->num, p);
+    /* with the cells near the camera refined, the probe's coarser levels alias the shortest wave
+     * and its estimate leans high (docs/reference.md 2.2, "Near the camera") */
+    const char *near = gr_meta_get(&res->meta, "godrays:surface_refine_near")
+                           ? "; the cells near the camera are refined already (godrays:surface_refine_near), and on such "
+                             "views this estimate leans high (docs/reference.md 2.2, \"Near the camera\")"
+                           : "";
     fprintf(stderr,
             "godrays reference: warning: the surface tessellation's bias is about %.2g%% of the image mean in the worst channel%s "
             "(godrays:bias_surface_rel_est): the surface cells, 1/%d of the lit region (godrays:lit_region), are coarse "
-            "for this view; --surface-res %d should divide it by %.2g to 4 (the beam builds' time and memory grow 4x)\n",
-            100.0 * est, with, scene->reference.surface_res, 2 * scene->reference.surface_res, pow(2.0, p));
+            "for this view; --surface-res %d should divide it by %.2g to 4 (the beam builds' time and memory grow 4x)%s\n",
+            100.0 * est, with, scene->reference.surface_res, 2 * scene->reference.surface_res, pow(2.0, p), near);
 }
 
 /* "I/N" with 0 <= I < N: 0, else the exit code of the usage error. */
