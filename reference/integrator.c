@@ -86,6 +86,32 @@ static void refraction_range(const gr_ref_renderer *r, double *drift, double *mu
     *mu = tilt > 0.0 ? 0.99 * least : least;
 }
 
+/* The plain grid's cell at surface_res res: the lit region with its pad over res (as
+ * gr_beams_build); 0 when the region is empty or res < 1. */
+static double plain_cell(const gr_ref_renderer *r, int res)
+{
+    double eu = r->region.u1 - r->region.u0 + 2.0 * r->pad, ew = r->region.w1 - r->region.w0 + 2.0 * r->pad;
+    return eu > 0.0 && ew > 0.0 && res >= 1 ? sqrt(eu * ew) / res : 0.0;
+}
+
+/* The square of half side R around P_s, the camera's sheared position (u0 u1 w0 w1). */
+static void box_around_ps(const gr_ref_renderer *r, double R, double box[4])
+{
+    double pu = r->cam.x - r->sx * r->cam.y, pw = r->cam.z - r->sz * r->cam.y;
+    box[0] = pu - R; box[1] = pu + R;
+    box[2] = pw - R; box[3] = pw + R;
+}
+
+/* The estimated surface cells of a set over box on the plain grid's cells (prepare_pass): the
+ * box padded, those within disc_r + h of P_s split F x F. */
+static double set_cells(const gr_ref_renderer *r, const double box[4], double disc_r, int F)
+{
+    double h = plain_cell(r, r->set.surface_res), R = 0.5 * (box[1] - box[0]);
+    if (!(h > 0.0)) return 0.0;
+    double side = 2.0 * (R + r->pad) / h + 2.0, disc = GR_PI * (disc_r / h + 1.0) * (disc_r / h + 1.0);
+    return side * side + disc * ((double)F * F - 1.0);
+}
+
 /* Refinement near the camera (docs/reference.md 2.2, "Near the camera"): when the plain grid
  * (surface_res cells across the lit region) has fewer than near_cells_per_wavelength cells
  * across the shortest wave, the cells within near_radius_cells of them around P_s are split
@@ -100,9 +126,8 @@ static void near_refinement(gr_ref_renderer *r)
     double lam = INFINITY;
     for (int i = 0; i < r->scene.water.n_waves; i++)
         if (r->scene.water.waves[i].amplitude_m != 0.0) lam = fmin(lam, r->scene.water.waves[i].wavelength_m);
-    double eu = r->region.u1 - r->region.u0 + 2.0 * r->pad, ew = r->region.w1 - r->region.w0 + 2.0 * r->pad;
-    if (r->flat || !isfinite(lam) || !(eu > 0.0 && ew > 0.0) || st->surface_res < 1) return;
-    double h = sqrt(eu * ew) / st->surface_res; /* the plain grid's cell (gr_beams_build) */
+    double h = plain_cell(r, st->surface_res);
+    if (r->flat || !isfinite(lam) || !(h > 0.0)) return;
     r->near_lambda = lam;
     r->near_cpw = lam / h;
     if (!(st->near_cells_per_wavelength > 0.0)) return;
@@ -118,9 +143,7 @@ static void near_refinement(gr_ref_renderer *r)
     r->near_F = F;
     r->near_D = st->near_radius_cells * h;
     /* the set covers the disc and the waves' horizontal displacement around P_s */
-    double R = r->near_D + wave_amplitude_sum(&r->scene.water), pu = r->cam.x - r->sx * r->cam.y, pw = r->cam.z - r->sz * r->cam.y;
-    r->near_box[0] = pu - R; r->near_box[1] = pu + R;
-    r->near_box[2] = pw - R; r->near_box[3] = pw + R;
+    box_around_ps(r, r->near_D + wave_amplitude_sum(&r->scene.water), r->near_box);
 }
 
 /* The lit region: sheared bounds of the visible volume (camera frustum up to each ray's
@@ -267,10 +290,8 @@ gr_status gr_ref_create(const gr_scene *s, const gr_ref_options *o, gr_ref_rende
         double rho = r->flat ? -1.0 : gr_beam_refine_radius(&bp);
         if (rho >= 0.0) {
             /* its rays stay within rho of P_s (sheared); the waves' displacement as margin */
-            double R = rho + wave_amplitude_sum(&s->water), pu = r->cam.x - r->sx * r->cam.y, pw = r->cam.z - r->sz * r->cam.y;
             r->cone_on = 1;
-            r->cone_box[0] = pu - R; r->cone_box[1] = pu + R;
-            r->cone_box[2] = pw - R; r->cone_box[3] = pw + R;
+            box_around_ps(r, rho + wave_amplitude_sum(&s->water), r->cone_box);
             r->cone_cos = cos(bp.refine_angle);
             /* the near set covers the cone's disc at least as finely: no cone set, its rays'
              * points look up the near set (march.c) */
@@ -335,6 +356,37 @@ static void *destroy_job(void *arg)
 {
     gr_beams_destroy(*(gr_beams **)arg);
     return NULL;
+}
+
+static gr_status build_set(gr_ref_renderer *r, const gr_beam_params *bp, gr_beams **out, gr_error *err)
+{
+    gr_status st = gr_beams_build(r->rtc, bp, out, err);
+    if (st == GR_OK) {
+        account_build(r, *out);
+        r->tally.beam_build_s += gr_beams_stats(*out)->build_s;
+    }
+    return st;
+}
+
+/* A set over box (sheared u0 u1 w0 w1) on the plain set's grid lines (the camera cone's, the
+ * one near the camera: docs/reference.md 2.2), its cells near P_s split F x F (within radius
+ * m; 0: the cone's own radius); bp holds the pass's parameters and is changed. */
+static gr_status build_on_plain_lines(gr_ref_renderer *r, gr_beam_params *bp, const double box[4], int F, double radius,
+                                      double slab_cells, gr_beams **out, gr_error *err)
+{
+    const gr_beam_stats *bs = gr_beams_stats(r->beams);
+    bp->region.u0 = box[0];
+    bp->region.u1 = box[1];
+    bp->region.w0 = box[2];
+    bp->region.w1 = box[3];
+    bp->refine_factor = F;
+    bp->refine_radius_m = radius;
+    bp->cell_m = bs->cell_m;
+    bp->anchor_u = bs->grid_u0;
+    bp->anchor_w = bs->grid_w0;
+    bp->surface_mesh = 1;
+    bp->slab_cells = slab_cells;
+    return build_set(r, bp, out, err);
 }
 
 gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
@@ -407,52 +459,14 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
      * serves every other ray */
     bp.refine_factor = 1;
     int prev = gr_ref_phases_switch(&r->phases, REF_PH_BEAMS);
-    gr_status st = gr_beams_build(r->rtc, &bp, &r->beams, err);
-    if (st == GR_OK) {
-        account_build(r, r->beams);
-        r->tally.beam_build_s += gr_beams_stats(r->beams)->build_s;
-    }
-    if (r->cone_on && st == GR_OK) {
-        const gr_beam_stats *bs = gr_beams_stats(r->beams);
-        bp.region.u0 = r->cone_box[0];
-        bp.region.u1 = r->cone_box[1];
-        bp.region.w0 = r->cone_box[2];
-        bp.region.w1 = r->cone_box[3];
-        bp.refine_factor = r->set.refine_factor;
-        bp.cell_m = bs->cell_m;
-        bp.anchor_u = bs->grid_u0;
-        bp.anchor_w = bs->grid_w0;
-        bp.surface_mesh = 1;
-        /* slabs of a cell's drift: the cone set's refined cells are many and only the cone's
-         * rays look them up (measured: its builds 5.6 s -> 3.8 s of a render, the same bias) */
-        bp.slab_cells = 1.0;
-        if (st == GR_OK) st = gr_beams_build(r->rtc, &bp, &r->cone, err);
-        if (st == GR_OK) {
-            account_build(r, r->cone);
-            r->tally.beam_build_s += gr_beams_stats(r->cone)->build_s;
-        }
-    }
-    if (r->near_F > 1 && st == GR_OK) {
-        /* near the camera (docs/reference.md 2.2): near_box on the plain grid's lines, the
-         * disc of radius near_D around P_s split near_F x near_F */
-        const gr_beam_stats *bs = gr_beams_stats(r->beams);
-        bp.region.u0 = r->near_box[0];
-        bp.region.u1 = r->near_box[1];
-        bp.region.w0 = r->near_box[2];
-        bp.region.w1 = r->near_box[3];
-        bp.refine_factor = r->near_F;
-        bp.refine_radius_m = r->near_D;
-        bp.cell_m = bs->cell_m;
-        bp.anchor_u = bs->grid_u0;
-        bp.anchor_w = bs->grid_w0;
-        bp.surface_mesh = 1;
-        bp.slab_cells = r->rendering ? 0.5 : 1.0; /* as the plain set's (measured: 1.0 and 2.0 cost more) */
-        st = gr_beams_build(r->rtc, &bp, &r->near, err);
-        if (st == GR_OK) {
-            account_build(r, r->near);
-            r->tally.beam_build_s += gr_beams_stats(r->near)->build_s;
-        }
-    }
+    gr_status st = build_set(r, &bp, &r->beams, err);
+    /* slabs of a cell's drift for the cone's set: its refined cells are many and only the
+     * cone's rays look them up (measured: its builds 5.6 s -> 3.8 s of a render, the same
+     * bias); the near set's as the plain set's (measured: 1.0 and 2.0 cost more there) */
+    if (r->cone_on && st == GR_OK)
+        st = build_on_plain_lines(r, &bp, r->cone_box, r->set.refine_factor, 0.0, 1.0, &r->cone, err);
+    if (r->near_F > 1 && st == GR_OK)
+        st = build_on_plain_lines(r, &bp, r->near_box, r->near_F, r->near_D, r->rendering ? 0.5 : 1.0, &r->near, err);
     gr_ref_phases_switch(&r->phases, prev);
     if (st != GR_OK) return st;
     r->beams_pass = pass;
@@ -499,22 +513,10 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
     info->near_factor = r->near_F;
     info->near_radius_m = r->near_D;
     info->cells_per_wave = r->near_cpw;
-    if (r->near_F > 1) {
-        /* the near set (prepare_pass): near_box (half side R) padded, on the plain grid's cells
-         * h, those within near_D + h of P_s split F x F */
-        double eu = r->region.u1 - r->region.u0 + 2.0 * r->pad, ew = r->region.w1 - r->region.w0 + 2.0 * r->pad;
-        double h = sqrt(eu * ew) / r->set.surface_res, R = 0.5 * (r->near_box[1] - r->near_box[0]);
-        double side = 2.0 * (R + r->pad) / h + 2.0, F = r->near_F, disc = GR_PI * (r->near_D / h + 1.0) * (r->near_D / h + 1.0);
-        info->near_cells = side * side + disc * (F * F - 1.0);
-    }
-    if (r->cone_on && r->set.surface_res > 0) {
-        /* the camera cone's set (prepare_pass): cone_box (half side R) padded, on the plain
-         * grid's cells h, those within R + h of P_s split F x F */
-        double eu = r->region.u1 - r->region.u0 + 2.0 * r->pad, ew = r->region.w1 - r->region.w0 + 2.0 * r->pad;
-        double h = sqrt(eu * ew) / r->set.surface_res, R = 0.5 * (r->cone_box[1] - r->cone_box[0]);
-        double side = 2.0 * (R + r->pad) / h + 2.0, F = r->set.refine_factor, disc = GR_PI * (R / h + 1.0) * (R / h + 1.0);
-        info->cone_cells = side * side + disc * (F * F - 1.0);
-    }
+    /* the near set's and the camera cone's (prepare_pass) */
+    if (r->near_F > 1) info->near_cells = set_cells(r, r->near_box, r->near_D, r->near_F);
+    if (r->cone_on && r->set.surface_res > 0)
+        info->cone_cells = set_cells(r, r->cone_box, 0.5 * (r->cone_box[1] - r->cone_box[0]), r->set.refine_factor);
 }
 
 gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
