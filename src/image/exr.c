@@ -122,6 +122,28 @@ static gr_status write_attrs(exr_context_t ctx, int part, const char *path, cons
     return GR_OK;
 }
 
+/* OpenEXR 3.1's ZIP encoder keeps its zlib output when that output is exactly as long as the
+ * raw chunk, but a reader takes a chunk of the raw length as stored uncompressed (the format's
+ * rule), so such a chunk reads back as garbage (OpenEXR issue 2306, fixed upstream in 2026 by
+ * testing >= instead of >). Deterministic and data-dependent: a 48 x 27 ground truth of a
+ * level view hit it. This wrapper around the library's compressor stores the raw bytes then,
+ * as the format says; tests/unit/test_exr.c case "equal sizes" sweeps data across the size. */
+typedef struct exr_compress_guard {
+    exr_result_t (*compress)(exr_encode_pipeline_t *enc);
+} exr_compress_guard;
+
+static exr_result_t compress_guarded(exr_encode_pipeline_t *enc)
+{
+    const exr_compress_guard *g = enc->encoding_user_data;
+    exr_result_t rv = g->compress(enc);
+    if (rv == EXR_ERR_SUCCESS && enc->compressed_buffer && enc->compressed_buffer != enc->packed_buffer &&
+        enc->compressed_bytes >= enc->packed_bytes && enc->compressed_alloc_size >= enc->packed_bytes) {
+        memcpy(enc->compressed_buffer, enc->packed_buffer, enc->packed_bytes);
+        enc->compressed_bytes = enc->packed_bytes;
+    }
+    return rv;
+}
+
 /* Encodes every chunk of img into the open context (header already written). */
 static gr_status write_chunks(exr_context_t ctx, int part, const char *path, const gr_image *img,
                               gr_error *err)
@@ -131,6 +153,7 @@ static gr_status write_chunks(exr_context_t ctx, int part, const char *path, con
     if (rv != EXR_ERR_SUCCESS || lines <= 0) return exr_fail(err, path, rv, GR_E_RUNTIME, "scanlines per chunk");
     const size_t nc = (size_t)img->nchannels, w = (size_t)img->width;
     exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+    exr_compress_guard guard = {NULL};
     gr_status st = GR_OK;
     int first = 1;
     for (int y = 0; y < img->height && st == GR_OK; y += lines) {
@@ -154,6 +177,11 @@ static gr_status write_chunks(exr_context_t ctx, int part, const char *path, con
         if (first) {
             rv = exr_encoding_choose_default_routines(ctx, part, &enc);
             if (rv != EXR_ERR_SUCCESS) { st = exr_fail(err, path, rv, GR_E_RUNTIME, "encoder routines"); break; }
+            if (enc.compress_fn) {
+                guard.compress = enc.compress_fn;
+                enc.encoding_user_data = &guard;
+                enc.compress_fn = compress_guarded;
+            }
             first = 0;
         }
         rv = exr_encoding_run(ctx, part, &enc);
