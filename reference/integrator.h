@@ -129,6 +129,7 @@ typedef struct gr_ref_info {
     int near_factor;        /* refinement near the camera (docs/reference.md 2.2): the factor (1: none), */
     double near_radius_m;   /* its radius around P_s (sheared, m), */
     double near_cells;      /* estimated surface cells of its beam set, the refined sub-cells included */
+    double probe_near_cells; /* the same for the bias probe's fourth level (its cells 2x finer), 0: none */
     double cells_per_wave;  /* the plain grid's cells across the shortest wave (0: flat water) */
 } gr_ref_info;
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info);

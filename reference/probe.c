@@ -6,9 +6,14 @@
 
 #include "reference/stats.h"
 
-int gr_ref_probe_stats(gr_ref_renderer *r, double *const sum[3], uint32_t *const cnt[3], size_t np, int pw, int ph, int off)
+int gr_ref_probe_stats(gr_ref_renderer *r, double *const sum[], uint32_t *const cnt[], int nl, size_t np, int pw, int ph,
+                       int off)
 {
     enum { NL = 3 };
+    /* a fourth level: h with the cells near the camera 2x finer (gr_ref_probe_holds_near): their
+     * own error by Richardson toward finer cells, e = (L_h - L_h/2) 2^p / (2^p - 1), with p = 2
+     * for the estimate (4/3) and p = 1 for the conservative figures (2) */
+    const int near = nl > NL;
     float *bpx = malloc(np * 3 * sizeof *bpx + 1);
     if (!bpx) return -1;
     /* per channel c: d1 = sum |L_2h - L_h|, d2 = sum |L_4h - L_2h|, v = sum L_h over the probe
@@ -26,7 +31,9 @@ int gr_ref_probe_stats(gr_ref_renderer *r, double *const sum[3], uint32_t *const
         d2 += fabs(l[2] - l[1]);
         v += l[0];
         for (int c = 0; c < 3; c++) {
-            d1c[c] += fabs(lc[1][c] - lc[0][c]);
+            /* with the fourth level: |the plain grid's e + the near cells' e| x 3 (order 2) */
+            double en = near && cnt[NL][i] ? (lc[0][c] - sum[NL][i * 3 + c] / cnt[NL][i]) * (4.0 / 3.0) : 0.0;
+            d1c[c] += fabs(lc[1][c] - lc[0][c] + 3.0 * en);
             vc[c] += lc[0][c];
         }
     }
@@ -35,7 +42,7 @@ int gr_ref_probe_stats(gr_ref_renderer *r, double *const sum[3], uint32_t *const
      * error, e.g. red on a level view: 4.9 % against 2.6 % for blue, docs/reference.md 4).
      * Channels below 1e-3 of the brightest one's light are left out (invisible, and their
      * relative difference is the probe's residual noise). */
-    double vmax = fmax(vc[0], fmax(vc[1], vc[2])), rel1 = v > 0.0 ? d1 / v : 0.0;
+    double vmax = fmax(vc[0], fmax(vc[1], vc[2])), rel1 = v > 0.0 && !near ? d1 / v : 0.0;
     for (int c = 0; c < 3; c++)
         if (vc[c] > 1e-3 * vmax && d1c[c] / vc[c] > rel1) rel1 = d1c[c] / vc[c];
     /* the measured order of convergence, clamped to [1, 2] */
@@ -43,17 +50,25 @@ int gr_ref_probe_stats(gr_ref_renderer *r, double *const sum[3], uint32_t *const
     if (!(order <= 2.0)) order = 2.0;
     if (!(order >= 1.0)) order = 1.0;
     double div = pow(2.0, order) - 1.0; /* Richardson: e_h = (L_2h - L_h) / (2^p - 1) */
+    /* the conservative figure per channel (with the fourth level: the near cells' e with p = 1) */
+    double consc[3] = {0.0, 0.0, 0.0};
     for (size_t i = 0; i < np; i++)
         for (int c = 0; c < 3; c++) {
             double lh = cnt[0][i] ? sum[0][i * 3 + c] / cnt[0][i] : 0.0, l2h = cnt[1][i] ? sum[1][i * 3 + c] / cnt[1][i] : 0.0;
             double e = (l2h - lh) / div; /* signed, per channel */
+            if (near && cnt[NL][i]) e += 2.0 * (lh - sum[NL][i * 3 + c] / cnt[NL][i]);
+            consc[c] += fabs(e);
             bpx[i * 3 + c] = isfinite(e) ? (float)e : 0.0f;
         }
+    double rel_cons = v > 0.0 && !near ? d1 / v / div : 0.0;
+    for (int c = 0; c < 3; c++)
+        if (vc[c] > 1e-3 * vmax && consc[c] / vc[c] > rel_cons) rel_cons = consc[c] / vc[c];
+    if (!near) rel_cons = rel1 / div; /* the same figure as before the fourth level, bit for bit */
     /* the estimate: the asymptotic order 2 (divide by 3); the conservative figure: the
      * measured order (convergence accelerates as h shrinks, so the order measured on the
      * coarser pair is a lower bound of the order at h and the figure an upper one) */
     r->bias_rel = v > 0.0 && isfinite(rel1) ? rel1 / 3.0 : (d1 > 0.0 ? -1.0 : 0.0);
-    r->bias_rel_cons = v > 0.0 && isfinite(rel1) ? rel1 / div : (d1 > 0.0 ? -1.0 : 0.0);
+    r->bias_rel_cons = v > 0.0 && isfinite(rel_cons) ? rel_cons : (d1 > 0.0 ? -1.0 : 0.0);
     r->bias_ratio = ratio;
     r->bias_order = order;
     r->bias_probe_pixels = (long long)np;
@@ -73,18 +88,34 @@ void gr_ref_probe_grid(const gr_ref_renderer *r, int *off, int *pw, int *ph)
     *ph = (H - *off + PROBE_STRIDE - 1) / PROBE_STRIDE;
 }
 
-gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *captured, gr_ref_pool *pool,
-                           gr_progress *prog, double frac0, double span, ref_march_totals *tot, gr_error *err)
+int gr_ref_probe_holds_near(const gr_ref_renderer *r)
 {
-    enum { NL = 3 }; /* levels h, 2h, 4h */
+    enum { NL = 3, FMAX = 64 }; /* levels h, 2h, 4h; beams.c's largest refine_factor */
+    return r->near_F > 1 && r->near_F * r->near_cpw >= r->scene.reference.near_cells_per_wavelength &&
+           (r->near_F << (NL - 1)) <= FMAX;
+}
+
+gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *captured, ref_accum *captured_fine,
+                           gr_ref_pool *pool, gr_progress *prog, double frac0, double span, ref_march_totals *tot,
+                           gr_error *err)
+{
+    enum { NL = 3, NMAX = 4 }; /* levels h, 2h, 4h (and h with the near cells 2x finer) */
+    /* the near set's cells keep their size at 2h and 4h, and a fourth level measures their own
+     * error (gr_ref_probe_holds_near) */
+    const int F0 = r->near_F, hold = gr_ref_probe_holds_near(r), nl = NL + hold;
     int off, pw, ph;
     gr_ref_probe_grid(r, &off, &pw, &ph);
-    int res = r->set.surface_res, lres[NL];
-    for (int k = 0; k < NL; k++) lres[k] = (res >> k) > 2 ? res >> k : 2;
-    int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
-    ref_accum a[NL];
-    memset(a, 0, sizeof a);
+    int res = r->set.surface_res, lres[NMAX], lnear[NMAX];
     for (int k = 0; k < NL; k++) {
+        lres[k] = (res >> k) > 2 ? res >> k : 2;
+        lnear[k] = hold ? F0 << k : F0;
+    }
+    lres[NL] = res;
+    lnear[NL] = 2 * F0;
+    int passes = r->passes_per_round < PROBE_PASSES ? r->passes_per_round : PROBE_PASSES;
+    ref_accum a[NMAX];
+    memset(a, 0, sizeof a);
+    for (int k = 0; k < nl; k++) {
         a[k].W = pw;
         a[k].H = ph;
         a[k].B = 1; /* the passes summed: the sums a part file carries (src/farm/parts.h) */
@@ -93,16 +124,27 @@ gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *cap
     gr_status st = GR_OK;
     /* level h taken from the main passes when every probe pass ran there (a part whose batches
      * miss some of them renders level h here, as the others) */
-    int k0 = 0;
+    int have[NMAX] = {0, 0, 0, 0};
     unsigned want = (1u << passes) - 1u;
     if (captured && captured->sum && (r->probe_captured & want) == want) {
         a[0].sum = captured->sum;
         a[0].count = captured->count;
         captured->sum = NULL;
         captured->count = NULL;
-        k0 = 1;
+        have[0] = 1;
     }
-    for (int k = k0; k < NL && st == GR_OK; k++) {
+    /* the fourth level likewise (gr_ref_render marched it with the main passes' plain sets) */
+    if (hold && captured_fine && captured_fine->sum && (r->probe_captured_fine & want) == want) {
+        a[NL].sum = captured_fine->sum;
+        a[NL].count = captured_fine->count;
+        captured_fine->sum = NULL;
+        captured_fine->count = NULL;
+        have[NL] = 1;
+    }
+    int todo = 0; /* the levels rendered here */
+    for (int k = 0; k < nl; k++) todo += !have[k];
+    for (int k = 0; k < nl && st == GR_OK; k++) {
+        if (have[k]) continue;
         a[k].sum = calloc(np * 3, sizeof *a[k].sum);
         a[k].count = calloc(np, sizeof *a[k].count);
         if (!a[k].sum || !a[k].count) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
@@ -111,31 +153,42 @@ gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *cap
     /* a part probes its own rows' probe pixels */
     int y0 = gr_ref_probe_row(r->opt.row0, PROBE_STRIDE, off, a[0].H);
     int y1 = gr_ref_probe_row(r->opt.row1, PROBE_STRIDE, off, a[0].H);
-    for (int p = 0; p < passes && st == GR_OK && complete; p++)
-        for (int k = k0; k < NL && st == GR_OK && complete; k++) {
+    for (int p = 0, done = 0; p < passes && st == GR_OK && complete; p++)
+        for (int k = 0; k < nl && st == GR_OK && complete; k++) {
+            if (have[k]) continue;
             r->set.surface_res = lres[k];
+            r->near_F = lnear[k];
+            /* the fourth level as gr_ref_render takes it: the pass's sets with the finer near
+             * set beside them, marched in its place (the same sums either way) */
+            r->near_fine_F = k == NL ? lnear[NL] : 0;
+            if (k == NL) r->near_F = F0;
             r->beams_pass = -1; /* another resolution: rebuild */
             st = gr_ref_prepare_pass(r, p, err);
             if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; break; }
+            gr_beams *keep_near = r->near;
+            if (k == NL) r->near = r->near_fine;
             if (st == GR_OK)
                 st = gr_ref_march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, y0, y1, pool, prog,
-                                frac0 + span * ((NL - k0) * p + k - k0) / ((NL - k0) * (double)passes),
-                                span / ((NL - k0) * (double)passes),
+                                frac0 + span * done / (todo * (double)passes), span / (todo * (double)passes),
                                 "surface-bias probe", tot, &complete, err);
+            r->near = keep_near;
+            done++;
         }
     r->set.surface_res = res;
+    r->near_F = F0;
+    r->near_fine_F = 0;
     r->beams_pass = -1;
     if (st == GR_OK && complete) {
-        double *sums[NL] = {a[0].sum, a[1].sum, a[2].sum};
-        uint32_t *cnts[NL] = {a[0].count, a[1].count, a[2].count};
-        if (gr_ref_probe_stats(r, sums, cnts, np, a[0].W, a[0].H, off) != 0)
+        double *sums[NMAX] = {a[0].sum, a[1].sum, a[2].sum, a[3].sum};
+        uint32_t *cnts[NMAX] = {a[0].count, a[1].count, a[2].count, a[3].count};
+        if (gr_ref_probe_stats(r, sums, cnts, nl, np, a[0].W, a[0].H, off) != 0)
             st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
         r->bias_probe_passes = passes;
         if (st == GR_OK && keep) { /* hand the sums over */
             keep->probe_w = a[0].W;
             keep->probe_h = a[0].H;
-            keep->probe_levels = NL;
-            for (int k = 0; k < NL; k++) {
+            keep->probe_levels = nl;
+            for (int k = 0; k < nl; k++) {
                 free(keep->probe_sum[k]);
                 free(keep->probe_count[k]);
                 keep->probe_sum[k] = a[k].sum;
@@ -149,7 +202,7 @@ gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *cap
             keep->probe_passes = passes;
         }
     }
-    for (int k = 0; k < NL; k++) {
+    for (int k = 0; k < NMAX; k++) {
         free(a[k].sum);
         free(a[k].count);
     }

@@ -7,11 +7,13 @@
 #include "reference/march.h"
 #include "reference/renderer.h"
 
-/* The probe's figures from its per-level sums (np probe pixels, [pixel * 3 + c]; level k has
- * cells 2^k h): the estimate (order 2), the figure with the measured order, the order, and
+/* The probe's figures from its nl per-level sums (np probe pixels, [pixel * 3 + c]; level k < 3
+ * has cells 2^k h; a fourth level, where the probe holds the near set's cells, is h with those
+ * cells 2x finer): the estimate (order 2), the figure with the measured order, the order, and
  * the per-pixel signed estimates (bias channels). Shared by gr_ref_render and
  * gr_ref_assemble, so that merged parts give the same bytes. 0, or -1 when out of memory. */
-int gr_ref_probe_stats(gr_ref_renderer *r, double *const sum[3], uint32_t *const cnt[3], size_t np, int pw, int ph, int off);
+int gr_ref_probe_stats(gr_ref_renderer *r, double *const sum[], uint32_t *const cnt[], int nl, size_t np, int pw, int ph,
+                       int off);
 /* The probe's pixel grid: its offset in the image and its size. */
 void gr_ref_probe_grid(const gr_ref_renderer *r, int *off, int *pw, int *ph);
 /* Surface-bias probe (docs/reference.md, section 4). Every PROBE_STRIDE-th pixel in x and y
@@ -24,11 +26,21 @@ void gr_ref_probe_grid(const gr_ref_renderer *r, int *off, int *pw, int *ph);
  * also overestimates). Richardson then gives the bias at h per pixel as
  * (L_2h - L_h) / (2^p - 1); r->bias_rel = the mean of its absolute value over the probe
  * pixels divided by their mean value: the same figure as the convergence study's table. */
+/* Whether the probe's coarser levels keep the cells near the camera (docs/reference.md 2.2,
+ * "Near the camera") at their size at h (factor near_F 2^k at level k over the same disc) and
+ * a fourth level measures their own error (h with factor 2 near_F): where the near set reaches
+ * its near_cells_per_wavelength. Halving those cells would take them past the point where a
+ * wave has too few cells to be seen, and Richardson's extrapolation from there reads 3-30x high
+ * (docs/reference.md 4, "The probe and the cells near the camera"); where the cap
+ * (near_max_factor) keeps them short of the target, they are coarsened with the rest (the
+ * figure then leans high, never low). */
+int gr_ref_probe_holds_near(const gr_ref_renderer *r);
 /* The probe's passes over the part's rows (the first min(passes per round, PROBE_PASSES)),
- * level h taken from `captured` when the main passes took all of it; with keep, its sums
- * are handed over. The progress bar goes from frac0 to frac0 + span. */
-gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *captured, gr_ref_pool *pool,
-                           gr_progress *prog, double frac0, double span, ref_march_totals *tot, gr_error *err);
+ * level h taken from `captured` and the fourth level from `captured_fine` when the main
+ * passes took all of it (gr_ref_render); with keep, its sums are handed over. The progress bar goes from frac0 to frac0 + span. */
+gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *captured, ref_accum *captured_fine,
+                           gr_ref_pool *pool, gr_progress *prog, double frac0, double span, ref_march_totals *tot,
+                           gr_error *err);
 
 /* The surface-bias estimate of image pixel (x, y), channel c: that of its probe pixel (the
  * PROBE_STRIDE x PROBE_STRIDE block it lies in). */

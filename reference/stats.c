@@ -319,7 +319,7 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
 {
     gr_metadata *m = &out->meta;
     gr_status st = GR_OK;
-    char key[64], buf[256];
+    char key[64], buf[512];
 #define SET(call) do { if (st == GR_OK) st = (call); } while (0)
     SET(gr_meta_set_string(m, "godrays:renderer", "reference (Embree ray-marched single scattering, beam prisms)"));
     SET(gr_meta_set_string(m, "godrays:layer", "in-scattered radiance of refracted sunlight (single scattering)"));
@@ -408,13 +408,22 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     else if (r->bias_rel >= 0.0)
         snprintf(buf, sizeof buf,
                  "Richardson from %lld pixels (every %dth) x %d passes at surface_res %d, %d and %d: difference ratio "
-                 "%.2f, measured order %.2f (clamped to [1, 2]), %.2f s",
+                 "%.2f, measured order %.2f (clamped to [1, 2]), %.2f s%s",
                  r->bias_probe_pixels, PROBE_STRIDE, r->bias_probe_passes, r->set.surface_res,
                  r->set.surface_res / 2 > 2 ? r->set.surface_res / 2 : 2, r->set.surface_res / 4 > 2 ? r->set.surface_res / 4 : 2,
-                 r->bias_ratio, r->bias_order, r->tally.probe_s);
+                 r->bias_ratio, r->bias_order, r->tally.probe_s,
+                 r->near_F <= 1 ? ""
+                 : gr_ref_probe_holds_near(r)
+                     ? "; the cells near the camera held at their size there, and their own error from a fourth level "
+                       "with them 2x finer (p = 2; p = 1 in the conservative figures)"
+                     : "; the cells near the camera coarsened with the rest (under their target: leans high)");
     else
         snprintf(buf, sizeof buf, "not estimated (reference.bias_probe = false or interrupted); -1");
     SET(gr_meta_set_string(m, "godrays:bias_surface_probe", buf));
+    /* where there is a near set: 1 when the probe held its cells at their size and measured their
+     * own error with them 2x finer, 0 when it coarsened them with the rest (it leans high) */
+    if (r->bias_rel >= 0.0 && !r->flat && r->near_F > 1)
+        SET(gr_meta_set_int(m, "godrays:bias_probe_near_held", gr_ref_probe_holds_near(r)));
     /* per-block bias next to the mean's (bias.R/G/B channels; 10 x 10 pixel blocks) */
     SET(gr_meta_set_double(m, "godrays:bias_block_p95_rel", r->bias_px ? finite_or(r->bias_block_p95, -1.0) : (r->flat ? 0.0 : -1.0)));
     SET(gr_meta_set_int(m, "godrays:stderr_dof", r->batches - 1));

@@ -109,12 +109,16 @@ static void warn_bias(const gr_scene *scene, const gr_ref_result *res, int quiet
     const double p = po && po->num >= 1.0 && po->num <= 2.0 ? po->num : 1.0;
     char with[96] = "";
     if (mo && mo->num > est) snprintf(with, sizeof with, ", %.2g%% with the measured order %.2g", 100.0 * mo->num, p);
-    /* with the cells near the camera refined, the probe's coarser levels alias the shortest wave
-     * and its estimate leans high (docs/reference.md 2.2, "Near the camera") */
-    const char *near = gr_meta_get(&res->meta, "godrays:surface_refine_near")
-                           ? "; the cells near the camera are refined already (godrays:surface_refine_near), and on such "
-                             "views this estimate leans high (docs/reference.md 2.2, \"Near the camera\")"
-                           : "";
+    /* with the cells near the camera refined (docs/reference.md 2.2, "Near the camera"): where
+     * they reach their target the probe measures their error with them 2x finer; where the cap
+     * kept them short of it, its coarser levels alias the shortest wave and it leans high */
+    const gr_meta_item *held = gr_meta_get(&res->meta, "godrays:bias_probe_near_held");
+    const char *near = !gr_meta_get(&res->meta, "godrays:surface_refine_near") ? ""
+                       : held && held->num == 1.0
+                           ? "; it includes the error of the cells near the camera, refined (godrays:surface_refine_near) "
+                             "and measured with them 2x finer (godrays:bias_probe_near_held)"
+                           : "; the cells near the camera are refined already (godrays:surface_refine_near), but short of "
+                             "their target, and on such views this estimate leans high (docs/reference.md 2.2, \"Near the camera\")";
     fprintf(stderr,
             "godrays reference: warning: the surface tessellation's bias is about %.2g%% of the image mean in the worst channel%s "
             "(godrays:bias_surface_rel_est): the surface cells, 1/%d of the lit region (godrays:lit_region), are coarse "

@@ -79,7 +79,16 @@ ck "bias: exit 0" [ "$rc" -eq 0 ]
 ck "bias: one warning naming the remedy" [ "$(grep -c "warning: the surface tessellation's bias is about .*--surface-res 64 should" err.txt)" -eq 1 ]
 # the default scene at 32 cells has 1 cell per wave: the cells near the camera are refined
 # (docs/reference.md 2.2, "Near the camera"), and the warning says the estimate leans high there
-ck "bias: the warning names the refinement near the camera" grep -qF "the cells near the camera are refined already (godrays:surface_refine_near)" err.txt
+ck "bias: the warning names the refinement near the camera" grep -qF "the cells near the camera are refined already (godrays:surface_refine_near), but short of their target" err.txt
+# where the near cells reach their target (here a target of 2 cells per wave, which factor 3
+# reaches on a level view at 64 cells), the probe measures their own error with them 2x finer
+# (docs/reference.md 4, "The probe and the cells near the camera") and the warning says the
+# figure includes it
+"$bin" reference "$scene" -o bias_held.exr --size 16x9 --surface-res 64 --steps 17 --set camera.pitch_deg=5 \
+    --set reference.near_cells_per_wavelength=2 --no-preview >out.txt 2>err_held.txt
+rc=$?
+ck "bias, near cells held: exit 0" [ "$rc" -eq 0 ]
+ck "bias, near cells held: the warning says the figure includes them" grep -qF "it includes the error of the cells near the camera, refined (godrays:surface_refine_near) and measured with them 2x finer (godrays:bias_probe_near_held)" err_held.txt
 if command -v iinfo >/dev/null 2>&1; then
     iinfo -v bias.exr >meta.txt
     est=$(sed -n "s/^ *godrays:bias_surface_rel_est: *\([-0-9.eE+]*\).*/\1/p" meta.txt | head -n 1)

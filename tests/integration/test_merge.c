@@ -116,6 +116,11 @@ static void same_image(const char *a, const char *b, int expect_probe)
             have |= ra != NULL;
         }
         if (expect_probe) CHECK_MSG(have, "no refinement stated on %s (the view looks at the sun)", a);
+        /* the probe's fourth level (the near cells 2x finer) ran and came through the parts */
+        if (expect_probe)
+            CHECK_MSG(meta_num(&ma, "godrays:bias_probe_near_held") == 1.0 && meta_num(&mb, "godrays:bias_probe_near_held") == 1.0,
+                      "%s: the probe held the near cells (single %g, merged %g)", a, meta_num(&ma, "godrays:bias_probe_near_held"),
+                      meta_num(&mb, "godrays:bias_probe_near_held"));
         double bias = meta_num(&ma, "godrays:bias_surface_rel_est");
         CHECK_MSG(expect_probe ? bias > 0.0 : bias == 0.0, "%s: bias estimate %g (probe expected: %d)", a, bias, expect_probe);
         CHECK(meta_num(&mb, "godrays:merged_parts") == 32.0);
@@ -142,10 +147,13 @@ int main(void)
     static const struct { const char *scene; int probe; } scenes[] = {{"default.json", 1}, {"flat.json", 0}};
     /* small and fast: 96x54, 8 batches of one pass each; the default scene's 64 cells leave
      * 2 per wave, so a set near the camera is built (docs/reference.md 2.2): a disc of 6 plain
-     * cells keeps it in the parts at a quarter of the default disc's cost */
+     * cells keeps it in the parts at a quarter of the default disc's cost; a target of 5.5
+     * cells per wave, which factor 3 reaches, makes the bias probe hold the near cells and
+     * render its fourth level (docs/reference.md 4), so the parts carry four probe levels */
     static const char *const q[] = {"--size", "96x54", "--surface-res", "64", "--steps", "32", "--quiet",
-                                    "--set", "reference.near_radius_cells=6"};
-#define Q q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8]
+                                    "--set", "reference.near_radius_cells=6", "--set",
+                                    "reference.near_cells_per_wavelength=5.5"};
+#define Q q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8], q[9], q[10]
     char parts[32][4300];
     for (int s = 0; s < 2; s++) {
         char scene[4200], full[4300], merged[4300];

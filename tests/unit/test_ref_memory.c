@@ -55,6 +55,15 @@ int main(void)
     gr_memlimit_set(1000.0);
     CHECK(gr_ref_memory_check(s, &info, &err) == GR_E_INPUT);
     CHECK_MSG(strstr(err.msg, "surface_res 10, near_factor 3 within 8.5 m of the camera (70 cells)"), "message: %s", err.msg);
+    /* the bias probe's fourth level (docs/reference.md 4): its finer near set is held beside the
+     * near set during the passes it rides on, so its cells add */
+    gr_memlimit_set(1e12);
+    info.probe_near_cells = 200.0;
+    CHECK_NEAR(gr_ref_memory_estimate(s, &info), 67456.0 + 270.0 * (344.0 + 320.0), 0.0);
+    gr_memlimit_set(1000.0);
+    CHECK(gr_ref_memory_check(s, &info, &err) == GR_E_INPUT);
+    CHECK_MSG(strstr(err.msg, "near_factor 3 within 8.5 m of the camera (270 cells, the bias probe's 2x finer ones included)"),
+              "message: %s", err.msg);
     free(s);
     free(big);
     CHECK_DONE();
