@@ -316,7 +316,6 @@ void gr_ref_destroy(gr_ref_renderer *r)
     gr_beams_destroy(r->beams);
     gr_beams_destroy(r->cone);
     gr_beams_destroy(r->near);
-    gr_beams_destroy(r->near_fine);
     free(r->bias_px);
     free(r->steps_px);
     free(r->alloc_px);
@@ -390,12 +389,13 @@ static gr_status build_on_plain_lines(gr_ref_renderer *r, gr_beam_params *bp, co
     return build_set(r, bp, out, err);
 }
 
-gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
+/* The beam parameters of pass `pass` for its plain set (r->Ip: the pass's sun direction,
+ * set by gr_ref_prepare_pass). The grid's offset: the pass's own; with reference.antithetic,
+ * the (2m + 1)-th pass of a batch in a round takes the (2m)-th's moved by half a cell in both
+ * directions (a batch then holds antithetic pairs, the batches stay independent:
+ * docs/reference.md 2.5) */
+static void pass_params(const gr_ref_renderer *r, int pass, gr_beam_params *bp)
 {
-    r->Ip = gr_ref_pass_sun_dir(r, pass);
-    /* the grid's offset: the pass's own; with reference.antithetic, the (2m + 1)-th pass of a
-     * batch in a round takes the (2m)-th's moved by half a cell in both directions (a batch
-     * then holds antithetic pairs, the batches stay independent: docs/reference.md 2.5) */
     int half = pass_antithetic(r, pass);
     ref_rng g = rng_make(r->set.seed, STREAM_PASS, (uint64_t)pass_stream(r, pass));
     (void)rng_u(&g);
@@ -406,6 +406,43 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
         jit[1] = jit[1] < 0.5 ? jit[1] + 0.5 : jit[1] - 0.5;
     }
     if (r->opt.fixed_grid) jit[0] = jit[1] = 0.5;
+    memset(bp, 0, sizeof *bp);
+    bp->water = &r->scene.water;
+    bp->origin = r->origin;
+    bp->sun_dir = r->Ip;
+    bp->ior = r->scene.medium.ior;
+    bp->fresnel = r->opt.fresnel;
+    bp->shear_x = r->sx;
+    bp->shear_z = r->sz;
+    bp->region = r->region;
+    bp->pad_m = r->pad;
+    bp->res = r->set.surface_res;
+    bp->interrupt = r->opt.interrupt;
+    bp->jitter[0] = jit[0];
+    bp->jitter[1] = jit[1];
+    bp->max_prims = r->opt.max_prims;
+    bp->surface_mesh = 1;
+    /* a render's march looks up millions of points per beam set: thinner slabs pay off
+     * there (docs/reference.md, "Lookups"); probes keep the cheaper build */
+    bp->slab_cells = r->rendering ? 0.5 : 1.0;
+    bp->threads = r->threads;
+    bp->refine_angle = r->set.refine_angle_deg * GR_PI / 180.0;
+    bp->camera = &r->scene.camera;
+    bp->eye = r->cam;
+    if (r->convolve) {
+        bp->disc_radius = r->sun_radius;
+        bp->disc_e1 = r->e1;
+        bp->disc_e2 = r->e2;
+    }
+    /* the camera cone (docs/reference.md 2.2): the rays within refine_angle of +-T0 stay in
+     * cone_box; their set covers it, refined, on the plain grid's lines; the plain grid
+     * serves every other ray */
+    bp->refine_factor = 1;
+}
+
+gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
+{
+    r->Ip = gr_ref_pass_sun_dir(r, pass);
     /* Oracle 1: flat refraction, E_w / E_sun = F_t cos(theta_i) / cos(theta_t) */
     gr_dvec3 T = gr_refract_d(r->Ip, gr_d3(0, 1, 0), 1.0 / r->scene.medium.ior);
     double cos_i = -r->Ip.y;
@@ -415,50 +452,19 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     r->flat_eperp = (float)(ft * cos_i / -T.y);
     if (r->flat || r->beams_pass == pass) return GR_OK;
     /* the last pass's sets freed side by side (their pages go back: issue 30's serial part) */
-    gr_beams *old[4] = {r->beams, r->cone, r->near, r->near_fine};
+    gr_beams *old[3] = {r->beams, r->cone, r->near};
     int nold = 0;
-    for (int i = 0; i < 4; i++)
+    for (int i = 0; i < 3; i++)
         if (old[i]) old[nold++] = old[i];
     if (nold > 1 && r->threads > 1)
         r->phases.par_total += gr_beams_run_jobs(destroy_job, old, sizeof old[0], nold);
     else
         for (int i = 0; i < nold; i++) gr_beams_destroy(old[i]);
-    r->beams = r->cone = r->near = r->near_fine = NULL;
+    r->beams = r->cone = r->near = NULL;
     r->beams_pass = -1;
+    r->near_stats_valid = 0;
     gr_beam_params bp;
-    memset(&bp, 0, sizeof bp);
-    bp.water = &r->scene.water;
-    bp.origin = r->origin;
-    bp.sun_dir = r->Ip;
-    bp.ior = r->scene.medium.ior;
-    bp.fresnel = r->opt.fresnel;
-    bp.shear_x = r->sx;
-    bp.shear_z = r->sz;
-    bp.region = r->region;
-    bp.pad_m = r->pad;
-    bp.res = r->set.surface_res;
-    bp.interrupt = r->opt.interrupt;
-    bp.jitter[0] = jit[0];
-    bp.jitter[1] = jit[1];
-    bp.max_prims = r->opt.max_prims;
-    bp.surface_mesh = 1;
-    /* a render's march looks up millions of points per beam set: thinner slabs pay off
-     * there (docs/reference.md, "Lookups"); probes keep the cheaper build */
-    bp.slab_cells = r->rendering ? 0.5 : 1.0;
-    bp.threads = r->threads;
-    bp.refine_factor = r->set.refine_factor; /* local refinement (docs/reference.md 2.2) */
-    bp.refine_angle = r->set.refine_angle_deg * GR_PI / 180.0;
-    bp.camera = &r->scene.camera;
-    bp.eye = r->cam;
-    if (r->convolve) {
-        bp.disc_radius = r->sun_radius;
-        bp.disc_e1 = r->e1;
-        bp.disc_e2 = r->e2;
-    }
-    /* the camera cone (docs/reference.md 2.2): the rays within refine_angle of +-T0 stay in
-     * cone_box; their set covers it, refined, on the plain grid's lines; the plain grid
-     * serves every other ray */
-    bp.refine_factor = 1;
+    pass_params(r, pass, &bp);
     int prev = gr_ref_phases_switch(&r->phases, REF_PH_BEAMS);
     gr_status st = build_set(r, &bp, &r->beams, err);
     /* slabs of a cell's drift for the cone's set: its refined cells are many and only the
@@ -466,17 +472,36 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
      * bias); the near set's as the plain set's (measured: 1.0 and 2.0 cost more there) */
     if (r->cone_on && st == GR_OK)
         st = build_on_plain_lines(r, &bp, r->cone_box, r->set.refine_factor, 0.0, 1.0, &r->cone, err);
-    if (r->near_F > 1 && st == GR_OK)
+    if (r->near_F > 1 && st == GR_OK) {
         st = build_on_plain_lines(r, &bp, r->near_box, r->near_F, r->near_D, r->rendering ? 0.5 : 1.0, &r->near, err);
-    /* the bias probe's fourth level, the near cells finer, on the same plain grid (probe.c);
-     * only its sparse pixels look it up, so thicker slabs, a cheaper build (measured on the
-     * level view at 160x90: grid fill 19.2 -> 10.0 CPU-s from 0.5 to 2 cells, the same bytes) */
-    if (r->near_F > 1 && r->near_fine_F > 1 && st == GR_OK)
-        st = build_on_plain_lines(r, &bp, r->near_box, r->near_fine_F, r->near_D, 2.0, &r->near_fine, err);
+        if (st == GR_OK && r->near) {
+            r->near_stats = *gr_beams_stats(r->near);
+            r->near_stats_valid = 1;
+        }
+    }
     gr_ref_phases_switch(&r->phases, prev);
     if (st != GR_OK) return st;
     r->beams_pass = pass;
     return GR_OK;
+}
+
+gr_status gr_ref_near_fine(gr_ref_renderer *r, int pass, int F, gr_error *err)
+{
+    if (r->flat || !r->beams || r->beams_pass != pass || r->near_F <= 1)
+        return gr_fail(err, GR_E_RUNTIME, "reference: the finer near set needs pass %d's sets (internal)", pass);
+    /* one near set at a time (the memory estimate counts the larger) */
+    gr_beams_destroy(r->near);
+    r->near = NULL;
+    r->beams_pass = -1; /* the next prepare_pass builds this pass's sets again */
+    gr_beam_params bp;
+    pass_params(r, pass, &bp);
+    int prev = gr_ref_phases_switch(&r->phases, REF_PH_BEAMS);
+    /* only the probe's sparse pixels look it up: thicker slabs, a cheaper build (measured on
+     * the level view at 160x90: grid fill 19.2 -> 10.0 CPU-s from 0.5 to 2 cells, the same
+     * bytes) */
+    gr_status st = build_on_plain_lines(r, &bp, r->near_box, F, r->near_D, 2.0, &r->near, err);
+    gr_ref_phases_switch(&r->phases, prev);
+    return st;
 }
 
 double gr_ref_irradiance_h(const gr_ref_renderer *r, gr_dvec3 world)
@@ -598,8 +623,6 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
         for (int pp = 0; pp < P && st == GR_OK; pp++, pass++) {
             if (pass % acc.B < r->opt.batch0 || pass % acc.B >= r->opt.batch1) continue; /* another part's batch */
             if (r->opt.interrupt && *r->opt.interrupt) { out->partial = 1; break; }
-            const int probe_pass = pass < (P < PROBE_PASSES ? P : PROBE_PASSES);
-            r->near_fine_F = capf.sum && probe_pass ? 2 * r->near_F : 0;
             st = gr_ref_prepare_pass(r, pass, err);
             if (st == GR_E_INTERRUPTED) { st = GR_OK; out->partial = 1; break; }
             if (st != GR_OK) break;
@@ -612,19 +635,20 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
                                 mainw * (rounds > 1 ? pp : pass) / P, mainw / P, note, &tot, &complete, err);
             if (r->probe_capture && st == GR_OK && complete) r->probe_captured |= 1u << pass;
             r->probe_capture = NULL;
-            if (st == GR_OK && complete && r->near_fine) {
-                /* the probe's fourth level: its pixels with the finer near set (the probe's own
-                 * march arguments, so the same sums as when it renders the level itself) */
-                gr_beams *keep_near = r->near;
-                r->near = r->near_fine;
+            if (st == GR_OK && complete && capf.sum && pass < (P < PROBE_PASSES ? P : PROBE_PASSES)) {
+                /* the probe's fourth level: its pixels with the near set 2x finer in place of the
+                 * near set, on this pass's plain set (the probe's own march arguments, so the
+                 * same sums as when it renders the level itself: probe.c) */
                 int y0 = gr_ref_probe_row(r->opt.row0, PROBE_STRIDE, r->probe_capture_off, capf.H);
                 int y1 = gr_ref_probe_row(r->opt.row1, PROBE_STRIDE, r->probe_capture_off, capf.H);
                 ref_march_totals ftot = {0.0, 0, 0, 0};
                 gr_ref_phases_switch(&r->phases, REF_PH_PROBE);
-                st = gr_ref_march_pass(r, &capf, pass, 0, PROBE_STRIDE, r->probe_capture_off, y0, y1, pool, prog,
-                                       mainw * (rounds > 1 ? pp + 1 : pass + 1) / P, 0.0, note, &ftot, &complete, err);
+                st = gr_ref_near_fine(r, pass, 2 * r->near_F, err);
+                if (st == GR_OK)
+                    st = gr_ref_march_pass(r, &capf, pass, 0, PROBE_STRIDE, r->probe_capture_off, y0, y1, pool, prog,
+                                           mainw * (rounds > 1 ? pp + 1 : pass + 1) / P, 0.0, note, &ftot, &complete, err);
                 gr_ref_phases_switch(&r->phases, REF_PH_MARCH);
-                r->near = keep_near;
+                if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; }
                 if (st == GR_OK && complete) r->probe_captured_fine |= 1u << pass;
             }
             if (st != GR_OK) break;
@@ -664,8 +688,8 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
             t->beam_transition_cells = (long long)rs->transition_cells;
             t->beam_triangles = (long long)rs->triangles;
         }
-        if (r->near) {
-            const gr_beam_stats *ns = gr_beams_stats(r->near);
+        if (r->near_stats_valid) { /* as prepare_pass built it (the probe's level may have replaced it) */
+            const gr_beam_stats *ns = &r->near_stats;
             t->beam_near_factor = ns->refine_factor;
             t->beam_near_radius_m = ns->refine_radius_m;
             t->beam_near_cells = (long long)ns->refined_cells;
@@ -710,7 +734,6 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     free(cap.count);
     free(capf.sum);
     free(capf.count);
-    r->near_fine_F = 0;
     free(acc.sum);
     free(acc.count);
     free(acc.aov);

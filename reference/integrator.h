@@ -106,6 +106,10 @@ gr_status gr_ref_assemble(gr_ref_renderer *r, const gr_ref_sums *sums, double wa
 /* ---- probes for the oracles and the second estimator ---- */
 /* Builds the beam set of pass `pass` (sun direction and grid jitter of that pass). */
 gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err);
+/* The bias probe's fourth level (reference/probe.c): after gr_ref_prepare_pass(pass), replaces
+ * the near set by one with factor F on the same plain grid and jitter (the old one freed first;
+ * the next gr_ref_prepare_pass builds the pass's sets again). */
+gr_status gr_ref_near_fine(gr_ref_renderer *r, int pass, int F, gr_error *err);
 /* Sun direction I of a pass (unit, world): the disc's centre when the disc is convolved. */
 gr_dvec3 gr_ref_pass_sun_dir(const gr_ref_renderer *r, int pass);
 /* Horizontal irradiance per unit sun irradiance at a world point for the prepared pass,

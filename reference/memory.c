@@ -17,9 +17,9 @@ double gr_ref_memory_estimate(const gr_scene *scene, const gr_ref_info *info)
 {
     const double px = (double)scene->camera.width * (double)scene->camera.height;
     const double B = scene->reference.batches, sr = scene->reference.surface_res, cc = info->cone_cells;
-    /* the sets of one pass at a time; the passes that the bias probe's fourth level rides on
-     * hold its finer near set beside the near set (reference/probe.c) */
-    const double cells = sr * sr, nc = info->near_cells + info->probe_near_cells;
+    /* the sets of one pass at a time; the bias probe's fourth level replaces the near set by
+     * its finer one (reference/probe.c, gr_ref_near_fine): the larger counts */
+    const double cells = sr * sr, nc = fmax(info->near_cells, info->probe_near_cells);
     return px * (PER_PIXEL_BATCH * B + PER_PIXEL_AOV + PER_PIXEL_IMAGE) + (cells + cc + nc) * PER_CELL +
            (fmin(2.0 * cells, PRIM_BUDGET) + fmin(2.0 * cc, PRIM_BUDGET) + fmin(2.0 * nc, PRIM_BUDGET)) * PER_PRIM;
 }
@@ -33,8 +33,8 @@ gr_status gr_ref_memory_check(const gr_scene *scene, const gr_ref_info *info, gr
     char near[160] = "";
     if (info->near_cells > 0.0)
         snprintf(near, sizeof near, ", near_factor %d within %.1f m of the camera (%.0f cells%s)", info->near_factor,
-                 info->near_radius_m, info->near_cells + info->probe_near_cells,
-                 info->probe_near_cells > 0.0 ? ", the bias probe's 2x finer ones included" : "");
+                 info->near_radius_m, fmax(info->near_cells, info->probe_near_cells),
+                 info->probe_near_cells > info->near_cells ? " at the bias probe's 2x finer level" : "");
     snprintf(detail, sizeof detail, "%d x %d pixels x %d batches, surface_res %d%s%s", scene->camera.width,
              scene->camera.height, scene->reference.batches, scene->reference.surface_res, cone, near);
     return gr_memlimit_check("the ground truth", gr_ref_memory_estimate(scene, info), detail, err);

@@ -157,26 +157,21 @@ gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *cap
         for (int k = 0; k < nl && st == GR_OK && complete; k++) {
             if (have[k]) continue;
             r->set.surface_res = lres[k];
-            r->near_F = lnear[k];
-            /* the fourth level as gr_ref_render takes it: the pass's sets with the finer near
-             * set beside them, marched in its place (the same sums either way) */
-            r->near_fine_F = k == NL ? lnear[NL] : 0;
-            if (k == NL) r->near_F = F0;
+            /* the fourth level as gr_ref_render takes it: the pass's sets, then the near set
+             * replaced by the finer one (gr_ref_near_fine; the same sums either way) */
+            r->near_F = k == NL ? F0 : lnear[k];
             r->beams_pass = -1; /* another resolution: rebuild */
             st = gr_ref_prepare_pass(r, p, err);
+            if (st == GR_OK && k == NL) st = gr_ref_near_fine(r, p, lnear[NL], err);
             if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; break; }
-            gr_beams *keep_near = r->near;
-            if (k == NL) r->near = r->near_fine;
             if (st == GR_OK)
                 st = gr_ref_march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, y0, y1, pool, prog,
                                 frac0 + span * done / (todo * (double)passes), span / (todo * (double)passes),
                                 "surface-bias probe", tot, &complete, err);
-            r->near = keep_near;
             done++;
         }
     r->set.surface_res = res;
     r->near_F = F0;
-    r->near_fine_F = 0;
     r->beams_pass = -1;
     if (st == GR_OK && complete) {
         double *sums[NMAX] = {a[0].sum, a[1].sum, a[2].sum, a[3].sum};

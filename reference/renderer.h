@@ -77,10 +77,10 @@ struct gr_ref_renderer {
      * grid's cells across the shortest wave, near_lambda (m) */
     gr_beams *near;
     int near_F;
-    /* The bias probe's fourth level (reference/probe.c): while near_fine_F > 1, each pass also
-     * builds near_fine, the near set with that factor (2 near_F) on the same grid and jitter */
-    gr_beams *near_fine;
-    int near_fine_F;
+    /* the near set's statistics as the last gr_ref_prepare_pass built it (the bias probe's
+     * fourth level replaces `near` by a finer set afterwards: gr_ref_near_fine) */
+    gr_beam_stats near_stats;
+    int near_stats_valid;     /* 1: near_stats describe the last pass's near set */
     double near_D, near_cpw, near_lambda, near_box[4];
     double cone_box[4], cone_cos;
     int beams_pass;
@@ -121,7 +121,7 @@ struct gr_ref_renderer {
     int probe_capture_off;
     unsigned probe_captured;
     /* the same for the probe's fourth level (the near cells 2x finer): bit p once pass p's probe
-     * pixels were marched with near_fine in place of near (gr_ref_render) */
+     * pixels were marched with gr_ref_near_fine's set (gr_ref_render) */
     unsigned probe_captured_fine;
     /* per probe pixel (pw x ph, stride PROBE_STRIDE, offset poff), RGB: the signed Richardson
      * estimate of the surface bias (bias.R/G/B channels; NULL when not estimated) */

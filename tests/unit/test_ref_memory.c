@@ -55,14 +55,14 @@ int main(void)
     gr_memlimit_set(1000.0);
     CHECK(gr_ref_memory_check(s, &info, &err) == GR_E_INPUT);
     CHECK_MSG(strstr(err.msg, "surface_res 10, near_factor 3 within 8.5 m of the camera (70 cells)"), "message: %s", err.msg);
-    /* the bias probe's fourth level (docs/reference.md 4): its finer near set is held beside the
-     * near set during the passes it rides on, so its cells add */
+    /* the bias probe's fourth level (docs/reference.md 4): its finer near set replaces the near
+     * set for the probe's pixels, so the larger of the two counts, and the message says which */
     gr_memlimit_set(1e12);
     info.probe_near_cells = 200.0;
-    CHECK_NEAR(gr_ref_memory_estimate(s, &info), 67456.0 + 270.0 * (344.0 + 320.0), 0.0);
+    CHECK_NEAR(gr_ref_memory_estimate(s, &info), 67456.0 + 200.0 * (344.0 + 320.0), 0.0);
     gr_memlimit_set(1000.0);
     CHECK(gr_ref_memory_check(s, &info, &err) == GR_E_INPUT);
-    CHECK_MSG(strstr(err.msg, "near_factor 3 within 8.5 m of the camera (270 cells, the bias probe's 2x finer ones included)"),
+    CHECK_MSG(strstr(err.msg, "near_factor 3 within 8.5 m of the camera (200 cells at the bias probe's 2x finer level)"),
               "message: %s", err.msg);
     free(s);
     free(big);
