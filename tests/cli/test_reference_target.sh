@@ -85,7 +85,7 @@ ck "bias: the warning names the refinement near the camera" grep -qF "the cells 
 # (docs/reference.md 4, "The probe and the cells near the camera") and the warning says the
 # figure includes it
 "$bin" reference "$scene" -o bias_held.exr --size 16x9 --surface-res 64 --steps 17 --set camera.pitch_deg=5 \
-    --set reference.near_cells_per_wavelength=2 --no-preview >out.txt 2>err_held.txt
+    --set reference.near_cells_per_wavelength=2 --set reference.near_radius_cells=6 --no-preview >out.txt 2>err_held.txt
 rc=$?
 ck "bias, near cells held: exit 0" [ "$rc" -eq 0 ]
 ck "bias, near cells held: the warning says the figure includes them" grep -qF "it includes the error of the cells near the camera, refined (godrays:surface_refine_near) and measured with them 2x finer (godrays:bias_probe_near_held)" err_held.txt

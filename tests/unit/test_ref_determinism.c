@@ -1,7 +1,9 @@
 /* Determinism: the same seed gives the same bytes whatever the thread count (per-pixel
  * counter-based random streams, per-pixel accumulation in a fixed order, beam sums sorted
  * by primitive id); a different seed gives a different image. Waves, an occluder and a
- * seabed, so every code path (beams, shadow rays, Embree ends) is exercised. */
+ * seabed, so every code path (beams, shadow rays, Embree ends) is exercised; the coarse
+ * surface builds a set near the camera (a disc of 6 plain cells, for the time) and the bias
+ * probe its fourth level (docs/reference.md 4). */
 #include "check.h"
 #include "test_ref_util.h"
 
@@ -15,7 +17,7 @@ static gr_ref_result render(int threads, int seed)
         "\"occluders\":[{\"type\":\"box\",\"center_m\":[0.5,-2.5,3],\"size_m\":[1,0.5,1],\"yaw_deg\":20}],"
         "\"seabed\":{\"depth_m\":15},"
         "\"reference\":{\"spp\":1,\"steps\":24,\"surface_res\":96,\"sun_samples\":2,\"batches\":2,"
-        "\"threads\":%d,\"seed\":%d,\"patch_radius_m\":20}}", threads, seed);
+        "\"threads\":%d,\"seed\":%d,\"patch_radius_m\":20,\"near_radius_cells\":6}}", threads, seed);
     gr_ref_result res;
     ref_render(s, NULL, &res);
     free(s);
