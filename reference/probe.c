@@ -60,10 +60,12 @@ int gr_ref_probe_stats(gr_ref_renderer *r, double *const sum[], uint32_t *const 
             consc[c] += fabs(e);
             bpx[i * 3 + c] = isfinite(e) ? (float)e : 0.0f;
         }
-    double rel_cons = v > 0.0 && !near ? d1 / v / div : 0.0;
-    for (int c = 0; c < 3; c++)
-        if (vc[c] > 1e-3 * vmax && consc[c] / vc[c] > rel_cons) rel_cons = consc[c] / vc[c];
-    if (!near) rel_cons = rel1 / div; /* the same figure as before the fourth level, bit for bit */
+    double rel_cons = rel1 / div; /* three levels: the estimate's figure with the measured order */
+    if (near) { /* four: the worst channel's sum of the two errors, the near cells' with p = 1 */
+        rel_cons = 0.0;
+        for (int c = 0; c < 3; c++)
+            if (vc[c] > 1e-3 * vmax && consc[c] / vc[c] > rel_cons) rel_cons = consc[c] / vc[c];
+    }
     /* the estimate: the asymptotic order 2 (divide by 3); the conservative figure: the
      * measured order (convergence accelerates as h shrinks, so the order measured on the
      * coarser pair is a lower bound of the order at h and the figure an upper one) */

@@ -96,7 +96,7 @@ static double block_p95(const gr_image *a, const gr_image *b)
  * and measures their own error with a fourth level, the cells near the camera 2x finer. The
  * oracle is the same render with the near cells 7/3 as fine (factor 7, 19.6 per wave; an
  * independent finer discretization, whose difference from the limit is a fifth of factor 3's
- * at order 2; CI's reduced variant: factor 5): the image
+ * at order 2; CI's reduced variant below): the image
  * mean's and the 10 x 10 blocks' differences from it must lie under the figures the render
  * states. The near cells' error is visible at this size (over 1 % at the blocks' 95th
  * percentile, checked), so the check is not vacuous: a probe that held the near cells without
@@ -104,32 +104,39 @@ static double block_p95(const gr_image *a, const gr_image *b)
  * differs by over 2 % in the image mean: the error of this view lives near the camera. */
 static void probe_with_near_set(const char *scene)
 {
+    /* CI's reduced variant: the oracle's near cells factor 5 (5/3 as fine: 64 % of factor 3's
+     * error shows at order 2) instead of 7, both renders' near discs 12 plain cells instead of
+     * 24 (the error sits within a few metres of P_s: docs/benchmarks.md, twelfth session), and
+     * no render without the near set (the first part of the test shows that at 128 cells):
+     * 14 instead of 38 CPU-s */
+    const int red = ref_reduced(), Ff = red ? 5 : 7;
     const char *base[] = {"camera.width=64", "camera.height=36", "reference.sun_samples=4", "reference.batches=4",
-                          "reference.surface_res=256", "camera.pitch_deg=5", "reference.seed=3"};
-    const char *ov_rule[9], *ov_fine[10], *ov_off[9];
-    for (int i = 0; i < 7; i++) ov_rule[i] = ov_fine[i] = ov_off[i] = base[i];
-    ov_rule[7] = "reference.bias_probe=true";
-    ov_fine[7] = "reference.bias_probe=false";
-    /* the oracle's near cells: factor 7 (7/3 as fine; 25 CPU-s), in CI's reduced variant 5
-     * (5/3 as fine, 12 CPU-s: 64 % of factor 3's error shows at order 2) */
-    const int Ff = ref_reduced() ? 5 : 7;
+                          "reference.surface_res=256", "camera.pitch_deg=5", "reference.seed=3",
+                          red ? "reference.near_radius_cells=12" : "reference.near_radius_cells=24"};
+    enum { NB = 8 };
+    const char *ov_rule[NB + 1], *ov_fine[NB + 3], *ov_off[NB + 2];
+    for (int i = 0; i < NB; i++) ov_rule[i] = ov_fine[i] = ov_off[i] = base[i];
+    ov_rule[NB] = "reference.bias_probe=true";
+    ov_fine[NB] = "reference.bias_probe=false";
     char cpw_fine[64], max_fine[64], want_fine[32];
     snprintf(cpw_fine, sizeof cpw_fine, "reference.near_cells_per_wavelength=%d", 2 * Ff + 5);
     snprintf(max_fine, sizeof max_fine, "reference.near_max_factor=%d", Ff);
     snprintf(want_fine, sizeof want_fine, "factor %d within", Ff);
-    ov_fine[8] = cpw_fine;
-    ov_fine[9] = max_fine;
-    ov_off[7] = "reference.bias_probe=false";
-    ov_off[8] = "reference.near_cells_per_wavelength=0";
-    gr_scene *s_rule = ref_scene_file(scene, ov_rule, 8), *s_fine = ref_scene_file(scene, ov_fine, 10),
-             *s_off = ref_scene_file(scene, ov_off, 9);
+    ov_fine[NB + 1] = cpw_fine;
+    ov_fine[NB + 2] = max_fine;
+    ov_off[NB] = "reference.bias_probe=false";
+    ov_off[NB + 1] = "reference.near_cells_per_wavelength=0";
+    gr_scene *s_rule = ref_scene_file(scene, ov_rule, NB + 1), *s_fine = ref_scene_file(scene, ov_fine, NB + 3);
     gr_ref_result rule, fine, off;
     ref_render(s_rule, NULL, &rule);
     ref_render(s_fine, NULL, &fine);
-    ref_render(s_off, NULL, &off);
     free(s_rule);
     free(s_fine);
-    free(s_off);
+    if (!red) {
+        gr_scene *s_off = ref_scene_file(scene, ov_off, NB + 2);
+        ref_render(s_off, NULL, &off);
+        free(s_off);
+    }
     const char *near_fine = meta_string(&fine, "godrays:surface_refine_near");
     CHECK_MSG(near_fine && strstr(near_fine, want_fine), "the finer near set: %s", near_fine ? near_fine : "(none)");
     CHECK_MSG(meta_num(&rule, "godrays:bias_probe_near_held") == 1.0, "the probe held the near cells (%g)",
@@ -138,16 +145,19 @@ static void probe_with_near_set(const char *scene)
     double mr[3], mf[3], mo[3], near_err = 0.0, off_err = 0.0;
     image_mean(&rule, mr);
     image_mean(&fine, mf);
-    image_mean(&off, mo);
+    if (!red) image_mean(&off, mo);
     for (int c = 0; c < 3; c++) {
         near_err = fmax(near_err, fabs(mr[c] - mf[c]) / mf[c]);
-        off_err = fmax(off_err, fabs(mo[c] - mf[c]) / mf[c]);
+        if (!red) off_err = fmax(off_err, fabs(mo[c] - mf[c]) / mf[c]);
     }
     double b_rule = block_p95(rule.image, fine.image);
     printf("probe with the near set: estimate %.3f %%, block p95 %.3f %%; against the near cells %d/3 as fine: "
-           "image mean %.3f %%, block p95 %.3f %%; without the near set: image mean %.2f %%\n",
-           100.0 * est, 100.0 * blk, Ff, 100.0 * near_err, 100.0 * b_rule, 100.0 * off_err);
-    CHECK_MSG(off_err > 0.02, "without the near set the image mean is off by over 2 %% (%.2f %%)", 100.0 * off_err);
+           "image mean %.3f %%, block p95 %.3f %%",
+           100.0 * est, 100.0 * blk, Ff, 100.0 * near_err, 100.0 * b_rule);
+    if (!red) printf("; without the near set: image mean %.2f %%", 100.0 * off_err);
+    printf("\n");
+    if (!red)
+        CHECK_MSG(off_err > 0.02, "without the near set the image mean is off by over 2 %% (%.2f %%)", 100.0 * off_err);
     CHECK_MSG(near_err <= est, "the near cells' own error (%.3f %%) lies under the estimate (%.3f %%)", 100.0 * near_err,
               100.0 * est);
     CHECK_MSG(b_rule <= blk, "the near cells' own block error (%.3f %%) lies under the block figure (%.3f %%)",
@@ -155,7 +165,7 @@ static void probe_with_near_set(const char *scene)
     CHECK_MSG(b_rule > 0.01, "the near cells' own error is visible at the blocks (%.3f %% over 1 %%)", 100.0 * b_rule);
     gr_ref_result_free(&rule);
     gr_ref_result_free(&fine);
-    gr_ref_result_free(&off);
+    if (!red) gr_ref_result_free(&off);
 }
 
 int main(void)
