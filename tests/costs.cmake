@@ -7,6 +7,7 @@
 # 4 s or more; re-measure when the suite changes much (the table need not be exact to help).
 set(GR_TEST_COSTS
   unit.ref_coverage 60 0
+  unit.ref_near 22 0
   farm.slurm 57 0
   integration.tune_default 37 0
   cli.capture_own 32 40
@@ -35,7 +36,7 @@ set(GR_TEST_COSTS
   integration.volume_flat 13 30
   cli.report_browser 12 16
   unit.ref_focus 12 0
-  unit.ref_camera_rays 11 26
+  unit.ref_camera_rays 11 0
   cli.rel_signals 11 0
   cli.compare 10 14
   cli.sweep 10 14
@@ -45,9 +46,9 @@ set(GR_TEST_COSTS
   cli.run_progress 8 10
   integration.tune_starts 7 15
   cli.rel_readers 7 9
-  integration.merge 6 15
+  integration.merge 10 22
   cli.tune_rgb 6 14
-  cli.reference_target 6 13
+  cli.reference_target 8 20
   integration.ref_hard 6 11
   integration.tune_identify 6 10
   cli.export_compare 5 10
