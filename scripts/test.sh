@@ -84,8 +84,8 @@ phase "ctest build/ (all)"
 # A short fuzz run of each libFuzzer target where clang is present (docs/reliability.md):
 # 20 s each, two at a time (60 s before 2026-11-27: the CI budget went to new tests).
 if command -v clang >/dev/null 2>&1; then
-  FUZZ_JOBS=2 ./scripts/fuzz.sh 20 || { status=1; echo "test.sh: FAILED: fuzzing (build-fuzz/findings/)" >&2; }
-  phase "fuzz (5 targets x 20 s)"
+  FUZZ_JOBS=2 ./scripts/fuzz.sh 14 || { status=1; echo "test.sh: FAILED: fuzzing (build-fuzz/findings/)" >&2; }
+  phase "fuzz (5 targets x 14 s)"
 fi
 
 summary
