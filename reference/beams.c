@@ -218,6 +218,36 @@ static void zero_work(void *arg, int chunk, size_t k0, size_t k1)
     }
 }
 
+/* The surface vertex over the rest point (x0, z0) (world): displaced (seed eq. 5.5.7), its
+ * normal (5.5.8, into *n), the sun refracted (5.5.1), Fresnel; *pos its local position.
+ * Returns 0 for a vertex that carries no beam (v->ft < 0): a refracted ray that does not head
+ * down (grazing sun on a steep back slope) leaves the water again at once
+ * (docs/reference.md). */
+static int surface_vertex(const gr_beam_params *p, double x0, double z0, gr_dvec3 *pos, gr_dvec3 *n, beam_vertex *v)
+{
+    double eta = 1.0 / p->ior; /* air (n = 1) to water, seed eq. 5.5.1 with eta = n1 / n2 */
+    gr_dvec3 P = gr_gerstner_position(p->water, x0, z0, p->water->time_s);
+    gr_gerstner_frame(p->water, x0, z0, p->water->time_s, NULL, NULL, n);
+    *pos = gr_d3_sub(P, p->origin);
+    double cos_i = -gr_d3_dot(p->sun_dir, *n);
+    gr_dvec3 T = cos_i > 0.0 ? gr_refract_d(p->sun_dir, *n, eta) : gr_d3(0, 0, 0);
+    v->py = (float)pos->y;
+    v->pu = (float)(pos->x - p->shear_x * pos->y);
+    v->pw = (float)(pos->z - p->shear_z * pos->y);
+    v->tx = (float)T.x; v->ty = (float)T.y; v->tz = (float)T.z;
+    if (!(T.y < -1e-4)) {
+        v->ft = -1.0f;
+        v->au = v->aw = 0.0f;
+        v->ity = -1.0f;
+        return 0;
+    }
+    v->ft = p->fresnel ? (float)(1.0 - gr_fresnel_exact(cos_i, 1.0, p->ior)) : 1.0f;
+    v->au = (float)(T.x / T.y - p->shear_x);
+    v->aw = (float)(T.z / T.y - p->shear_z);
+    v->ity = (float)(1.0 / T.y);
+    return 1;
+}
+
 /* Vertices [k0, k1): displaced (seed eq. 5.5.7), normal (5.5.8), refraction, Fresnel, the
  * disc's slope Jacobian. */
 static void vertex_work(void *arg, int chunk, size_t k0, size_t k1)
@@ -243,34 +273,14 @@ static void vertex_work(void *arg, int chunk, size_t k0, size_t k1)
             x0 = p->origin.x + j->start_u + tp->rx[2 * (k - tp->nv0)];
             z0 = p->origin.z + j->start_w + tp->rx[2 * (k - tp->nv0) + 1];
         }
-        gr_dvec3 P = gr_gerstner_position(p->water, x0, z0, p->water->time_s);
         gr_dvec3 n;
-        gr_gerstner_frame(p->water, x0, z0, p->water->time_s, NULL, NULL, &n);
-        j->pos[k] = gr_d3_sub(P, p->origin);
         beam_vertex *v = &b->v[k];
-        double cos_i = -gr_d3_dot(I, n);
-        gr_dvec3 T = cos_i > 0.0 ? gr_refract_d(I, n, eta) : gr_d3(0, 0, 0);
-        v->py = (float)j->pos[k].y;
-        v->pu = (float)(j->pos[k].x - p->shear_x * j->pos[k].y);
-        v->pw = (float)(j->pos[k].z - p->shear_z * j->pos[k].y);
-        v->tx = (float)T.x; v->ty = (float)T.y; v->tz = (float)T.z;
-        /* a refracted ray that does not head down (grazing sun on a steep back slope)
-         * leaves the water again at once: such vertices carry no beam (docs/reference.md) */
-        if (!(T.y < -1e-4)) {
-            v->ft = -1.0f;
-            v->au = v->aw = 0.0f;
-            v->ity = -1.0f;
-            continue;
-        }
-        v->ft = p->fresnel ? (float)(1.0 - gr_fresnel_exact(cos_i, 1.0, p->ior)) : 1.0f;
+        if (!surface_vertex(p, x0, z0, &j->pos[k], &n, v)) continue;
         if (j->disc) {
             double J[4];
             slope_jacobian(I, n, eta, p->disc_e1, p->disc_e2, J);
             for (int c = 0; c < 4; c++) j->jv[4 * k + (size_t)c] = (float)J[c];
         }
-        v->au = (float)(T.x / T.y - p->shear_x);
-        v->aw = (float)(T.z / T.y - p->shear_z);
-        v->ity = (float)(1.0 / T.y);
     }
 }
 
@@ -426,18 +436,73 @@ static gr_status build_surface_mesh(gr_rtc *rtc, gr_beams *b, const gr_dvec3 *po
     return gr_rtc_check(rtc, "reference: building the surface mesh", err);
 }
 
+/* The rest patch's grid of a set: cell size *h, nu x nw cells, its corner (sheared local,
+ * the jitter included; on another set's lines when p->cell_m > 0). */
+static gr_status patch_grid(const gr_beam_params *p, double *h, double *nu, double *nw, double *start_u, double *start_w,
+                            gr_error *err)
+{
+    const gr_beam_region *r = &p->region;
+    double ext_u = (r->u1 - r->u0) + 2.0 * p->pad_m, ext_w = (r->w1 - r->w0) + 2.0 * p->pad_m;
+    if (!(ext_u > 0.0 && ext_w > 0.0) || p->res < 1)
+        return gr_fail(err, GR_E_INPUT, "reference: empty lit region (%g x %g m) or surface_res %d < 1", ext_u, ext_w, p->res);
+    *h = p->cell_m > 0.0 ? p->cell_m : sqrt(ext_u * ext_w) / (double)p->res;
+    *nu = ceil(ext_u / *h) + 1.0;
+    *nw = ceil(ext_w / *h) + 1.0;
+    if (*nu * *nw * 2.0 > 1.0e9)
+        return gr_fail(err, GR_E_INPUT, "reference.surface_res: %d gives %.0f x %.0f cells, too many", p->res, *nu, *nw);
+    *start_u = r->u0 - p->pad_m - p->jitter[0] * *h;
+    *start_w = r->w0 - p->pad_m - p->jitter[1] * *h;
+    if (p->cell_m > 0.0) { /* another set's grid lines: the last at or before the patch's start */
+        *start_u = p->anchor_u + floor((r->u0 - p->pad_m - p->anchor_u) / *h) * *h;
+        *start_w = p->anchor_w + floor((r->w0 - p->pad_m - p->anchor_w) / *h) * *h;
+    }
+    return GR_OK;
+}
+
+double gr_beams_prims_per_triangle(const gr_beam_params *p, int fine, int samples)
+{
+    double h = 0.0, nu = 0.0, nw = 0.0, su = 0.0, sw = 0.0;
+    gr_error e;
+    if (samples < 1 || patch_grid(p, &h, &nu, &nw, &su, &sw, &e) != GR_OK) return 0.0;
+    const double scale = p->slab_cells > 0.0 ? p->slab_cells : 1.0;
+    const int F = fine > 1 ? fine : 1;
+    const double c = h / F; /* the sampled cells' side: a plain cell, or a refined sub-cell */
+    double sum = 0.0;
+    for (int sj = 0; sj < samples; sj++)
+        for (int si = 0; si < samples; si++) {
+            /* the cell at the centre of stratum (si, sj) of the patch: its 4 corners */
+            double x = p->origin.x + su + floor((si + 0.5) * nu / samples) * h;
+            double z = p->origin.z + sw + floor((sj + 0.5) * nw / samples) * h;
+            gr_dvec3 pos[4], n;
+            beam_vertex v[4];
+            int ok[4];
+            for (int k = 0; k < 4; k++) ok[k] = surface_vertex(p, x + (k & 1) * c, z + (k >> 1) * c, &pos[k], &n, &v[k]);
+            /* its two triangles, wound so that their rest area vectors point down (as the grid's) */
+            static const int tri[2][3] = {{0, 1, 2}, {1, 3, 2}};
+            for (int t = 0; t < 2; t++) {
+                const int *q = tri[t];
+                if (!ok[q[0]] || !ok[q[1]] || !ok[q[2]]) continue;
+                gr_dvec3 a = gr_d3_cross(gr_d3_sub(pos[q[1]], pos[q[0]]), gr_d3_sub(pos[q[2]], pos[q[0]]));
+                if (!(gr_d3_dot(p->sun_dir, a) > 0.0)) continue; /* no beam: no primitive (slab_count_work) */
+                float d = 0.0f, ytop = -INFINITY;
+                for (int k = 0; k < 3; k++) {
+                    d = fmaxf(d, hypotf(v[q[k]].au, v[q[k]].aw));
+                    ytop = fmaxf(ytop, v[q[k]].py);
+                }
+                sum += slab_count((double)ytop - p->region.y_min, (double)d * F, h, scale);
+            }
+        }
+    return sum / (2.0 * samples * samples);
+}
+
 gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err)
 {
     *out = NULL;
     double t_start = now_s();
     const gr_beam_region *r = &p->region;
-    double ext_u = (r->u1 - r->u0) + 2.0 * p->pad_m, ext_w = (r->w1 - r->w0) + 2.0 * p->pad_m;
-    if (!(ext_u > 0.0 && ext_w > 0.0) || p->res < 1)
-        return gr_fail(err, GR_E_INPUT, "reference: empty lit region (%g x %g m) or surface_res %d < 1", ext_u, ext_w, p->res);
-    double h = p->cell_m > 0.0 ? p->cell_m : sqrt(ext_u * ext_w) / (double)p->res;
-    double nu_d = ceil(ext_u / h) + 1.0, nw_d = ceil(ext_w / h) + 1.0;
-    if (nu_d * nw_d * 2.0 > 1.0e9)
-        return gr_fail(err, GR_E_INPUT, "reference.surface_res: %d gives %.0f x %.0f cells, too many", p->res, nu_d, nw_d);
+    double h = 0.0, nu_d = 0.0, nw_d = 0.0, start_u = 0.0, start_w = 0.0;
+    gr_status pst = patch_grid(p, &h, &nu_d, &nw_d, &start_u, &start_w, err);
+    if (pst != GR_OK) return pst;
     gr_beams *b = calloc(1, sizeof *b);
     if (!b) return gr_fail(err, GR_E_NOMEM, "reference: out of memory for beams");
     b->nu = (int)nu_d;
@@ -445,11 +510,6 @@ gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, g
     b->y_min = r->y_min;
     b->sx = (float)p->shear_x;
     b->sz = (float)p->shear_z;
-    double start_u = r->u0 - p->pad_m - p->jitter[0] * h, start_w = r->w0 - p->pad_m - p->jitter[1] * h;
-    if (p->cell_m > 0.0) { /* another set's grid lines: the last at or before the patch's start */
-        start_u = p->anchor_u + floor((r->u0 - p->pad_m - p->anchor_u) / h) * h;
-        start_w = p->anchor_w + floor((r->w0 - p->pad_m - p->anchor_w) / h) * h;
-    }
     /* topology: the grid, with the cells near P_s refined (docs/reference.md 2.2) */
     topo tp;
     memset(&tp, 0, sizeof tp);

@@ -100,6 +100,13 @@ typedef struct gr_beam_stats {
 } gr_beam_stats;
 
 gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err);
+/* The expected beam-slab primitives per surface triangle of a set built with p, without
+ * building it (the memory estimate, reference/memory.h): the slabs (at p->slab_cells) of
+ * both triangles of one cell per stratum of a samples x samples partition of the patch,
+ * computed as the build computes them, a triangle without a beam counting 0; fine = F > 1:
+ * of the F x F sub-cells of a refined cell instead (their drift in plain cells F times
+ * larger). 0 for an empty patch. */
+double gr_beams_prims_per_triangle(const gr_beam_params *p, int fine, int samples);
 void gr_beams_destroy(gr_beams *b); /* accepts NULL */
 const gr_beam_stats *gr_beams_stats(const gr_beams *b);
 /* The tessellation, for tests: the number of triangles; vertex k's displaced local position

@@ -104,12 +104,28 @@ static void box_around_ps(const gr_ref_renderer *r, double R, double box[4])
 
 /* The estimated surface cells of a set over box on the plain grid's cells (prepare_pass): the
  * box padded, those within disc_r + h of P_s split F x F. */
-static double set_cells(const gr_ref_renderer *r, const double box[4], double disc_r, int F)
+static double set_cells(const gr_ref_renderer *r, const double box[4], double disc_r, int F, double *plain, double *fine)
 {
     double h = plain_cell(r, r->set.surface_res), R = 0.5 * (box[1] - box[0]);
+    *plain = *fine = 0.0;
     if (!(h > 0.0)) return 0.0;
     double side = 2.0 * (R + r->pad) / h + 2.0, disc = GR_PI * (disc_r / h + 1.0) * (disc_r / h + 1.0);
-    return side * side + disc * ((double)F * F - 1.0);
+    disc = fmin(disc, side * side);
+    *plain = side * side - disc; /* the cells left whole */
+    *fine = disc * (double)F * F; /* the refined cells' sub-cells */
+    return *plain + *fine;
+}
+
+/* The expected beam primitives of a set (the memory estimate): its whole cells' and its
+ * sub-cells' two triangles each, times their sampled slabs per triangle (beams.h). */
+static double set_prims(const gr_beam_params *bp, double plain, double fine, int F, double slab_cells)
+{
+    enum { SAMPLES = 48 }; /* 2304 cells: the mean slab count to about 1 % */
+    gr_beam_params q = *bp;
+    q.slab_cells = slab_cells;
+    double n = 2.0 * plain * gr_beams_prims_per_triangle(&q, 1, SAMPLES);
+    if (fine > 0.0) n += 2.0 * fine * gr_beams_prims_per_triangle(&q, F, SAMPLES);
+    return n;
 }
 
 /* Refinement near the camera (docs/reference.md 2.2, "Near the camera"): when the plain grid
@@ -544,13 +560,28 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
     info->near_factor = r->near_F;
     info->near_radius_m = r->near_D;
     info->cells_per_wave = r->near_cpw;
-    /* the near set's and the camera cone's (prepare_pass) */
-    if (r->near_F > 1) info->near_cells = set_cells(r, r->near_box, r->near_D, r->near_F);
+    if (r->flat || !(plain_cell(r, r->set.surface_res) > 0.0)) return;
+    /* the sets of pass 0 (prepare_pass), their slabs as a render builds them: the plain set's
+     * and the near set's 0.5 cells of drift, the cone's 1, the probe's finer near set's 2 */
+    gr_beam_params bp;
+    pass_params(r, 0, &bp);
+    bp.sun_dir = gr_ref_pass_sun_dir(r, 0);
+    double sr = r->set.surface_res, plain, fine;
+    info->plain_prims = set_prims(&bp, sr * sr, 0.0, 1, 0.5);
+    if (r->near_F > 1) {
+        info->near_cells = set_cells(r, r->near_box, r->near_D, r->near_F, &plain, &fine);
+        info->near_prims = set_prims(&bp, plain, fine, r->near_F, 0.5);
+    }
     /* the probe's fourth level: the plain set with the near cells 2x finer (probe.c) */
-    if (r->near_F > 1 && r->set.bias_probe && !r->flat && gr_ref_probe_holds_near(r))
-        info->probe_near_cells = set_cells(r, r->near_box, r->near_D, 2 * r->near_F);
-    if (r->cone_on && r->set.surface_res > 0)
-        info->cone_cells = set_cells(r, r->cone_box, 0.5 * (r->cone_box[1] - r->cone_box[0]), r->set.refine_factor);
+    if (r->near_F > 1 && r->set.bias_probe && gr_ref_probe_holds_near(r)) {
+        info->probe_near_cells = set_cells(r, r->near_box, r->near_D, 2 * r->near_F, &plain, &fine);
+        info->probe_near_prims = set_prims(&bp, plain, fine, 2 * r->near_F, 2.0);
+    }
+    if (r->cone_on && r->set.surface_res > 0) {
+        info->cone_cells = set_cells(r, r->cone_box, 0.5 * (r->cone_box[1] - r->cone_box[0]), r->set.refine_factor,
+                                     &plain, &fine);
+        info->cone_prims = set_prims(&bp, plain, fine, r->set.refine_factor, 1.0);
+    }
 }
 
 gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)

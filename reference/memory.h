@@ -9,19 +9,20 @@
 #include "reference/integrator.h"
 #include "scene/scene.h"
 
-/* Bytes a render of scene needs, from the renderer's info (gr_ref_get_info after
- * gr_ref_create: the camera cone's cells are known once the lit region is): per pixel the
- * batch sums (3 doubles) and counts (uint32) of every batch, the two AOVs and the 8-channel
- * float image; per surface cell two beam triangles (128 B + 4 B drift each), a vertex (24 B
- * position, 40 B beam vertex, 16 B Jacobian) and up to two beam primitives with their lookup
- * grid (box, id, at most 16 grid entries of 10 B: 160 B each, at most the budget of 2^24), for the
- * plain grid and, with local refinement, the camera cone's set and the set near the camera. */
+/* Bytes a render of scene needs (the model and its measurements: docs/reliability.md
+ * "Memory"), from the renderer's info (gr_ref_get_info after gr_ref_create: the lit region,
+ * the sets' cells and their sampled primitives): *fixed for the process and its libraries,
+ * *pixels for the per-pixel sums, AOVs and image, *sets for the beam sets at their peak
+ * (pass 0's sets kept while the next is built, each set's triangles, vertices, Embree mesh,
+ * primitives and lookup grid; 0 on flat water). */
+void gr_ref_memory_parts(const gr_scene *scene, const gr_ref_info *info, double *fixed, double *pixels, double *sets);
+/* Their sum. */
 double gr_ref_memory_estimate(const gr_scene *scene, const gr_ref_info *info);
 
 /* GR_OK when the estimate fits the limit, else GR_E_INPUT "the ground truth needs about X GiB
  * (W x H pixels x B batches, surface_res N[, refine_factor F (C cells near the camera)][, near_factor
- * F within D m of the camera (C cells)]), over
- * the memory limit of Y GiB (SOURCE)" (gr_memlimit_check). */
+ * F within D m of the camera (C cells)][; beam sets S GiB for P primitives]), over the memory
+ * limit of Y GiB (SOURCE)" (gr_memlimit_check). */
 gr_status gr_ref_memory_check(const gr_scene *scene, const gr_ref_info *info, gr_error *err);
 
 #endif
