@@ -670,14 +670,12 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
                 /* the probe's fourth level: its pixels with the near set 2x finer in place of the
                  * near set, on this pass's plain set (the probe's own march arguments, so the
                  * same sums as when it renders the level itself: probe.c) */
-                int y0 = gr_ref_probe_row(r->opt.row0, PROBE_STRIDE, r->probe_capture_off, capf.H);
-                int y1 = gr_ref_probe_row(r->opt.row1, PROBE_STRIDE, r->probe_capture_off, capf.H);
                 ref_march_totals ftot = {0.0, 0, 0, 0};
                 gr_ref_phases_switch(&r->phases, REF_PH_PROBE);
                 st = gr_ref_near_fine(r, pass, 2 * r->near_F, err);
                 if (st == GR_OK)
-                    st = gr_ref_march_pass(r, &capf, pass, 0, PROBE_STRIDE, r->probe_capture_off, y0, y1, pool, prog,
-                                           mainw * (rounds > 1 ? pp + 1 : pass + 1) / P, 0.0, note, &ftot, &complete, err);
+                    st = gr_ref_probe_march(r, &capf, pass, r->probe_capture_off, pool, prog,
+                                            mainw * (rounds > 1 ? pp + 1 : pass + 1) / P, 0.0, note, &ftot, &complete, err);
                 gr_ref_phases_switch(&r->phases, REF_PH_MARCH);
                 if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; }
                 if (st == GR_OK && complete) r->probe_captured_fine |= 1u << pass;

@@ -97,6 +97,16 @@ int gr_ref_probe_holds_near(const gr_ref_renderer *r)
            (r->near_F << (NL - 1)) <= FMAX;
 }
 
+gr_status gr_ref_probe_march(gr_ref_renderer *r, ref_accum *a, int pass, int off, gr_ref_pool *pool, gr_progress *prog,
+                             double frac0, double span, const char *note, ref_march_totals *tot, int *complete,
+                             gr_error *err)
+{
+    /* a part probes its own rows' probe pixels */
+    int y0 = gr_ref_probe_row(r->opt.row0, PROBE_STRIDE, off, a->H);
+    int y1 = gr_ref_probe_row(r->opt.row1, PROBE_STRIDE, off, a->H);
+    return gr_ref_march_pass(r, a, pass, 0, PROBE_STRIDE, off, y0, y1, pool, prog, frac0, span, note, tot, complete, err);
+}
+
 gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *captured, ref_accum *captured_fine,
                            gr_ref_pool *pool, gr_progress *prog, double frac0, double span, ref_march_totals *tot,
                            gr_error *err)
@@ -152,9 +162,6 @@ gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *cap
         if (!a[k].sum || !a[k].count) st = gr_fail(err, GR_E_NOMEM, "reference: out of memory for the bias probe");
     }
     int complete = 1;
-    /* a part probes its own rows' probe pixels */
-    int y0 = gr_ref_probe_row(r->opt.row0, PROBE_STRIDE, off, a[0].H);
-    int y1 = gr_ref_probe_row(r->opt.row1, PROBE_STRIDE, off, a[0].H);
     for (int p = 0, done = 0; p < passes && st == GR_OK && complete; p++)
         for (int k = 0; k < nl && st == GR_OK && complete; k++) {
             if (have[k]) continue;
@@ -167,9 +174,8 @@ gr_status gr_ref_probe_run(gr_ref_renderer *r, gr_ref_sums *keep, ref_accum *cap
             if (st == GR_OK && k == NL) st = gr_ref_near_fine(r, p, lnear[NL], err);
             if (st == GR_E_INTERRUPTED) { st = GR_OK; complete = 0; break; }
             if (st == GR_OK)
-                st = gr_ref_march_pass(r, &a[k], p, 0, PROBE_STRIDE, off, y0, y1, pool, prog,
-                                frac0 + span * done / (todo * (double)passes), span / (todo * (double)passes),
-                                "surface-bias probe", tot, &complete, err);
+                st = gr_ref_probe_march(r, &a[k], p, off, pool, prog, frac0 + span * done / (todo * (double)passes),
+                                        span / (todo * (double)passes), "surface-bias probe", tot, &complete, err);
             done++;
         }
     r->set.surface_res = res;

@@ -35,6 +35,13 @@ void gr_ref_probe_grid(const gr_ref_renderer *r, int *off, int *pw, int *ph);
  * (near_max_factor) keeps them short of the target, they are coarsened with the rest (the
  * figure then leans high, never low). */
 int gr_ref_probe_holds_near(const gr_ref_renderer *r);
+/* One probe level's march of pass `pass` (its sets prepared) over the probe pixels (every
+ * PROBE_STRIDE-th pixel from the grid's offset `off`, gr_ref_probe_grid) in the part's rows,
+ * into a (batch 0): the one call of the probe's own passes and of the fourth level the main
+ * passes take (gr_ref_render), so both give the same sums. */
+gr_status gr_ref_probe_march(gr_ref_renderer *r, ref_accum *a, int pass, int off, gr_ref_pool *pool, gr_progress *prog,
+                             double frac0, double span, const char *note, ref_march_totals *tot, int *complete,
+                             gr_error *err);
 /* The probe's passes over the part's rows (the first min(passes per round, PROBE_PASSES)),
  * level h taken from `captured` and the fourth level from `captured_fine` when the main
  * passes took all of it (gr_ref_render); with keep, its sums are handed over. The progress bar goes from frac0 to frac0 + span. */
