@@ -65,7 +65,7 @@ static void prims_against_build(gr_rtc *rtc, const char *label, const gr_scene *
     CHECK_OK(gr_beams_build(rtc, &p, &b, &err), err);
     if (!b) exit(1);
     const gr_beam_stats *st = gr_beams_stats(b);
-    double est = gr_beams_prims_per_triangle(&p, F, 48) * (double)st->triangles;
+    double est = gr_beams_prims_per_triangle(&p, F, 32) * (double)st->triangles;
     double rel = est / (double)st->prims - 1.0;
     printf("%-40s %zu triangles (%zu refined cells), %zu primitives built, %.0f estimated (%+.1f %%)\n", label,
            st->triangles, st->refined_cells, st->prims, est, 100.0 * rel);
