@@ -256,11 +256,6 @@ wedges:
 
 float gr_beam_atan2_fast(float y, float x) { return atan2_fast(y, x); }
 
-/* min and max of non-NaN floats without the libm calls that fminf/fmaxf are here (no
- * -ffinite-math-only): a NaN b gives a, as fminf/fmaxf do, so the boxes keep their bytes */
-static inline float min_f(float a, float b) { return b < a ? b : a; }
-static inline float max_f(float a, float b) { return b > a ? b : a; }
-
 /* The box of primitive `prim` (a triangle's beam over one slab) in sheared coordinates:
  * lo/hi = {u, y, w}. */
 static void prim_box(const gr_beams *b, uint32_t prim, float lo3[3], float hi3[3])
@@ -272,33 +267,8 @@ static void prim_box(const gr_beams *b, uint32_t prim, float lo3[3], float hi3[3
     float ylo = isinf(lo) ? (float)b->y_min : lo, yhi = isinf(hi) ? b->tri[t].ytop : hi;
     uint32_t idx[3];
     tri_vertices(b, t, idx);
-    float u0 = FLT_MAX, u1 = -FLT_MAX, w0 = FLT_MAX, w1 = -FLT_MAX;
-    for (int c = 0; c < 3; c++) {
-        const beam_vertex *v = &b->v[idx[c]];
-        for (int e = 0; e < 2; e++) {
-            float y = e ? yhi : ylo;
-            float u = v->pu + v->au * (y - v->py), w = v->pw + v->aw * (y - v->py);
-            u0 = min_f(u0, u); u1 = max_f(u1, u);
-            w0 = min_f(w0, w); w1 = max_f(w1, w);
-        }
-    }
-    if (b->disc) {
-        /* the disc kernel reaches d J disc around the cross-section, d up to ybar - ylo */
-        const float *M = b->tri[t].kern;
-        float dmax = b->tri[t].ybar - ylo;
-        if (dmax > 0.0f) {
-            /* the unit disc's image: half widths |row of M| (slightly widened for rounding) */
-            float ku = 1.0001f * dmax * sqrtf(M[0] * M[0] + M[1] * M[1]), kw = 1.0001f * dmax * sqrtf(M[2] * M[2] + M[3] * M[3]);
-            u0 -= ku; u1 += ku;
-            w0 -= kw; w1 += kw;
-        }
-    }
-    /* widen by a few ulps of the coordinates so float rounding in the test cannot fall outside */
-    float eu = 1e-5f * (1.0f + max_f(fabsf(u0), fabsf(u1))), ew = 1e-5f * (1.0f + max_f(fabsf(w0), fabsf(w1)));
-    float ey = 1e-5f * (1.0f + max_f(fabsf(ylo), fabsf(yhi)));
-    lo3[0] = u0 - eu; hi3[0] = u1 + eu;
-    lo3[1] = ylo - ey; hi3[1] = yhi + ey;
-    lo3[2] = w0 - ew; hi3[2] = w1 + ew;
+    const beam_vertex *v[3] = {&b->v[idx[0]], &b->v[idx[1]], &b->v[idx[2]]};
+    beam_slab_box(v, b->tri[t].kern, b->tri[t].ybar, b->disc, ylo, yhi, lo3, hi3);
 }
 
 typedef struct lookup_state {
@@ -962,6 +932,25 @@ static gr_status build_grid(gr_beams *b, uint32_t np, int threads, gr_error *err
     b->stats.grid_entries = (size_t)entries;
     b->stats.grid_cells = ncells;
     return GR_OK;
+}
+
+double gr_beams_entries_per_prim(const gr_beam_prim_sample *s, const double *weight, int n)
+{
+    double np = 0.0, e1[3] = {0, 0, 0};
+    for (int i = 0; i < n; i++) {
+        np += weight[i] * s[i].prims;
+        for (int a = 0; a < 3; a++) e1[a] += weight[i] * s[i].e1[a];
+    }
+    double c[3];
+    for (int a = 0; a < 3; a++) c[a] = GRID_CELL_BOX * e1[a] / np; /* build_grid's cells */
+    if (!(np > 0.0) || !(c[0] > 0.0 && c[1] > 0.0 && c[2] > 0.0)) return 0.0;
+    /* sum over the primitives of (1 + e_u / c_u)(1 + e_y / c_y)(1 + e_w / c_w), expanded */
+    double sum = 0.0;
+    for (int i = 0; i < n; i++)
+        sum += weight[i] * (s[i].prims + s[i].e1[0] / c[0] + s[i].e1[1] / c[1] + s[i].e1[2] / c[2] +
+                            s[i].e2[0] / (c[0] * c[1]) + s[i].e2[1] / (c[0] * c[2]) + s[i].e2[2] / (c[1] * c[2]) +
+                            s[i].e3 / (c[0] * c[1] * c[2]));
+    return fmin(sum / np, GRID_ENTRIES_PER_PRIM);
 }
 
 gr_status gr_beams_index(gr_beams *b, uint32_t np, int threads, gr_error *err)

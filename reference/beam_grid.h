@@ -5,6 +5,7 @@
 #ifndef GR_REF_BEAM_GRID_H
 #define GR_REF_BEAM_GRID_H
 
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include "reference/beams.h"
@@ -100,6 +101,45 @@ static inline void slab_range(const gr_beams *b, uint32_t t, uint32_t k, uint32_
 {
     *hi = k == 0 ? INFINITY : b->tri[t].ytop - (float)k * b->tri[t].dy;
     *lo = k + 1 == nslab ? -INFINITY : b->tri[t].ytop - (float)(k + 1) * b->tri[t].dy;
+}
+
+/* min and max of non-NaN floats without the libm calls that fminf/fmaxf are here (no
+ * -ffinite-math-only): a NaN b gives a, as fminf/fmaxf do, so the boxes keep their bytes */
+static inline float min_f(float a, float b) { return b < a ? b : a; }
+static inline float max_f(float a, float b) { return b > a ? b : a; }
+
+/* The box, in sheared coordinates lo/hi = {u, y, w}, of a beam (vertices v, its triangle's
+ * disc kernel kern and ybar when disc) over the slab [ylo, yhi]: the lookups' boxes
+ * (beam_grid.c) and the memory estimate's sampled ones (beams.c). */
+static inline void beam_slab_box(const beam_vertex *const v[3], const float kern[4], float ybar, int disc, float ylo,
+                                 float yhi, float lo3[3], float hi3[3])
+{
+    float u0 = FLT_MAX, u1 = -FLT_MAX, w0 = FLT_MAX, w1 = -FLT_MAX;
+    for (int c = 0; c < 3; c++) {
+        for (int e = 0; e < 2; e++) {
+            float y = e ? yhi : ylo;
+            float u = v[c]->pu + v[c]->au * (y - v[c]->py), w = v[c]->pw + v[c]->aw * (y - v[c]->py);
+            u0 = min_f(u0, u); u1 = max_f(u1, u);
+            w0 = min_f(w0, w); w1 = max_f(w1, w);
+        }
+    }
+    if (disc) {
+        /* the disc kernel reaches d J disc around the cross-section, d up to ybar - ylo */
+        const float *M = kern;
+        float dmax = ybar - ylo;
+        if (dmax > 0.0f) {
+            /* the unit disc's image: half widths |row of M| (slightly widened for rounding) */
+            float ku = 1.0001f * dmax * sqrtf(M[0] * M[0] + M[1] * M[1]), kw = 1.0001f * dmax * sqrtf(M[2] * M[2] + M[3] * M[3]);
+            u0 -= ku; u1 += ku;
+            w0 -= kw; w1 += kw;
+        }
+    }
+    /* widen by a few ulps of the coordinates so float rounding in the test cannot fall outside */
+    float eu = 1e-5f * (1.0f + max_f(fabsf(u0), fabsf(u1))), ew = 1e-5f * (1.0f + max_f(fabsf(w0), fabsf(w1)));
+    float ey = 1e-5f * (1.0f + max_f(fabsf(ylo), fabsf(yhi)));
+    lo3[0] = u0 - eu; hi3[0] = u1 + eu;
+    lo3[1] = ylo - ey; hi3[1] = yhi + ey;
+    lo3[2] = w0 - ew; hi3[2] = w1 + ew;
 }
 
 /* The lookup structure of b's np primitives (b->prim_tri and the triangles set): their

@@ -459,15 +459,16 @@ static gr_status patch_grid(const gr_beam_params *p, double *h, double *nu, doub
     return GR_OK;
 }
 
-double gr_beams_prims_per_triangle(const gr_beam_params *p, int fine, int samples)
+void gr_beams_sample_prims(const gr_beam_params *p, int fine, int samples, gr_beam_prim_sample *out)
 {
+    memset(out, 0, sizeof *out);
     double h = 0.0, nu = 0.0, nw = 0.0, su = 0.0, sw = 0.0;
     gr_error e;
-    if (samples < 1 || patch_grid(p, &h, &nu, &nw, &su, &sw, &e) != GR_OK) return 0.0;
-    const double scale = p->slab_cells > 0.0 ? p->slab_cells : 1.0;
-    const int F = fine > 1 ? fine : 1;
+    if (samples < 1 || patch_grid(p, &h, &nu, &nw, &su, &sw, &e) != GR_OK) return;
+    const double scale = p->slab_cells > 0.0 ? p->slab_cells : 1.0, eta = 1.0 / p->ior;
+    const int F = fine > 1 ? fine : 1, disc = p->disc_radius > 0.0;
     const double c = h / F; /* the sampled cells' side: a plain cell, or a refined sub-cell */
-    double sum = 0.0;
+    enum { MAX_SLABS = 32 }; /* slabs whose boxes are measured per triangle, evenly spread */
     for (int sj = 0; sj < samples; sj++)
         for (int si = 0; si < samples; si++) {
             /* the cell at the centre of stratum (si, sj) of the patch: its 4 corners */
@@ -475,24 +476,58 @@ double gr_beams_prims_per_triangle(const gr_beam_params *p, int fine, int sample
             double z = p->origin.z + sw + floor((sj + 0.5) * nw / samples) * h;
             gr_dvec3 pos[4], n;
             beam_vertex v[4];
+            float J[4][4];
             int ok[4];
-            for (int k = 0; k < 4; k++) ok[k] = surface_vertex(p, x + (k & 1) * c, z + (k >> 1) * c, &pos[k], &n, &v[k]);
+            for (int k = 0; k < 4; k++) {
+                ok[k] = surface_vertex(p, x + (k & 1) * c, z + (k >> 1) * c, &pos[k], &n, &v[k]);
+                if (ok[k] && disc) {
+                    double Jd[4];
+                    slope_jacobian(p->sun_dir, n, eta, p->disc_e1, p->disc_e2, Jd);
+                    for (int q = 0; q < 4; q++) J[k][q] = (float)Jd[q];
+                }
+            }
             /* its two triangles, wound so that their rest area vectors point down (as the grid's) */
             static const int tri[2][3] = {{0, 1, 2}, {1, 3, 2}};
             for (int t = 0; t < 2; t++) {
                 const int *q = tri[t];
+                out->tris += 1.0;
                 if (!ok[q[0]] || !ok[q[1]] || !ok[q[2]]) continue;
                 gr_dvec3 a = gr_d3_cross(gr_d3_sub(pos[q[1]], pos[q[0]]), gr_d3_sub(pos[q[2]], pos[q[0]]));
                 if (!(gr_d3_dot(p->sun_dir, a) > 0.0)) continue; /* no beam: no primitive (slab_count_work) */
-                float d = 0.0f, ytop = -INFINITY;
-                for (int k = 0; k < 3; k++) {
-                    d = fmaxf(d, hypotf(v[q[k]].au, v[q[k]].aw));
-                    ytop = fmaxf(ytop, v[q[k]].py);
+                /* as triangle_work: the drift, the top, the disc kernel */
+                const beam_vertex *vs[3] = {&v[q[0]], &v[q[1]], &v[q[2]]};
+                float d = 0.0f, ytop = fmaxf(vs[0]->py, fmaxf(vs[1]->py, vs[2]->py)), ybar = ytop, kern[4] = {0, 0, 0, 0};
+                for (int k = 0; k < 3; k++) d = fmaxf(d, hypotf(vs[k]->au, vs[k]->aw));
+                if (disc) {
+                    for (int m = 0; m < 4; m++)
+                        kern[m] = (float)(p->disc_radius * ((double)J[q[0]][m] + J[q[1]][m] + J[q[2]][m]) / 3.0);
+                    ybar = (vs[0]->py + vs[1]->py + vs[2]->py) / 3.0f;
                 }
-                sum += slab_count((double)ytop - p->region.y_min, (double)d * F, h, scale);
+                double depth = (double)ytop - p->region.y_min;
+                uint32_t ns = slab_count(depth, (double)d * F, h, scale);
+                out->prims += ns;
+                /* the boxes of (up to MAX_SLABS of) its slabs, as slab_range and prim_box make them */
+                float dy = depth > 0.0 ? (float)(depth / ns) : 1.0f;
+                uint32_t m = ns < MAX_SLABS ? ns : MAX_SLABS;
+                double w = (double)ns / m;
+                for (uint32_t r = 0; r < m; r++) {
+                    uint32_t k = (uint32_t)(((uint64_t)r * ns) / m);
+                    float yhi = k == 0 ? ytop : ytop - (float)k * dy;
+                    float ylo = k + 1 == ns ? (float)p->region.y_min : ytop - (float)(k + 1) * dy;
+                    float lo3[3], hi3[3];
+                    beam_slab_box(vs, kern, ybar, disc, ylo, yhi, lo3, hi3);
+                    double ex[3];
+                    for (int ax = 0; ax < 3; ax++) {
+                        ex[ax] = (double)hi3[ax] - lo3[ax];
+                        out->e1[ax] += w * ex[ax];
+                    }
+                    out->e2[0] += w * ex[0] * ex[1];
+                    out->e2[1] += w * ex[0] * ex[2];
+                    out->e2[2] += w * ex[1] * ex[2];
+                    out->e3 += w * ex[0] * ex[1] * ex[2];
+                }
             }
         }
-    return sum / (2.0 * samples * samples);
 }
 
 gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err)

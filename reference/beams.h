@@ -100,13 +100,25 @@ typedef struct gr_beam_stats {
 } gr_beam_stats;
 
 gr_status gr_beams_build(gr_rtc *rtc, const gr_beam_params *p, gr_beams **out, gr_error *err);
-/* The expected beam-slab primitives per surface triangle of a set built with p, without
- * building it (the memory estimate, reference/memory.h): the slabs (at p->slab_cells) of
- * both triangles of one cell per stratum of a samples x samples partition of the patch,
- * computed as the build computes them, a triangle without a beam counting 0; fine = F > 1:
- * of the F x F sub-cells of a refined cell instead (their drift in plain cells F times
- * larger). 0 for an empty patch. */
-double gr_beams_prims_per_triangle(const gr_beam_params *p, int fine, int samples);
+/* A sample of a set's beam-slab primitives, without building the set (the memory estimate,
+ * reference/memory.h): both triangles of one cell per stratum of a samples x samples
+ * partition of the patch, computed as the build computes them (vertices, drift, slab count,
+ * disc kernel, slab boxes); fine = F > 1: of the F x F sub-cells of a refined cell instead
+ * (their drift in plain cells F times larger). Sums over the sampled triangles: */
+typedef struct gr_beam_prim_sample {
+    double tris;             /* triangles sampled (a triangle without a beam counts, with no primitive) */
+    double prims;            /* their primitives (slabs) */
+    double e1[3];            /* over those primitives: their boxes' extents along u, y, w, */
+    double e2[3];            /* the products e_u e_y, e_u e_w, e_y e_w, */
+    double e3;               /* and e_u e_y e_w */
+} gr_beam_prim_sample;
+void gr_beams_sample_prims(const gr_beam_params *p, int fine, int samples, gr_beam_prim_sample *out);
+/* The expected lookup-grid entries per primitive of a set made of n classes of primitives
+ * (s[i] sampled, weight[i] = that class's primitives in the set per sampled one): the grid's
+ * cells are GRID_CELL_BOX times the boxes' mean extent c per axis, and a box of extents e
+ * at a random offset meets prod_a (1 + e_a / c_a) cells on average; at most the grid's
+ * budget per primitive (beam_grid.c). 0 when nothing was sampled. */
+double gr_beams_entries_per_prim(const gr_beam_prim_sample *s, const double *weight, int n);
 void gr_beams_destroy(gr_beams *b); /* accepts NULL */
 const gr_beam_stats *gr_beams_stats(const gr_beams *b);
 /* The tessellation, for tests: the number of triangles; vertex k's displaced local position

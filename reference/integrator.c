@@ -116,16 +116,21 @@ static double set_cells(const gr_ref_renderer *r, const double box[4], double di
     return *plain + *fine;
 }
 
-/* The expected beam primitives of a set (the memory estimate): its whole cells' and its
- * sub-cells' two triangles each, times their sampled slabs per triangle (beams.h). */
-static double set_prims(const gr_beam_params *bp, double plain, double fine, int F, double slab_cells)
+/* The expected beam primitives of a set (the memory estimate) and their lookup-grid entries
+ * per primitive: its whole cells' and its sub-cells' two triangles each, sampled (beams.h). */
+static double set_prims(const gr_beam_params *bp, double plain, double fine, int F, double slab_cells, double *entries)
 {
-    enum { SAMPLES = 32 }; /* 1024 cells: the mean slab count to about 2 % (unit.ref_memory) */
+    enum { SAMPLES = 32 }; /* 1024 cells: the counts to about 2 % (unit.ref_memory) */
     gr_beam_params q = *bp;
     q.slab_cells = slab_cells;
-    double n = 2.0 * plain * gr_beams_prims_per_triangle(&q, 1, SAMPLES);
-    if (fine > 0.0) n += 2.0 * fine * gr_beams_prims_per_triangle(&q, F, SAMPLES);
-    return n;
+    gr_beam_prim_sample s[2];
+    gr_beams_sample_prims(&q, 1, SAMPLES, &s[0]);
+    memset(&s[1], 0, sizeof s[1]);
+    if (fine > 0.0) gr_beams_sample_prims(&q, F, SAMPLES, &s[1]);
+    /* each class's primitives in the set per sampled one: its triangles over the sampled ones */
+    double w[2] = {s[0].tris > 0.0 ? 2.0 * plain / s[0].tris : 0.0, s[1].tris > 0.0 ? 2.0 * fine / s[1].tris : 0.0};
+    *entries = gr_beams_entries_per_prim(s, w, 2);
+    return w[0] * s[0].prims + w[1] * s[1].prims;
 }
 
 /* Refinement near the camera (docs/reference.md 2.2, "Near the camera"): when the plain grid
@@ -567,20 +572,20 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
     pass_params(r, 0, &bp);
     bp.sun_dir = gr_ref_pass_sun_dir(r, 0);
     double sr = r->set.surface_res, plain, fine;
-    info->plain_prims = set_prims(&bp, sr * sr, 0.0, 1, 0.5);
+    info->plain_prims = set_prims(&bp, sr * sr, 0.0, 1, 0.5, &info->plain_entries);
     if (r->near_F > 1) {
         info->near_cells = set_cells(r, r->near_box, r->near_D, r->near_F, &plain, &fine);
-        info->near_prims = set_prims(&bp, plain, fine, r->near_F, 0.5);
+        info->near_prims = set_prims(&bp, plain, fine, r->near_F, 0.5, &info->near_entries);
     }
     /* the probe's fourth level: the plain set with the near cells 2x finer (probe.c) */
     if (r->near_F > 1 && r->set.bias_probe && gr_ref_probe_holds_near(r)) {
         info->probe_near_cells = set_cells(r, r->near_box, r->near_D, 2 * r->near_F, &plain, &fine);
-        info->probe_near_prims = set_prims(&bp, plain, fine, 2 * r->near_F, 2.0);
+        info->probe_near_prims = set_prims(&bp, plain, fine, 2 * r->near_F, 2.0, &info->probe_near_entries);
     }
     if (r->cone_on && r->set.surface_res > 0) {
         info->cone_cells = set_cells(r, r->cone_box, 0.5 * (r->cone_box[1] - r->cone_box[0]), r->set.refine_factor,
                                      &plain, &fine);
-        info->cone_prims = set_prims(&bp, plain, fine, r->set.refine_factor, 1.0);
+        info->cone_prims = set_prims(&bp, plain, fine, r->set.refine_factor, 1.0, &info->cone_entries);
     }
 }
 

@@ -134,9 +134,11 @@ typedef struct gr_ref_info {
     double near_radius_m;   /* its radius around P_s (sheared, m), */
     double near_cells;      /* estimated surface cells of its beam set, the refined sub-cells included */
     double probe_near_cells; /* the same for the bias probe's fourth level (its cells 2x finer), 0: none */
-    /* expected beam-slab primitives of pass 0's sets (gr_beams_prims_per_triangle, sampled;
-     * 0: no such set): the plain set, the camera cone's, the near set, the probe's finer one */
+    /* expected beam-slab primitives of pass 0's sets and their lookup-grid entries per
+     * primitive (gr_beams_sample_prims, gr_beams_entries_per_prim; 0: no such set): the plain
+     * set, the camera cone's, the near set, the probe's finer one */
     double plain_prims, cone_prims, near_prims, probe_near_prims;
+    double plain_entries, cone_entries, near_entries, probe_near_entries;
     double cells_per_wave;  /* the plain grid's cells across the shortest wave (0: flat water) */
 } gr_ref_info;
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info);

@@ -15,15 +15,21 @@ docs/reliability.md). Anything else (exit 1, a signal, a timeout, "non-finite") 
 view; the script prints one line per view and exits 1 if any view failed. The same --seed
 gives the same scenes. Two bugs were found this way on 2026-11-30 (docs/benchmarks.md).
 
+--memory (truth mode): each view's memory estimate (read from the refusal of a render under
+a 1 KiB limit, which exits before any beam is built) against the render's peak RSS (the
+child's ru_maxrss); a view that peaks over its estimate fails.
+
 usage: scripts/random_views.py [--count N] [--seed S] [--mode truth|run] [--size WxH]
-                               [--real-sun] [--out DIR] [--binary PATH] [--timeout S]
+                               [--real-sun] [--out DIR] [--binary PATH] [--timeout S] [--memory]
 """
 import argparse
 import json
 import os
 import random
+import re
 import subprocess
 import sys
+import threading
 import time
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -66,6 +72,31 @@ def draw(base, rng, name, real_sun, size):
     return s
 
 
+def run_measured(cmd, env, timeout):
+    """Runs cmd; returns (exit code or "timeout", its stderr, its peak RSS in MiB or None). The
+    child is reaped with wait4, whose rusage is that child's alone."""
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    chunks = []
+    reader = threading.Thread(target=lambda: chunks.append(p.stderr.read()))
+    reader.start()
+    deadline = time.monotonic() + timeout
+    while True:
+        pid, status, ru = os.wait4(p.pid, os.WNOHANG)
+        if pid:
+            break
+        if time.monotonic() > deadline:
+            p.kill()
+            os.wait4(p.pid, 0)
+            reader.join()
+            p.returncode = -9
+            return "timeout", "", None
+        time.sleep(0.05)
+    reader.join()
+    p.returncode = os.waitstatus_to_exitcode(status)
+    err = b"".join(chunks).decode("utf-8", "replace")
+    return p.returncode, err, ru.ru_maxrss / 1024.0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--count", type=int, default=10)
@@ -76,6 +107,7 @@ def main():
     ap.add_argument("--out", default="out/random_views")
     ap.add_argument("--binary", default=os.path.join(HERE, "build", "godrays"))
     ap.add_argument("--timeout", type=float, default=600)
+    ap.add_argument("--memory", action="store_true")
     a = ap.parse_args()
     try:
         w, h = (int(v) for v in a.size.lower().split("x"))
@@ -105,13 +137,14 @@ def main():
         else:
             cmd = [a.binary, "run", scene, "-o", os.path.join(a.out, name), "-q"]
             ok_codes = {0, 3}
+        est = None
+        if a.memory and a.mode == "truth":
+            q = subprocess.run(cmd + ["--max-memory", "1K"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               env=env, text=True, errors="replace")
+            m = re.search(r"the ground truth needs about ([0-9.]+) GiB", q.stderr)
+            est = float(m.group(1)) * 1024.0 if m else None  # MiB
         t0 = time.monotonic()
-        try:
-            p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, timeout=a.timeout,
-                               text=True, errors="replace")
-            rc, err = p.returncode, p.stderr
-        except subprocess.TimeoutExpired:
-            rc, err = "timeout", ""
+        rc, err, peak = run_measured(cmd, env, a.timeout)
         dt = time.monotonic() - t0
         lines = [l for l in err.splitlines() if l.strip()]
         why = ""
@@ -121,10 +154,15 @@ def main():
             why = "exit 2 without naming the scene"
         elif rc != 2 and rc not in ok_codes:
             why = f"exit {rc}"
+        mem = ""
+        if est is not None and peak is not None and rc == 0:
+            mem = f" peak {peak:.0f} / estimate {est:.0f} MiB"
+            if peak > est and not why:
+                why = "peak RSS over the memory estimate"
         verdict = "FAIL" if why else "ok"
         failed += bool(why)
         last = lines[-1][:160] if lines else ""
-        print(f"{verdict:4s} {name} exit {rc} {dt:6.1f} s{(' (' + why + ')') if why else ''}  {last}", flush=True)
+        print(f"{verdict:4s} {name} exit {rc} {dt:6.1f} s{mem}{(' (' + why + ')') if why else ''}  {last}", flush=True)
     print(f"random_views: {a.count - failed} of {a.count} views passed (seed {a.seed}, mode {a.mode}, {a.size})")
     return 1 if failed else 0
 

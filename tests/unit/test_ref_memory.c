@@ -1,9 +1,10 @@
 /* reference/memory: the ground truth's memory estimate and its check (docs/reliability.md,
  * "Memory"), against three oracles:
- *  1. the beam builds themselves: gr_beams_prims_per_triangle (sampled, nothing built) times
- *     the triangles must come within 8 % of the primitives gr_beams_build makes, on gentle
- *     and steep waves, a high and a low sun, slabs of 0.5, 1 and 2 cells of drift, and a set
- *     whose every cell is refined 3 x 3 (its drift in plain cells 3x larger);
+ *  1. the beam builds themselves: gr_beams_sample_prims (nothing built) must come within 8 %
+ *     of the primitives gr_beams_build makes and gr_beams_entries_per_prim within -8 % and
+ *     +25 % of its lookup grid's entries per primitive (above where the grid coarsens its cells), on gentle and steep waves, a high and a low sun,
+ *     slabs of 0.5, 1 and 2 cells of drift, a set whose every cell is refined 3 x 3 (its drift
+ *     in plain cells 3x larger) and one 100 m deep (slabs of 2 cells, long disc kernels);
  *  2. the byte counts written out by hand from the model's constants (memory.c);
  *  3. the operating system: what a render of the default scene's sets (2 passes, 16 x 9
  *     pixels) adds to the process's peak RSS (getrusage's ru_maxrss) must lie under the
@@ -65,13 +66,21 @@ static void prims_against_build(gr_rtc *rtc, const char *label, const gr_scene *
     CHECK_OK(gr_beams_build(rtc, &p, &b, &err), err);
     if (!b) exit(1);
     const gr_beam_stats *st = gr_beams_stats(b);
-    double est = gr_beams_prims_per_triangle(&p, F, 32) * (double)st->triangles;
-    double rel = est / (double)st->prims - 1.0;
-    printf("%-40s %zu triangles (%zu refined cells), %zu primitives built, %.0f estimated (%+.1f %%)\n", label,
-           st->triangles, st->refined_cells, st->prims, est, 100.0 * rel);
+    gr_beam_prim_sample sm;
+    gr_beams_sample_prims(&p, F, 32, &sm);
+    double w = (double)st->triangles / sm.tris, est = w * sm.prims, entries = gr_beams_entries_per_prim(&sm, &w, 1);
+    double built = (double)st->grid_entries / (double)st->prims;
+    double rel = est / (double)st->prims - 1.0, rel_e = entries / built - 1.0;
+    printf("%-36s %zu triangles, %zu primitives built, %.0f sampled (%+.1f %%); grid entries per primitive %.2f "
+           "built, %.2f sampled (%+.1f %%)\n",
+           label, st->triangles, st->prims, est, 100.0 * rel, built, entries, 100.0 * rel_e);
     CHECK_MSG(st->prims > st->triangles, "%s: %zu primitives for %zu triangles: no slabs, the check says nothing", label,
               st->prims, st->triangles);
     CHECK_MSG(fabs(rel) <= 0.08, "%s: the sampled primitives are %+.1f %% off the build's", label, 100.0 * rel);
+    /* above, not below: where the grid has more cells than its budget allows it coarsens them,
+     * and its boxes then meet fewer cells than the model's (1 + e / c)^3 */
+    CHECK_MSG(rel_e >= -0.08 && rel_e <= 0.25, "%s: the sampled grid entries are %+.1f %% off the build's", label,
+              100.0 * rel_e);
     gr_beams_destroy(b);
 }
 
@@ -130,15 +139,17 @@ int main(void)
     prims_against_build(rtc, "one gentle wave, sun 50 deg, slabs 2", gentle, 2.0, 1, -7.0);
     prims_against_build(rtc, "default waves, sun 20 deg, slabs 1", steep, 1.0, 1, -20.0);
     prims_against_build(rtc, "default waves, sun 20 deg, 3x3 refined", steep, 0.5, 3, -7.0);
+    prims_against_build(rtc, "default waves, sun 20 deg, 100 m, slabs 2", steep, 2.0, 1, -100.0);
     gr_rtc_destroy(rtc);
     free(gentle);
     free(steep);
 
     /* 2. the model's bytes by hand: 4 x 2 pixels, 3 batches (3 x 28 + 16 + 32 = 132 B a pixel),
-     * FIXED 144 MiB, SLACK 1.25; a set keeps per cell 2 x (128 + 85) + 40 = 466 B and per
-     * primitive 4 + 9 x 10 = 94 B, and its build adds 40 B a cell and 56 B a primitive; the
-     * sets are built in order (plain, cone, near) and kept, so the peak is the largest of
-     * the kept ones plus the one being built */
+     * FIXED 144 MiB, SLACK 1.35; a set keeps per cell 2 x (128 + 85) + 40 = 466 B and per
+     * primitive 4 + 10 B per grid entry (10 entries here: 104 B; 16 for the probe's finer near
+     * set: 164 B), and its build adds 40 B a cell and 56 B a primitive; the sets are built in order
+     * (plain, cone, near) and kept, so the peak is the largest of the kept ones plus the one
+     * being built */
     gr_scene *s = calloc(1, sizeof *s);
     const char *ov[] = {"camera.width=4", "camera.height=2", "reference.batches=3", "reference.surface_res=10",
                         "reference.refine_factor=3"};
@@ -147,16 +158,18 @@ int main(void)
     gr_ref_info info;
     memset(&info, 0, sizeof info);
     info.plain_prims = 1000.0;
-    const double plain = 100.0 * 466.0 + 1000.0 * 94.0, plain_build = 100.0 * 40.0 + 1000.0 * 56.0;
-    CHECK_NEAR(gr_ref_memory_estimate(s, &info), fixed + 1.25 * (plain + plain_build), 1e-6);
+    info.plain_entries = info.cone_entries = info.near_entries = 10.0;
+    info.probe_near_entries = 16.0;
+    const double plain = 100.0 * 466.0 + 1000.0 * 104.0, plain_build = 100.0 * 40.0 + 1000.0 * 56.0;
+    CHECK_NEAR(gr_ref_memory_estimate(s, &info), fixed + 1.35 * (plain + plain_build), 1e-6);
     /* a camera cone kept beside the plain set: its build on top of both */
     info.cone_cells = 50.0;
     info.cone_prims = 2000.0;
-    const double cone = 50.0 * 466.0 + 2000.0 * 94.0, cone_build = 50.0 * 40.0 + 2000.0 * 56.0;
-    CHECK_NEAR(gr_ref_memory_estimate(s, &info), fixed + 1.25 * (plain + cone + cone_build), 1e-6);
+    const double cone = 50.0 * 466.0 + 2000.0 * 104.0, cone_build = 50.0 * 40.0 + 2000.0 * 56.0;
+    CHECK_NEAR(gr_ref_memory_estimate(s, &info), fixed + 1.35 * (plain + cone + cone_build), 1e-6);
     /* a cone much smaller than the plain set: the plain set's own build is the peak */
     info.cone_prims = 10.0;
-    CHECK_NEAR(gr_ref_memory_estimate(s, &info), fixed + 1.25 * (plain + plain_build), 1e-6);
+    CHECK_NEAR(gr_ref_memory_estimate(s, &info), fixed + 1.35 * (plain + plain_build), 1e-6);
     info.cone_prims = 2000.0;
     /* the near set and the probe's finer one in its place: the larger */
     info.near_cells = 70.0;
@@ -165,8 +178,8 @@ int main(void)
     info.near_radius_m = 8.5;
     info.probe_near_cells = 200.0;
     info.probe_near_prims = 3000.0;
-    const double pnear = 200.0 * 466.0 + 3000.0 * 94.0, pnear_build = 200.0 * 40.0 + 3000.0 * 56.0;
-    CHECK_NEAR(gr_ref_memory_estimate(s, &info), fixed + 1.25 * (plain + cone + pnear + pnear_build), 1e-6);
+    const double pnear = 200.0 * 466.0 + 3000.0 * 164.0, pnear_build = 200.0 * 40.0 + 3000.0 * 56.0;
+    CHECK_NEAR(gr_ref_memory_estimate(s, &info), fixed + 1.35 * (plain + cone + pnear + pnear_build), 1e-6);
     double f = 0.0, px = 0.0, sets = 0.0;
     gr_ref_memory_parts(s, &info, &f, &px, &sets);
     CHECK_NEAR(f + px + sets, gr_ref_memory_estimate(s, &info), 1e-6);
@@ -179,7 +192,8 @@ int main(void)
     gr_ref_info big;
     memset(&big, 0, sizeof big);
     big.plain_prims = 1e9;
-    CHECK_NEAR(gr_ref_memory_estimate(s, &big), fixed + 1.25 * (100.0 * 506.0 + 16777216.0 * 150.0), 1e-3);
+    big.plain_entries = 10.0;
+    CHECK_NEAR(gr_ref_memory_estimate(s, &big), fixed + 1.35 * (100.0 * 506.0 + 16777216.0 * 160.0), 1e-3);
 
     gr_memlimit_set(1e12);
     CHECK(gr_ref_memory_check(s, &info, &err) == GR_OK);
