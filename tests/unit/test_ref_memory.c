@@ -33,29 +33,12 @@
 /* the sampled count against a build's, for the beam parameters of scene s */
 static void prims_against_build(gr_rtc *rtc, const char *label, const gr_scene *s, double slab_cells, int F, double y_min)
 {
-    gr_dvec3 I0 = gr_d3_norm(gr_d3(s->sun.dir[0], s->sun.dir[1], s->sun.dir[2]));
-    gr_dvec3 T0 = gr_refract_d(I0, gr_d3(0, 1, 0), 1.0 / s->medium.ior);
     gr_beam_params p;
-    memset(&p, 0, sizeof p);
-    p.water = &s->water;
-    p.ior = s->medium.ior;
-    p.fresnel = 1;
-    p.sun_dir = I0;
-    p.shear_x = T0.x / T0.y;
-    p.shear_z = T0.z / T0.y;
-    p.region.u0 = p.region.w0 = -3.0;
-    p.region.u1 = p.region.w1 = 3.0;
-    p.region.y_min = y_min;
-    p.pad_m = 0.7;
-    p.res = F > 1 ? 32 : 96; /* the refined set under the primitive budget (over it the build coarsens its slabs) */
+    /* the refined set under the primitive budget (over it the build coarsens its slabs) */
+    ref_beam_params(s, 3.0, y_min, F > 1 ? 32 : 96, slab_cells, &p);
     p.jitter[0] = 0.3;
     p.jitter[1] = 0.6;
-    p.max_prims = (size_t)1 << 24;
-    p.slab_cells = slab_cells;
     p.threads = 2;
-    p.disc_radius = 0.5 * 0.53 * GR_PI / 180.0;
-    p.disc_e1 = gr_d3_norm(gr_d3_cross(I0, gr_d3(0, 1, 0)));
-    p.disc_e2 = gr_d3_cross(I0, p.disc_e1);
     if (F > 1) { /* every cell refined: a radius far beyond the patch */
         p.refine_factor = F;
         p.refine_radius_m = 100.0;

@@ -7,6 +7,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/optics.h"
+#include "reference/beams.h"
 #include "reference/integrator.h"
 #include "reference/sums.h"
 #include "scene/scene.h"
@@ -62,6 +64,35 @@ static inline gr_scene *ref_scene_file(const char *path, const char *const *ov, 
         exit(1);
     }
     return s;
+}
+
+/* Beam parameters for scene s's water, sun and medium, as a render sets them (the shear
+ * along the flat-water refracted sun, exact Fresnel, the sun's 0.53-degree disc convolved),
+ * over the square sheared region [-half, half]^2 down to y_min, pad 0.7 m, at surface_res
+ * res, slabs of `slab_cells`, jitter 0.5; the caller sets the rest (test code only). */
+static inline void ref_beam_params(const gr_scene *s, double half, double y_min, int res, double slab_cells,
+                                   gr_beam_params *p)
+{
+    gr_dvec3 I0 = gr_d3_norm(gr_d3(s->sun.dir[0], s->sun.dir[1], s->sun.dir[2]));
+    gr_dvec3 T0 = gr_refract_d(I0, gr_d3(0, 1, 0), 1.0 / s->medium.ior);
+    memset(p, 0, sizeof *p);
+    p->water = &s->water;
+    p->ior = s->medium.ior;
+    p->fresnel = 1;
+    p->sun_dir = I0;
+    p->shear_x = T0.x / T0.y;
+    p->shear_z = T0.z / T0.y;
+    p->region.u0 = p->region.w0 = -half;
+    p->region.u1 = p->region.w1 = half;
+    p->region.y_min = y_min;
+    p->pad_m = 0.7;
+    p->res = res;
+    p->jitter[0] = p->jitter[1] = 0.5;
+    p->max_prims = (size_t)1 << 24;
+    p->slab_cells = slab_cells;
+    p->disc_radius = 0.5 * 0.53 * GR_PI / 180.0;
+    p->disc_e1 = gr_d3_norm(gr_d3_cross(I0, gr_d3(0, 1, 0)));
+    p->disc_e2 = gr_d3_cross(I0, p->disc_e1);
 }
 
 /* Renders s with options o (NULL = defaults, quiet); exits the test on failure. */
