@@ -103,7 +103,7 @@ pid=
 
 # ---- d: a signal while the beams of a fine surface (surface_res 4096) are built ---------------
 rm -f early.exr
-# (its memory estimate, about 20 GB, is over 80 % of a small machine's memory: the limit is
+# (its memory estimate, about 18 GiB, is over 80 % of a small machine's memory: the limit is
 # lifted, since the build is stopped long before it allocates that much)
 GODRAYS_MAX_MEMORY=1T "$bin" reference "$scene" --size 32x18 --set reference.surface_res=4096 -o early.exr >out.txt 2>err.txt &
 pid=$!

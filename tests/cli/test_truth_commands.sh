@@ -14,7 +14,7 @@ small_scene s.json 16 9
 pid=
 trap '[ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$dir"' EXIT
 
-# ---- a: the memory preflight (surface_res 4096: about 17 GiB of beams) ----------------------
+# ---- a: the memory preflight (surface_res 4096: about 18 GiB of beams) ----------------------
 fine="--set reference.surface_res=4096"
 expect 2 "over the memory limit of 1.00 GiB (--max-memory)" tune s.json -q -o t --params shafts.K $fine --max-memory 1G
 expect 2 "the ground truth needs about" sweep s.json -q -o sw --param shafts.K=0.5:1:2 $fine --max-memory 1G
