@@ -95,12 +95,17 @@ static inline void tri_vertices(const gr_beams *b, uint32_t t, uint32_t idx[3])
     idx[2] = bt->vi[2];
 }
 
-/* Slab k of triangle t spans [lo, hi); the top slab is open upward and the bottom one
- * downward, so each point of the beam belongs to exactly one slab (no double counting). */
+/* Slab k of nslab of a beam whose top is ytop, each dy high, spans [lo, hi); the top slab is
+ * open upward and the bottom one downward, so each point of the beam belongs to exactly one
+ * slab (no double counting). slab_range: triangle t's. */
+static inline void slab_bounds(float ytop, float dy, uint32_t k, uint32_t nslab, float *lo, float *hi)
+{
+    *hi = k == 0 ? INFINITY : ytop - (float)k * dy;
+    *lo = k + 1 == nslab ? -INFINITY : ytop - (float)(k + 1) * dy;
+}
 static inline void slab_range(const gr_beams *b, uint32_t t, uint32_t k, uint32_t nslab, float *lo, float *hi)
 {
-    *hi = k == 0 ? INFINITY : b->tri[t].ytop - (float)k * b->tri[t].dy;
-    *lo = k + 1 == nslab ? -INFINITY : b->tri[t].ytop - (float)(k + 1) * b->tri[t].dy;
+    slab_bounds(b->tri[t].ytop, b->tri[t].dy, k, nslab, lo, hi);
 }
 
 /* min and max of non-NaN floats without the libm calls that fminf/fmaxf are here (no

@@ -284,6 +284,24 @@ static void vertex_work(void *arg, int chunk, size_t k0, size_t k1)
     }
 }
 
+/* A beam's disc kernel: the disc radius times its vertices' mean slope Jacobian (ja, jb, jc;
+ * first order: the cross-section moves rigidly with the sun direction), and the mean height
+ * of its vertices, from which the kernel's depth is measured. */
+static void tri_kernel(double radius, const float *ja, const float *jb, const float *jc, const beam_vertex *const vs[3],
+                       float kern[4], float *ybar)
+{
+    for (int c = 0; c < 4; c++) kern[c] = (float)(radius * (ja[c] + jb[c] + jc[c]) / 3.0);
+    *ybar = (vs[0]->py + vs[1]->py + vs[2]->py) / 3.0f;
+}
+
+/* A beam's drift per metre of height (sheared): its vertices' largest. */
+static float tri_drift(const beam_vertex *const vs[3])
+{
+    float d = 0.0f;
+    for (int c = 0; c < 3; c++) d = fmaxf(d, hypotf(vs[c]->au, vs[c]->aw));
+    return d;
+}
+
 /* Triangles [k0, k1): flux, the cross-section's coefficients, the disc kernel, the drift. */
 static void triangle_work(void *arg, int chunk, size_t k0, size_t k1)
 {
@@ -328,17 +346,12 @@ static void triangle_work(void *arg, int chunk, size_t k0, size_t k1)
             bt->c[4 * c + 3] = (float)(c ? (double)vs[c]->aw - v0->aw : v0->aw);
         }
         if (disc) {
-            /* the beam's kernel: the disc radius times its vertices' mean Jacobian (first
-             * order: the cross-section moves rigidly with the sun direction) */
-            for (int c = 0; c < 4; c++)
-                bt->kern[c] = (float)(p->disc_radius * (jv[4 * (size_t)idx[0] + (size_t)c] + jv[4 * (size_t)idx[1] + (size_t)c] +
-                                                        jv[4 * (size_t)idx[2] + (size_t)c]) / 3.0);
-            bt->ybar = (v0->py + v1->py + v2->py) / 3.0f;
+            tri_kernel(p->disc_radius, &jv[4 * (size_t)idx[0]], &jv[4 * (size_t)idx[1]], &jv[4 * (size_t)idx[2]], vs, bt->kern,
+                       &bt->ybar);
             const float *M = bt->kern;
             bt->kr = 1.0001f * sqrtf(M[0] * M[0] + M[1] * M[1] + M[2] * M[2] + M[3] * M[3]);
         }
-        float d = 0.0f;
-        for (int c = 0; c < 3; c++) d = fmaxf(d, hypotf(vs[c]->au, vs[c]->aw));
+        float d = tri_drift(vs);
         /* in cells of the grid: a fine triangle's slabs are F times thinner (its box as tight) */
         drift[t] = lev[t] == 1 ? d * (float)j->tp->F : d;
         j->lit++;
@@ -496,15 +509,10 @@ void gr_beams_sample_prims(const gr_beam_params *p, int fine, int samples, gr_be
                 if (!(gr_d3_dot(p->sun_dir, a) > 0.0)) continue; /* no beam: no primitive (slab_count_work) */
                 /* as triangle_work: the drift, the top, the disc kernel */
                 const beam_vertex *vs[3] = {&v[q[0]], &v[q[1]], &v[q[2]]};
-                float d = 0.0f, ytop = fmaxf(vs[0]->py, fmaxf(vs[1]->py, vs[2]->py)), ybar = ytop, kern[4] = {0, 0, 0, 0};
-                for (int k = 0; k < 3; k++) d = fmaxf(d, hypotf(vs[k]->au, vs[k]->aw));
-                if (disc) {
-                    for (int m = 0; m < 4; m++)
-                        kern[m] = (float)(p->disc_radius * ((double)J[q[0]][m] + J[q[1]][m] + J[q[2]][m]) / 3.0);
-                    ybar = (vs[0]->py + vs[1]->py + vs[2]->py) / 3.0f;
-                }
+                float ytop = fmaxf(vs[0]->py, fmaxf(vs[1]->py, vs[2]->py)), ybar = ytop, kern[4] = {0, 0, 0, 0};
+                if (disc) tri_kernel(p->disc_radius, J[q[0]], J[q[1]], J[q[2]], vs, kern, &ybar);
                 double depth = (double)ytop - p->region.y_min;
-                uint32_t ns = slab_count(depth, (double)d * F, h, scale);
+                uint32_t ns = slab_count(depth, (double)tri_drift(vs) * F, h, scale);
                 out->prims += ns;
                 /* the boxes of (up to MAX_SLABS of) its slabs, as slab_range and prim_box make them */
                 float dy = depth > 0.0 ? (float)(depth / ns) : 1.0f;
@@ -512,8 +520,9 @@ void gr_beams_sample_prims(const gr_beam_params *p, int fine, int samples, gr_be
                 double w = (double)ns / m;
                 for (uint32_t r = 0; r < m; r++) {
                     uint32_t k = (uint32_t)(((uint64_t)r * ns) / m);
-                    float yhi = k == 0 ? ytop : ytop - (float)k * dy;
-                    float ylo = k + 1 == ns ? (float)p->region.y_min : ytop - (float)(k + 1) * dy;
+                    float lo, hi;
+                    slab_bounds(ytop, dy, k, ns, &lo, &hi);
+                    float ylo = isinf(lo) ? (float)p->region.y_min : lo, yhi = isinf(hi) ? ytop : hi;
                     float lo3[3], hi3[3];
                     beam_slab_box(vs, kern, ybar, disc, ylo, yhi, lo3, hi3);
                     double ex[3];

@@ -565,6 +565,19 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
     info->near_factor = r->near_F;
     info->near_radius_m = r->near_D;
     info->cells_per_wave = r->near_cpw;
+    double plain, fine;
+    /* the near set's and the camera cone's (prepare_pass) */
+    if (r->near_F > 1) info->near_cells = set_cells(r, r->near_box, r->near_D, r->near_F, &plain, &fine);
+    /* the probe's fourth level: the plain set with the near cells 2x finer (probe.c) */
+    if (r->near_F > 1 && r->set.bias_probe && !r->flat && gr_ref_probe_holds_near(r))
+        info->probe_near_cells = set_cells(r, r->near_box, r->near_D, 2 * r->near_F, &plain, &fine);
+    if (r->cone_on && r->set.surface_res > 0)
+        info->cone_cells = set_cells(r, r->cone_box, 0.5 * (r->cone_box[1] - r->cone_box[0]), r->set.refine_factor,
+                                     &plain, &fine);
+}
+
+void gr_ref_sample_sets(const gr_ref_renderer *r, gr_ref_info *info)
+{
     if (r->flat || !(plain_cell(r, r->set.surface_res) > 0.0)) return;
     /* the sets of pass 0 (prepare_pass), their slabs as a render builds them: the plain set's
      * and the near set's 0.5 cells of drift, the cone's 1, the probe's finer near set's 2 */
@@ -573,18 +586,16 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
     bp.sun_dir = gr_ref_pass_sun_dir(r, 0);
     double sr = r->set.surface_res, plain, fine;
     info->plain_prims = set_prims(&bp, sr * sr, 0.0, 1, 0.5, &info->plain_entries);
-    if (r->near_F > 1) {
-        info->near_cells = set_cells(r, r->near_box, r->near_D, r->near_F, &plain, &fine);
+    if (info->near_cells > 0.0) {
+        set_cells(r, r->near_box, r->near_D, r->near_F, &plain, &fine);
         info->near_prims = set_prims(&bp, plain, fine, r->near_F, 0.5, &info->near_entries);
     }
-    /* the probe's fourth level: the plain set with the near cells 2x finer (probe.c) */
-    if (r->near_F > 1 && r->set.bias_probe && gr_ref_probe_holds_near(r)) {
-        info->probe_near_cells = set_cells(r, r->near_box, r->near_D, 2 * r->near_F, &plain, &fine);
+    if (info->probe_near_cells > 0.0) {
+        set_cells(r, r->near_box, r->near_D, 2 * r->near_F, &plain, &fine);
         info->probe_near_prims = set_prims(&bp, plain, fine, 2 * r->near_F, 2.0, &info->probe_near_entries);
     }
-    if (r->cone_on && r->set.surface_res > 0) {
-        info->cone_cells = set_cells(r, r->cone_box, 0.5 * (r->cone_box[1] - r->cone_box[0]), r->set.refine_factor,
-                                     &plain, &fine);
+    if (info->cone_cells > 0.0) {
+        set_cells(r, r->cone_box, 0.5 * (r->cone_box[1] - r->cone_box[0]), r->set.refine_factor, &plain, &fine);
         info->cone_prims = set_prims(&bp, plain, fine, r->set.refine_factor, 1.0, &info->cone_entries);
     }
 }

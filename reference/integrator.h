@@ -135,13 +135,17 @@ typedef struct gr_ref_info {
     double near_cells;      /* estimated surface cells of its beam set, the refined sub-cells included */
     double probe_near_cells; /* the same for the bias probe's fourth level (its cells 2x finer), 0: none */
     /* expected beam-slab primitives of pass 0's sets and their lookup-grid entries per
-     * primitive (gr_beams_sample_prims, gr_beams_entries_per_prim; 0: no such set): the plain
-     * set, the camera cone's, the near set, the probe's finer one */
+     * primitive (gr_ref_sample_sets; 0: not sampled, or no such set): the plain set, the
+     * camera cone's, the near set, the probe's finer one */
     double plain_prims, cone_prims, near_prims, probe_near_prims;
     double plain_entries, cone_entries, near_entries, probe_near_entries;
     double cells_per_wave;  /* the plain grid's cells across the shortest wave (0: flat water) */
 } gr_ref_info;
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info);
+/* Fills info's primitives and entries (info from gr_ref_get_info): pass 0's sets sampled
+ * without building them (gr_beams_sample_prims, gr_beams_entries_per_prim), for the memory
+ * estimate (reference/memory.h). 9-15 ms, so kept out of gr_ref_get_info. */
+void gr_ref_sample_sets(const gr_ref_renderer *r, gr_ref_info *info);
 /* For the benchmark (reference/bench.c): the displaced surface mesh of the prepared pass
  * (NULL on flat water), its triangle count, and the rate of bare beam lookups (1 thread)
  * at random local points of box = {u0, u1, w0, w1, y0, y1}. */

@@ -10,8 +10,8 @@
 #include "scene/scene.h"
 
 /* Bytes a render of scene needs (the model and its measurements: docs/reliability.md
- * "Memory"), from the renderer's info (gr_ref_get_info after gr_ref_create: the lit region,
- * the sets' cells and their sampled primitives): *fixed for the process and its libraries,
+ * "Memory"), from the renderer's info (gr_ref_get_info, then gr_ref_sample_sets, after
+ * gr_ref_create: the lit region, the sets' cells and their sampled primitives): *fixed for the process and its libraries,
  * *pixels for the per-pixel sums, AOVs and image, *sets for the beam sets at their peak
  * (pass 0's sets kept while the next is built, each set's triangles, vertices, Embree mesh,
  * primitives and lookup grid; 0 on flat water). */

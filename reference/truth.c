@@ -51,6 +51,7 @@ static gr_status render(const gr_scene *scene, const gr_ref_options *opt, gr_ref
     gr_ref_info info;
     gr_ref_get_info(r, &info);
     *passes_per_round = info.passes_per_round;
+    gr_ref_sample_sets(r, &info);
     st = gr_ref_memory_check(scene, &info, err);
     if (st == GR_OK) {
         gr_signals_hold_begin(); /* the first signal only sets the flag; the renderer stops at its next check */

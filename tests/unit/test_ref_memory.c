@@ -89,6 +89,7 @@ static void peak_against_estimate(void)
     CHECK_OK(gr_ref_create(d, &opt, &r, &err), err);
     if (!r) exit(1);
     gr_ref_get_info(r, &info);
+    gr_ref_sample_sets(r, &info);
     double fixed = 0.0, pixels = 0.0, sets = 0.0;
     gr_ref_memory_parts(d, &info, &fixed, &pixels, &sets);
     const double est = pixels + sets; /* the render's part: no preview's libraries here */
