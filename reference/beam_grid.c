@@ -264,7 +264,7 @@ static void prim_box(const gr_beams *b, uint32_t prim, float lo3[3], float hi3[3
     uint32_t nslab = b->tri[t].nslab, k = prim - b->tri[t].first;
     float lo, hi;
     slab_range(b, t, k, nslab, &lo, &hi);
-    float ylo = isinf(lo) ? (float)b->y_min : lo, yhi = isinf(hi) ? b->tri[t].ytop : hi;
+    float ylo = isinf(lo) ? (float)b->y_min : lo, yhi = isinf(hi) ? b->tri[t].ys : hi;
     uint32_t idx[3];
     tri_vertices(b, t, idx);
     const beam_vertex *v[3] = {&b->v[idx[0]], &b->v[idx[1]], &b->v[idx[2]]};
@@ -285,8 +285,8 @@ static void beam_test(const gr_beams *b, uint32_t prim, uint32_t t, lookup_state
     uint32_t k = prim - bt->first;
     float y = s->y;
     /* the slab's half-open height interval (top slab open upward, bottom one downward) */
-    if (k > 0 && !(y < bt->ytop - (float)k * bt->dy)) return;
-    if (k + 1 < bt->nslab && !(y >= bt->ytop - (float)(k + 1) * bt->dy)) return;
+    if (k > 0 && !(y < bt->ys - (float)k * bt->dy)) return;
+    if (k + 1 < bt->nslab && !(y >= bt->ys - (float)(k + 1) * bt->dy)) return;
     /* cross-section vertices at height y, relative to vertex 0 */
     const float *cs = bt->c;
     float dt = y - bt->ytop;

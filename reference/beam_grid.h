@@ -24,6 +24,7 @@ typedef struct beam_vertex {
 typedef struct beam_tri {
     float phi;               /* F_t |I . a| (0 = no beam) */
     float ytop, dy;          /* top of the beam, slab height */
+    float ys;                /* top of its slabs: ytop, or the region's top below it */
     /* sun-disc kernel (zero without it): M = R J (2x2, row-major: shift in u, w per unit
      * depth for a unit offset in the disc frame); ybar = the mean height of the surface
      * vertices, from which the kernel's depth d = ybar - y is measured; kr = rho |M|_F, a
@@ -36,7 +37,7 @@ typedef struct beam_tri {
      * (c[4] + c[6] d, c[5] + c[7] d) and (c[8] + c[10] d, c[9] + c[11] d), the differences
      * taken in double (edges a few cm long, positions tens of metres from the origin) */
     float c[12];
-    float pad_[6];
+    float pad_[5];
 } beam_tri;
 _Static_assert(sizeof(beam_tri) == 128, "beam_tri fills two cache lines (aligned_alloc needs a multiple of 64)");
 
@@ -95,17 +96,17 @@ static inline void tri_vertices(const gr_beams *b, uint32_t t, uint32_t idx[3])
     idx[2] = bt->vi[2];
 }
 
-/* Slab k of nslab of a beam whose top is ytop, each dy high, spans [lo, hi); the top slab is
- * open upward and the bottom one downward, so each point of the beam belongs to exactly one
- * slab (no double counting). slab_range: triangle t's. */
-static inline void slab_bounds(float ytop, float dy, uint32_t k, uint32_t nslab, float *lo, float *hi)
+/* Slab k of nslab of a beam whose slabs start at ys, each dy high, spans [lo, hi); the top
+ * slab is open upward and the bottom one downward, so each point of the beam belongs to
+ * exactly one slab (no double counting). slab_range: triangle t's. */
+static inline void slab_bounds(float ys, float dy, uint32_t k, uint32_t nslab, float *lo, float *hi)
 {
-    *hi = k == 0 ? INFINITY : ytop - (float)k * dy;
-    *lo = k + 1 == nslab ? -INFINITY : ytop - (float)(k + 1) * dy;
+    *hi = k == 0 ? INFINITY : ys - (float)k * dy;
+    *lo = k + 1 == nslab ? -INFINITY : ys - (float)(k + 1) * dy;
 }
 static inline void slab_range(const gr_beams *b, uint32_t t, uint32_t k, uint32_t nslab, float *lo, float *hi)
 {
-    slab_bounds(b->tri[t].ytop, b->tri[t].dy, k, nslab, lo, hi);
+    slab_bounds(b->tri[t].ys, b->tri[t].dy, k, nslab, lo, hi);
 }
 
 /* min and max of non-NaN floats without the libm calls that fminf/fmaxf are here (no

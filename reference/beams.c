@@ -174,6 +174,15 @@ static int cell_tris(topo *T, const uint8_t *ref, int i, int j, uint32_t *vi, ui
 
 
 
+/* The top of a beam's slabs: its top, or the region's top (and a centimetre for float
+ * rounding) where that is lower: no lookup asks above it; the slab there stays open upward,
+ * its box stops at it */
+static float slab_top(float ytop, const gr_beam_region *r)
+{
+    double top = r->y_top + 0.01;
+    return r->has_top && (double)ytop > top ? (float)top : ytop;
+}
+
 /* Number of depth slabs for a beam whose corners drift by up to `drift` metres per metre
  * of height (in sheared coordinates): about `scale` cells of drift per slab keeps its box
  * tight. */
@@ -325,6 +334,7 @@ static void triangle_work(void *arg, int chunk, size_t k0, size_t k1)
         tri_vertices(b, (uint32_t)t, idx);
         const beam_vertex *v0 = &b->v[idx[0]], *v1 = &b->v[idx[1]], *v2 = &b->v[idx[2]];
         bt->ytop = fmaxf(v0->py, fmaxf(v1->py, v2->py));
+        bt->ys = slab_top(bt->ytop, &p->region);
         bt->ybar = bt->ytop;
         drift[t] = 0.0f;
         if (v0->ft < 0.0f || v1->ft < 0.0f || v2->ft < 0.0f) continue;
@@ -365,7 +375,7 @@ static void slab_count_work(void *arg, int chunk, size_t k0, size_t k1)
     const gr_beams *b = j->b;
     size_t n = 0;
     for (size_t t = k0; t < k1; t++)
-        if (b->tri[t].phi > 0.0f) n += slab_count(b->tri[t].ytop - j->y_min, j->drift[t], j->h, j->scale);
+        if (b->tri[t].phi > 0.0f) n += slab_count(b->tri[t].ys - j->y_min, j->drift[t], j->h, j->scale);
     j->chunk_slabs[chunk] = n;
 }
 
@@ -382,7 +392,7 @@ static void slab_fill_work(void *arg, int chunk, size_t k0, size_t k1)
         bt->nslab = 0;
         bt->dy = 1.0f;
         if (!(bt->phi > 0.0f)) continue;
-        double depth = bt->ytop - j->y_min;
+        double depth = bt->ys - j->y_min;
         uint32_t ns = slab_count(depth, j->drift[t], j->h, j->scale);
         bt->dy = depth > 0.0 ? (float)(depth / ns) : 1.0f;
         bt->nslab = ns;
@@ -511,7 +521,8 @@ void gr_beams_sample_prims(const gr_beam_params *p, int fine, int samples, gr_be
                 const beam_vertex *vs[3] = {&v[q[0]], &v[q[1]], &v[q[2]]};
                 float ytop = fmaxf(vs[0]->py, fmaxf(vs[1]->py, vs[2]->py)), ybar = ytop, kern[4] = {0, 0, 0, 0};
                 if (disc) tri_kernel(p->disc_radius, J[q[0]], J[q[1]], J[q[2]], vs, kern, &ybar);
-                double depth = (double)ytop - p->region.y_min;
+                float ys = slab_top(ytop, &p->region);
+                double depth = (double)ys - p->region.y_min;
                 uint32_t ns = slab_count(depth, (double)tri_drift(vs) * F, h, scale);
                 out->prims += ns;
                 /* the boxes of (up to MAX_SLABS of) its slabs, as slab_range and prim_box make them */
@@ -521,8 +532,8 @@ void gr_beams_sample_prims(const gr_beam_params *p, int fine, int samples, gr_be
                 for (uint32_t r = 0; r < m; r++) {
                     uint32_t k = (uint32_t)(((uint64_t)r * ns) / m);
                     float lo, hi;
-                    slab_bounds(ytop, dy, k, ns, &lo, &hi);
-                    float ylo = isinf(lo) ? (float)p->region.y_min : lo, yhi = isinf(hi) ? ytop : hi;
+                    slab_bounds(ys, dy, k, ns, &lo, &hi);
+                    float ylo = isinf(lo) ? (float)p->region.y_min : lo, yhi = isinf(hi) ? ys : hi;
                     float lo3[3], hi3[3];
                     beam_slab_box(vs, kern, ybar, disc, ylo, yhi, lo3, hi3);
                     double ex[3];

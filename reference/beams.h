@@ -31,6 +31,11 @@
 typedef struct gr_beam_region {
     double u0, u1, w0, w1;   /* sheared horizontal bounds of the lit volume (local, m) */
     double y_min;            /* local height of its bottom (<= 0) */
+    /* has_top: no lookup asks above y_top (local), so the beams' slabs stop there (the
+     * frustum's highest point: docs/reference.md 2.2, "The region's top"); 0: the whole
+     * column up to the surface */
+    int has_top;
+    double y_top;
 } gr_beam_region;
 
 typedef struct gr_beam_params {

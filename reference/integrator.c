@@ -167,6 +167,26 @@ static void near_refinement(gr_ref_renderer *r)
     box_around_ps(r, r->near_D + wave_amplitude_sum(&r->scene.water), r->near_box);
 }
 
+/* The largest w_y of any camera ray: straight up where the frustum holds it, else the
+ * largest on the image's border (w_y over the image plane has no other local maximum: its
+ * only one on the directions in front of the camera is the one nearest +y), sampled 4096
+ * times an edge, plus 1e-4 for the samples' spacing. */
+static double frustum_max_wy(const gr_ref_renderer *r, double ta, double tf)
+{
+    const gr_camera *c = &r->scene.camera;
+    double z = c->forward[1], x = c->right[1], y = c->up[1];
+    if (z > 0.0 && fabs(x) <= ta * z && fabs(y) <= tf * z) return 1.0;
+    enum { NE = 4096 };
+    double best = -1.0;
+    for (int e = 0; e < 4; e++)
+        for (int i = 0; i <= NE; i++) {
+            double s = 2.0 * i / NE - 1.0;
+            double a = e < 2 ? s * ta : (e == 2 ? -ta : ta), b = e < 2 ? (e == 0 ? -tf : tf) : s * tf;
+            best = fmax(best, cam_dir(r, a, b).y);
+        }
+    return fmin(1.0, best + 1e-4);
+}
+
 /* The lit region: sheared bounds of the visible volume (camera frustum up to each ray's
  * end), clamped to reference.patch_radius_m around the camera. */
 static void compute_region(gr_ref_renderer *r)
@@ -211,6 +231,23 @@ static void compute_region(gr_ref_renderer *r)
     }
     ymin = fmax(ymin, seabed_y);
     ymin = fmin(ymin, -A) - 0.05;
+    /* the region's top (docs/reference.md 2.2, "The region's top"): a ray rising at w_y ends
+     * by w_y D(w_y), which grows with w_y (gr_ref_cutoff_d), so the steepest ray's end is the
+     * highest point any lookup asks for; 5 cm and 1 % of the column above it. With a lit box
+     * (the irradiance probes of tests), or where the steepest ray reaches the crests, none. */
+    r->region.has_top = 0;
+    r->region.y_top = A;
+    if (!r->opt.lit_box_valid && !r->opt.full_column) {
+        const gr_camera *c = &s->camera;
+        double tf = tan(0.5 * c->fov_deg * GR_PI / 180.0), ta = tf * (double)c->width / (double)c->height;
+        double wy = frustum_max_wy(r, ta, tf), top = o.y;
+        if (wy > 0.0) top += wy * gr_ref_cutoff_d(r, wy);
+        top = fmax(top, o.y) + 0.05 + 0.01 * (top - ymin);
+        if (top < A) {
+            r->region.has_top = 1;
+            r->region.y_top = top;
+        }
+    }
     double mu = 0.02 * fmax(b[1] - b[0], b[3] - b[2]) + 0.1;
     r->region.u0 = b[0] - mu; r->region.u1 = b[1] + mu;
     r->region.w0 = b[2] - mu; r->region.w1 = b[3] + mu;
@@ -558,6 +595,7 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
     info->region[0] = r->region.u0; info->region[1] = r->region.u1;
     info->region[2] = r->region.w0; info->region[3] = r->region.w1;
     info->region[4] = r->region.y_min; info->region[5] = r->pad;
+    info->y_top = r->region.has_top ? r->region.y_top : INFINITY;
     if (r->beams) {
         info->cell_m = gr_beams_stats(r->beams)->cell_m;
         info->prims = gr_beams_stats(r->beams)->prims;

@@ -37,6 +37,8 @@ typedef struct gr_ref_options {
      * y_min. Unused when lit_box_valid = 0 (the region then follows the camera frustum). */
     int lit_box_valid;
     double lit_box[5];      /* x0, x1, z0, z1, y_min (world) */
+    int full_column;        /* 1: beams' slabs up to the surface even where no ray rises so
+                               high (the check of the region's top: docs/reference.md 2.2) */
     /* A part of the work (godrays farm, docs/farm.md): image rows [row0, row1) and batches
      * [batch0, batch1) only; both 0, 0 = all. Passes of other batches are skipped, the pixel
      * and pass random numbers stay keyed as in a full render, so a part's sums are the same
@@ -126,6 +128,7 @@ typedef struct gr_ref_info {
     int spp_per_pass;
     double cutoff_distance_m;
     double region[6];       /* sheared u0, u1, w0, w1, y_min (local), pad_m */
+    double y_top;           /* the region's top (local; INFINITY: the whole column) */
     double cell_m;          /* surface cell size of the last beam set (0 before one is built) */
     size_t prims;           /* beam-slab primitives of the last beam set */
     double cone_cells;      /* estimated surface cells of the camera cone's beam set, its

@@ -37,7 +37,8 @@ static inline int light_at(const gr_ref_renderer *r, const gr_beams *bs, gr_vec3
     if (!r->flat) {
         double u = x.x - r->sx * x.y, w = x.z - r->sz * x.y;
         const gr_beam_region *g = &r->region;
-        if (x.y >= g->y_min && u >= g->u0 && u <= g->u1 && w >= g->w0 && w <= g->w1) {
+        if (x.y >= g->y_min && (!g->has_top || x.y <= g->y_top) && u >= g->u0 && u <= g->u1 && w >= g->w0 &&
+            w <= g->w1) {
             int n = gr_beams_lookup(bs, x, hits);
             if (n < 0) return -1;
             if (n > *lcap) {

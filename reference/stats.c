@@ -366,8 +366,10 @@ static gr_status fill_metadata(const gr_ref_renderer *r, gr_ref_result *out, con
     SET(gr_meta_set_double(m, "godrays:preview_exposure", out->preview_exposure));
     SET(gr_meta_set_double(m, "godrays:queries_per_s", qps));
     SET(gr_meta_set_double(m, "godrays:beam_build_s", r->tally.beam_build_s));
-    snprintf(buf, sizeof buf, "u [%.3f, %.3f] w [%.3f, %.3f] y_min %.3f pad %.3f (local sheared, m)",
-             r->region.u0, r->region.u1, r->region.w0, r->region.w1, r->region.y_min, r->pad);
+    char top[48] = "";
+    if (r->region.has_top) snprintf(top, sizeof top, " y_top %.3f", r->region.y_top);
+    snprintf(buf, sizeof buf, "u [%.3f, %.3f] w [%.3f, %.3f] y_min %.3f%s pad %.3f (local sheared, m)", r->region.u0,
+             r->region.u1, r->region.w0, r->region.w1, r->region.y_min, top, r->pad);
     SET(gr_meta_set_string(m, "godrays:lit_region", buf));
     if (r->have_main_beams) {
         const gr_ref_sums *bs = &r->tally;

@@ -33,7 +33,8 @@ static int cacheable(const gr_ref_options *o)
     gr_ref_options_default(&d);
     return o->fresnel == d.fresnel && o->force_beams == d.force_beams && o->aovs == d.aovs &&
            o->max_prims == d.max_prims && o->max_rounds == d.max_rounds && o->fixed_grid == d.fixed_grid &&
-           o->lit_box_valid == d.lit_box_valid && o->row0 == d.row0 && o->row1 == d.row1 && o->batch0 == d.batch0 &&
+           o->lit_box_valid == d.lit_box_valid && o->full_column == d.full_column && o->row0 == d.row0 &&
+           o->row1 == d.row1 && o->batch0 == d.batch0 &&
            o->batch1 == d.batch1 && o->keep_sums == d.keep_sums;
 }
 
