@@ -48,6 +48,9 @@ static void usage(FILE *f)
             "  --partition P        Slurm partition (default: the cluster's)\n"
             "  --time T             time limit per job (sbatch --time)\n"
             "  --cpus N             cores per task (sbatch --cpus-per-task; the render's threads)\n"
+            "  --mem SIZE|auto      memory per job (sbatch --mem, e.g. 1536M or 4G) on every job;\n"
+            "                       auto: the parts and the merge from the ground truth's memory\n"
+            "                       estimate, the final job the site's default (docs/farm.md)\n"
             "  --max-parallel K     at most K array tasks at once\n"
             "  --retries R          attempts per part before it is reported failed (default 3)\n"
             "  --then tune|run|none the final job on the merged truths (default tune;\n"
@@ -306,6 +309,7 @@ static int farm_with(gr_args *args)
         STR_OPT("--frames", frames)
         STR_OPT("--partition", partition)
         STR_OPT("--time", time_limit)
+        STR_OPT("--mem", mem)
         STR_OPT("--then", then)
         STR_OPT("--then-args", then_args)
         else rc = gr_args_take_scene(args);
@@ -350,6 +354,7 @@ static int farm_with(gr_args *args)
     if (!rc && suite && !realpath(suite, plan.suite)) rc = gr_cli_usage_error(cmd, "--suite %s: %s", suite, strerror(errno));
     if (!rc) {
         gr_status st = s ? gr_farm_plan_suite(&plan, s, &err) : gr_farm_plan_cases(&plan, scene, &err);
+        if (st == GR_OK) st = gr_farm_plan_memory(&plan, scene, s, &err);
         if (st == GR_OK) st = gr_farm_write(&plan, scene, s, &err);
         if (st == GR_OK) st = gr_farm_verify_copies(&plan, &err); /* the jobs load the copies: the same keys */
         rc = st != GR_OK ? gr_cli_report(cmd, &err) : submit(&plan, dry);

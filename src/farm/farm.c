@@ -2,6 +2,7 @@
 
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,6 +13,8 @@
 
 #include "common/outfile.h"
 #include "reference/cache.h"
+#include "reference/integrator.h"
+#include "reference/memory.h"
 #include "tune/objective.h"
 #include "tune/session.h"
 
@@ -111,6 +114,60 @@ gr_status gr_farm_plan_suite(gr_farm_plan *plan, const gr_suite *suite, gr_error
     }
     if (st == GR_OK) refresh(plan);
     return st;
+}
+
+/* Bytes of one case's render (fixed, pixels, sets: reference/memory.h) */
+static gr_status case_memory(const gr_scene *cs, double *fixed, double *pixels, double *sets, gr_error *err)
+{
+    gr_ref_options o;
+    gr_ref_options_default(&o);
+    o.progress = 0;
+    gr_ref_renderer *r = NULL;
+    gr_status st = gr_ref_create(cs, &o, &r, err);
+    if (st != GR_OK) return st;
+    gr_ref_info info;
+    gr_ref_get_info(r, &info);
+    gr_ref_sample_sets(r, &info);
+    gr_ref_memory_parts(cs, &info, fixed, pixels, sets);
+    gr_ref_destroy(r);
+    return GR_OK;
+}
+
+gr_status gr_farm_plan_memory(gr_farm_plan *plan, const gr_scene *scene, const gr_suite *suite, gr_error *err)
+{
+    plan->mem_part_b = plan->mem_merge_b = 0.0;
+    if (strcmp(plan->mem, "auto") != 0) return GR_OK;
+    gr_scene *cs = malloc(sizeof *cs);
+    if (!cs) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
+    gr_status st = GR_OK;
+    for (int c = 0; c < plan->n_cases && st == GR_OK; c++) {
+        const gr_farm_case *fc = &plan->cases[c];
+        if (suite) {
+            *cs = suite->cases[c].scene;
+        } else {
+            gr_tune_view view = {0.0, 0.0};
+            if (fc->view) st = gr_tune_parse_view("--view", plan->views[fc->view - 1], &view, err);
+            if (st == GR_OK) st = gr_tune_make_case(scene, fc->time_s, fc->view ? &view : NULL, cs, err);
+        }
+        double fixed = 0.0, pixels = 0.0, sets = 0.0;
+        if (st == GR_OK) st = case_memory(cs, &fixed, &pixels, &sets, err);
+        /* a part: the whole render's (it allocates the image's sums; it touches its rows');
+         * the merge: every part's sums read, the merged sums, the image (docs/farm.md "Memory") */
+        plan->mem_part_b = fmax(plan->mem_part_b, fixed + pixels + sets);
+        plan->mem_merge_b = fmax(plan->mem_merge_b, fixed + 2.0 * pixels);
+    }
+    free(cs);
+    return st;
+}
+
+/* The #SBATCH --mem line of a job: auto's figure in MiB (rounded up), or the size given */
+static void mem_line(FILE *f, const gr_farm_plan *plan, double auto_b)
+{
+    if (!strcmp(plan->mem, "auto")) {
+        if (auto_b > 0.0) fprintf(f, "#SBATCH --mem=%.0fM\n", ceil(auto_b / 1048576.0));
+    } else if (plan->mem[0]) {
+        fprintf(f, "#SBATCH --mem=%s\n", plan->mem);
+    }
 }
 
 void gr_farm_plan_free(gr_farm_plan *plan)
@@ -215,6 +272,22 @@ static gr_status plain_word(const char *what, const char *v, gr_error *err)
     return GR_OK;
 }
 
+/* "", "auto" or a size as sbatch --mem takes it (digits, then K, M, G, T or nothing for M) */
+static gr_status check_mem(const char *mem, gr_error *err)
+{
+    if (!mem[0] || !strcmp(mem, "auto")) return GR_OK;
+    size_t n = strspn(mem, "0123456789");
+    int ok = n > 0 && n <= 12 && (mem[n] == '\0' || (strchr("KMGT", mem[n]) && mem[n + 1] == '\0'));
+    if (ok) {
+        ok = 0;
+        for (size_t k = 0; k < n; k++) ok |= mem[k] != '0';
+    }
+    if (!ok)
+        return gr_fail(err, GR_E_USAGE, "--mem %s: expected auto or a size as sbatch --mem takes it (a number > 0, then K, M, "
+                                        "G or T; no unit: M), e.g. 1536M or 4G", mem);
+    return GR_OK;
+}
+
 gr_status gr_farm_check(const gr_farm_plan *plan, gr_error *err)
 {
     const struct { const char *what, *v; } vals[] = {
@@ -228,6 +301,7 @@ gr_status gr_farm_check(const gr_farm_plan *plan, gr_error *err)
     if (st == GR_OK) st = plain_word("--frames", plan->frames, err);
     for (int v = 0; st == GR_OK && v < plan->n_views; v++) st = plain_word("--view", plan->views[v], err);
     for (int k = 0; st == GR_OK && k < plan->n_sets; k++) st = no_control("--set", plan->sets[k], err);
+    if (st == GR_OK) st = check_mem(plan->mem, err);
     return st;
 }
 
@@ -343,6 +417,7 @@ static gr_status write_final(const gr_farm_plan *plan, gr_error *err)
     header(f, plan, "the final job on the merged ground truths (found in the cache)");
     sbatch_common(f, plan, "godrays-final", "final");
     if (plan->cpus > 0) fprintf(f, "#SBATCH --cpus-per-task=%d\n", plan->cpus);
+    mem_line(f, plan, 0.0); /* auto: the site's default (tune and run are not estimated) */
     fputs("set -u\nGODRAYS=", f);
     sq(f, plan->binary);
     fputs("\nFARM=", f);
@@ -440,6 +515,7 @@ gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, const g
             per, per, plan->batch_parts, plan->batch_parts, plan->n_cases * per - 1);
     sbatch_common(f, plan, "godrays-parts", "part-%a");
     if (plan->cpus > 0) fprintf(f, "#SBATCH --cpus-per-task=%d\n", plan->cpus);
+    mem_line(f, plan, plan->mem_part_b);
     fputs("#SBATCH --requeue\n", f);
     vars(f, plan);
     fprintf(f, "RETRIES=%d\n", plan->retries);
@@ -482,6 +558,7 @@ gr_status gr_farm_write(const gr_farm_plan *plan, const gr_scene *scene, const g
           "# reported with the tail of their logs (exit 1).\n",
           f);
     sbatch_common(f, plan, "godrays-merge", "merge-%a");
+    mem_line(f, plan, plan->mem_merge_b);
     vars(f, plan);
     fputs("mkdir -p \"$FARM/truth\"\n"
           "fail=0\n"

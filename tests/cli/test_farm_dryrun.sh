@@ -62,6 +62,28 @@ GODRAYS_CACHE=$T/cache "$BIN" farm --suite "$T/suite.json" --frames 0:10:10 --dr
 check "--suite with --frames: exit 2" test $? -eq 2
 GODRAYS_CACHE=$T/cache "$BIN" farm --suite "$T/suite.json" --batch-parts 9 --dry-run -o "$T/x" > "$T/bp.txt" 2>&1
 check "--suite --batch-parts 9: exit 2 naming the case" grep -q "case up: --tiles" "$T/bp.txt"
+# memory requests (docs/farm.md "Memory"): none unless asked; a size on every job; auto on the
+# parts and the merge, the part's the largest of the cases' estimates, which `reference` states
+# when it refuses a render over GODRAYS_MAX_MEMORY (0.01 GiB steps there)
+check "no --mem: no request" sh -c "! grep -q '^#SBATCH --mem' '$T/f/parts.sh' '$T/f/merge.sh' '$T/f/final.sh'"
+GODRAYS_CACHE=$T/cache "$BIN" farm "$SRC/data/scenes/default.json" --mem 4G --dry-run -o "$T/m4" > /dev/null 2>&1
+for s in parts.sh merge.sh final.sh; do check "--mem 4G: $s" grep -qx "#SBATCH --mem=4G" "$T/m4/$s"; done
+GODRAYS_CACHE=$T/cache "$BIN" farm --suite "$T/suite.json" --mem auto --dry-run -o "$T/ma" > /dev/null 2>&1
+check "--mem auto: exit 0" test $? -eq 0
+pm=$(sed -n 's/^#SBATCH --mem=\([0-9]*\)M$/\1/p' "$T/ma/parts.sh")
+mm=$(sed -n 's/^#SBATCH --mem=\([0-9]*\)M$/\1/p' "$T/ma/merge.sh")
+check "--mem auto: parts.sh and merge.sh request MiB ($pm, $mm)" test -n "$pm" -a -n "$mm"
+check "--mem auto: final.sh keeps the site's default" sh -c "! grep -q '^#SBATCH --mem' '$T/ma/final.sh'"
+for c in up across; do
+  GODRAYS_MAX_MEMORY=1M "$BIN" reference "$T/ma/cases/$c/scene.json" -o "$T/x.exr" > "$T/ref_$c.txt" 2>&1
+done
+check "--mem auto: the parts' request is the larger case's estimate" python3 -c "import re, sys
+g = [float(re.search(r'needs about ([0-9.]+) GiB', open(sys.argv[1] + '/ref_' + c + '.txt').read()).group(1))
+     for c in ('up', 'across')]
+print('  cases', g, 'GiB; parts', sys.argv[2], 'MiB')
+sys.exit(abs(max(g) * 1024 - int(sys.argv[2])) > 12)" "$T" "${pm:-0}"
+GODRAYS_CACHE=$T/cache "$BIN" farm "$SRC/data/scenes/default.json" --mem 12X --dry-run -o "$T/mx" > "$T/mx.txt" 2>&1
+check "--mem 12X: exit 2 naming --mem" sh -c "[ $? -eq 2 ] && grep -q -- '--mem 12X' '$T/mx.txt' && [ ! -e '$T/mx' ]"
 # bad options
 GODRAYS_CACHE=$T/cache "$BIN" farm "$SRC/data/scenes/default.json" --tiles 0 --dry-run -o "$T/x" > /dev/null 2>&1
 check "--tiles 0: exit 2" test $? -eq 2

@@ -4,7 +4,9 @@
 # proctrack/linuxproc, select/cons_tres, no cgroups, no systemd) from a generated slurm.conf
 # naming this host, all stopped at the end by their pids. Then:
 #  1. farm submits a 2-frame x 4-tile job array of a small scene, a merge job after it and a
-#     final tune job after that; one part's process is killed (SIGKILL) mid-way;
+#     final tune job after that, the parts and the merge requesting the memory the estimate
+#     gives (--mem auto; the node has its RealMemory); one part's process is killed (SIGKILL)
+#     mid-way;
 #  2. all jobs finish: the killed part was retried (its log shows attempt 1 failed with 137 and
 #     attempt 2 done), both frames' truths are in the cache, and each is byte for byte (every
 #     channel, idiff with zero tolerance, and the batch statistics) a single local render;
@@ -56,6 +58,8 @@ munged --socket="$T/munge/munge.sock" --key-file="$T/munge/munge.key" --log-file
 H=$(hostname -s)
 PORT=$((20000 + ($$ % 5000) * 2))
 CPUS=$(nproc)
+# the node's memory (MiB, a little under what it has), so that jobs may request memory (--mem auto)
+MEM=$(awk '/^MemTotal:/ {print int($2 / 1024) - 256}' /proc/meminfo)
 cat > "$T/slurm.conf" <<EOF
 ClusterName=godraystest
 SlurmctldHost=$H(127.0.0.1)
@@ -82,7 +86,7 @@ SelectTypeParameters=CR_Core
 ReturnToService=2
 MpiDefault=none
 SwitchType=switch/none
-NodeName=$H NodeAddr=127.0.0.1 CPUs=$CPUS State=UNKNOWN
+NodeName=$H NodeAddr=127.0.0.1 CPUs=$CPUS RealMemory=$MEM State=UNKNOWN
 PartitionName=test Nodes=$H Default=YES MaxTime=INFINITE State=UP
 EOF
 export SLURM_CONF=$T/slurm.conf
@@ -108,9 +112,10 @@ export GODRAYS_CACHE=$T/cache
 SCENE=$SRC/data/scenes/default.json
 Q=(--size 96x54 --set reference.surface_res=64 --set reference.steps=48)
 t0=$(date +%s.%N)
-"$BIN" farm "$SCENE" "${Q[@]}" --frames 0:10:10 --tiles 4 --cpus 1 --partition test -o "$T/farm" \
+"$BIN" farm "$SCENE" "${Q[@]}" --frames 0:10:10 --tiles 4 --cpus 1 --partition test -o "$T/farm" --mem auto \
   --then tune --then-args "--params shafts.K --max-evals 4" > "$T/farm1.txt" 2>&1
 check "farm submitted (exit 0)" test $? -eq 0
+for s in parts.sh merge.sh; do check "$s requests memory (--mem auto)" grep -q '^#SBATCH --mem=[0-9]*M$' "$T/farm/$s"; done
 cat "$T/farm1.txt"
 killed=""
 for _ in $(seq 400); do
