@@ -447,6 +447,24 @@ static gr_status build_on_plain_lines(gr_ref_renderer *r, gr_beam_params *bp, co
     return build_set(r, bp, out, err);
 }
 
+/* The slabs of a render's plain and near sets, in cells of drift (docs/reference.md 2.2,
+ * "Slab thickness"): half a cell (tight boxes, fewer candidates per lookup) where the march
+ * looks the set up more than SLAB_THIN_RHO times per primitive, one cell above SLAB_MID_RHO,
+ * else two (fewer primitives to build, sort and grid). Slabs change the boxes, never the
+ * hits: the pixels are the same bytes for any choice. Outside a render (the tests' probes):
+ * one cell. */
+enum { SLAB_THIN_RHO_X10 = 23, SLAB_MID_RHO_X10 = 6 };
+static double slab_cells_for(double lookups, double prims)
+{
+    if (!(lookups > 0.0) || !(prims > 0.0)) return 0.5;
+    double rho = lookups / prims;
+    return rho >= SLAB_THIN_RHO_X10 / 10.0 ? 0.5 : rho >= SLAB_MID_RHO_X10 / 10.0 ? 1.0 : 2.0;
+}
+static double render_slab_cells(const gr_ref_renderer *r)
+{
+    return r->rendering ? slab_cells_for(r->lookups_next, r->slab_prims) : 1.0;
+}
+
 /* The beam parameters of pass `pass` for its plain set (r->Ip: the pass's sun direction,
  * set by gr_ref_prepare_pass). The grid's offset: the pass's own; with reference.antithetic,
  * the (2m + 1)-th pass of a batch in a round takes the (2m)-th's moved by half a cell in both
@@ -480,9 +498,9 @@ static void pass_params(const gr_ref_renderer *r, int pass, gr_beam_params *bp)
     bp->jitter[1] = jit[1];
     bp->max_prims = r->opt.max_prims;
     bp->surface_mesh = 1;
-    /* a render's march looks up millions of points per beam set: thinner slabs pay off
-     * there (docs/reference.md, "Lookups"); probes keep the cheaper build */
-    bp->slab_cells = r->rendering ? 0.5 : 1.0;
+    /* thinner slabs where the march looks the set up many times per primitive (docs/reference.md
+     * 2.2, "Lookups" and "Slab thickness") */
+    bp->slab_cells = render_slab_cells(r);
     bp->threads = r->threads;
     bp->refine_angle = r->set.refine_angle_deg * GR_PI / 180.0;
     bp->camera = &r->scene.camera;
@@ -531,7 +549,7 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     if (r->cone_on && st == GR_OK)
         st = build_on_plain_lines(r, &bp, r->cone_box, r->set.refine_factor, 0.0, 1.0, &r->cone, err);
     if (r->near_F > 1 && st == GR_OK) {
-        st = build_on_plain_lines(r, &bp, r->near_box, r->near_F, r->near_D, r->rendering ? 0.5 : 1.0, &r->near, err);
+        st = build_on_plain_lines(r, &bp, r->near_box, r->near_F, r->near_D, render_slab_cells(r), &r->near, err);
         if (st == GR_OK && r->near) {
             r->near_stats = *gr_beams_stats(r->near);
             r->near_stats_valid = 1;
@@ -617,16 +635,25 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
 void gr_ref_sample_sets(const gr_ref_renderer *r, gr_ref_info *info)
 {
     if (r->flat || !(plain_cell(r, r->set.surface_res) > 0.0)) return;
-    /* the sets of pass 0 (prepare_pass), their slabs as a render builds them: the plain set's
-     * and the near set's 0.5 cells of drift, the cone's 1, the probe's finer near set's 2 */
+    /* the sets of pass 0 (prepare_pass), their slabs as a render builds them at the thinnest:
+     * the plain set's and the near set's (0.5 cells of drift where it looks them up enough),
+     * the cone's 1, the probe's finer near set's 2 */
     gr_beam_params bp;
     pass_params(r, 0, &bp);
     bp.sun_dir = gr_ref_pass_sun_dir(r, 0);
     double sr = r->set.surface_res, plain, fine;
     info->plain_prims = set_prims(&bp, sr * sr, 0.0, 1, 0.5, &info->plain_entries);
+    /* the render's slabs are no thinner than its most lookups make them (render_slab_cells):
+     * every pixel of its rows at the step cap, or the pilot's rays */
+    const gr_camera *c = &r->scene.camera;
+    double most = fmax((double)c->width * (r->opt.row1 - r->opt.row0) * r->spp_pass * r->set.steps,
+                       (double)((c->width + PILOT_STRIDE - 1) / PILOT_STRIDE) * ((c->height + PILOT_STRIDE - 1) / PILOT_STRIDE) *
+                           r->set.pilot_steps);
+    double thin = slab_cells_for(most, info->plain_prims);
+    if (thin > 0.5) info->plain_prims = set_prims(&bp, sr * sr, 0.0, 1, thin, &info->plain_entries);
     if (info->near_cells > 0.0) {
         set_cells(r, r->near_box, r->near_D, r->near_F, &plain, &fine);
-        info->near_prims = set_prims(&bp, plain, fine, r->near_F, 0.5, &info->near_entries);
+        info->near_prims = set_prims(&bp, plain, fine, r->near_F, thin, &info->near_entries);
     }
     if (info->probe_near_cells > 0.0) {
         set_cells(r, r->near_box, r->near_D, 2 * r->near_F, &plain, &fine);
@@ -666,6 +693,15 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     memset(&e, 0, sizeof e);
     int pass = 0;
     r->rendering = 1;
+    /* the plain set's primitives at half a cell, for the slabs' choice (render_slab_cells) */
+    r->slab_prims = r->lookups_next = 0.0;
+    if (!r->flat && plain_cell(r, r->set.surface_res) > 0.0) {
+        gr_beam_params sbp;
+        double entries, sr = r->set.surface_res;
+        pass_params(r, 0, &sbp);
+        sbp.sun_dir = gr_ref_pass_sun_dir(r, 0);
+        r->slab_prims = set_prims(&sbp, sr * sr, 0.0, 1, 0.5, &entries);
+    }
     int probe = r->set.bias_probe && !r->flat && r->opt.batch0 == 0; /* a part: the one with batch 0 */
     double mainw = probe ? 0.95 : 1.0; /* share of the progress bar for the main passes */
     ref_march_totals tot = {0.0, 0, 0, 0};
@@ -704,10 +740,16 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     st = gr_ref_step_pilot(r, pool, prog, &pilot_done, err);
     if (st == GR_OK && !pilot_done) out->partial = 1;
     gr_ref_phases_switch(&r->phases, REF_PH_MARCH);
+    /* a pass's lookups: one per stratum, the pixels' steps per camera sample, this part's rows */
+    double lookups = 0.0;
+    for (int y = r->opt.row0; y < r->opt.row1; y++)
+        for (int x = 0; x < acc.W; x++) lookups += r->steps_px ? r->steps_px[(size_t)y * acc.W + x] : r->set.steps;
+    lookups *= r->spp_pass;
     for (int round = 0; round < rounds && st == GR_OK && !out->partial; round++) {
         for (int pp = 0; pp < P && st == GR_OK; pp++, pass++) {
             if (pass % acc.B < r->opt.batch0 || pass % acc.B >= r->opt.batch1) continue; /* another part's batch */
             if (r->opt.interrupt && *r->opt.interrupt) { out->partial = 1; break; }
+            r->lookups_next = lookups;
             st = gr_ref_prepare_pass(r, pass, err);
             if (st == GR_E_INTERRUPTED) { st = GR_OK; out->partial = 1; break; }
             if (st != GR_OK) break;
@@ -784,6 +826,7 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     if (st == GR_OK && probe && !out->partial) {
         double tp = gr_ref_mono_s();
         gr_ref_phases_switch(&r->phases, REF_PH_PROBE);
+        r->lookups_next = lookups / (PROBE_STRIDE * PROBE_STRIDE); /* every PROBE_STRIDE-th pixel and row */
         st = gr_ref_probe_run(r, keep, &cap, capf.sum ? &capf : NULL, pool, prog, mainw, 1.0 - mainw, &ptot, err);
         gr_ref_phases_switch(&r->phases, REF_PH_OTHER);
         t->probe_s = gr_ref_mono_s() - tp;

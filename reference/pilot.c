@@ -318,6 +318,7 @@ gr_status gr_ref_step_pilot(gr_ref_renderer *r, gr_ref_pool *pool, gr_progress *
         free(job.pl); free(job.pv); free(job.pvs);
         return gr_fail(err, GR_E_NOMEM, "reference: out of memory for the step pilot (%dx%d)", W, H);
     }
+    r->lookups_next = (double)job.pw * (job.jb1 - job.jb0) * job.n0; /* its rays' steps (the slabs' choice) */
     gr_status st = gr_ref_prepare_pass(r, PILOT_PASS, err);
     if (st == GR_E_INTERRUPTED) { *complete = 0; st = GR_OK; goto out; }
     if (st != GR_OK) goto out;
