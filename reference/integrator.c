@@ -632,6 +632,16 @@ void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info)
                                      &plain, &fine);
 }
 
+/* Pass 0's plain set (its parameters in *bp): the primitives sampled at half a cell of drift
+ * and their grid entries per primitive (*entries) */
+static double plain_prims_half(const gr_ref_renderer *r, gr_beam_params *bp, double *entries)
+{
+    pass_params(r, 0, bp);
+    bp->sun_dir = gr_ref_pass_sun_dir(r, 0);
+    double sr = r->set.surface_res;
+    return set_prims(bp, sr * sr, 0.0, 1, 0.5, entries);
+}
+
 void gr_ref_sample_sets(const gr_ref_renderer *r, gr_ref_info *info)
 {
     if (r->flat || !(plain_cell(r, r->set.surface_res) > 0.0)) return;
@@ -639,10 +649,8 @@ void gr_ref_sample_sets(const gr_ref_renderer *r, gr_ref_info *info)
      * the plain set's and the near set's (0.5 cells of drift where it looks them up enough),
      * the cone's 1, the probe's finer near set's 2 */
     gr_beam_params bp;
-    pass_params(r, 0, &bp);
-    bp.sun_dir = gr_ref_pass_sun_dir(r, 0);
     double sr = r->set.surface_res, plain, fine;
-    info->plain_prims = set_prims(&bp, sr * sr, 0.0, 1, 0.5, &info->plain_entries);
+    info->plain_prims = plain_prims_half(r, &bp, &info->plain_entries);
     /* the render's slabs are no thinner than its most lookups make them (render_slab_cells):
      * every pixel of its rows at the step cap, or the pilot's rays */
     const gr_camera *c = &r->scene.camera;
@@ -696,11 +704,9 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     /* the plain set's primitives at half a cell, for the slabs' choice (render_slab_cells) */
     r->slab_prims = r->lookups_next = 0.0;
     if (!r->flat && plain_cell(r, r->set.surface_res) > 0.0) {
-        gr_beam_params sbp;
-        double entries, sr = r->set.surface_res;
-        pass_params(r, 0, &sbp);
-        sbp.sun_dir = gr_ref_pass_sun_dir(r, 0);
-        r->slab_prims = set_prims(&sbp, sr * sr, 0.0, 1, 0.5, &entries);
+        gr_beam_params bp;
+        double entries;
+        r->slab_prims = plain_prims_half(r, &bp, &entries);
     }
     int probe = r->set.bias_probe && !r->flat && r->opt.batch0 == 0; /* a part: the one with batch 0 */
     double mainw = probe ? 0.95 : 1.0; /* share of the progress bar for the main passes */

@@ -171,6 +171,22 @@ gr_status gr_truth_image(const gr_scene *scene, const gr_truth_options *o, gr_im
     return st;
 }
 
+gr_status gr_truth_memory(const gr_scene *scene, double *fixed, double *pixels, double *sets, gr_error *err)
+{
+    gr_ref_options o;
+    gr_ref_options_default(&o);
+    o.progress = 0;
+    gr_ref_renderer *r = NULL;
+    gr_status st = gr_ref_create(scene, &o, &r, err);
+    if (st != GR_OK) return st;
+    gr_ref_info info;
+    gr_ref_get_info(r, &info);
+    gr_ref_sample_sets(r, &info);
+    gr_ref_memory_parts(scene, &info, fixed, pixels, sets);
+    gr_ref_destroy(r);
+    return GR_OK;
+}
+
 gr_status gr_truth_assemble(const gr_scene *scene, const gr_ref_sums *sums, double wall_s, gr_truth_sums_check check,
                             void *user, gr_ref_result *out, gr_error *err)
 {

@@ -69,6 +69,12 @@ gr_status gr_truth_get(const gr_scene *scene, const gr_truth_options *o, gr_ref_
 gr_status gr_truth_image(const gr_scene *scene, const gr_truth_options *o, gr_image **img, gr_truth_info *info,
                          gr_error *err);
 
+/* The memory a render of scene would need, renderer's default options (reference/memory.h:
+ * *fixed for the process, *pixels for its sums and image, *sets for its beam sets at their
+ * peak), from its lit region and its sets sampled; nothing rendered. For sizing jobs
+ * (`godrays farm --mem auto`). */
+gr_status gr_truth_memory(const gr_scene *scene, double *fixed, double *pixels, double *sets, gr_error *err);
+
 /* What a render of the scene gives (its passes and samples per pass), for checking sums
  * that came from elsewhere before they are assembled; a status other than GR_OK stops. */
 typedef gr_status (*gr_truth_sums_check)(void *user, const gr_ref_info *info, gr_error *err);

@@ -13,8 +13,7 @@
 
 #include "common/outfile.h"
 #include "reference/cache.h"
-#include "reference/integrator.h"
-#include "reference/memory.h"
+#include "reference/truth.h"
 #include "tune/objective.h"
 #include "tune/session.h"
 
@@ -116,23 +115,6 @@ gr_status gr_farm_plan_suite(gr_farm_plan *plan, const gr_suite *suite, gr_error
     return st;
 }
 
-/* Bytes of one case's render (fixed, pixels, sets: reference/memory.h) */
-static gr_status case_memory(const gr_scene *cs, double *fixed, double *pixels, double *sets, gr_error *err)
-{
-    gr_ref_options o;
-    gr_ref_options_default(&o);
-    o.progress = 0;
-    gr_ref_renderer *r = NULL;
-    gr_status st = gr_ref_create(cs, &o, &r, err);
-    if (st != GR_OK) return st;
-    gr_ref_info info;
-    gr_ref_get_info(r, &info);
-    gr_ref_sample_sets(r, &info);
-    gr_ref_memory_parts(cs, &info, fixed, pixels, sets);
-    gr_ref_destroy(r);
-    return GR_OK;
-}
-
 gr_status gr_farm_plan_memory(gr_farm_plan *plan, const gr_scene *scene, const gr_suite *suite, gr_error *err)
 {
     plan->mem_part_b = plan->mem_merge_b = 0.0;
@@ -150,7 +132,7 @@ gr_status gr_farm_plan_memory(gr_farm_plan *plan, const gr_scene *scene, const g
             if (st == GR_OK) st = gr_tune_make_case(scene, fc->time_s, fc->view ? &view : NULL, cs, err);
         }
         double fixed = 0.0, pixels = 0.0, sets = 0.0;
-        if (st == GR_OK) st = case_memory(cs, &fixed, &pixels, &sets, err);
+        if (st == GR_OK) st = gr_truth_memory(cs, &fixed, &pixels, &sets, err);
         /* a part: the whole render's (it allocates the image's sums; it touches its rows');
          * the merge: every part's sums read, the merged sums, the image (docs/farm.md "Memory") */
         plan->mem_part_b = fmax(plan->mem_part_b, fixed + pixels + sets);
