@@ -38,6 +38,18 @@ static int cacheable(const gr_ref_options *o)
            o->batch1 == d.batch1 && o->keep_sums == d.keep_sums;
 }
 
+/* A renderer for scene and what its memory estimate needs (its info, its sets sampled:
+ * reference/memory.h); nothing built yet */
+static gr_status create_sampled(const gr_scene *scene, const gr_ref_options *o, gr_ref_renderer **r, gr_ref_info *info,
+                                gr_error *err)
+{
+    gr_status st = gr_ref_create(scene, o, r, err);
+    if (st != GR_OK) return st;
+    gr_ref_get_info(*r, info);
+    gr_ref_sample_sets(*r, info);
+    return GR_OK;
+}
+
 /* Create, memory check, render in a held region, destroy. Building the scene and the beams'
  * lit region renders nothing yet and holds nothing to keep: a signal before the held region
  * ends the process at once (common/signals). */
@@ -47,12 +59,10 @@ static gr_status render(const gr_scene *scene, const gr_ref_options *opt, gr_ref
     gr_ref_options o = *opt;
     o.interrupt = gr_signals_flag(); /* SIGINT and SIGTERM (common/signals, installed by main) */
     gr_ref_renderer *r = NULL;
-    gr_status st = gr_ref_create(scene, &o, &r, err);
-    if (st != GR_OK) return st;
     gr_ref_info info;
-    gr_ref_get_info(r, &info);
+    gr_status st = create_sampled(scene, &o, &r, &info, err);
+    if (st != GR_OK) return st;
     *passes_per_round = info.passes_per_round;
-    gr_ref_sample_sets(r, &info);
     st = gr_ref_memory_check(scene, &info, err);
     if (st == GR_OK) {
         gr_signals_hold_begin(); /* the first signal only sets the flag; the renderer stops at its next check */
@@ -177,11 +187,9 @@ gr_status gr_truth_memory(const gr_scene *scene, double *fixed, double *pixels, 
     gr_ref_options_default(&o);
     o.progress = 0;
     gr_ref_renderer *r = NULL;
-    gr_status st = gr_ref_create(scene, &o, &r, err);
-    if (st != GR_OK) return st;
     gr_ref_info info;
-    gr_ref_get_info(r, &info);
-    gr_ref_sample_sets(r, &info);
+    gr_status st = create_sampled(scene, &o, &r, &info, err);
+    if (st != GR_OK) return st;
     gr_ref_memory_parts(scene, &info, fixed, pixels, sets);
     gr_ref_destroy(r);
     return GR_OK;
