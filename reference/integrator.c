@@ -543,11 +543,15 @@ gr_status gr_ref_prepare_pass(gr_ref_renderer *r, int pass, gr_error *err)
     pass_params(r, pass, &bp);
     int prev = gr_ref_phases_switch(&r->phases, REF_PH_BEAMS);
     gr_status st = build_set(r, &bp, &r->beams, err);
-    /* slabs of a cell's drift for the cone's set: its refined cells are many and only the
-     * cone's rays look them up (measured: its builds 5.6 s -> 3.8 s of a render, the same
-     * bias); the near set's as the plain set's (measured: 1.0 and 2.0 cost more there) */
-    if (r->cone_on && st == GR_OK)
-        st = build_on_plain_lines(r, &bp, r->cone_box, r->set.refine_factor, 0.0, 1.0, &r->cone, err);
+    /* the cone's set: twice the plain set's slabs, one or two cells of drift (its refined
+     * cells are many and only the cone's rays look them up: at one cell its builds 5.6 s ->
+     * 3.8 s of a 640 x 360 render, the same bias; two cost the same there and less below
+     * it, docs/reference.md 2.2, "Slab thickness"); the near set's as the plain set's
+     * (measured: 1.0 and 2.0 cost more there) */
+    if (r->cone_on && st == GR_OK) {
+        double cone_slabs = r->rendering ? fmin(2.0, 2.0 * bp.slab_cells) : 1.0;
+        st = build_on_plain_lines(r, &bp, r->cone_box, r->set.refine_factor, 0.0, cone_slabs, &r->cone, err);
+    }
     if (r->near_F > 1 && st == GR_OK) {
         st = build_on_plain_lines(r, &bp, r->near_box, r->near_F, r->near_D, render_slab_cells(r), &r->near, err);
         if (st == GR_OK && r->near) {
