@@ -646,7 +646,7 @@ static double plain_prims_half(const gr_ref_renderer *r, gr_beam_params *bp, dou
     return set_prims(bp, sr * sr, 0.0, 1, 0.5, entries);
 }
 
-void gr_ref_sample_sets(const gr_ref_renderer *r, gr_ref_info *info)
+void gr_ref_sample_sets(gr_ref_renderer *r, gr_ref_info *info)
 {
     if (r->flat || !(plain_cell(r, r->set.surface_res) > 0.0)) return;
     /* the sets of pass 0 (prepare_pass), their slabs as a render builds them at the thinnest:
@@ -654,7 +654,7 @@ void gr_ref_sample_sets(const gr_ref_renderer *r, gr_ref_info *info)
      * the cone's 1, the probe's finer near set's 2 */
     gr_beam_params bp;
     double sr = r->set.surface_res, plain, fine;
-    info->plain_prims = plain_prims_half(r, &bp, &info->plain_entries);
+    info->plain_prims = r->slab_prims = plain_prims_half(r, &bp, &info->plain_entries); /* kept for the render */
     /* the render's slabs are no thinner than its most lookups make them (render_slab_cells):
      * every pixel of its rows at the step cap, or the pilot's rays */
     const gr_camera *c = &r->scene.camera;
@@ -705,9 +705,10 @@ gr_status gr_ref_render(gr_ref_renderer *r, gr_ref_result *out, gr_error *err)
     memset(&e, 0, sizeof e);
     int pass = 0;
     r->rendering = 1;
-    /* the plain set's primitives at half a cell, for the slabs' choice (render_slab_cells) */
-    r->slab_prims = r->lookups_next = 0.0;
-    if (!r->flat && plain_cell(r, r->set.surface_res) > 0.0) {
+    /* the plain set's primitives at half a cell, for the slabs' choice (render_slab_cells):
+     * sampled here unless gr_ref_sample_sets did (the memory check before the render) */
+    r->lookups_next = 0.0;
+    if (!(r->slab_prims > 0.0) && !r->flat && plain_cell(r, r->set.surface_res) > 0.0) {
         gr_beam_params bp;
         double entries;
         r->slab_prims = plain_prims_half(r, &bp, &entries);

@@ -147,8 +147,9 @@ typedef struct gr_ref_info {
 void gr_ref_get_info(const gr_ref_renderer *r, gr_ref_info *info);
 /* Fills info's primitives and entries (info from gr_ref_get_info): pass 0's sets sampled
  * without building them (gr_beams_sample_prims, gr_beams_entries_per_prim), for the memory
- * estimate (reference/memory.h). 9-15 ms, so kept out of gr_ref_get_info. */
-void gr_ref_sample_sets(const gr_ref_renderer *r, gr_ref_info *info);
+ * estimate (reference/memory.h). 9-15 ms, so kept out of gr_ref_get_info; the renderer keeps
+ * the plain set's count for its slabs' choice (gr_ref_render would sample it otherwise). */
+void gr_ref_sample_sets(gr_ref_renderer *r, gr_ref_info *info);
 /* For the benchmark (reference/bench.c): the displaced surface mesh of the prepared pass
  * (NULL on flat water), its triangle count, and the rate of bare beam lookups (1 thread)
  * at random local points of box = {u0, u1, w0, w1, y0, y1}. */

@@ -92,8 +92,8 @@ struct gr_ref_renderer {
     double sun_radius;        /* angular radius in air (rad) */
     int convolve;             /* 1: the disc by the analytic convolution, passes use I0 */
     int rendering;            /* 1 inside gr_ref_render (beam sets for the march) */
-    /* the slabs' thickness (gr_ref_slab_cells): the plain set's primitives at half a cell of
-     * drift (sampled when the render starts), and the lookups the march of the next set to be
+    /* the slabs' thickness (render_slab_cells): the plain set's primitives at half a cell of
+     * drift (sampled by gr_ref_sample_sets or when the render starts; 0: not yet), and the lookups the march of the next set to be
      * built will ask (set before each gr_ref_prepare_pass inside a render; 0: unknown) */
     double slab_prims, lookups_next;
     double cutoff_d;          /* D_cut of rays that do not rise (w_y <= 0); gr_ref_cutoff_d */

@@ -354,7 +354,6 @@ static int farm_with(gr_args *args)
     if (!rc && suite && !realpath(suite, plan.suite)) rc = gr_cli_usage_error(cmd, "--suite %s: %s", suite, strerror(errno));
     if (!rc) {
         gr_status st = s ? gr_farm_plan_suite(&plan, s, &err) : gr_farm_plan_cases(&plan, scene, &err);
-        if (st == GR_OK) st = gr_farm_plan_memory(&plan, scene, s, &err);
         if (st == GR_OK) st = gr_farm_write(&plan, scene, s, &err);
         if (st == GR_OK) st = gr_farm_verify_copies(&plan, &err); /* the jobs load the copies: the same keys */
         rc = st != GR_OK ? gr_cli_report(cmd, &err) : submit(&plan, dry);

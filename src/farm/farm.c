@@ -46,6 +46,19 @@ static void refresh(gr_farm_plan *plan)
     }
 }
 
+/* With plan->mem "auto": case scene cs's memory estimate into the plan's maxima (a part: the
+ * whole render's, as it allocates the image's sums and touches its rows'; the merge: every
+ * part's sums read, the merged sums, the image: docs/farm.md "Memory"). Else nothing. */
+static gr_status case_memory(gr_farm_plan *plan, const gr_scene *cs, gr_error *err)
+{
+    if (strcmp(plan->mem, "auto") != 0) return GR_OK;
+    double fixed = 0.0, pixels = 0.0, sets = 0.0;
+    gr_status st = gr_truth_memory(cs, &fixed, &pixels, &sets, err);
+    plan->mem_part_b = fmax(plan->mem_part_b, fixed + pixels + sets);
+    plan->mem_merge_b = fmax(plan->mem_merge_b, fixed + 2.0 * pixels);
+    return st;
+}
+
 gr_status gr_farm_plan_cases(gr_farm_plan *plan, const gr_scene *scene, gr_error *err)
 {
     double times[GR_FARM_MAX_CASES];
@@ -86,6 +99,7 @@ gr_status gr_farm_plan_cases(gr_farm_plan *plan, const gr_scene *scene, gr_error
         }
         st = gr_tune_make_case(scene, fc->time_s, v ? &view : NULL, cs, err);
         if (st == GR_OK) st = gr_cache_key(cs, fc->key, err);
+        if (st == GR_OK) st = case_memory(plan, cs, err);
     }
     free(cs);
     if (st == GR_OK) refresh(plan);
@@ -110,35 +124,9 @@ gr_status gr_farm_plan_suite(gr_farm_plan *plan, const gr_suite *suite, gr_error
         snprintf(fc->scene, sizeof fc->scene, "cases/%s/scene.json", sc->name);
         fc->time_s = sc->scene.water.time_s;
         st = gr_cache_key(&sc->scene, fc->key, err);
+        if (st == GR_OK) st = case_memory(plan, &sc->scene, err);
     }
     if (st == GR_OK) refresh(plan);
-    return st;
-}
-
-gr_status gr_farm_plan_memory(gr_farm_plan *plan, const gr_scene *scene, const gr_suite *suite, gr_error *err)
-{
-    plan->mem_part_b = plan->mem_merge_b = 0.0;
-    if (strcmp(plan->mem, "auto") != 0) return GR_OK;
-    gr_scene *cs = malloc(sizeof *cs);
-    if (!cs) return gr_fail(err, GR_E_NOMEM, "farm: out of memory");
-    gr_status st = GR_OK;
-    for (int c = 0; c < plan->n_cases && st == GR_OK; c++) {
-        const gr_farm_case *fc = &plan->cases[c];
-        if (suite) {
-            *cs = suite->cases[c].scene;
-        } else {
-            gr_tune_view view = {0.0, 0.0};
-            if (fc->view) st = gr_tune_parse_view("--view", plan->views[fc->view - 1], &view, err);
-            if (st == GR_OK) st = gr_tune_make_case(scene, fc->time_s, fc->view ? &view : NULL, cs, err);
-        }
-        double fixed = 0.0, pixels = 0.0, sets = 0.0;
-        if (st == GR_OK) st = gr_truth_memory(cs, &fixed, &pixels, &sets, err);
-        /* a part: the whole render's (it allocates the image's sums; it touches its rows');
-         * the merge: every part's sums read, the merged sums, the image (docs/farm.md "Memory") */
-        plan->mem_part_b = fmax(plan->mem_part_b, fixed + pixels + sets);
-        plan->mem_merge_b = fmax(plan->mem_merge_b, fixed + 2.0 * pixels);
-    }
-    free(cs);
     return st;
 }
 
@@ -450,6 +438,7 @@ gr_status gr_farm_verify_copies(const gr_farm_plan *plan, gr_error *err)
     gr_farm_plan check = *plan; /* a frames farm: the cases planned again from the one copy */
     check.cases = NULL;
     check.n_cases = 0;
+    check.mem[0] = '\0'; /* their keys only: no memory estimates */
     char p[8400], key[48];
     gr_status st = GR_OK;
     for (int c = 0; st == GR_OK && c < plan->n_cases; c++) {

@@ -52,9 +52,10 @@ typedef struct gr_farm_plan {
     int tiles, batch_parts, retries, max_parallel;
     /* sbatch --mem: "" (none: the site's default), a size as sbatch takes it ("1536M", "4G"),
      * written on every job, or "auto": the parts and the merge from the ground truth's memory
-     * estimate (gr_farm_plan_memory), the final job the site's default */
+     * estimate, the final job the site's default */
     char mem[32];
-    double mem_part_b, mem_merge_b; /* "auto": bytes a part and the merge need at most over the cases */
+    double mem_part_b, mem_merge_b; /* "auto": bytes a part and the merge need at most over the
+                                       cases (their estimates, taken as the cases are planned) */
     char suite[4096];       /* a suite farm: the suite file (absolute; "" = a frames farm) */
     const char *const *sets; /* the command's overrides (--set, --size) for the final run --suite
                                 (borrowed; n_sets of them) */
@@ -73,11 +74,6 @@ gr_status gr_farm_plan_cases(gr_farm_plan *plan, const gr_scene *scene, gr_error
  * overrides), each rendering its own scene copy cases/NAME/scene.json, and what the cache holds
  * of them. plan->frames and views must be empty. */
 gr_status gr_farm_plan_suite(gr_farm_plan *plan, const gr_suite *suite, gr_error *err);
-/* With plan->mem "auto": plan->mem_part_b and mem_merge_b, the largest over the cases (scene's
- * frames and views, or suite's cases) of the ground truth's memory estimate (reference/memory.h,
- * docs/farm.md "Memory"): a part the whole render's, the merge its fixed part and twice its
- * pixels' (every part's sums read, and the merged sums). Else nothing. */
-gr_status gr_farm_plan_memory(gr_farm_plan *plan, const gr_scene *scene, const gr_suite *suite, gr_error *err);
 void gr_farm_plan_free(gr_farm_plan *plan); /* frees the cases; accepts NULL */
 
 /* Path of part (tile i, batch group j) of case c in the cache. */
