@@ -410,7 +410,10 @@ static int cmp_hit(const void *a, const void *b)
 static void sort_hits(gr_beam_hit *hits, int n)
 {
     /* primitive ids are unique: any sort gives the same order; long lists (near a focus)
-     * must not cost n^2 */
+     * must not cost n^2, nor n log n when they come sorted (the grid's lookups always do) */
+    int sorted = 1;
+    for (int i = 1; i < n && sorted; i++) sorted = hits[i - 1].prim < hits[i].prim;
+    if (sorted) return;
     if (n > 32) {
         qsort(hits, (size_t)n, sizeof *hits, cmp_hit);
         return;

@@ -14,7 +14,7 @@ GODRAYS_PACKAGES=(
   # toolchain
   gcc g++ cmake ninja-build pkg-config git
   # ray tracing, images, JSON
-  libembree-dev libopenexr-dev libopenimageio-dev openimageio-tools libcjson-dev
+  libembree-dev libopenexr-dev libopenimageio-dev openimageio-tools libcjson-dev libpng-dev
   # headless OpenGL through EGL (GLVND) with Mesa's software rasterizer
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   # the local HTTP server of `godrays watch`

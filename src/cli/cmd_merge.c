@@ -11,7 +11,7 @@
 
 #include "farm/parts.h"
 #include "image/exr.h"
-#include "image/oiio.h"
+#include "image/png.h"
 #include "reference/truth.h"
 
 static void usage(FILE *f)
@@ -89,7 +89,7 @@ static int merge_with(gr_args *args)
         char pp[4096];
         gr_args_preview_path(out_path, pp, sizeof pp);
         const int rgb[3] = {0, 1, 2};
-        st = gr_oiio_write_preview(pp, res.image, rgb, res.preview_exposure, &err);
+        st = gr_png_write_preview(pp, res.image, rgb, res.preview_exposure, &err);
     }
     gr_truth_info ti;
     memset(&ti, 0, sizeof ti);

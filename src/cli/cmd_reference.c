@@ -11,7 +11,7 @@
 
 #include "farm/parts.h"
 #include "image/exr.h"
-#include "image/oiio.h"
+#include "image/png.h"
 #include "reference/bench.h"
 #include "reference/integrator.h"
 #include "reference/truth.h"
@@ -184,7 +184,7 @@ static int write_image(const gr_scene *scene, const gr_ref_result *res, const ch
         char pp[4096];
         gr_args_preview_path(out_path, pp, sizeof pp);
         const int rgb[3] = {0, 1, 2};
-        st = gr_oiio_write_preview(pp, res->image, rgb, res->preview_exposure, &err);
+        st = gr_png_write_preview(pp, res->image, rgb, res->preview_exposure, &err);
     }
     if (st != GR_OK) return gr_cli_report("reference", &err);
     char bias[224];

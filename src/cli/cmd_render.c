@@ -13,7 +13,7 @@
 #include "gl/gl.h"
 #include "gl/glctx.h"
 #include "image/exr.h"
-#include "image/oiio.h"
+#include "image/png.h"
 #include "realtime/technique.h"
 #include "realtime/timing.h"
 #include "scene/scene.h"
@@ -254,7 +254,7 @@ static gr_status write_frame(const render_opts *o, gr_technique *r, const gr_sce
         static const int rgb[3] = {0, 1, 2};
         char png[4200];
         gr_args_preview_path(path, png, sizeof png);
-        st = gr_oiio_write_preview(png, img, rgb, o->exposure > 0 ? o->exposure : auto_exposure(img), err);
+        st = gr_png_write_preview(png, img, rgb, o->exposure > 0 ? o->exposure : auto_exposure(img), err);
     }
     if (st == GR_OK && o->target_path) {
         char tpath[4096];

@@ -9,7 +9,7 @@
 
 #include <cjson/cJSON.h>
 
-#include "image/oiio.h"
+#include "image/png.h"
 #include "reference/progress.h"
 #include "report/report.h"
 #include "tune/page.h"
@@ -139,10 +139,10 @@ static gr_status write_images(const char *dir, gr_tune_problem *p, const double 
         int rr[3];
         gr_metrics_pick_rgb(p->refs[0], rr);
         snprintf(path, sizeof path, "%s/reference.png", dir);
-        st = gr_oiio_write_preview(path, p->refs[0], rr, e, err);
+        st = gr_png_write_preview(path, p->refs[0], rr, e, err);
         if (st == GR_OK) {
             snprintf(path, sizeof path, "%s/best.png", dir);
-            st = gr_oiio_write_preview(path, img, rgb, e * (p->fit ? m.fit.scale : 1.0), err);
+            st = gr_png_write_preview(path, img, rgb, e * (p->fit ? m.fit.scale : 1.0), err);
         }
     }
     gr_image_destroy(img);

@@ -14,6 +14,7 @@
 #include <cjson/cJSON.h>
 
 #include "image/oiio.h"
+#include "image/png.h"
 #include "reference/progress.h"
 #include "report/report.h"
 #include "tune/page.h"
@@ -140,11 +141,11 @@ static gr_status write_images(const char *dir, const gr_tune_session *s, gr_tune
         static const int rgb[3] = {0, 1, 2};
         gr_metrics_pick_rgb(p->refs[i], rr);
         snprintf(path, sizeof path, "%s/reference_%02d.png", dir, i);
-        if ((st = gr_oiio_write_preview(path, p->refs[i], rr, e, err)) != GR_OK) break;
+        if ((st = gr_png_write_preview(path, p->refs[i], rr, e, err)) != GR_OK) break;
         snprintf(path, sizeof path, "%s/before_%02d.png", dir, i);
-        if ((st = gr_oiio_write_preview(path, ib, rgb, e * ab, err)) != GR_OK) break;
+        if ((st = gr_png_write_preview(path, ib, rgb, e * ab, err)) != GR_OK) break;
         snprintf(path, sizeof path, "%s/after_%02d.png", dir, i);
-        if ((st = gr_oiio_write_preview(path, ia, rgb, e * aa, err)) != GR_OK) break;
+        if ((st = gr_png_write_preview(path, ia, rgb, e * aa, err)) != GR_OK) break;
         if (i == 0) {
             if ((st = gr_report_display(p->refs[0], e, &disp[0], err)) != GR_OK) break;
             if ((st = gr_report_display(ib, e * ab, &disp[1], err)) != GR_OK) break;

@@ -101,7 +101,7 @@ static const gr_oiio_api *loaded(gr_error *err)
     pthread_once(&load_once, load);
     if (!api)
         gr_fail(err, GR_E_RUNTIME,
-                "OpenImageIO (image files other than EXR, PNG previews, text, maps) is not available: cannot load "
+                "OpenImageIO (image files other than EXR and PNG previews, text, maps) is not available: cannot load "
                 "%s (%s); set GODRAYS_OIIO_MODULE to its path",
                 GR_OIIO_MODULE_FILE, load_error);
     return api;
@@ -129,21 +129,6 @@ gr_status gr_oiio_read_info(const char *path, int linearize, gr_image **out, gr_
     if (info) memset(info, 0, sizeof *info);
     const gr_oiio_api *a = loaded(err);
     return a ? a->read_info(path, linearize, out, info, err) : GR_E_RUNTIME;
-}
-
-gr_status gr_oiio_write_preview(const char *path, const gr_image *img, const int rgb[3], double exposure,
-                                gr_error *err)
-{
-    const gr_oiio_api *a = loaded(err);
-    return a ? a->write_preview(path, img, rgb, exposure, err) : GR_E_RUNTIME;
-}
-
-gr_status gr_oiio_encode_png(const gr_image *img, unsigned char **buf, size_t *len, gr_error *err)
-{
-    *buf = NULL;
-    *len = 0;
-    const gr_oiio_api *a = loaded(err);
-    return a ? a->encode_png(img, buf, len, err) : GR_E_RUNTIME;
 }
 
 gr_status gr_oiio_write(const char *path, const gr_image *img, gr_error *err)

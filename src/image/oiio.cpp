@@ -45,13 +45,7 @@ gr_status fail(gr_error *err, gr_status st, const char *path, const char *what, 
     return host->fail(err, st, "%s: %s: %s", path, what, one_line(why).c_str());
 }
 
-// sRGB OETF, IEC 61966-2-1 (piecewise: linear toe below 0.0031308, 1/2.4 power above).
-float srgb_encode(float v)
-{
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
-
-// Its inverse (the sRGB EOTF as the standard writes it).
+// The sRGB EOTF as IEC 61966-2-1 writes it (the inverse of image/png.c's OETF).
 float srgb_decode(float c)
 {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
@@ -434,40 +428,6 @@ static gr_status oiio_read_info(const char *path, int linearize, gr_image **out,
     }
 }
 
-static gr_status oiio_write_preview(const char *path, const gr_image *img, const int rgb[3],
-                                           double exposure, gr_error *err)
-{
-    if (!path || !path[0]) return host->fail(err, GR_E_USAGE, "preview: no output path");
-    if (!image_ok(img)) return host->fail(err, GR_E_INPUT, "%s: no image or bad image size", path);
-    if (!rgb) return host->fail(err, GR_E_INPUT, "%s: no channels chosen for the preview", path);
-    for (int k = 0; k < 3; k++)
-        if (rgb[k] < 0 || rgb[k] >= img->nchannels)
-            return host->fail(err, GR_E_INPUT, "%s: preview channel %d is %d, the image has %d channels", path, k, rgb[k], img->nchannels);
-    if (!std::isfinite(exposure) || exposure < 0.0)
-        return host->fail(err, GR_E_INPUT, "%s: preview exposure %g is not a finite value >= 0", path, exposure);
-    try {
-        const size_t w = static_cast<size_t>(img->width), h = static_cast<size_t>(img->height);
-        const size_t nc = static_cast<size_t>(img->nchannels);
-        std::vector<unsigned char> codes(w * h * 3);
-        const float e = static_cast<float>(exposure);
-        for (size_t p = 0; p < w * h; p++) {
-            for (size_t k = 0; k < 3; k++) {
-                float v = img->pixels[p * nc + static_cast<size_t>(rgb[k])] * e;
-                // NaN and +-Inf have no display value: written as 0 (the renderer's bug
-                // shows as black instead of crashing the preview).
-                if (!std::isfinite(v)) v = 0.0f;
-                v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
-                codes[p * 3 + k] = static_cast<unsigned char>(std::floor(srgb_encode(v) * 255.0f + 0.5f));
-            }
-        }
-        OIIO::ImageSpec spec(img->width, img->height, 3, OIIO::TypeDesc::UINT8);
-        spec.attribute("oiio:ColorSpace", "sRGB");
-        return write_via_temp(path, spec, OIIO::TypeDesc::UINT8, codes.data(), err);
-    } catch (...) {
-        return exception_status(err, path, "writing preview");
-    }
-}
-
 static gr_status oiio_write(const char *path, const gr_image *img, gr_error *err)
 {
     if (!path || !path[0]) return host->fail(err, GR_E_USAGE, "image write: no output path");
@@ -632,51 +592,12 @@ static gr_status oiio_write_animation(const char *path, const gr_image *const *f
     }
 }
 
-#include <OpenImageIO/filesystem.h>
-
-static gr_status oiio_encode_png(const gr_image *img, unsigned char **buf, size_t *len, gr_error *err)
-{
-    *buf = nullptr;
-    *len = 0;
-    if (!image_ok(img) || img->nchannels < 3) return host->fail(err, GR_E_INPUT, "PNG in memory: no image or fewer than 3 channels");
-    try {
-        const size_t w = static_cast<size_t>(img->width), h = static_cast<size_t>(img->height);
-        const size_t nc = static_cast<size_t>(img->nchannels);
-        std::vector<unsigned char> codes(w * h * 3);
-        for (size_t p = 0; p < w * h; p++)
-            for (size_t k = 0; k < 3; k++) {
-                float v = img->pixels[p * nc + k]; // display-encoded already: codes = round(255 v)
-                if (!std::isfinite(v)) v = 0.0f;
-                v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
-                codes[p * 3 + k] = static_cast<unsigned char>(std::floor(v * 255.0f + 0.5f));
-            }
-        std::vector<unsigned char> bytes;
-        OIIO::Filesystem::IOVecOutput vec(bytes);
-        auto out = OIIO::ImageOutput::create("png");
-        if (!out) return host->fail(err, GR_E_RUNTIME, "PNG in memory: no PNG writer (%s)", OIIO::geterror().c_str());
-        OIIO::ImageSpec spec(img->width, img->height, 3, OIIO::TypeDesc::UINT8);
-        spec.attribute("oiio:ColorSpace", "sRGB");
-        if (!out->supports("ioproxy") || !out->set_ioproxy(&vec) || !out->open("mem.png", spec) ||
-            !out->write_image(OIIO::TypeDesc::UINT8, codes.data()) || !out->close())
-            return host->fail(err, GR_E_RUNTIME, "PNG in memory: %s", out->geterror().c_str());
-        out.reset();
-        unsigned char *b = static_cast<unsigned char *>(malloc(bytes.size() ? bytes.size() : 1));
-        if (!b) return host->fail(err, GR_E_NOMEM, "PNG in memory: out of memory");
-        if (!bytes.empty()) memcpy(b, bytes.data(), bytes.size());
-        *buf = b;
-        *len = bytes.size();
-        return GR_OK;
-    } catch (...) {
-        return exception_status(err, "PNG in memory", "encoding");
-    }
-}
-
 // ---- the module's entry (oiio_module.h) -----------------------------------------------------
 
 extern "C" __attribute__((visibility("default"))) const gr_oiio_api *gr_oiio_module_open(const gr_oiio_host *h, int abi)
 {
-    static const gr_oiio_api api = {oiio_version,     oiio_read_info,   oiio_write_preview, oiio_encode_png,
-                                    oiio_write,       oiio_color_map,   oiio_render_text,   oiio_write_animation};
+    static const gr_oiio_api api = {oiio_version,   oiio_read_info,   oiio_write,
+                                    oiio_color_map, oiio_render_text, oiio_write_animation};
     if (abi != GR_OIIO_MODULE_ABI || !h) return nullptr;
     host = h;
     return &api;

@@ -32,15 +32,7 @@ typedef struct gr_oiio_info {
 
 /* gr_oiio_read, and *info (may be NULL) filled. */
 gr_status gr_oiio_read_info(const char *path, int linearize, gr_image **out, gr_oiio_info *info, gr_error *err);
-/* Writes a display-encoded 8-bit preview (PNG, by extension): the channels rgb[0..2] of img
- * times `exposure`, clamped to [0, 1], then sRGB-encoded (OpenImageIO writes floats to 8-bit
- * files without encoding). Written to a temporary name and renamed into place. */
-gr_status gr_oiio_write_preview(const char *path, const gr_image *img, const int rgb[3],
-                                double exposure, gr_error *err);
-/* Encodes the first three channels of img, display-encoded values in [0, 1] (gr_report_display,
- * gr_diffmap_create, gr_flip_heatmap; clamped, not encoded further), as an 8-bit PNG in memory:
- * *buf (malloc'd, the caller frees it) of *len bytes. For `godrays watch`'s page. */
-gr_status gr_oiio_encode_png(const gr_image *img, unsigned char **buf, size_t *len, gr_error *err);
+/* (PNG previews and in-memory PNGs: image/png.h, through libpng.) */
 /* Writes img as-is in the format the extension names (float data where the format allows). */
 gr_status gr_oiio_write(const char *path, const gr_image *img, gr_error *err);
 

@@ -17,7 +17,7 @@ extern "C" {
 #endif
 
 /* Raised whenever either struct below changes: a stale module is refused, not called. */
-#define GR_OIIO_MODULE_ABI 1
+#define GR_OIIO_MODULE_ABI 2
 #define GR_OIIO_MODULE_FILE "libgodrays_oiio.so"
 #define GR_OIIO_MODULE_ENTRY "gr_oiio_module_open"
 
@@ -41,9 +41,6 @@ typedef struct gr_oiio_host {
 typedef struct gr_oiio_api {
     const char *(*version)(void);
     gr_status (*read_info)(const char *path, int linearize, gr_image **out, gr_oiio_info *info, gr_error *err);
-    gr_status (*write_preview)(const char *path, const gr_image *img, const int rgb[3], double exposure,
-                               gr_error *err);
-    gr_status (*encode_png)(const gr_image *img, unsigned char **buf, size_t *len, gr_error *err);
     gr_status (*write)(const char *path, const gr_image *img, gr_error *err);
     gr_status (*color_map)(const gr_image *src, int channel, const char *map, gr_image **out, gr_error *err);
     gr_status (*render_text)(gr_image *img, int x, int y, const char *text, int size_px, const float rgb[3],

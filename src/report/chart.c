@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "compare/fit.h"
-#include "image/oiio.h"
+#include "image/png.h"
 #include "report/report.h"
 
 /* Tableau's 10 colours (matplotlib's default cycle), then 10 darker ones. */
@@ -290,5 +290,5 @@ gr_status gr_chart_write_thumb(const char *dir, const char *name, const gr_image
     /* the fit of the report's T.png: the technique at the truth's level, at the truth's exposure */
     if (truth && gr_fit_scales(truth, img, NULL, rgb, rgb, GR_FIT_SCALE, a) != 3) a[0] = 1;
     const double exposure = truth ? gr_report_exposure(truth, 1.0, 0.99, 0.8) : gr_report_exposure(img, 1.0, 0.99, 0.8);
-    return gr_oiio_write_preview(path, img, rgb, exposure * a[0], err);
+    return gr_png_write_preview(path, img, rgb, exposure * a[0], err);
 }

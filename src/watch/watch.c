@@ -17,7 +17,7 @@
 #include "compare/flip.h"
 #include "compare/metrics.h"
 #include "compare/registry.h"
-#include "image/oiio.h"
+#include "image/png.h"
 #include "realtime/toolkit.h"
 #include "realtime/usertech.h"
 #include "report/profile.h"
@@ -123,7 +123,7 @@ static gr_status to_png(gr_image *img, const char *name, gr_watch_blob *b, gr_er
 {
     unsigned char *buf = NULL;
     size_t len = 0;
-    gr_status st = gr_oiio_encode_png(img, &buf, &len, err);
+    gr_status st = gr_png_encode_display(img, &buf, &len, err);
     gr_image_destroy(img);
     b->name = name;
     b->data = buf;

@@ -53,6 +53,19 @@ GODRAYS_OIIO_MODULE=$dir/none.so "$bin" reference scene.json -o t.exr --no-previ
 rc=$?
 ck "reference to EXR without the module (exit $rc: $(head -c 300 ref_out.txt))" test "$rc" -eq 0
 ck "its EXR" test -s t.exr
+# nor do PNG previews (image/png.c, libpng): the same ground truth with its preview, and a
+# technique's render with its preview; the preview's codes read back through the module are
+# those of the EXR's pixels (docs/images.md, "PNG previews"), checked in unit.oiio
+GODRAYS_OIIO_MODULE=$dir/none.so "$bin" reference scene.json -o tp.exr -q \
+    --set reference.batches=2 --set reference.sun_samples=2 >refp_out.txt 2>&1
+rc=$?
+ck "reference with its PNG preview without the module (exit $rc: $(head -c 300 refp_out.txt))" test "$rc" -eq 0
+ck "its preview is a PNG" sh -c "head -c 8 tp.png | od -An -tx1 | tr -d ' \n' | grep -q '^89504e470d0a1a0a\$'"
+first=$("$bin" techniques --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["techniques"][0]["name"])')
+GODRAYS_OIIO_MODULE=$dir/none.so "$bin" render "$first" scene.json -o r.exr -q >render_out.txt 2>&1
+rc=$?
+ck "render $first with its PNG preview without the module (exit $rc: $(head -c 300 render_out.txt))" test "$rc" -eq 0
+ck "its preview" test -s r.png
 # compare of two EXR files without -o reads them with the project's reader, without the module;
 # its metrics are those of the same float pixels read through OpenImageIO (float TIFF copies)
 oiiotool --create 32x24 3 --fill:color=0.3,0.1,0.05 16x12 -d float -o test.exr >/dev/null || exit 1

@@ -20,7 +20,7 @@
 
 #include "gl/glctx.h"
 #include "image/exr.h"
-#include "image/oiio.h"
+#include "image/png.h"
 #include "rb_test.h"
 
 #define PI 3.14159265358979323846
@@ -54,7 +54,7 @@ static void preview(const gr_image *img, const char *name, double exposure)
     gr_error err;
     int rgb[3] = {0, 1, 2};
     snprintf(path, sizeof path, "%s/%s.png", dir, name);
-    if (gr_oiio_write_preview(path, img, rgb, exposure, &err) != GR_OK) fprintf(stderr, "preview: %s\n", err.msg);
+    if (gr_png_write_preview(path, img, rgb, exposure, &err) != GR_OK) fprintf(stderr, "preview: %s\n", err.msg);
     /* and the linear layer, for `godrays compare` against a ground truth by hand */
     snprintf(path, sizeof path, "%s/%s.exr", dir, name);
     if (gr_exr_write(path, img, NULL, &err) != GR_OK) fprintf(stderr, "exr: %s\n", err.msg);

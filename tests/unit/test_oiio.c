@@ -5,6 +5,7 @@
 #include "check.h"
 #include "image/exr.h"
 #include "image/oiio.h"
+#include "image/png.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -81,7 +82,7 @@ static void test_preview_gradient(void)
     char path[1024];
     path_of(path, sizeof path, "gradient.png");
     gr_error err = {0};
-    gr_status st = gr_oiio_write_preview(path, img, rgb, exposure, &err);
+    gr_status st = gr_png_write_preview(path, img, rgb, exposure, &err);
     CHECK_OK(st, err);
     CHECK(count_temp_files() == 0);
 
@@ -149,7 +150,7 @@ static void test_preview_nonfinite(void)
     path_of(path, sizeof path, "nonfinite.png");
     gr_error err = {0};
     const int rgb[3] = {0, 1, 2};
-    gr_status st = gr_oiio_write_preview(path, img, rgb, 1.0, &err);
+    gr_status st = gr_png_write_preview(path, img, rgb, 1.0, &err);
     CHECK_OK(st, err);
     gr_image *back = NULL;
     st = gr_oiio_read(path, 0, &back, &err);
@@ -263,17 +264,17 @@ static void test_errors(void)
     CHECK_MSG(st == GR_E_INPUT && strstr(err.msg, path) && strchr(err.msg, '\n') == NULL, "garbage: %d %s", (int)st, err.msg);
 
     path_of(path, sizeof path, "no_such_dir/p.png");
-    st = gr_oiio_write_preview(path, img, rgb, 1.0, &err);
+    st = gr_png_write_preview(path, img, rgb, 1.0, &err);
     CHECK_MSG(st == GR_E_IO && strstr(err.msg, path), "missing dir: %d %s", (int)st, err.msg);
     CHECK(!file_exists(path));
 
     path_of(path, sizeof path, "bad.png");
     const int bad_rgb[3] = {0, 1, 3};
-    st = gr_oiio_write_preview(path, img, bad_rgb, 1.0, &err);
+    st = gr_png_write_preview(path, img, bad_rgb, 1.0, &err);
     CHECK_MSG(st == GR_E_INPUT && strstr(err.msg, path), "bad channel: %d %s", (int)st, err.msg);
-    st = gr_oiio_write_preview(path, img, rgb, -1.0, &err);
+    st = gr_png_write_preview(path, img, rgb, -1.0, &err);
     CHECK_MSG(st == GR_E_INPUT && strstr(err.msg, "exposure"), "bad exposure: %d %s", (int)st, err.msg);
-    st = gr_oiio_write_preview(path, img, rgb, NAN, &err);
+    st = gr_png_write_preview(path, img, rgb, NAN, &err);
     CHECK(st == GR_E_INPUT);
     CHECK(!file_exists(path));
 
@@ -290,7 +291,7 @@ static void test_errors(void)
     CHECK(!file_exists(path));
 
     CHECK(gr_oiio_read(NULL, 0, &back, &err) == GR_E_USAGE);
-    CHECK(gr_oiio_write_preview(path, NULL, rgb, 1.0, NULL) == GR_E_INPUT); /* err may be NULL */
+    CHECK(gr_png_write_preview(path, NULL, rgb, 1.0, NULL) == GR_E_INPUT); /* err may be NULL */
     CHECK(count_temp_files() == 0);
     gr_image_destroy(img);
 }
