@@ -167,6 +167,57 @@ static void test_preview_nonfinite(void)
     gr_image_destroy(img);
 }
 
+/* gr_png_encode_display (watch's page): display values, code = floor(255 v + 0.5), clamped,
+ * NaN and +-Inf as 0; the bytes written to a file read back through OpenImageIO's PNG reader
+ * (an independent decoder) as those codes. */
+static void test_encode_display(void)
+{
+    const int W = 7, H = 2;
+    gr_image *img = gr_image_create(W, H, 4, NULL);
+    CHECK(img != NULL);
+    if (!img) return;
+    const float v[7] = {0.0f, 0.1f, 0.5f, 1.0f, 1.5f, -0.2f, NAN};
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            for (int k = 0; k < 4; k++) gr_image_pixel(img, x, y)[k] = k == 3 ? 0.3f : v[(x + k + y) % W];
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    gr_error err = {0};
+    gr_status st = gr_png_encode_display(img, &buf, &len, &err);
+    CHECK_OK(st, err);
+    CHECK(buf != NULL && len > 8 && buf && memcmp(buf, "\x89PNG\r\n\x1a\n", 8) == 0);
+    char path[1024];
+    path_of(path, sizeof path, "encoded.png");
+    FILE *f = buf ? fopen(path, "wb") : NULL;
+    CHECK(f != NULL);
+    if (f) {
+        CHECK(fwrite(buf, 1, len, f) == len);
+        fclose(f);
+        gr_image *back = NULL;
+        st = gr_oiio_read(path, 0, &back, &err);
+        CHECK_OK(st, err);
+        if (back && back->nchannels == 3 && back->width == W && back->height == H)
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++)
+                    for (int k = 0; k < 3; k++) {
+                        float a = v[(x + k + y) % W];
+                        int want = !isfinite(a) || a <= 0.0f ? 0 : a >= 1.0f ? 255 : (int)floor(255.0 * a + 0.5);
+                        CHECK_MSG(code_of(gr_image_pixel(back, x, y)[k]) == want, "encoded (%d, %d) ch %d: %d != %d", x, y,
+                                  k, code_of(gr_image_pixel(back, x, y)[k]), want);
+                    }
+        else
+            CHECK_MSG(0, "encoded PNG read back as %d x %d x %d", back ? back->width : -1, back ? back->height : -1,
+                      back ? back->nchannels : -1);
+        gr_image_destroy(back);
+    }
+    free(buf);
+    gr_image *two = gr_image_create(2, 2, 2, NULL); /* fewer than three channels: refused */
+    CHECK(two != NULL);
+    CHECK(two && gr_png_encode_display(two, &buf, &len, &err) == GR_E_INPUT && buf == NULL && len == 0);
+    gr_image_destroy(two);
+    gr_image_destroy(img);
+}
+
 /* gr_oiio_write to PNG: values k/255 are exact 8-bit (and 16-bit: 65535 = 255 * 257) codes. */
 static void test_write_png(void)
 {
@@ -307,6 +358,7 @@ int main(void)
     test_version();
     test_preview_gradient();
     test_preview_nonfinite();
+    test_encode_display();
     test_write_png();
     test_write_exr_cross();
     test_errors();
