@@ -52,6 +52,9 @@ static void usage(FILE *f)
             "  --max-memory SIZE      refuse (exit 2) a render estimated to need more (e.g. 8G;\n"
             "                         default $GODRAYS_MAX_MEMORY, else 80 %% of the memory)\n"
             "  --quiet                no progress bar\n"
+            "  --phases               print where the time went: per phase (beam builds, lookup grid,\n"
+            "                         pilot, march, bias probe, statistics) wall, CPU and serial\n"
+            "                         seconds, the serial fraction and Amdahl's speed-up to 16 threads\n"
             "  --bench                benchmark instead of writing files: hot-loop lookups per second\n"
             "                         with 1 and 2 threads, Embree's raw occlusion-ray throughput\n"
             "\n"
@@ -174,6 +177,33 @@ static int write_part(const gr_args *args, const gr_scene *scene, const gr_ref_o
     return 0;
 }
 
+/* --phases: the render's phase table on stdout (docs/reference.md 2.8; the same figures as the
+ * metadata's godrays:phase.NAME.*), the serial fraction s of the wall time and what Amdahl's law
+ * predicts from this render's n threads to 16: (s + p) / (s + p n / 16), p = 1 - s. */
+static void print_phases(const gr_ref_result *res)
+{
+    if (!res->phases) {
+        printf("phases: not measured\n");
+        return;
+    }
+    double w = 0.0, c = 0.0, se = 0.0;
+    printf("%-8s %10s %10s %10s\n", "phase", "wall s", "CPU s", "serial s");
+    for (int i = 0; i < GR_REF_PHASES; i++) {
+        printf("%-8s %10.3f %10.3f %10.3f\n", gr_ref_phase_names[i], res->phase_wall_s[i], res->phase_cpu_s[i],
+               res->phase_serial_s[i]);
+        w += res->phase_wall_s[i];
+        c += res->phase_cpu_s[i];
+        se += res->phase_serial_s[i];
+    }
+    printf("%-8s %10.3f %10.3f %10.3f\n", "all", w, c, se);
+    const gr_meta_item *t = gr_meta_get(&res->meta, "godrays:threads");
+    const int n = t && t->num >= 1.0 ? (int)t->num : 0;
+    const double sf = res->serial_frac, p = 1.0 - sf;
+    printf("serial fraction %.2f %% of the wall time on %d threads", 100.0 * sf, n);
+    if (n > 0 && n < 16 && sf >= 0.0 && sf <= 1.0) printf("; Amdahl from %d to 16 threads: %.2fx", n, 1.0 / (sf + p * n / 16.0));
+    printf("\n");
+}
+
 /* The EXR, its preview and the summary line; an exit code (1 for a partial render). */
 static int write_image(const gr_scene *scene, const gr_ref_result *res, const char *out_path, int preview, int quiet,
                        int per_round)
@@ -233,7 +263,7 @@ static int reference_with(gr_args *args)
         {"--cutoff", "reference.transmittance_cutoff"}, {"--step-error", "reference.step_error"}};
     const char *cmd = "reference", *out_path = NULL;
     gr_scene *scene = NULL;
-    int quiet = 0, aov = 0, preview = 1, bench = 0, rc = 0;
+    int quiet = 0, aov = 0, preview = 1, bench = 0, phases = 0, rc = 0;
     int tile_i = 0, tile_n = 0, bp_j = 0, bp_m = 0, have_view = 0;
     const char *frame_s = NULL, *fps_s = NULL, *v = NULL;
     gr_tune_view view = {0.0, 0.0};
@@ -246,6 +276,7 @@ static int reference_with(gr_args *args)
         if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) { quiet = 1; continue; }
         if (!strcmp(a, "--aov")) { aov = 1; continue; }
         if (!strcmp(a, "--bench")) { bench = 1; continue; }
+        if (!strcmp(a, "--phases")) { phases = 1; continue; }
         if (!strcmp(a, "--no-preview")) { preview = 0; continue; }
         if (!strcmp(a, "--fixed-steps")) {
             if ((rc = gr_args_add_set(args, "reference.adaptive_steps=false")) != 0) return rc;
@@ -274,6 +305,7 @@ static int reference_with(gr_args *args)
     if (!out_path && !bench) return gr_cli_usage_error(cmd, "no output given (-o OUT.exr)");
     const int part = tile_n > 0 || bp_m > 0;
     if (part && bench) return gr_cli_usage_error(cmd, "--tile/--batch-part and --bench: give one of them");
+    if (phases && bench) return gr_cli_usage_error(cmd, "--phases and --bench: give one of them (--bench renders nothing)");
     if (part && aov) return gr_cli_usage_error(cmd, "--aov with --tile/--batch-part: parts carry no AOVs (docs/farm.md)");
     long frame = 0;
     double fps = 30.0;
@@ -332,6 +364,7 @@ static int reference_with(gr_args *args)
     }
     if (part) rc = write_part(args, scene, opt, &res, out_path, quiet);
     else rc = write_image(scene, &res, out_path, preview, quiet, ti.passes_per_round);
+    if (phases && (rc == 0 || res.partial)) print_phases(&res);
     gr_ref_result_free(&res);
 done:
     free(scene);
