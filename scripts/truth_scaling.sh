@@ -26,9 +26,9 @@ echo "|---|---|---|---|---|---|---|"
 first=
 for n in $threads; do
     "$bin" reference "$scene" --size "$size" --threads "$n" -q --no-preview --phases -o "$out/t$n.exr" >"$out/phases$n.txt"
-    # the "all" row: wall, CPU and serial seconds of the phases; the serial fraction's line
-    set -- $(awk '$1 == "all" { print $2, $3, $4 }' "$out/phases$n.txt")
-    wall=$1 cpu=$2
+    # the "all" row: wall and CPU seconds of the phases; the serial fraction's line
+    wall=$(awk '$1 == "all" { print $2 }' "$out/phases$n.txt")
+    cpu=$(awk '$1 == "all" { print $3 }' "$out/phases$n.txt")
     sf=$(awk '/^serial fraction/ { print $3 / 100 }' "$out/phases$n.txt")
     if [ -z "$first" ]; then
         first=$n wall0=$wall sf0=$sf same="(the first)"
