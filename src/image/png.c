@@ -55,24 +55,21 @@ gr_status gr_png_encode(int width, int height, int channels, const unsigned char
     if (!codes || !setup(&im, width, height, channels))
         return gr_fail(err, GR_E_INPUT, "PNG in memory: no image, or %d x %d pixels of %d channels cannot be a PNG", width,
                        height, channels);
-    png_alloc_size_t n = 0;
-    /* first the size (a NULL buffer), then the bytes */
-    if (!png_image_write_to_memory(&im, NULL, &n, 0, codes, 0, NULL) || n == 0) {
-        gr_status st = gr_fail(err, GR_E_RUNTIME, "PNG in memory: %s", im.message[0] ? im.message : "libpng failed");
-        png_image_free(&im);
-        return st;
-    }
-    unsigned char *b = malloc(n);
+    /* one encoding into a buffer of libpng's bound on the file's size, then trimmed */
+    png_alloc_size_t cap = PNG_IMAGE_PNG_SIZE_MAX(im), n = cap;
+    unsigned char *b = malloc(cap);
     if (!b) {
         png_image_free(&im);
-        return gr_fail(err, GR_E_NOMEM, "PNG in memory: out of memory (%zu bytes)", (size_t)n);
+        return gr_fail(err, GR_E_NOMEM, "PNG in memory: out of memory (%zu bytes)", (size_t)cap);
     }
-    if (!png_image_write_to_memory(&im, b, &n, 0, codes, 0, NULL)) {
+    if (!png_image_write_to_memory(&im, b, &n, 0, codes, 0, NULL) || n == 0 || n > cap) {
         gr_status st = gr_fail(err, GR_E_RUNTIME, "PNG in memory: %s", im.message[0] ? im.message : "libpng failed");
         png_image_free(&im);
         free(b);
         return st;
     }
+    unsigned char *t = realloc(b, n);
+    if (t) b = t;
     png_image_free(&im);
     *buf = b;
     *len = (size_t)n;
