@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/parallel.h"
 #include "compare/blur.h"
 #include "compare/registry.h"
 
@@ -47,6 +48,53 @@ static gr_status rung(const gr_image *ref, const gr_image *rgb, double sigma, co
     return st;
 }
 
+/* The baselines' jobs (gr_parallel_for): 0 black, 1 constant, 2 the blur baseline, then the
+ * ladder's rungs; each writes only its own slot. */
+typedef struct bl_ctx {
+    const gr_image *ref, *rgb;
+    const gr_metrics_options *o, *lo;
+    gr_baselines *out;
+    gr_status st[GR_BASELINE_COUNT + GR_BASELINE_LADDER_N];
+    gr_error err[GR_BASELINE_COUNT + GR_BASELINE_LADDER_N];
+} bl_ctx;
+
+static void bl_job(void *arg, int i)
+{
+    bl_ctx *c = arg;
+    gr_error *err = &c->err[i];
+    const gr_image *ref = c->ref;
+    if (i == GR_BASELINE_BLUR) {
+        double v;
+        c->st[i] = rung(ref, c->rgb, GR_BASELINE_BLUR_SIGMA, c->o, &c->out->m[GR_BASELINE_BLUR], &v, err);
+        return;
+    }
+    if (i >= GR_BASELINE_COUNT) { /* rung k: the verdict alone */
+        const int k = i - GR_BASELINE_COUNT;
+        gr_metrics *m = malloc(sizeof *m);
+        c->st[i] = m ? rung(ref, c->rgb, c->out->sigma_px[k], c->lo, m, &c->out->verdict[k], err)
+                     : gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
+        free(m);
+        return;
+    }
+    /* black: the image as created (zeros); constant: the truth's mean per channel (sums in double) */
+    gr_image *flat = gr_image_create(ref->width, ref->height, 3, NULL);
+    if (!flat) {
+        c->st[i] = gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
+        return;
+    }
+    if (i == GR_BASELINE_CONSTANT) {
+        const size_t n = (size_t)ref->width * (size_t)ref->height;
+        const float *px = c->rgb->pixels;
+        double mean[3] = {0, 0, 0};
+        for (size_t p = 0; p < n; p++)
+            for (int ch = 0; ch < 3; ch++) mean[ch] += px[3 * p + (size_t)ch];
+        for (size_t p = 0; p < n; p++)
+            for (int ch = 0; ch < 3; ch++) flat->pixels[3 * p + (size_t)ch] = (float)(mean[ch] / (double)n);
+    }
+    c->st[i] = gr_metrics_compute(ref, flat, c->o, &c->out->m[i], err);
+    gr_image_destroy(flat);
+}
+
 gr_status gr_baselines_compute(const gr_image *ref, const gr_metrics_options *opt, gr_baselines *out,
                                gr_error *err)
 {
@@ -54,39 +102,37 @@ gr_status gr_baselines_compute(const gr_image *ref, const gr_metrics_options *op
     memset(out, 0, sizeof *out);
     gr_metrics_options o = opt ? *opt : (gr_metrics_options){0};
     o.fit_scale = 1;
-    gr_image *rgb = rgb_copy(ref), *flat = gr_image_create(ref->width, ref->height, 3, NULL);
-    gr_status st = rgb && flat ? GR_OK : gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
-    const size_t n = (size_t)ref->width * (size_t)ref->height;
-    /* black: the image as created (zeros) */
-    if (st == GR_OK) st = gr_metrics_compute(ref, flat, &o, &out->m[GR_BASELINE_BLACK], err);
-    if (st == GR_OK) { /* constant at the truth's mean per channel (sums in double) */
-        double mean[3] = {0, 0, 0};
-        for (size_t p = 0; p < n; p++)
-            for (int c = 0; c < 3; c++) mean[c] += rgb->pixels[3 * p + (size_t)c];
-        for (size_t p = 0; p < n; p++)
-            for (int c = 0; c < 3; c++) flat->pixels[3 * p + (size_t)c] = (float)(mean[c] / (double)n);
-        st = gr_metrics_compute(ref, flat, &o, &out->m[GR_BASELINE_CONSTANT], err);
-    }
-    if (st == GR_OK) {
-        double v;
-        st = rung(ref, rgb, GR_BASELINE_BLUR_SIGMA, &o, &out->m[GR_BASELINE_BLUR], &v, err);
-    }
     /* the ladder: the verdict alone (no FLIP, SSIM, blurs or own-function metrics) */
     gr_metrics_options lo = o;
     lo.flip = NULL, lo.skip_ssim = 1, lo.skip_blur = 1, lo.skip_extra = 1;
-    gr_metrics *m = st == GR_OK ? malloc(sizeof *m) : NULL;
-    if (st == GR_OK && !m) st = gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
-    for (int k = 0; k < GR_BASELINE_LADDER_N && st == GR_OK; k++) {
-        out->sigma_px[k] = 0.5 * pow(2.0, 0.5 * k);
-        st = rung(ref, rgb, out->sigma_px[k], &lo, m, &out->verdict[k], err);
-        /* the blurred truth gets worse with blur; where a measure wobbles, the running maximum
-         * keeps the curve monotone so that each verdict has one equivalent blur */
-        out->envelope[k] = k == 0 || out->verdict[k] > out->envelope[k - 1] ? out->verdict[k] : out->envelope[k - 1];
-        out->n_ladder = k + 1;
+    gr_image *rgb = rgb_copy(ref);
+    if (!rgb) return gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
+    for (int k = 0; k < GR_BASELINE_LADDER_N; k++) out->sigma_px[k] = 0.5 * pow(2.0, 0.5 * k);
+    bl_ctx *c = calloc(1, sizeof *c);
+    if (!c) {
+        gr_image_destroy(rgb);
+        return gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
     }
-    free(m);
+    *c = (bl_ctx){.ref = ref, .rgb = rgb, .o = &o, .lo = &lo, .out = out};
+    /* independent jobs on a few threads (common/parallel.h): the same numbers for any count */
+    gr_parallel_for(GR_BASELINE_COUNT + GR_BASELINE_LADDER_N, 0, bl_job, c);
+    gr_status st = GR_OK;
+    for (int i = 0; i < GR_BASELINE_COUNT + GR_BASELINE_LADDER_N && st == GR_OK; i++) {
+        if (c->st[i] == GR_OK) {
+            if (i >= GR_BASELINE_COUNT) { /* the rungs in order, up to the first that failed */
+                const int k = i - GR_BASELINE_COUNT;
+                /* the blurred truth gets worse with blur; where a measure wobbles, the running
+                 * maximum keeps the curve monotone so that each verdict has one equivalent blur */
+                out->envelope[k] = k == 0 || out->verdict[k] > out->envelope[k - 1] ? out->verdict[k] : out->envelope[k - 1];
+                out->n_ladder = k + 1;
+            }
+            continue;
+        }
+        st = c->st[i];
+        if (err) *err = c->err[i];
+    }
+    free(c);
     gr_image_destroy(rgb);
-    gr_image_destroy(flat);
     return st;
 }
 

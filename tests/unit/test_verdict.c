@@ -15,6 +15,7 @@
 
 #include "check.h"
 #include "compare/baseline.h"
+#include "compare/blur.h"
 #include "compare/metrics.h"
 #include "compare/registry.h"
 #include "report/leaderboard.h"
@@ -116,6 +117,46 @@ int main(void)
     CHECK_NEAR(bl->sigma_px[GR_BASELINE_LADDER_N - 1], 64.0, 1e-9);
     for (int k = 1; k < bl->n_ladder; k++) CHECK(bl->envelope[k] >= bl->envelope[k - 1]);
     for (int k = 0; k < bl->n_ladder; k++) printf("ladder sigma %6.3f px: verdict %.4f\n", bl->sigma_px[k], bl->verdict[k]);
+    /* the baselines run as jobs on a few threads (common/parallel.h): each rung's verdict and the
+     * constant baseline's numbers are those of the same computation done here, one at a time */
+    {
+        int rgb[3];
+        gr_metrics_pick_rgb(truth, rgb);
+        gr_image *tr = gr_image_create(truth->width, truth->height, 3, NULL), *flat = gr_image_create(truth->width, truth->height, 3, NULL);
+        CHECK(tr && flat);
+        const size_t np = (size_t)truth->width * (size_t)truth->height;
+        double mean[3] = {0, 0, 0};
+        for (size_t p = 0; tr && p < np; p++)
+            for (int c = 0; c < 3; c++) {
+                tr->pixels[3 * p + (size_t)c] = truth->pixels[p * (size_t)truth->nchannels + (size_t)rgb[c]];
+                mean[c] += tr->pixels[3 * p + (size_t)c];
+            }
+        gr_metrics_options lo = mo;
+        lo.fit_scale = 1, lo.flip = NULL, lo.skip_ssim = 1, lo.skip_blur = 1, lo.skip_extra = 1;
+        gr_metrics *m1 = malloc(sizeof *m1);
+        CHECK(m1 != NULL);
+        for (int k = 0; tr && m1 && k < bl->n_ladder; k++) {
+            gr_image *bk = NULL;
+            CHECK_OK(gr_blur_image(tr, bl->sigma_px[k], &bk, &err), err);
+            CHECK_OK(gr_metrics_compute(truth, bk, &lo, m1, &err), err);
+            const double v = gr_metric_value(&m1->fit, GR_METRIC_VERDICT);
+            CHECK_MSG(v == bl->verdict[k] || (isnan(v) && isnan(bl->verdict[k])), "rung %d: %.17g here, %.17g in the jobs", k, v,
+                      bl->verdict[k]);
+            gr_image_destroy(bk);
+        }
+        gr_metrics_options co = mo;
+        co.fit_scale = 1;
+        for (size_t p = 0; flat && p < np; p++)
+            for (int c = 0; c < 3; c++) flat->pixels[3 * p + (size_t)c] = (float)(mean[c] / (double)np);
+        if (flat && m1) {
+            CHECK_OK(gr_metrics_compute(truth, flat, &co, m1, &err), err);
+            CHECK(gr_metric_value(&m1->fit, GR_METRIC_VERDICT) == gr_metric_value(&bl->m[GR_BASELINE_CONSTANT].fit, GR_METRIC_VERDICT));
+            CHECK(gr_metric_value(&m1->raw, GR_METRIC_VERDICT) == gr_metric_value(&bl->m[GR_BASELINE_CONSTANT].raw, GR_METRIC_VERDICT));
+        }
+        free(m1);
+        gr_image_destroy(tr);
+        gr_image_destroy(flat);
+    }
 
     /* the truth blurred by 5 px reads 5 +- 0.5 px */
     gr_metrics m;
