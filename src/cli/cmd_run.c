@@ -553,11 +553,8 @@ static gr_status get_references(const run_opts *o, run_state *rs, gr_error *err)
     return GR_OK;
 }
 
-/* Each technique's metrics against frame 0's ground truth (compare/metrics.h): raw and after
- * the best scale fit, reference-stderr aware. */
 /* compute_metrics's jobs: technique k's metrics against the truth (gr_parallel_for). */
 typedef struct metrics_jobs {
-    const run_opts *o;
     run_state *rs;
     const gr_metrics_options *mopt;
     gr_status *st;
@@ -571,6 +568,8 @@ static void metrics_job(void *arg, int k)
     j->st[k] = gr_metrics_compute(j->rs->ro.img, j->rs->test[k], j->mopt, &j->rs->mets[k], &j->err[k]);
 }
 
+/* Each technique's metrics against frame 0's ground truth (compare/metrics.h): raw and after
+ * the best scale fit, reference-stderr aware. */
 static gr_status compute_metrics(const run_opts *o, run_state *rs, gr_error *err)
 {
     const gr_scene *scene = rs->scene;
@@ -588,7 +587,7 @@ static gr_status compute_metrics(const run_opts *o, run_state *rs, gr_error *err
     if (dof && dof->type != GR_META_STRING && dof->num >= 1.0) mopt.stderr_dof = (int)dof->num;
     /* every technique's metrics on a few threads (common/parallel.h: the same numbers for any
      * count), the first failure in the techniques' order reported */
-    metrics_jobs mj = {o, rs, &mopt, calloc((size_t)o->nt, sizeof(gr_status)), calloc((size_t)o->nt, sizeof(gr_error))};
+    metrics_jobs mj = {rs, &mopt, calloc((size_t)o->nt, sizeof(gr_status)), calloc((size_t)o->nt, sizeof(gr_error))};
     if (!mj.st || !mj.err) {
         free(mj.st);
         free(mj.err);
@@ -598,7 +597,7 @@ static gr_status compute_metrics(const run_opts *o, run_state *rs, gr_error *err
     gr_status mst = GR_OK;
     for (int k = 0; k < o->nt && mst == GR_OK; k++) {
         if (rs->failed[k]) continue;
-        if ((mst = mj.st[k]) != GR_OK) *err = mj.err[k];
+        if ((mst = mj.st[k]) != GR_OK && err) *err = mj.err[k];
         else rs->ts[k].metrics = &rs->mets[k];
     }
     free(mj.st);
