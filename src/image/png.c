@@ -24,8 +24,11 @@ static int setup(png_image *im, int width, int height, int channels)
     return 1;
 }
 
-gr_status gr_png_write(const char *path, int width, int height, int channels, const unsigned char *codes,
-                       gr_error *err)
+/* Writes width x height pixels of `channels` (1 grey, 2 grey + alpha, 3 RGB, 4 RGBA) 8-bit
+ * codes, row by row from the top, to path, tagged sRGB (an sRGB chunk). Through common/outfile:
+ * a temporary name renamed into place, nothing half-written. */
+static gr_status png_write(const char *path, int width, int height, int channels, const unsigned char *codes,
+                           gr_error *err)
 {
     if (!path || !path[0]) return gr_fail(err, GR_E_USAGE, "PNG: no output path");
     png_image im;
@@ -46,8 +49,9 @@ gr_status gr_png_write(const char *path, int width, int height, int channels, co
     return gr_outfile_commit(&of, 57, err);
 }
 
-gr_status gr_png_encode(int width, int height, int channels, const unsigned char *codes, unsigned char **buf,
-                        size_t *len, gr_error *err)
+/* The same PNG in memory: *buf (malloc'd, the caller frees it) of *len bytes. */
+static gr_status png_encode(int width, int height, int channels, const unsigned char *codes, unsigned char **buf,
+                            size_t *len, gr_error *err)
 {
     *buf = NULL;
     *len = 0;
@@ -121,7 +125,7 @@ gr_status gr_png_write_preview(const char *path, const gr_image *img, const int 
         return gr_fail(err, GR_E_INPUT, "%s: preview exposure %g is not a finite value >= 0", path, exposure);
     unsigned char *c = codes_of(img, rgb, (float)exposure, 1);
     if (!c) return gr_fail(err, GR_E_NOMEM, "%s: out of memory for the preview", path);
-    gr_status st = gr_png_write(path, img->width, img->height, 3, c, err);
+    gr_status st = png_write(path, img->width, img->height, 3, c, err);
     free(c);
     return st;
 }
@@ -135,7 +139,7 @@ gr_status gr_png_encode_display(const gr_image *img, unsigned char **buf, size_t
     static const int rgb[3] = {0, 1, 2};
     unsigned char *c = codes_of(img, rgb, 1.0f, 0);
     if (!c) return gr_fail(err, GR_E_NOMEM, "PNG in memory: out of memory");
-    gr_status st = gr_png_encode(img->width, img->height, 3, c, buf, len, err);
+    gr_status st = png_encode(img->width, img->height, 3, c, buf, len, err);
     free(c);
     return st;
 }

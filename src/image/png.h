@@ -19,13 +19,4 @@ gr_status gr_png_write_preview(const char *path, const gr_image *img, const int 
  * watch`'s page. */
 gr_status gr_png_encode_display(const gr_image *img, unsigned char **buf, size_t *len, gr_error *err);
 
-/* Writes width x height pixels of `channels` (1 grey, 2 grey + alpha, 3 RGB, 4 RGBA) 8-bit
- * codes, row by row from the top, to path, tagged sRGB (an sRGB chunk: libpng's simplified
- * API). Through common/outfile: a temporary name renamed into place, nothing half-written. */
-gr_status gr_png_write(const char *path, int width, int height, int channels, const unsigned char *codes,
-                       gr_error *err);
-/* The same PNG in memory: *buf (malloc'd, the caller frees it) of *len bytes. */
-gr_status gr_png_encode(int width, int height, int channels, const unsigned char *codes, unsigned char **buf,
-                        size_t *len, gr_error *err);
-
 #endif
