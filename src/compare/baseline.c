@@ -105,12 +105,24 @@ gr_status gr_baselines_compute(const gr_image *ref, const gr_metrics_options *op
     /* the ladder: the verdict alone (no FLIP, SSIM, blurs or own-function metrics) */
     gr_metrics_options lo = o;
     lo.flip = NULL, lo.skip_ssim = 1, lo.skip_blur = 1, lo.skip_extra = 1;
+    /* the three baselines' FLIPs (raw and fitted) share the truth's half (compare/flip.h) */
+    gr_flip_reference *fref = NULL;
+    gr_flip_options fo;
+    if (o.flip && !o.flip->reference) {
+        gr_status fst = gr_flip_reference_create(ref, o.flip, GR_METRICS_FLIP_PREPARE_MAX, 0, &fref, err);
+        if (fst != GR_OK) return fst;
+        if (fref) fo = *o.flip, fo.reference = fref, o.flip = &fo;
+    }
     gr_image *rgb = rgb_copy(ref);
-    if (!rgb) return gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
+    if (!rgb) {
+        gr_flip_reference_destroy(fref);
+        return gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
+    }
     for (int k = 0; k < GR_BASELINE_LADDER_N; k++) out->sigma_px[k] = 0.5 * pow(2.0, 0.5 * k);
     bl_ctx *c = calloc(1, sizeof *c);
     if (!c) {
         gr_image_destroy(rgb);
+        gr_flip_reference_destroy(fref);
         return gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
     }
     *c = (bl_ctx){.ref = ref, .rgb = rgb, .o = &o, .lo = &lo, .out = out};
@@ -133,6 +145,7 @@ gr_status gr_baselines_compute(const gr_image *ref, const gr_metrics_options *op
     }
     free(c);
     gr_image_destroy(rgb);
+    gr_flip_reference_destroy(fref);
     return st;
 }
 

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/parallel.h"
 #include "compare/channels.h"
 #include "image/oiio.h"
 
@@ -241,63 +242,78 @@ nomem:
     return gr_fail(err, GR_E_NOMEM, "FLIP: out of memory for a %d x %d image", w, h);
 }
 
-/* LDR-FLIP of two linear RGB images in [0, 1] (interleaved rgb[img][3 n]); out[n] per pixel. */
-static void ldr_flip(flip_ws *s, const double *const rgb[2], float *out)
+/* Steps 1-3 of LDR-FLIP for image im of the pair (0 the reference, 1 the test), linear RGB in
+ * [0, 1] interleaved (rgb[3 n]): the opponent planes, their CSF-filtered planes and the feature
+ * responses, into the workspace. */
+static void flip_half(flip_ws *s, int im, const double *rgb)
 {
     double wh[3];
     white_xyz(wh);
     const int w = s->w, h = s->h;
     /* 1. Opponent space YCxCz (Zhang and Wandell's S-CIELAB linearization of CIELAB):
      *    Y' = 116 Y/Yn - 16, Cx = 500 (X/Xn - Y/Yn), Cz = 200 (Y/Yn - Z/Zn). */
-    for (int im = 0; im < 2; im++) {
-        for (size_t p = 0; p < s->n; p++) {
-            double xyz[3];
-            mat3(M_RGB2XYZ, rgb[im] + 3 * p, xyz);
-            const double xn = xyz[0] / wh[0], yn = xyz[1] / wh[1], zn = xyz[2] / wh[2];
-            s->plane[0][im][p] = 116.0 * yn - 16.0;
-            s->plane[1][im][p] = 500.0 * (xn - yn);
-            s->plane[2][im][p] = 200.0 * (yn - zn);
-        }
-        /* 2. Contrast sensitivity: each opponent channel filtered with its CSF's spatial kernel. */
-        for (int c = 0; c < 3; c++) {
-            conv_sep(s->plane[c][im], s->filt[c][im], s->tmp, w, h, s->csf_g[c][0], s->csf_g[c][0], s->rc);
-            if (s->csf_wt[c][1] > 0.0) {
-                conv_sep(s->plane[c][im], s->tmp2, s->tmp, w, h, s->csf_g[c][1], s->csf_g[c][1], s->rc);
-                for (size_t p = 0; p < s->n; p++)
-                    s->filt[c][im][p] = s->csf_wt[c][0] * s->filt[c][im][p] + s->csf_wt[c][1] * s->tmp2[p];
-            }
-        }
-        /* 3. Features on the unfiltered normalized luminance y = (Y' + 16) / 116 = Y / Yn. */
-        for (size_t p = 0; p < s->n; p++) s->tmp2[p] = (s->plane[0][im][p] + 16.0) / 116.0;
-        const double *k1[2] = {s->fe, s->fp};
-        for (int f = 0; f < 2; f++) {
-            conv_sep(s->tmp2, s->feat[im][f][0], s->tmp, w, h, k1[f], s->fg, s->rf);
-            conv_sep(s->tmp2, s->feat[im][f][1], s->tmp, w, h, s->fg, k1[f], s->rf);
+    for (size_t p = 0; p < s->n; p++) {
+        double xyz[3];
+        mat3(M_RGB2XYZ, rgb + 3 * p, xyz);
+        const double xn = xyz[0] / wh[0], yn = xyz[1] / wh[1], zn = xyz[2] / wh[2];
+        s->plane[0][im][p] = 116.0 * yn - 16.0;
+        s->plane[1][im][p] = 500.0 * (xn - yn);
+        s->plane[2][im][p] = 200.0 * (yn - zn);
+    }
+    /* 2. Contrast sensitivity: each opponent channel filtered with its CSF's spatial kernel. */
+    for (int c = 0; c < 3; c++) {
+        conv_sep(s->plane[c][im], s->filt[c][im], s->tmp, w, h, s->csf_g[c][0], s->csf_g[c][0], s->rc);
+        if (s->csf_wt[c][1] > 0.0) {
+            conv_sep(s->plane[c][im], s->tmp2, s->tmp, w, h, s->csf_g[c][1], s->csf_g[c][1], s->rc);
+            for (size_t p = 0; p < s->n; p++)
+                s->filt[c][im][p] = s->csf_wt[c][0] * s->filt[c][im][p] + s->csf_wt[c][1] * s->tmp2[p];
         }
     }
+    /* 3. Features on the unfiltered normalized luminance y = (Y' + 16) / 116 = Y / Yn. */
+    for (size_t p = 0; p < s->n; p++) s->tmp2[p] = (s->plane[0][im][p] + 16.0) / 116.0;
+    const double *k1[2] = {s->fe, s->fp};
+    for (int f = 0; f < 2; f++) {
+        conv_sep(s->tmp2, s->feat[im][f][0], s->tmp, w, h, k1[f], s->fg, s->rf);
+        conv_sep(s->tmp2, s->feat[im][f][1], s->tmp, w, h, s->fg, k1[f], s->rf);
+    }
+}
+
+/* What steps 4-5 read of image im at pixel p: the filtered colour back in linear RGB, clamped
+ * to the display gamut, as Hunt-adjusted CIELAB, and the edge and point feature magnitudes. */
+static void half_pixel(const flip_ws *s, int im, size_t p, const double wh[3], double lab[3], double mag[2])
+{
+    const double yn = (s->filt[0][im][p] + 16.0) / 116.0;
+    const double xyz[3] = {wh[0] * (s->filt[1][im][p] / 500.0 + yn), wh[1] * yn, wh[2] * (yn - s->filt[2][im][p] / 200.0)};
+    double c[3];
+    mat3(M_XYZ2RGB, xyz, c);
+    for (int k = 0; k < 3; k++) c[k] = c[k] < 0.0 ? 0.0 : (c[k] > 1.0 ? 1.0 : c[k]);
+    rgb_to_hunt_lab(c, wh, lab);
+    for (int f = 0; f < 2; f++) mag[f] = hypot(s->feat[im][f][0][p], s->feat[im][f][1][p]);
+}
+
+/* Steps 4-6 per pixel into out[n]: the test's half from the workspace (image 1); the
+ * reference's from ref_px (5 doubles a pixel: Lab, edge and point magnitudes, as half_pixel
+ * gives them) or, when NULL, from the workspace (image 0). */
+static void flip_combine(const flip_ws *s, const double *ref_px, float *out)
+{
+    double wh[3];
+    white_xyz(wh);
     const double bp = PC * s->cmax;
     for (size_t p = 0; p < s->n; p++) {
-        double lab[2][3];
-        for (int im = 0; im < 2; im++) {
-            /* back to linear RGB, clamped to the display gamut, then Hunt-adjusted CIELAB */
-            const double yn = (s->filt[0][im][p] + 16.0) / 116.0;
-            const double xyz[3] = {wh[0] * (s->filt[1][im][p] / 500.0 + yn), wh[1] * yn,
-                                   wh[2] * (yn - s->filt[2][im][p] / 200.0)};
-            double c[3];
-            mat3(M_XYZ2RGB, xyz, c);
-            for (int k = 0; k < 3; k++) c[k] = c[k] < 0.0 ? 0.0 : (c[k] > 1.0 ? 1.0 : c[k]);
-            rgb_to_hunt_lab(c, wh, lab[im]);
+        double lab[2][3], mag[2][2];
+        if (ref_px) {
+            memcpy(lab[0], ref_px + 5 * p, sizeof lab[0]);
+            memcpy(mag[0], ref_px + 5 * p + 3, sizeof mag[0]);
+        } else {
+            half_pixel(s, 0, p, wh, lab[0], mag[0]);
         }
+        half_pixel(s, 1, p, wh, lab[1], mag[1]);
         /* 4. Colour error: HyAB^q_c, redistributed so that [0, p_c cmax] maps to [0, p_t]
          *    and [p_c cmax, cmax] to [p_t, 1] (paper eq. 4). */
         const double dc = pow(hyab(lab[0], lab[1]), QC);
         const double ec = dc < bp ? (PT / bp) * dc : PT + (dc - bp) / (s->cmax - bp) * (1.0 - PT);
         /* 5. Feature error: max of the edge and point magnitude differences, over sqrt(2)
          *    (the largest magnitude of two unit responses), to the power q_f (paper eq. 6). */
-        double mag[2][2];
-        for (int im = 0; im < 2; im++)
-            for (int f = 0; f < 2; f++)
-                mag[im][f] = hypot(s->feat[im][f][0][p], s->feat[im][f][1][p]);
         const double df = fmax(fabs(mag[0][0] - mag[1][0]), fabs(mag[0][1] - mag[1][1]));
         const double ef = pow(df / sqrt(2.0), QF);
         /* 6. FLIP = colour error ^ (1 - feature error) (paper eq. 7). */
@@ -376,30 +392,6 @@ gr_status gr_flip_exposures(const gr_image *ref, gr_flip_tonemapper tm, double *
     return GR_OK;
 }
 
-gr_status gr_flip_compute_defined(const gr_image *ref, const gr_image *test, const gr_flip_options *opt, float *map,
-                                  gr_flip_result *res, int *undefined, char *why, size_t why_n, gr_error *err)
-{
-    *undefined = 0;
-    if (!ref || !opt || !res || opt->mode != GR_FLIP_HDR || opt->exposures_given)
-        return gr_flip_compute(ref, test, opt, map, res, err);
-    gr_flip_options o = *opt;
-    gr_error e = {GR_OK, ""};
-    gr_status st = gr_flip_exposures(ref, o.tonemapper, &o.start_exposure, &o.stop_exposure, &o.n_exposures, &e);
-    if (st == GR_E_INPUT) {
-        memset(res, 0, sizeof *res);
-        res->mode = o.mode;
-        res->tonemapper = o.tonemapper;
-        res->mean = res->min = res->max = res->median = res->q1 = res->q3 = NAN;
-        if (map) memset(map, 0, (size_t)ref->width * (size_t)ref->height * sizeof *map);
-        if (why && why_n) snprintf(why, why_n, "%s", e.msg);
-        *undefined = 1;
-        return GR_OK;
-    }
-    if (st != GR_OK) return gr_fail(err, st, "%s", e.msg);
-    o.exposures_given = 1; /* the same range gr_flip_compute would derive */
-    return gr_flip_compute(ref, test, &o, map, res, err);
-}
-
 static gr_status check_image(const gr_image *img, const char *role, gr_error *err)
 {
     if (!img || !img->pixels) return gr_fail(err, GR_E_INPUT, "FLIP: no %s image", role);
@@ -407,6 +399,80 @@ static gr_status check_image(const gr_image *img, const char *role, gr_error *er
     for (size_t i = 0; i < n; i++)
         if (!isfinite(img->pixels[i])) return gr_fail(err, GR_E_INPUT, "FLIP: the %s image has a non-finite sample", role);
     return GR_OK;
+}
+
+/* Image im's exposure, tone mapped (HDR) and clamped to [0, 1], into rgb[3 n]: scale times
+ * the image first (the test's fitted scale; 1 for the reference). HDR: the exposure's gain,
+ * then ACES per channel or Reinhard on luminance (colour / (1 + Y)), which keeps hues (checked
+ * against the published tool: per channel it differs); the tone mapper's output is taken as
+ * linear RGB (HDR-FLIP paper, section 3). */
+static void tone_image(const gr_image *img, const int ch[3], double scale, const gr_flip_options *opt, double gain,
+                       const double c[6], double *rgb)
+{
+    const size_t n = (size_t)img->width * (size_t)img->height;
+    for (size_t p = 0; p < n; p++)
+        for (int j = 0; j < 3; j++) {
+            double v = scale * img->pixels[p * (size_t)img->nchannels + (size_t)ch[j]];
+            if (opt->mode == GR_FLIP_HDR) {
+                v = gain * (v < 0.0 ? 0.0 : v);
+                v = opt->tonemapper == GR_FLIP_TM_REINHARD ? v / (1.0 + gain * scale * lum_pos(img, ch, p))
+                                                           : tonemap(c, v);
+            }
+            rgb[3 * p + (size_t)j] = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+        }
+}
+
+/* Exposure k of nexp from start to stop (HDR), as a gain: c_k = start + k (stop - start) / (N - 1). */
+static double exposure_gain(double start, double stop, int nexp, int k)
+{
+    const double ck = nexp > 1 ? start + (double)k * (stop - start) / (double)(nexp - 1) : start;
+    return exp2(ck);
+}
+
+/* The reference's half, prepared (flip.h): per exposure, per pixel, what flip_combine reads of
+ * the reference (5 doubles: Hunt-adjusted Lab of the filtered colour, edge and point
+ * magnitudes). */
+struct gr_flip_reference {
+    const gr_image *ref;
+    int w, h;
+    gr_flip_mode mode;
+    double ppd;
+    gr_flip_tonemapper tonemapper;
+    int given;                 /* the options gave the exposures (else derived from ref) */
+    int undefined;             /* HDR, derived: the reference gives no range (why) */
+    char why[256];
+    double start, stop;
+    int nexp;                  /* exposures (1 for LDR) */
+    double *px;                /* nexp x n x 5 */
+};
+
+/* The options' exposure range for ref, checked (HDR; LDR: one exposure). */
+static gr_status resolve_exposures(const gr_image *ref, const gr_flip_options *opt, double *start, double *stop,
+                                   int *nexp, gr_error *err)
+{
+    *start = *stop = 0.0;
+    *nexp = 0;
+    if (opt->mode != GR_FLIP_HDR) return GR_OK;
+    if (opt->exposures_given) {
+        if (!isfinite(opt->start_exposure) || !isfinite(opt->stop_exposure) || opt->stop_exposure < opt->start_exposure ||
+            opt->n_exposures < 1)
+            return gr_fail(err, GR_E_INPUT, "FLIP: exposures start %g stop %g count %d: need start <= stop, count >= 1",
+                           opt->start_exposure, opt->stop_exposure, opt->n_exposures);
+        *start = opt->start_exposure, *stop = opt->stop_exposure, *nexp = opt->n_exposures;
+        return GR_OK;
+    }
+    return gr_flip_exposures(ref, opt->tonemapper, start, stop, nexp, err);
+}
+
+static double options_ppd(const gr_flip_options *opt) { return opt->ppd == 0.0 ? GR_FLIP_DEFAULT_PPD : opt->ppd; }
+
+/* Does prepared reference r serve ref with these options and this resolved range? */
+static int reference_matches(const gr_flip_reference *r, const gr_image *ref, const gr_flip_options *opt, double ppd,
+                             double start, double stop, int nexp)
+{
+    return r->ref == ref && r->w == ref->width && r->h == ref->height && r->mode == opt->mode && r->ppd == ppd &&
+           r->px != NULL && (opt->mode != GR_FLIP_HDR || (r->tonemapper == opt->tonemapper && r->start == start &&
+                                                          r->stop == stop && r->nexp == nexp));
 }
 
 gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_flip_options *opt, float *map,
@@ -421,26 +487,26 @@ gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_fl
     if (ref->width != test->width || ref->height != test->height)
         return gr_fail(err, GR_E_INPUT, "FLIP: size mismatch: reference %d x %d, test %d x %d", ref->width, ref->height,
                        test->width, test->height);
-    const double ppd = opt->ppd == 0.0 ? GR_FLIP_DEFAULT_PPD : opt->ppd;
+    const double ppd = options_ppd(opt);
     if (!(ppd > 0.0) || !isfinite(ppd)) return gr_fail(err, GR_E_INPUT, "FLIP: pixels per degree %g is not > 0", ppd);
     memset(res, 0, sizeof *res);
     res->mode = opt->mode;
     res->ppd = ppd;
     res->tonemapper = opt->tonemapper;
-    if (opt->mode == GR_FLIP_HDR) {
-        if (opt->exposures_given) {
-            if (!isfinite(opt->start_exposure) || !isfinite(opt->stop_exposure) ||
-                opt->stop_exposure < opt->start_exposure || opt->n_exposures < 1)
-                return gr_fail(err, GR_E_INPUT, "FLIP: exposures start %g stop %g count %d: need start <= stop, count >= 1",
-                               opt->start_exposure, opt->stop_exposure, opt->n_exposures);
-            res->start_exposure = opt->start_exposure, res->stop_exposure = opt->stop_exposure;
-            res->n_exposures = opt->n_exposures;
-        } else {
-            st = gr_flip_exposures(ref, opt->tonemapper, &res->start_exposure, &res->stop_exposure, &res->n_exposures,
-                                   err);
-            if (st != GR_OK) return st;
-        }
+    const gr_flip_reference *prep = opt->reference;
+    if (prep && opt->mode == GR_FLIP_HDR && !opt->exposures_given && prep->ref == ref && !prep->given &&
+        !prep->undefined) {
+        /* the prepared reference derived the range from this image already */
+        res->start_exposure = prep->start, res->stop_exposure = prep->stop, res->n_exposures = prep->nexp;
+    } else if (opt->mode == GR_FLIP_HDR) {
+        st = resolve_exposures(ref, opt, &res->start_exposure, &res->stop_exposure, &res->n_exposures, err);
+        if (st != GR_OK) return st;
     }
+    const int nexp = opt->mode == GR_FLIP_HDR ? res->n_exposures : 1;
+    /* a prepared reference serves only the image and the settings it was made for (a derived
+     * range is the same numbers whichever call derived it) */
+    if (prep && !reference_matches(prep, ref, opt, ppd, res->start_exposure, res->stop_exposure, nexp))
+        return gr_fail(err, GR_E_INPUT, "FLIP: the prepared reference was made for another image or other options");
     const int w = ref->width, h = ref->height;
     const size_t n = (size_t)w * (size_t)h;
     flip_ws ws;
@@ -453,11 +519,9 @@ gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_fl
         st = gr_fail(err, GR_E_NOMEM, "FLIP: out of memory for a %d x %d image", w, h);
         goto done;
     }
-    const gr_image *im[2] = {ref, test};
     int ch[2][3];
     gr_metrics_pick_rgb(ref, ch[0]);
     gr_metrics_pick_rgb(test, ch[1]);
-    const int nexp = opt->mode == GR_FLIP_HDR ? res->n_exposures : 1;
     const double tscale = opt->test_scale == 0.0 ? 1.0 : opt->test_scale;
     if (!isfinite(tscale)) {
         st = gr_fail(err, GR_E_INPUT, "FLIP: test scale %g is not finite", tscale);
@@ -466,27 +530,14 @@ gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_fl
     double c[6];
     tm_coeffs(opt->tonemapper, c);
     for (int k = 0; k < nexp; k++) {
-        /* HDR: exposure c_k = start + k (stop - start) / (N - 1), tone mapped per channel; the
-         * tone mapper's output is taken as linear RGB (HDR-FLIP paper, section 3). */
-        const double ck = nexp > 1 ? res->start_exposure + (double)k * (res->stop_exposure - res->start_exposure) /
-                                                                   (double)(nexp - 1)
-                                   : res->start_exposure;
-        const double gain = exp2(ck);
-        for (int i = 0; i < 2; i++)
-            for (size_t p = 0; p < n; p++)
-                for (int j = 0; j < 3; j++) {
-                    double v = (i ? tscale : 1.0) * im[i]->pixels[p * (size_t)im[i]->nchannels + (size_t)ch[i][j]];
-                    if (opt->mode == GR_FLIP_HDR) {
-                        v = gain * (v < 0.0 ? 0.0 : v);
-                        /* ACES acts per channel; Reinhard on luminance (colour / (1 + Y)), which
-                         * keeps hues (checked against the published tool: per channel it differs) */
-                        v = opt->tonemapper == GR_FLIP_TM_REINHARD
-                                ? v / (1.0 + gain * (i ? tscale : 1.0) * lum_pos(im[i], ch[i], p))
-                                                                   : tonemap(c, v);
-                    }
-                    rgb[i][3 * p + (size_t)j] = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
-                }
-        ldr_flip(&ws, (const double *const *)rgb, e);
+        const double gain = exposure_gain(res->start_exposure, res->stop_exposure, nexp, k);
+        if (!prep) {
+            tone_image(ref, ch[0], 1.0, opt, gain, c, rgb[0]);
+            flip_half(&ws, 0, rgb[0]);
+        }
+        tone_image(test, ch[1], tscale, opt, gain, c, rgb[1]);
+        flip_half(&ws, 1, rgb[1]);
+        flip_combine(&ws, prep ? prep->px + (size_t)k * n * 5 : NULL, e);
         /* HDR-FLIP: per pixel the largest error over the exposures */
         for (size_t p = 0; p < n; p++) best[p] = (k == 0 || e[p] > best[p]) ? e[p] : best[p];
     }
@@ -516,6 +567,158 @@ done:
     free(rgb[0]), free(rgb[1]), free(e), free(best), free(sorted);
     ws_free(&ws);
     return st;
+}
+
+
+/* The reference's half of exposure k into px[n x 5] (one job of gr_flip_reference_create). */
+typedef struct prep_job {
+    gr_flip_reference *r;
+    const gr_flip_options *opt;
+    gr_status *st;
+    gr_error *err;
+} prep_job;
+
+static void prep_exposure(void *arg, int k)
+{
+    prep_job *j = arg;
+    gr_flip_reference *r = j->r;
+    const size_t n = (size_t)r->w * (size_t)r->h;
+    flip_ws ws;
+    j->st[k] = ws_init(&ws, r->w, r->h, r->ppd, &j->err[k]);
+    if (j->st[k] != GR_OK) return;
+    double *rgb = malloc(3 * n * sizeof(double));
+    if (!rgb) {
+        j->st[k] = gr_fail(&j->err[k], GR_E_NOMEM, "FLIP: out of memory for a %d x %d image", r->w, r->h);
+        ws_free(&ws);
+        return;
+    }
+    int ch[3];
+    gr_metrics_pick_rgb(r->ref, ch);
+    double c[6], wh[3];
+    tm_coeffs(r->tonemapper, c);
+    white_xyz(wh);
+    tone_image(r->ref, ch, 1.0, j->opt, exposure_gain(r->start, r->stop, r->nexp, k), c, rgb);
+    flip_half(&ws, 0, rgb);
+    double *out = r->px + (size_t)k * n * 5;
+    for (size_t p = 0; p < n; p++) half_pixel(&ws, 0, p, wh, out + 5 * p, out + 5 * p + 3);
+    free(rgb);
+    ws_free(&ws);
+}
+
+gr_status gr_flip_reference_create(const gr_image *ref, const gr_flip_options *opt, size_t max_bytes, int threads,
+                                   gr_flip_reference **out, gr_error *err)
+{
+    const gr_flip_options zero = {0};
+    if (!out) return gr_fail(err, GR_E_INPUT, "FLIP: NULL output");
+    *out = NULL;
+    if (!opt) opt = &zero;
+    gr_status st = check_image(ref, "reference", err);
+    if (st != GR_OK) return st;
+    const double ppd = options_ppd(opt);
+    if (!(ppd > 0.0) || !isfinite(ppd)) return gr_fail(err, GR_E_INPUT, "FLIP: pixels per degree %g is not > 0", ppd);
+    gr_flip_reference *r = calloc(1, sizeof *r);
+    if (!r) return gr_fail(err, GR_E_NOMEM, "FLIP: out of memory");
+    r->ref = ref, r->w = ref->width, r->h = ref->height, r->mode = opt->mode, r->ppd = ppd;
+    r->tonemapper = opt->tonemapper;
+    r->given = opt->mode == GR_FLIP_HDR && opt->exposures_given;
+    r->nexp = 1;
+    if (opt->mode == GR_FLIP_HDR) {
+        gr_error e = {GR_OK, ""};
+        st = resolve_exposures(ref, opt, &r->start, &r->stop, &r->nexp, &e);
+        if (st == GR_E_INPUT && !r->given) {
+            /* no range (a black truth): kept, so that gr_flip_compute_defined says so at once */
+            r->undefined = 1, r->nexp = 0;
+            snprintf(r->why, sizeof r->why, "%s", e.msg);
+            *out = r;
+            return GR_OK;
+        }
+        if (st != GR_OK) {
+            free(r);
+            return gr_fail(err, st, "%s", e.msg);
+        }
+    }
+    const size_t n = (size_t)r->w * (size_t)r->h;
+    if ((double)r->nexp * (double)n * 5.0 * sizeof(double) > (double)max_bytes) {
+        free(r); /* more memory than it is worth: every call computes the reference's half itself */
+        return GR_OK;
+    }
+    r->px = malloc((size_t)r->nexp * n * 5 * sizeof(double));
+    gr_status *sts = calloc((size_t)r->nexp, sizeof *sts);
+    gr_error *errs = calloc((size_t)r->nexp, sizeof *errs);
+    if (!r->px || !sts || !errs) {
+        const int nexp = r->nexp;
+        free(sts), free(errs), gr_flip_reference_destroy(r);
+        return gr_fail(err, GR_E_NOMEM, "FLIP: out of memory for the reference's %d exposures", nexp);
+    }
+    prep_job j = {r, opt, sts, errs};
+    gr_parallel_for(r->nexp, threads, prep_exposure, &j);
+    for (int k = 0; k < r->nexp && st == GR_OK; k++)
+        if ((st = sts[k]) != GR_OK && err) *err = errs[k];
+    free(sts), free(errs);
+    if (st != GR_OK) {
+        gr_flip_reference_destroy(r);
+        return st;
+    }
+    *out = r;
+    return GR_OK;
+}
+
+int gr_flip_reference_matches(const gr_flip_reference *r, const gr_image *ref, const gr_flip_options *opt)
+{
+    const gr_flip_options zero = {0};
+    if (!opt) opt = &zero;
+    if (!r || !ref || r->ref != ref || r->w != ref->width || r->h != ref->height || r->mode != opt->mode ||
+        r->ppd != options_ppd(opt))
+        return 0;
+    if (opt->mode != GR_FLIP_HDR) return 1;
+    if (r->tonemapper != opt->tonemapper || r->given != (opt->exposures_given != 0)) return 0;
+    return !r->given || (r->start == opt->start_exposure && r->stop == opt->stop_exposure && r->nexp == opt->n_exposures);
+}
+
+size_t gr_flip_reference_bytes(const gr_flip_reference *r)
+{
+    return r ? sizeof *r + (r->px ? (size_t)r->nexp * (size_t)r->w * (size_t)r->h * 5 * sizeof(double) : 0) : 0;
+}
+
+void gr_flip_reference_destroy(gr_flip_reference *r)
+{
+    if (!r) return;
+    free(r->px);
+    free(r);
+}
+
+gr_status gr_flip_compute_defined(const gr_image *ref, const gr_image *test, const gr_flip_options *opt, float *map,
+                                  gr_flip_result *res, int *undefined, char *why, size_t why_n, gr_error *err)
+{
+    *undefined = 0;
+    if (!ref || !opt || !res || opt->mode != GR_FLIP_HDR || opt->exposures_given)
+        return gr_flip_compute(ref, test, opt, map, res, err);
+    gr_flip_options o = *opt;
+    gr_error e = {GR_OK, ""};
+    gr_status st;
+    const gr_flip_reference *r = opt->reference;
+    if (r && r->ref == ref && !r->given) {
+        /* the prepared reference's range (or its reason for none): the same as derived here */
+        st = r->undefined ? GR_E_INPUT : GR_OK;
+        if (st != GR_OK) snprintf(e.msg, sizeof e.msg, "%s", r->why);
+        o.start_exposure = r->start, o.stop_exposure = r->stop, o.n_exposures = r->nexp;
+    } else {
+        st = gr_flip_exposures(ref, o.tonemapper, &o.start_exposure, &o.stop_exposure, &o.n_exposures, &e);
+    }
+    if (st == GR_E_INPUT) {
+        memset(res, 0, sizeof *res);
+        res->mode = o.mode;
+        res->tonemapper = o.tonemapper;
+        res->mean = res->min = res->max = res->median = res->q1 = res->q3 = NAN;
+        if (map) memset(map, 0, (size_t)ref->width * (size_t)ref->height * sizeof *map);
+        if (why && why_n) snprintf(why, why_n, "%s", e.msg);
+        *undefined = 1;
+        return GR_OK;
+    }
+    if (st != GR_OK) return gr_fail(err, st, "%s", e.msg);
+    o.exposures_given = 1; /* the same range gr_flip_compute would derive (a prepared reference's
+                              range matches it exactly) */
+    return gr_flip_compute(ref, test, &o, map, res, err);
 }
 
 gr_status gr_flip_heatmap(const float *map, int width, int height, gr_image **out, gr_error *err)

@@ -24,6 +24,9 @@ typedef enum gr_flip_tonemapper {
  * 0.7 m * (3840 / 0.7 m) * pi / 180. */
 #define GR_FLIP_DEFAULT_PPD (3840.0 * 3.14159265358979323846 / 180.0)
 
+/* The reference's half of FLIP, prepared once for many tests against it (gr_flip_reference_create). */
+typedef struct gr_flip_reference gr_flip_reference;
+
 /* Zero-initialized = defaults: LDR, 67.02 ppd, ACES, exposures from the reference. */
 typedef struct gr_flip_options {
     gr_flip_mode mode;
@@ -35,6 +38,9 @@ typedef struct gr_flip_options {
     double test_scale;             /* the test is multiplied by this first; 0: 1 */
     const unsigned char *scored;   /* per pixel, may be NULL: the pooled statistics use only
                                       pixels with scored[p] != 0 (filters still see every pixel) */
+    const gr_flip_reference *reference; /* may be NULL: the reference's half, prepared from the same
+                                           image with the same mode, ppd, tone mapper and exposures
+                                           (else GR_E_INPUT); the same numbers, faster */
 } gr_flip_options;
 
 typedef struct gr_flip_result {
@@ -65,6 +71,22 @@ gr_status gr_flip_exposures(const gr_image *ref, gr_flip_tonemapper tm, double *
  * statistics NaN (n_pooled 0), map zeros, the reason in why (may be NULL). */
 gr_status gr_flip_compute_defined(const gr_image *ref, const gr_image *test, const gr_flip_options *opt, float *map,
                                   gr_flip_result *res, int *undefined, char *why, size_t why_n, gr_error *err);
+
+/* Prepares ref's half of FLIP for opt's mode, ppd, tone mapper and exposures (test_scale and
+ * scored do not matter): per exposure, per pixel, the CSF-filtered colour as Hunt-adjusted Lab
+ * and the feature magnitudes (40 bytes), the exposures on up to `threads` threads (common/
+ * parallel.h; 1 inside another parallel job; the same numbers for any count). Every FLIP against ref with
+ * these settings and .reference set then computes only the test's half: the same numbers.
+ * *out = NULL (GR_OK) when that would take more than max_bytes; an HDR reference with no
+ * exposure range (a black truth) is prepared as such (gr_flip_compute_defined says undefined
+ * at once). ref must outlive the result. GR_E_INPUT as gr_flip_compute; GR_E_NOMEM. */
+gr_status gr_flip_reference_create(const gr_image *ref, const gr_flip_options *opt, size_t max_bytes, int threads,
+                                   gr_flip_reference **out, gr_error *err);
+void gr_flip_reference_destroy(gr_flip_reference *r);
+/* 1 if r was prepared from ref with opt's mode, ppd, tone mapper and exposures (given, or
+ * derived from ref); 0 otherwise or for NULL. */
+int gr_flip_reference_matches(const gr_flip_reference *r, const gr_image *ref, const gr_flip_options *opt);
+size_t gr_flip_reference_bytes(const gr_flip_reference *r); /* what it holds (0 for NULL) */
 
 /* The heat map: per-pixel FLIP values (clamped to [0, 1]) through the magma colour map, as a
  * new 3-channel display-encoded image (write it with gr_oiio_write). */

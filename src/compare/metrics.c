@@ -527,6 +527,29 @@ gr_status gr_metrics_compute(const gr_image *ref, const gr_image *test, const gr
     cx.ssim_c2 = (GR_SSIM_K2 * out->ssim_L) * (GR_SSIM_K2 * out->ssim_L);
     out->ssim_c1 = cx.ssim_c1, out->ssim_c2 = cx.ssim_c2;
 
+    /* FLIP of the raw and of the fitted test against the same reference: its half once
+     * (compare/flip.h; the same numbers), unless the caller prepared it */
+    gr_flip_reference *own_flip = NULL, *use_flip = NULL;
+    gr_flip_options fo_local;
+    gr_metrics_options o_local;
+    if (opt->flip && !opt->flip->reference && (opt->flip_ref || opt->fit_scale)) {
+        gr_flip_reference **keep = opt->flip_ref ? opt->flip_ref : &own_flip;
+        if (!gr_flip_reference_matches(*keep, ref, opt->flip)) {
+            gr_flip_reference_destroy(*keep);
+            *keep = NULL;
+            st = gr_flip_reference_create(ref, opt->flip, GR_METRICS_FLIP_PREPARE_MAX, 1, keep, err);
+            if (st != GR_OK) {
+                free(scored);
+                return st;
+            }
+        }
+        use_flip = *keep;
+    }
+    if (use_flip) {
+        fo_local = *opt->flip, fo_local.reference = use_flip;
+        o_local = *opt, o_local.flip = &fo_local;
+        cx.opt = &o_local;
+    }
     st = compute_set(&cx, rr, tr, 1.0, &out->raw, err);
     gr_image *scaled = NULL; /* the per-channel fitted test */
     if (st == GR_OK && opt->fit_scale) st = fit_set(&cx, rr, tr, out, &scaled, err);
@@ -536,6 +559,7 @@ gr_status gr_metrics_compute(const gr_image *ref, const gr_image *test, const gr
         if (st == GR_OK && scaled) st = structure_fill(&cx, scaled, sets + 1, 1, err);
     }
     gr_image_destroy(scaled);
+    gr_flip_reference_destroy(own_flip);
     free(scored);
     return st;
 }

@@ -24,6 +24,9 @@ extern const double gr_metrics_blur_sigmas[GR_METRICS_NSCALES];
 #define GR_METRICS_STDERR_BOUND 0.5    /* default bound on the reference's relative stderr */
 #define GR_METRICS_RELMSE_K 1e-2       /* rel MSE epsilon = K * mean(|r|)^2 ... */
 #define GR_METRICS_RELMSE_FLOOR 1e-30  /* ... but at least this (all-zero reference) */
+/* FLIP of the raw and the fitted test share the reference's half when it takes at most this
+ * (compare/flip.h: 40 bytes a pixel an exposure; 83 MB at 640 x 360 with 9 exposures) */
+#define GR_METRICS_FLIP_PREPARE_MAX ((size_t)256 << 20)
 #define GR_SSIM_K1 0.01
 #define GR_SSIM_K2 0.03
 #define GR_SSIM_SIGMA 1.5
@@ -51,6 +54,11 @@ typedef struct gr_metrics_options {
                                      between calls (a search): used when it matches this ref and
                                      these options (gr_structure_ref_matches), else remade into
                                      it. The caller destroys *structure_ref */
+    gr_flip_reference **flip_ref; /* may be NULL; else the reference's half of FLIP kept between
+                                     calls, as structure_ref (gr_flip_reference_matches; made with
+                                     at most GR_METRICS_FLIP_PREPARE_MAX, else left NULL). Without
+                                     it, a call that computes FLIP twice (raw and fitted) prepares
+                                     its own. The caller destroys *flip_ref */
 } gr_metrics_options;
 
 /* Computes every metric between ref and test (same size; any channel layouts). ref may carry

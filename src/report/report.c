@@ -747,6 +747,7 @@ typedef struct ctx {
     const gr_report_input *in;
     double exposure, noise_y;
     gr_image *disp_ref;
+    const gr_flip_reference *flip_ref; /* the truth's half of HDR-FLIP, shared by the jobs; may be NULL */
     tctx t[GR_REPORT_MAX_TECHNIQUES];
     int order[GR_REPORT_MAX_TECHNIQUES];
     gr_leaderboard lb;             /* every row: techniques, baselines, failures */
@@ -1690,7 +1691,7 @@ static void flip_job(void *arg, int k)
     tctx *tc = &c->t[k];
     const gr_image *ref = c->in->ref;
     tc->flip_px = malloc((size_t)ref->width * (size_t)ref->height * sizeof(float));
-    gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = tc->a};
+    gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = tc->a, .reference = c->flip_ref};
     tc->flip_st = tc->flip_px ? gr_flip_compute_defined(ref, tc->t->test, &fo, tc->flip_px, &tc->flip, &tc->flip_undefined,
                                                         tc->flip_why, sizeof tc->flip_why, &tc->flip_err)
                               : gr_fail(&tc->flip_err, GR_E_NOMEM, "report: out of memory for the FLIP map");
@@ -1808,6 +1809,7 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
         tc->wall_ms = w >= 0 ? w : NAN;
     }
     gr_image *sheet = NULL, *rows[GR_REPORT_MAX_TECHNIQUES] = {NULL};
+    gr_flip_reference *flip_ref = NULL;
     char *json = NULL;
     gr_strbuf html;
     gr_sb_init(&html);
@@ -1816,7 +1818,13 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
     /* Everything that can fail for lack of memory or bad input is computed first. */
     if ((st = gr_report_make_dir(dir, err)) != GR_OK) goto done;
     if ((st = gr_report_display(in->ref, c->exposure, &c->disp_ref, err)) != GR_OK) goto done;
-    /* the techniques' HDR-FLIP maps, the report's dearest part, on a few threads */
+    /* the techniques' HDR-FLIP maps, the report's dearest part, on a few threads, the truth's
+     * half computed once (compare/flip.h: the same numbers) */
+    if (nt > 1) {
+        const gr_flip_options fo = {.mode = GR_FLIP_HDR};
+        if ((st = gr_flip_reference_create(in->ref, &fo, GR_METRICS_FLIP_PREPARE_MAX, 0, &flip_ref, err)) != GR_OK) goto done;
+        c->flip_ref = flip_ref;
+    }
     gr_parallel_for(nt, 0, flip_job, c);
     for (int k = 0; k < nt; k++) {
         tctx *tc = &c->t[k];
@@ -1931,6 +1939,7 @@ done:
     gr_image_destroy(sheet);
     for (int k = 0; k < GR_REPORT_MAX_TECHNIQUES; k++) gr_image_destroy(rows[k]);
     gr_image_destroy(c->disp_ref);
+    gr_flip_reference_destroy(flip_ref);
     for (int k = 0; k < nt; k++) {
         tctx *tc = &c->t[k];
         gr_image_destroy(tc->disp_fit);

@@ -456,6 +456,10 @@ gr_status gr_sequence_write(const char *dir, const gr_sequence_input *in, char *
     gr_sb_init(&html);
     char note[512] = "", path[4300];
     int charts = 0, anims = 0;
+    /* each frame's truth half of FLIP, kept for the techniques after the first while the frames'
+     * halves hold at most GR_SEQUENCE_FLIP_KEEP_MAX together (compare/flip.h: the same numbers) */
+    gr_flip_reference *fref[GR_SEQUENCE_MAX_FRAMES] = {NULL};
+    size_t fref_bytes = 0;
     if (!ts || !angles) {
         st = gr_fail(err, GR_E_NOMEM, "sequence: out of memory");
         goto done;
@@ -490,10 +494,13 @@ gr_status gr_sequence_write(const char *dir, const gr_sequence_input *in, char *
         int nf = 0;
         for (int i = 0; i < n; i++) {
             gr_metrics_options mo = {.fit_scale = 1, .skip_blur = 1, .flip = &fo, .structure = have_vp ? &so : NULL};
+            if (nt > 1 && (fref[i] || fref_bytes < GR_SEQUENCE_FLIP_KEEP_MAX)) mo.flip_ref = &fref[i];
+            const int made = mo.flip_ref && !fref[i];
             if ((st = gr_metrics_compute(in->refs[i], in->tests[k * n + i], &mo, &t->m[i], err)) != GR_OK) {
                 gr_error_prefix(err, "sequence: %s, frame %d", in->names[k], i);
                 goto done;
             }
+            if (made) fref_bytes += gr_flip_reference_bytes(fref[i]);
             const gr_metrics_set *f = t->m[i].have_fit ? &t->m[i].fit : &t->m[i].raw;
             const gr_channel_metrics *y = &f->ch[GR_MCH_Y];
             t->series[M_REL][i] = y->ref_mean != 0 ? y->rmse / fabs(y->ref_mean) : NAN;
@@ -561,6 +568,7 @@ done:
     }
     free(ts);
     free(angles);
+    for (int i = 0; i < GR_SEQUENCE_MAX_FRAMES; i++) gr_flip_reference_destroy(fref[i]);
     gr_sb_free(&html);
     return st;
 }

@@ -20,6 +20,8 @@
 #include "scene/scene.h"
 
 #define GR_SEQUENCE_MAX_FRAMES 64
+/* The frames' prepared FLIP halves (compare/flip.h) kept across techniques, at most this much in all. */
+#define GR_SEQUENCE_FLIP_KEEP_MAX ((size_t)512 << 20)
 #define GR_SEQUENCE_MAX_TECHNIQUES 32
 
 typedef struct gr_sequence_input {

@@ -145,7 +145,7 @@ static double now_s(void)
 gr_status gr_tune_problem_init(gr_tune_problem *p, gr_error *err)
 {
     p->scratch = p->scratch2 = NULL;
-    for (int i = 0; i < GR_TUNE_MAX_CASES; i++) p->angles[i] = NULL, p->sref[i] = NULL;
+    for (int i = 0; i < GR_TUNE_MAX_CASES; i++) p->angles[i] = NULL, p->sref[i] = NULL, p->fref[i] = NULL;
     if (p->n_cases < 1 || p->n_cases > GR_TUNE_MAX_CASES)
         return gr_fail(err, GR_E_INPUT, "tuning: %d cases (1..%d)", p->n_cases, GR_TUNE_MAX_CASES);
     if (p->n_params < 0 || p->n_params > GR_TUNE_MAX_PARAMS)
@@ -218,6 +218,8 @@ void gr_tune_problem_free(gr_tune_problem *p)
         p->angles[i] = NULL;
         gr_structure_ref_destroy(p->sref[i]);
         p->sref[i] = NULL;
+        gr_flip_reference_destroy(p->fref[i]);
+        p->fref[i] = NULL;
     }
 }
 
@@ -342,6 +344,9 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
         j->opt.fit_scale = p->fit;
         j->opt.skip_ssim = j->opt.skip_blur = j->opt.skip_extra = 1;
         j->opt.structure_ref = &p->sref[i]; /* the truth's half, made once per case */
+        size_t kept = 0; /* FLIP's truth half too, while the cases' halves fit GR_TUNE_FLIP_KEEP_MAX */
+        for (int k = 0; k < p->n_cases; k++) kept += gr_flip_reference_bytes(p->fref[k]);
+        if (p->fref[i] || kept < GR_TUNE_FLIP_KEEP_MAX) j->opt.flip_ref = &p->fref[i];
         case_options(p, i, &j->opt, &j->fo, &j->so);
         pending = i;
         threaded = i + 1 < p->n_cases && pthread_create(&th, NULL, score_run, j) == 0;

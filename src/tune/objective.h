@@ -55,6 +55,10 @@ typedef struct gr_tune_view {
 gr_status gr_tune_make_case(const gr_scene *base, double time_s, const gr_tune_view *view, gr_scene *out,
                             gr_error *err);
 
+/* The cases' prepared FLIP halves kept across evaluations, at most this much in all
+ * (compare/flip.h; 83 MB a case at 640 x 360 with 9 exposures). */
+#define GR_TUNE_FLIP_KEEP_MAX ((size_t)512 << 20)
+
 typedef struct gr_tune_problem {
     gr_technique *renderer;             /* created by the caller, reused for every render */
     const gr_technique_class *cls;      /* its class: every parameter is one of its settings */
@@ -88,6 +92,9 @@ typedef struct gr_tune_problem {
     gr_image *scratch, *scratch2;       /* two frames (R, G, B): one compared while the other renders */
     gr_structure_ref *sref[GR_TUNE_MAX_CASES]; /* each case's reference half of the structure
                                            comparison, kept across evaluations (metrics.h) */
+    gr_flip_reference *fref[GR_TUNE_MAX_CASES]; /* each case's reference half of FLIP, kept across
+                                           evaluations while they hold at most
+                                           GR_TUNE_FLIP_KEEP_MAX together (metrics.h) */
     /* accounting since init */
     long long renders;
     double work;                        /* gr_technique_stats_work summed over the renders */

@@ -35,6 +35,7 @@ typedef struct watch_ctx {
     float *angles;                /* the structure metric's angles (report/profile.h) */
     gr_structure_options so;
     int with_structure;
+    gr_flip_reference *fref;      /* the truth's half of HDR-FLIP, made at the first score */
     int id;                       /* renders so far */
     int truth_published;
 } watch_ctx;
@@ -113,6 +114,7 @@ static gr_status score(watch_ctx *c, outcome *out, gr_error *err)
     if (c->with_structure) mopt.structure = &c->so;
     gr_flip_options fo = {.mode = GR_FLIP_HDR}; /* the registry's FLIP mean too (the page lists it) */
     mopt.flip = &fo;
+    mopt.flip_ref = &c->fref; /* kept for every render of the session (the same numbers) */
     const gr_meta_item *dof = c->o->truth_meta ? gr_meta_get(c->o->truth_meta, "godrays:stderr_dof") : NULL;
     if (dof && dof->type != GR_META_STRING && dof->num >= 1.0) mopt.stderr_dof = (int)dof->num;
     return gr_metrics_compute(c->o->truth, out->img, &mopt, &out->m, err);
@@ -146,6 +148,7 @@ static gr_status make_images(watch_ctx *c, const outcome *out, gr_watch_blob *b,
     if (st == GR_OK) {
         float *fm = malloc((size_t)truth->width * (size_t)truth->height * sizeof(float));
         gr_flip_options fo = {.mode = GR_FLIP_HDR, .test_scale = a};
+        if (gr_flip_reference_matches(c->fref, truth, &fo)) fo.reference = c->fref;
         gr_flip_result fres;
         int undefined = 0; /* a black truth: no FLIP, a black map */
         st = fm ? gr_flip_compute_defined(truth, out->img, &fo, fm, &fres, &undefined, NULL, 0, err)
@@ -310,5 +313,6 @@ gr_status gr_watch_run(const gr_watch_options *o, gr_watch_server *srv, gr_error
     if (fd >= 0) close(fd);
     gr_gl_destroy(c.gl);
     free(c.angles);
+    gr_flip_reference_destroy(c.fref);
     return st;
 }

@@ -2,9 +2,11 @@
  * these images are in tests/data/flip/README.md (copied from ../shared/oracles/flip/): the
  * means within 1e-4, min/max within 1e-3, the LDR per-pixel map within 1/255 of the tool's
  * 8-bit map; plus closed-form properties (identical images give 0, exposures of a uniform
- * image). */
+ * image). A prepared reference (gr_flip_reference_create) must give every row's results and map
+ * bit for bit, on any number of threads, and refuse another image or other settings. */
 #include "check.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -103,6 +105,43 @@ int main(void)
                 gr_image_destroy(g);
             }
         }
+        /* the reference's half prepared once (1 and 3 threads): the same results and map, bit
+         * for bit, for the test as given and scaled */
+        for (int th = 1; th <= 3; th += 2) {
+            gr_flip_reference *fr = NULL;
+            CHECK_OK(gr_flip_reference_create(a, &o, (size_t)1 << 30, th, &fr, &err), err);
+            CHECK(fr != NULL && gr_flip_reference_matches(fr, a, &o) && !gr_flip_reference_matches(fr, b, &o));
+            CHECK(gr_flip_reference_bytes(fr) >= (size_t)a->width * (size_t)a->height * 40);
+            for (int sc = 0; sc < 2; sc++) {
+                gr_flip_options o1 = o, o2 = o;
+                o1.test_scale = o2.test_scale = sc ? 1.7 : 0.0;
+                o2.reference = fr;
+                gr_flip_result r1, r2;
+                float *m2 = malloc((size_t)a->width * (size_t)a->height * sizeof(float));
+                CHECK_OK(gr_flip_compute(a, b, &o1, map, &r1, &err), err);
+                CHECK_OK(gr_flip_compute(a, b, &o2, m2, &r2, &err), err);
+                CHECK(memcmp(&r1, &r2, sizeof r1) == 0);
+                CHECK(memcmp(map, m2, (size_t)a->width * (size_t)a->height * sizeof(float)) == 0);
+                int u1 = 0, u2 = 0;
+                CHECK_OK(gr_flip_compute_defined(a, b, &o2, m2, &r2, &u2, NULL, 0, &err), err);
+                CHECK_OK(gr_flip_compute_defined(a, b, &o1, map, &r1, &u1, NULL, 0, &err), err);
+                CHECK(!u1 && !u2 && memcmp(&r1, &r2, sizeof r1) == 0);
+                CHECK(memcmp(map, m2, (size_t)a->width * (size_t)a->height * sizeof(float)) == 0);
+                free(m2);
+            }
+            /* another test image as the reference, or other settings: refused */
+            gr_flip_options o3 = o;
+            o3.reference = fr;
+            CHECK(gr_flip_compute(b, a, &o3, NULL, &res, &err) == GR_E_INPUT && strstr(err.msg, "prepared reference"));
+            o3.ppd = 12.0;
+            CHECK(!gr_flip_reference_matches(fr, a, &o3));
+            CHECK(gr_flip_compute(a, b, &o3, NULL, &res, &err) == GR_E_INPUT && strstr(err.msg, "prepared reference"));
+            gr_flip_reference_destroy(fr);
+        }
+        /* over its memory bound: none (GR_OK), and FLIP computes as without */
+        gr_flip_reference *none = (gr_flip_reference *)&err;
+        CHECK_OK(gr_flip_reference_create(a, &o, 1000, 1, &none, &err), err);
+        CHECK(none == NULL);
         /* identical images: FLIP 0 everywhere (closed form: zero colour and feature error) */
         st = gr_flip_compute(a, a, &o, map, &res, &err);
         CHECK_OK(st, err);
@@ -122,6 +161,23 @@ int main(void)
     CHECK_NEAR(s0, log2(0.85 / 0.15), 1e-12);
     CHECK_NEAR(s1, log2(0.85 / 0.15), 1e-12);
     CHECK(cnt == 2);
+    /* a black truth: no HDR exposure range; prepared as such, gr_flip_compute_defined says
+     * undefined through it as without it */
+    {
+        gr_image *k = gr_image_create(8, 8, 3, NULL);
+        gr_flip_options ho = {.mode = GR_FLIP_HDR};
+        gr_flip_reference *fr = NULL;
+        CHECK_OK(gr_flip_reference_create(k, &ho, (size_t)1 << 30, 2, &fr, &err), err);
+        CHECK(fr != NULL);
+        ho.reference = fr;
+        int und = 0;
+        char why[256] = "";
+        gr_flip_result rr;
+        CHECK_OK(gr_flip_compute_defined(k, u, &ho, NULL, &rr, &und, why, sizeof why, &err), err);
+        CHECK(und == 1 && isnan(rr.mean) && strstr(why, "not > 0"));
+        gr_flip_reference_destroy(fr);
+        gr_image_destroy(k);
+    }
     /* bad input: size mismatch, ppd <= 0 */
     gr_image *v = gr_image_create(4, 8, 3, NULL);
     gr_flip_result res;

@@ -1,6 +1,8 @@
 /* Pointwise metrics (bias, MAE, MSE/RMSE, relative MSE, PSNR with both peaks, max error and
  * where) on tiny images whose values are worked out by hand in the comments; channel picking
- * (by name, first three, gray) and the scan-order tie rule of the max error. */
+ * (by name, first three, gray) and the scan-order tie rule of the max error; FLIP's truth half
+ * kept between calls (options.flip_ref) gives the same FLIP, bit for bit. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "check.h"
@@ -182,11 +184,58 @@ static void test_errors(void)
     gr_image_destroy(b);
 }
 
+/* options.flip_ref: made at the first call, kept while the truth and settings match, remade
+ * for another truth; every FLIP result the same bytes as without it. */
+static void test_flip_kept(void)
+{
+    const int w = 48, h = 32;
+    gr_image *ref = gr_image_create(w, h, 3, NULL), *ref2 = gr_image_create(w, h, 3, NULL);
+    gr_image *test = gr_image_create(w, h, 3, NULL);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int c = 0; c < 3; c++) {
+                const size_t i = 3 * ((size_t)y * w + (size_t)x) + (size_t)c;
+                ref->pixels[i] = 0.05f + 0.02f * (float)x * (float)(c + 1) + ((x / 6 + y / 6) % 2 ? 0.5f : 0.0f);
+                ref2->pixels[i] = 2.0f * ref->pixels[i] + 0.1f;
+                test->pixels[i] = 0.7f * ref->pixels[i] + (((x + y) % 5) ? 0.0f : 0.3f);
+            }
+    gr_flip_options fo = {.mode = GR_FLIP_HDR};
+    gr_metrics_options o = {.fit_scale = 1, .skip_ssim = 1, .skip_blur = 1, .flip = &fo};
+    gr_flip_reference *keep = NULL;
+    gr_metrics_options ok = o;
+    ok.flip_ref = &keep;
+    gr_metrics *m = malloc(3 * sizeof *m);
+    gr_error err = {0};
+    CHECK_OK(gr_metrics_compute(ref, test, &o, &m[0], &err), err);
+    CHECK_OK(gr_metrics_compute(ref, test, &ok, &m[1], &err), err);
+    CHECK(keep != NULL && gr_flip_reference_matches(keep, ref, &fo));
+    const gr_flip_reference *first = keep;
+    CHECK_OK(gr_metrics_compute(ref, test, &ok, &m[2], &err), err);
+    CHECK(keep == first); /* kept */
+    CHECK(m[0].raw.have_flip && m[0].have_fit && m[0].fit.have_flip && m[0].raw.flip.mean > 0.0);
+    for (int k = 1; k < 3; k++) {
+        CHECK(memcmp(&m[0].raw.flip, &m[k].raw.flip, sizeof m[0].raw.flip) == 0);
+        CHECK(memcmp(&m[0].fit.flip, &m[k].fit.flip, sizeof m[0].fit.flip) == 0);
+    }
+    /* another truth: remade for it, and its FLIP as without */
+    CHECK_OK(gr_metrics_compute(ref2, test, &o, &m[0], &err), err);
+    CHECK_OK(gr_metrics_compute(ref2, test, &ok, &m[1], &err), err);
+    CHECK(gr_flip_reference_matches(keep, ref2, &fo) && !gr_flip_reference_matches(keep, ref, &fo));
+    CHECK(memcmp(&m[0].raw.flip, &m[1].raw.flip, sizeof m[0].raw.flip) == 0);
+    CHECK(memcmp(&m[0].fit.flip, &m[1].fit.flip, sizeof m[0].fit.flip) == 0);
+    gr_flip_reference_destroy(keep);
+    free(m);
+    gr_image_destroy(ref);
+    gr_image_destroy(ref2);
+    gr_image_destroy(test);
+}
+
 int main(void)
 {
     test_hand_values();
     test_ties();
     test_layouts();
     test_errors();
+    test_flip_kept();
     CHECK_DONE();
 }
