@@ -28,6 +28,7 @@ typedef struct ctx {
     double peak_ref[GR_MCH_COUNT];
     double ssim_c1, ssim_c2;
     const gr_metrics_options *opt;
+    int fitted;                   /* computing the fitted set (fit_set) */
 } ctx;
 
 static inline double refv(const ctx *cx, size_t p, int c, const int rgb[3])
@@ -283,7 +284,7 @@ static gr_status compute_set(const ctx *cx, const int rr[3], const int tr[3], do
         if (st != GR_OK) return st;
         set->have_blur = 1;
     }
-    if (cx->opt->flip) {
+    if (cx->opt->flip && (cx->fitted || !cx->opt->flip_fit_only || !cx->opt->fit_scale)) {
         gr_flip_options fo = *cx->opt->flip;
         fo.scored = cx->scored, fo.test_scale = scale;
         /* a black reference (all zero, or a zero median) gives HDR-FLIP no exposure range: FLIP
@@ -352,7 +353,9 @@ static gr_status fit_set(const ctx *cx, const int rr[3], const int tr[3], gr_met
     out->have_fit = 1;
     out->fit_mode = (int)mode;
     out->fit_defined = gr_fit_scales(cx->ref, cx->test, cx->scored, rr, tr, mode, a) > 0;
-    if (mode == GR_FIT_SCALE) return compute_set(cx, rr, tr, a[0], &out->fit, err);
+    ctx c2 = *cx;
+    c2.fitted = 1;
+    if (mode == GR_FIT_SCALE) return compute_set(&c2, rr, tr, a[0], &out->fit, err);
     static const char *const rgb_names[3] = {"R", "G", "B"};
     static const int rgb_idx[3] = {0, 1, 2};
     const gr_image *test = cx->test;
@@ -361,7 +364,6 @@ static gr_status fit_set(const ctx *cx, const int rr[3], const int tr[3], gr_met
     for (size_t p = 0; p < cx->n; p++)
         for (int c = 0; c < 3; c++)
             t->pixels[3 * p + (size_t)c] = (float)(a[c] * (double)test->pixels[p * (size_t)test->nchannels + (size_t)tr[c]]);
-    ctx c2 = *cx;
     c2.test = t;
     gr_status st = compute_set(&c2, rr, rgb_idx, 1.0, &out->fit, err);
     const double mean_t[3] = {out->raw.ch[0].test_mean, out->raw.ch[1].test_mean, out->raw.ch[2].test_mean};
@@ -532,7 +534,7 @@ gr_status gr_metrics_compute(const gr_image *ref, const gr_image *test, const gr
     gr_flip_reference *own_flip = NULL, *use_flip = NULL;
     gr_flip_options fo_local;
     gr_metrics_options o_local;
-    if (opt->flip && !opt->flip->reference && (opt->flip_ref || opt->fit_scale)) {
+    if (opt->flip && !opt->flip->reference && (opt->flip_ref || (opt->fit_scale && !opt->flip_fit_only))) {
         gr_flip_reference **keep = opt->flip_ref ? opt->flip_ref : &own_flip;
         if (!gr_flip_reference_matches(*keep, ref, opt->flip)) {
             gr_flip_reference_destroy(*keep);

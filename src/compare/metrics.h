@@ -54,6 +54,8 @@ typedef struct gr_metrics_options {
                                      between calls (a search): used when it matches this ref and
                                      these options (gr_structure_ref_matches), else remade into
                                      it. The caller destroys *structure_ref */
+    int flip_fit_only;            /* with fit_scale: FLIP of the fitted test only (the raw set's
+                                     have_flip 0), for a search that reads only the fitted set */
     gr_flip_reference **flip_ref; /* may be NULL; else the reference's half of FLIP kept between
                                      calls, as structure_ref (gr_flip_reference_matches; made with
                                      at most GR_METRICS_FLIP_PREPARE_MAX, else left NULL). Without

@@ -343,6 +343,7 @@ gr_status gr_tune_evaluate(gr_tune_problem *p, const double *x, double *mean, do
         j->opt.stderr_bound = p->stderr_bound;
         j->opt.fit_scale = p->fit;
         j->opt.skip_ssim = j->opt.skip_blur = j->opt.skip_extra = 1;
+        j->opt.flip_fit_only = 1; /* take_score reads the fitted set alone when fitting */
         j->opt.structure_ref = &p->sref[i]; /* the truth's half, made once per case */
         size_t kept = 0; /* FLIP's truth half too, while the cases' halves fit GR_TUNE_FLIP_KEEP_MAX */
         for (int k = 0; k < p->n_cases; k++) kept += gr_flip_reference_bytes(p->fref[k]);

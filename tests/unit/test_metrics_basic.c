@@ -1,7 +1,8 @@
 /* Pointwise metrics (bias, MAE, MSE/RMSE, relative MSE, PSNR with both peaks, max error and
  * where) on tiny images whose values are worked out by hand in the comments; channel picking
  * (by name, first three, gray) and the scan-order tie rule of the max error; FLIP's truth half
- * kept between calls (options.flip_ref) gives the same FLIP, bit for bit. */
+ * kept between calls (options.flip_ref) gives the same FLIP, bit for bit, as does the fitted
+ * set's FLIP alone (options.flip_fit_only). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -217,6 +218,15 @@ static void test_flip_kept(void)
         CHECK(memcmp(&m[0].raw.flip, &m[k].raw.flip, sizeof m[0].raw.flip) == 0);
         CHECK(memcmp(&m[0].fit.flip, &m[k].fit.flip, sizeof m[0].fit.flip) == 0);
     }
+    /* the fitted set's FLIP alone (a search): the same bytes, none for the raw set */
+    gr_metrics_options of = ok;
+    of.flip_fit_only = 1;
+    CHECK_OK(gr_metrics_compute(ref, test, &of, &m[1], &err), err);
+    CHECK(!m[1].raw.have_flip && m[1].fit.have_flip);
+    CHECK(memcmp(&m[0].fit.flip, &m[1].fit.flip, sizeof m[0].fit.flip) == 0);
+    of.flip_ref = NULL;
+    CHECK_OK(gr_metrics_compute(ref, test, &of, &m[1], &err), err);
+    CHECK(!m[1].raw.have_flip && memcmp(&m[0].fit.flip, &m[1].fit.flip, sizeof m[0].fit.flip) == 0);
     /* another truth: remade for it, and its FLIP as without */
     CHECK_OK(gr_metrics_compute(ref2, test, &o, &m[0], &err), err);
     CHECK_OK(gr_metrics_compute(ref2, test, &ok, &m[1], &err), err);
