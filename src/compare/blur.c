@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/clones.h"
+
 int gr_blur_radius(double sigma)
 {
     if (!(sigma > 0.0) || !isfinite(sigma)) return 1;
@@ -31,7 +33,7 @@ gr_status gr_gaussian_kernel(double sigma, int radius, double *w, gr_error *err)
     return GR_OK;
 }
 
-gr_status gr_blur_fields(const double *const *src, int nch, const double *weight, int width, int height,
+GR_CLONES_AVX2 gr_status gr_blur_fields(const double *const *src, int nch, const double *weight, int width, int height,
                          double sigma, int radius, double *const *dst, double *dst_weight, gr_error *err)
 {
     if (width <= 0 || height <= 0 || nch < 0 || (nch > 0 && (!src || !dst)))

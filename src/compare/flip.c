@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/clones.h"
 #include "common/parallel.h"
 #include "compare/channels.h"
 #include "image/oiio.h"
@@ -74,7 +75,7 @@ static double hyab(const double p[3], const double q[3])
 
 /* Correlation along x (dir 0) or y (dir 1) of a planar field with a 1-D kernel k[-r..r]
  * (k + r is the centre), edges clamped (the nearest in-image pixel is repeated). */
-static void conv1d(const double *src, double *dst, int w, int h, const double *k, int r, int dir)
+GR_CLONES_AVX2 static void conv1d(const double *src, double *dst, int w, int h, const double *k, int r, int dir)
 {
     /* The same sums in the same order as the direct form s = sum_{i=-r..r} k[i + r] src(clamped),
      * arranged for speed: rows without clamping in their interior (x), whole rows at once (y). */

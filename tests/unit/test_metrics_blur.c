@@ -1,7 +1,9 @@
 /* Gaussian blur (normalized convolution) used by the multi-scale RMSE and SSIM. Oracles: the
  * kernel's closed form and unit sum, a constant image staying constant up to the edges (the
  * truncated kernel is renormalized there), a brute-force 2-D weighted convolution written
- * independently here, and mass conservation of an interior impulse. */
+ * independently here, and mass conservation of an interior impulse; and the same bits as a
+ * plain scalar copy of the separable loops in the same order (gr_blur_fields may run as its
+ * AVX2 clone, common/clones.h: its numbers must not depend on the CPU). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -126,9 +128,76 @@ static void test_impulse(void)
     CHECK(gr_blur_fields(s, 1, NULL, 0, H, 4.0, 12, d, NULL, &err) == GR_E_INPUT);
 }
 
+/* gr_blur_fields against the same separable sums written here one element at a time, in its
+ * order (horizontal taps left to right from 0.0, then vertical taps top to bottom from 0.0,
+ * then the division by the weight's sum): equal to the bit, on a 67 x 41 image (odd widths:
+ * the vector loops' remainders) with and without a weight field, sigma 3 and 9 (radius 9 and
+ * 27: kernels wider than the image in y). */
+static void test_same_bits_as_scalar(void)
+{
+    enum { W = 67, H = 41, N = W * H };
+    static double x[2][N], wt[N], out[2][N], ow[N], hor[3][N], want[2][N], wantw[N];
+    unsigned s = 777u;
+    for (int i = 0; i < N; i++) {
+        s = s * 1664525u + 1013904223u;
+        x[0][i] = (double)(s >> 8) / 16777216.0 * 3.0;
+        s = s * 1664525u + 1013904223u;
+        x[1][i] = (double)(s >> 8) / 16777216.0 - 0.5;
+        wt[i] = (i % 7 == 3) ? 0.0 : 0.25 + (double)(i % 4) * 0.5;
+    }
+    const double *src[2] = {x[0], x[1]};
+    double *dst[2] = {out[0], out[1]};
+    gr_error err = {0};
+    const double sig[2] = {3.0, 9.0};
+    for (int k = 0; k < 2; k++)
+        for (int pass = 0; pass < 2; pass++) {
+            const double *w = pass ? wt : NULL;
+            const int r = gr_blur_radius(sig[k]);
+            double g[2 * 27 + 1];
+            CHECK_OK(gr_gaussian_kernel(sig[k], r, g, &err), err);
+            CHECK_OK(gr_blur_fields(src, 2, w, W, H, sig[k], r, dst, ow, &err), err);
+            /* volatile: one multiply and one add at a time, as the library's loops */
+            for (int f = 0; f < 3; f++)
+                for (int y = 0; y < H; y++)
+                    for (int xx = 0; xx < W; xx++) {
+                        volatile double a = 0.0;
+                        for (int i = -r; i <= r; i++) {
+                            if (xx + i < 0 || xx + i >= W) continue;
+                            const int q = y * W + xx + i;
+                            const double pw = w ? w[q] : 1.0;
+                            const double v = f == 2 ? pw : (!w ? x[f][q] : (w[q] == 0.0 ? 0.0 : w[q] * x[f][q]));
+                            volatile double t = g[i + r] * v;
+                            a = a + t;
+                        }
+                        hor[f][y * W + xx] = a;
+                    }
+            for (int y = 0; y < H; y++)
+                for (int xx = 0; xx < W; xx++) {
+                    double a3[3];
+                    for (int f = 0; f < 3; f++) {
+                        volatile double a = 0.0;
+                        for (int j = -r; j <= r; j++) {
+                            if (y + j < 0 || y + j >= H) continue;
+                            volatile double t = g[j + r] * hor[f][(y + j) * W + xx];
+                            a = a + t;
+                        }
+                        a3[f] = a;
+                    }
+                    for (int c = 0; c < 2; c++) want[c][y * W + xx] = a3[2] > 0.0 ? a3[c] / a3[2] : 0.0;
+                    wantw[y * W + xx] = a3[2];
+                }
+            int bad = 0;
+            for (int i = 0; i < N; i++)
+                bad += out[0][i] != want[0][i] || out[1][i] != want[1][i] || ow[i] != wantw[i];
+            CHECK_MSG(bad == 0, "sigma %g, %s weights: %d pixels differ from the scalar loops in some bit", sig[k],
+                      w ? "with" : "without", bad);
+        }
+}
+
 int main(void)
 {
     test_kernel();
+    test_same_bits_as_scalar();
     test_constant();
     test_against_direct();
     test_impulse();
