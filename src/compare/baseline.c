@@ -109,7 +109,7 @@ gr_status gr_baselines_compute(const gr_image *ref, const gr_metrics_options *op
     gr_flip_reference *fref = NULL;
     gr_flip_options fo;
     if (o.flip && !o.flip->reference) {
-        gr_status fst = gr_flip_reference_create(ref, o.flip, GR_METRICS_FLIP_PREPARE_MAX, 0, &fref, err);
+        gr_status fst = gr_flip_reference_create(ref, o.flip, GR_FLIP_SHARED_PREPARE_MAX, 0, &fref, err);
         if (fst != GR_OK) return fst;
         if (fref) fo = *o.flip, fo.reference = fref, o.flip = &fo;
     }

@@ -162,7 +162,9 @@ static void norm_signs(double *k, int n)
     }
 }
 
-static gr_status ws_init(flip_ws *s, int w, int h, double ppd, gr_error *err)
+/* images: which of the pair's planes to allocate (bit 0 the reference's, bit 1 the test's):
+ * with a prepared reference only the test's, for the reference's half only its own. */
+static gr_status ws_init(flip_ws *s, int w, int h, double ppd, unsigned images, gr_error *err)
 {
     memset(s, 0, sizeof *s);
     s->w = w, s->h = h, s->n = (size_t)w * (size_t)h;
@@ -218,6 +220,7 @@ static gr_status ws_init(flip_ws *s, int w, int h, double ppd, gr_error *err)
     norm_signs(s->fp, nf);
     for (int c = 0; c < 3; c++)
         for (int k = 0; k < 2; k++) {
+            if (!(images & (1u << k))) continue;
             s->plane[c][k] = malloc(s->n * sizeof(double));
             s->filt[c][k] = malloc(s->n * sizeof(double));
             if (!s->plane[c][k] || !s->filt[c][k]) goto nomem;
@@ -228,7 +231,7 @@ static gr_status ws_init(flip_ws *s, int w, int h, double ppd, gr_error *err)
     for (int i = 0; i < 2; i++)
         for (int j = 0; j < 2; j++)
             for (int k = 0; k < 2; k++)
-                if (!(s->feat[i][j][k] = malloc(s->n * sizeof(double)))) goto nomem;
+                if ((images & (1u << i)) && !(s->feat[i][j][k] = malloc(s->n * sizeof(double)))) goto nomem;
     /* cmax: the largest colour difference in the gamut, Hunt-adjusted HyAB between green and
      * blue, to the power q_c (paper section 4.1). */
     double wh[3], g[3], bl[3];
@@ -511,12 +514,12 @@ gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_fl
     const int w = ref->width, h = ref->height;
     const size_t n = (size_t)w * (size_t)h;
     flip_ws ws;
-    st = ws_init(&ws, w, h, ppd, err);
+    st = ws_init(&ws, w, h, ppd, prep ? 2u : 3u, err);
     if (st != GR_OK) return st;
-    double *rgb[2] = {malloc(3 * n * sizeof(double)), malloc(3 * n * sizeof(double))};
+    double *rgb[2] = {prep ? NULL : malloc(3 * n * sizeof(double)), malloc(3 * n * sizeof(double))};
     float *e = malloc(n * sizeof(float)), *best = malloc(n * sizeof(float));
     double *sorted = malloc(n * sizeof(double));
-    if (!rgb[0] || !rgb[1] || !e || !best || !sorted) {
+    if ((!prep && !rgb[0]) || !rgb[1] || !e || !best || !sorted) {
         st = gr_fail(err, GR_E_NOMEM, "FLIP: out of memory for a %d x %d image", w, h);
         goto done;
     }
@@ -585,7 +588,7 @@ static void prep_exposure(void *arg, int k)
     gr_flip_reference *r = j->r;
     const size_t n = (size_t)r->w * (size_t)r->h;
     flip_ws ws;
-    j->st[k] = ws_init(&ws, r->w, r->h, r->ppd, &j->err[k]);
+    j->st[k] = ws_init(&ws, r->w, r->h, r->ppd, 1u, &j->err[k]);
     if (j->st[k] != GR_OK) return;
     double *rgb = malloc(3 * n * sizeof(double));
     if (!rgb) {

@@ -27,6 +27,10 @@ extern const double gr_metrics_blur_sigmas[GR_METRICS_NSCALES];
 /* FLIP of the raw and the fitted test share the reference's half when it takes at most this
  * (compare/flip.h: 40 bytes a pixel an exposure; 83 MB at 640 x 360 with 9 exposures) */
 #define GR_METRICS_FLIP_PREPARE_MAX ((size_t)256 << 20)
+/* ... and one shared by a whole set of comparisons (the report's techniques, the baselines):
+ * it spares every FLIP its own reference planes (104 bytes a pixel per FLIP running), so it
+ * pays for itself in memory too; 1 GiB covers 1920 x 1080 with 9 exposures (746 MB). */
+#define GR_FLIP_SHARED_PREPARE_MAX ((size_t)1 << 30)
 #define GR_SSIM_K1 0.01
 #define GR_SSIM_K2 0.03
 #define GR_SSIM_SIGMA 1.5

@@ -1822,7 +1822,7 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
      * half computed once (compare/flip.h: the same numbers) */
     if (nt > 1) {
         const gr_flip_options fo = {.mode = GR_FLIP_HDR};
-        if ((st = gr_flip_reference_create(in->ref, &fo, GR_METRICS_FLIP_PREPARE_MAX, 0, &flip_ref, err)) != GR_OK) goto done;
+        if ((st = gr_flip_reference_create(in->ref, &fo, GR_FLIP_SHARED_PREPARE_MAX, 0, &flip_ref, err)) != GR_OK) goto done;
         c->flip_ref = flip_ref;
     }
     gr_parallel_for(nt, 0, flip_job, c);
