@@ -447,7 +447,7 @@ struct gr_flip_reference {
     char why[256];
     double start, stop;
     int nexp;                  /* exposures (1 for LDR) */
-    double *px;                /* nexp x n x 5 */
+    double *px;                /* nexp x n x 5; NULL when over the caller's bound */
 };
 
 /* The options' exposure range for ref, checked (HDR; LDR: one exposure). */
@@ -475,8 +475,8 @@ static int reference_matches(const gr_flip_reference *r, const gr_image *ref, co
                              double start, double stop, int nexp)
 {
     return r->ref == ref && r->w == ref->width && r->h == ref->height && r->mode == opt->mode && r->ppd == ppd &&
-           r->px != NULL && (opt->mode != GR_FLIP_HDR || (r->tonemapper == opt->tonemapper && r->start == start &&
-                                                          r->stop == stop && r->nexp == nexp));
+           (opt->mode != GR_FLIP_HDR || (r->tonemapper == opt->tonemapper && !r->undefined && r->start == start &&
+                                         r->stop == stop && r->nexp == nexp));
 }
 
 gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_flip_options *opt, float *map,
@@ -513,13 +513,14 @@ gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_fl
         return gr_fail(err, GR_E_INPUT, "FLIP: the prepared reference was made for another image or other options");
     const int w = ref->width, h = ref->height;
     const size_t n = (size_t)w * (size_t)h;
+    const double *ref_px = prep ? prep->px : NULL; /* NULL: the reference's half computed here */
     flip_ws ws;
-    st = ws_init(&ws, w, h, ppd, prep ? 2u : 3u, err);
+    st = ws_init(&ws, w, h, ppd, ref_px ? 2u : 3u, err);
     if (st != GR_OK) return st;
-    double *rgb[2] = {prep ? NULL : malloc(3 * n * sizeof(double)), malloc(3 * n * sizeof(double))};
+    double *rgb[2] = {ref_px ? NULL : malloc(3 * n * sizeof(double)), malloc(3 * n * sizeof(double))};
     float *e = malloc(n * sizeof(float)), *best = malloc(n * sizeof(float));
     double *sorted = malloc(n * sizeof(double));
-    if ((!prep && !rgb[0]) || !rgb[1] || !e || !best || !sorted) {
+    if ((!ref_px && !rgb[0]) || !rgb[1] || !e || !best || !sorted) {
         st = gr_fail(err, GR_E_NOMEM, "FLIP: out of memory for a %d x %d image", w, h);
         goto done;
     }
@@ -535,13 +536,13 @@ gr_status gr_flip_compute(const gr_image *ref, const gr_image *test, const gr_fl
     tm_coeffs(opt->tonemapper, c);
     for (int k = 0; k < nexp; k++) {
         const double gain = exposure_gain(res->start_exposure, res->stop_exposure, nexp, k);
-        if (!prep) {
+        if (!ref_px) {
             tone_image(ref, ch[0], 1.0, opt, gain, c, rgb[0]);
             flip_half(&ws, 0, rgb[0]);
         }
         tone_image(test, ch[1], tscale, opt, gain, c, rgb[1]);
         flip_half(&ws, 1, rgb[1]);
-        flip_combine(&ws, prep ? prep->px + (size_t)k * n * 5 : NULL, e);
+        flip_combine(&ws, ref_px ? ref_px + (size_t)k * n * 5 : NULL, e);
         /* HDR-FLIP: per pixel the largest error over the exposures */
         for (size_t p = 0; p < n; p++) best[p] = (k == 0 || e[p] > best[p]) ? e[p] : best[p];
     }
@@ -643,7 +644,8 @@ gr_status gr_flip_reference_create(const gr_image *ref, const gr_flip_options *o
     }
     const size_t n = (size_t)r->w * (size_t)r->h;
     if ((double)r->nexp * (double)n * 5.0 * sizeof(double) > (double)max_bytes) {
-        free(r); /* more memory than it is worth: every call computes the reference's half itself */
+        *out = r; /* more memory than it is worth: no planes (every FLIP computes the reference's
+                     half itself), the resolved range only, so that a kept one is not remade */
         return GR_OK;
     }
     r->px = malloc((size_t)r->nexp * n * 5 * sizeof(double));
@@ -683,6 +685,8 @@ size_t gr_flip_reference_bytes(const gr_flip_reference *r)
 {
     return r ? sizeof *r + (r->px ? (size_t)r->nexp * (size_t)r->w * (size_t)r->h * 5 * sizeof(double) : 0) : 0;
 }
+
+int gr_flip_reference_has_planes(const gr_flip_reference *r) { return r && r->px; }
 
 void gr_flip_reference_destroy(gr_flip_reference *r)
 {

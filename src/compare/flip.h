@@ -77,9 +77,11 @@ gr_status gr_flip_compute_defined(const gr_image *ref, const gr_image *test, con
  * and the feature magnitudes (40 bytes), the exposures on up to `threads` threads (common/
  * parallel.h; 1 inside another parallel job; the same numbers for any count). Every FLIP against ref with
  * these settings and .reference set then computes only the test's half: the same numbers.
- * *out = NULL (GR_OK) when that would take more than max_bytes; an HDR reference with no
- * exposure range (a black truth) is prepared as such (gr_flip_compute_defined says undefined
- * at once). ref must outlive the result. GR_E_INPUT as gr_flip_compute; GR_E_NOMEM. */
+ * When that would take more than max_bytes, the result holds no planes (a FLIP given it
+ * computes both halves, as without; it keeps the resolved exposure range, and a kept one is
+ * not remade at every call). An HDR reference with no exposure range (a black truth) is
+ * prepared as such (gr_flip_compute_defined says undefined at once). ref must outlive the
+ * result. GR_E_INPUT as gr_flip_compute; GR_E_NOMEM. */
 gr_status gr_flip_reference_create(const gr_image *ref, const gr_flip_options *opt, size_t max_bytes, int threads,
                                    gr_flip_reference **out, gr_error *err);
 void gr_flip_reference_destroy(gr_flip_reference *r);
@@ -87,6 +89,7 @@ void gr_flip_reference_destroy(gr_flip_reference *r);
  * derived from ref); 0 otherwise or for NULL. */
 int gr_flip_reference_matches(const gr_flip_reference *r, const gr_image *ref, const gr_flip_options *opt);
 size_t gr_flip_reference_bytes(const gr_flip_reference *r); /* what it holds (0 for NULL) */
+int gr_flip_reference_has_planes(const gr_flip_reference *r); /* 0: over its bound, or NULL */
 
 /* The heat map: per-pixel FLIP values (clamped to [0, 1]) through the magma colour map, as a
  * new 3-channel display-encoded image (write it with gr_oiio_write). */

@@ -111,7 +111,8 @@ int main(void)
         {
             gr_flip_reference *fr = NULL;
             CHECK_OK(gr_flip_reference_create(a, &o, (size_t)1 << 30, i % 2 ? 3 : 1, &fr, &err), err);
-            CHECK(fr != NULL && gr_flip_reference_matches(fr, a, &o) && !gr_flip_reference_matches(fr, b, &o));
+            CHECK(fr != NULL && gr_flip_reference_has_planes(fr) && gr_flip_reference_matches(fr, a, &o) &&
+                  !gr_flip_reference_matches(fr, b, &o));
             CHECK(gr_flip_reference_bytes(fr) >= (size_t)a->width * (size_t)a->height * 40);
             float *m2 = malloc((size_t)a->width * (size_t)a->height * sizeof(float));
             for (int sc = 0; sc < 2; sc++) {
@@ -141,10 +142,24 @@ int main(void)
             CHECK(gr_flip_compute(a, b, &o3, NULL, &res, &err) == GR_E_INPUT && strstr(err.msg, "prepared reference"));
             gr_flip_reference_destroy(fr);
         }
-        /* over its memory bound: none (GR_OK), and FLIP computes as without */
-        gr_flip_reference *none = (gr_flip_reference *)&err;
-        CHECK_OK(gr_flip_reference_create(a, &o, 1000, 1, &none, &err), err);
-        CHECK(none == NULL);
+        /* over its memory bound: no planes, and FLIP given it computes as without (the same
+         * bytes); it still matches, so that a kept one is not remade */
+        {
+            gr_flip_reference *np = NULL;
+            CHECK_OK(gr_flip_reference_create(a, &o, 1000, 1, &np, &err), err);
+            CHECK(np != NULL && !gr_flip_reference_has_planes(np) && gr_flip_reference_matches(np, a, &o));
+            CHECK(gr_flip_reference_bytes(np) < 1000);
+            gr_flip_options o2 = o;
+            o2.reference = np;
+            gr_flip_result r1, r2;
+            float *m2 = malloc((size_t)a->width * (size_t)a->height * sizeof(float));
+            CHECK_OK(gr_flip_compute(a, b, &o, map, &r1, &err), err);
+            CHECK_OK(gr_flip_compute(a, b, &o2, m2, &r2, &err), err);
+            CHECK(memcmp(&r1, &r2, sizeof r1) == 0);
+            CHECK(memcmp(map, m2, (size_t)a->width * (size_t)a->height * sizeof(float)) == 0);
+            free(m2);
+            gr_flip_reference_destroy(np);
+        }
         /* identical images: FLIP 0 everywhere (closed form: zero colour and feature error) */
         st = gr_flip_compute(a, a, &o, map, &res, &err);
         CHECK_OK(st, err);
