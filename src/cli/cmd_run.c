@@ -553,19 +553,17 @@ static gr_status get_references(const run_opts *o, run_state *rs, gr_error *err)
     return GR_OK;
 }
 
-/* compute_metrics's jobs: technique k's metrics against the truth (gr_parallel_for). */
+/* compute_metrics's jobs: technique k's metrics against the truth (gr_parallel_try). */
 typedef struct metrics_jobs {
     run_state *rs;
     const gr_metrics_options *mopt;
-    gr_status *st;
-    gr_error *err;
 } metrics_jobs;
 
-static void metrics_job(void *arg, int k)
+static gr_status metrics_job(void *arg, int k, gr_error *err)
 {
     metrics_jobs *j = arg;
-    if (j->rs->failed[k]) return;
-    j->st[k] = gr_metrics_compute(j->rs->ro.img, j->rs->test[k], j->mopt, &j->rs->mets[k], &j->err[k]);
+    if (j->rs->failed[k]) return GR_OK;
+    return gr_metrics_compute(j->rs->ro.img, j->rs->test[k], j->mopt, &j->rs->mets[k], err);
 }
 
 /* Each technique's metrics against frame 0's ground truth (compare/metrics.h): raw and after
@@ -587,22 +585,11 @@ static gr_status compute_metrics(const run_opts *o, run_state *rs, gr_error *err
     if (dof && dof->type != GR_META_STRING && dof->num >= 1.0) mopt.stderr_dof = (int)dof->num;
     /* every technique's metrics on a few threads (common/parallel.h: the same numbers for any
      * count), the first failure in the techniques' order reported */
-    metrics_jobs mj = {rs, &mopt, calloc((size_t)o->nt, sizeof(gr_status)), calloc((size_t)o->nt, sizeof(gr_error))};
-    if (!mj.st || !mj.err) {
-        free(mj.st);
-        free(mj.err);
-        return gr_fail(err, GR_E_NOMEM, "out of memory");
-    }
-    gr_parallel_for(o->nt, 0, metrics_job, &mj);
-    gr_status mst = GR_OK;
-    for (int k = 0; k < o->nt && mst == GR_OK; k++) {
-        if (rs->failed[k]) continue;
-        if ((mst = mj.st[k]) != GR_OK && err) *err = mj.err[k];
-        else rs->ts[k].metrics = &rs->mets[k];
-    }
-    free(mj.st);
-    free(mj.err);
+    metrics_jobs mj = {rs, &mopt};
+    gr_status mst = gr_parallel_try(o->nt, 0, metrics_job, &mj, err);
     if (mst != GR_OK) return mst;
+    for (int k = 0; k < o->nt; k++)
+        if (!rs->failed[k]) rs->ts[k].metrics = &rs->mets[k];
     /* the baselines, scored exactly as the techniques (and with HDR-FLIP, which the report
      * computes for each technique from its own map) */
     gr_flip_options fo = {.mode = GR_FLIP_HDR};

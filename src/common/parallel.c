@@ -1,6 +1,7 @@
 #include "common/parallel.h"
 
 #include <pthread.h>
+#include <stdlib.h>
 #include <stdatomic.h>
 #include <unistd.h>
 
@@ -39,4 +40,36 @@ void gr_parallel_for(int n, int threads, void (*fn)(void *ctx, int i), void *ctx
         if (pthread_create(&th[started], NULL, worker, &j) == 0) started++;
     worker(&j);
     for (int k = 0; k < started; k++) pthread_join(th[k], NULL);
+}
+
+typedef struct tjob {
+    gr_status (*fn)(void *ctx, int i, gr_error *err);
+    void *ctx;
+    gr_status *st;
+    gr_error *err;
+} tjob;
+
+static void try_one(void *arg, int i)
+{
+    tjob *t = arg;
+    t->err[i] = (gr_error){GR_OK, ""};
+    t->st[i] = t->fn(t->ctx, i, &t->err[i]);
+}
+
+gr_status gr_parallel_try(int n, int threads, gr_status (*fn)(void *ctx, int i, gr_error *err), void *ctx,
+                          gr_error *err)
+{
+    if (n <= 0 || !fn) return GR_OK;
+    tjob t = {fn, ctx, calloc((size_t)n, sizeof *t.st), calloc((size_t)n, sizeof *t.err)};
+    gr_status st = GR_OK;
+    if (!t.st || !t.err) {
+        st = gr_fail(err, GR_E_NOMEM, "out of memory for %d jobs", n);
+    } else {
+        gr_parallel_for(n, threads, try_one, &t);
+        for (int i = 0; i < n && st == GR_OK; i++)
+            if ((st = t.st[i]) != GR_OK && err) *err = t.err[i];
+    }
+    free(t.st);
+    free(t.err);
+    return st;
 }

@@ -4,6 +4,8 @@
 #ifndef GR_PARALLEL_H
 #define GR_PARALLEL_H
 
+#include "common/status.h"
+
 /* At most this many threads, whatever is asked: each comparison job holds tens of MB at
  * 640 x 360 (some hundreds at 1080p). */
 #define GR_PARALLEL_MAX 4
@@ -14,5 +16,10 @@ int gr_parallel_threads(int want);
  * (the calling one included; a thread that cannot be started leaves its share to the others);
  * returns when every call has returned. */
 void gr_parallel_for(int n, int threads, void (*fn)(void *ctx, int i), void *ctx);
+/* gr_parallel_for for jobs that can fail: fn(ctx, i, e) returns a status with its message in
+ * its own e. Every job runs; the result is the first failure in index order (its message in
+ * *err), else GR_OK; GR_E_NOMEM when the statuses cannot be held (then no job runs). */
+gr_status gr_parallel_try(int n, int threads, gr_status (*fn)(void *ctx, int i, gr_error *err), void *ctx,
+                          gr_error *err);
 
 #endif

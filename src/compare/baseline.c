@@ -48,40 +48,33 @@ static gr_status rung(const gr_image *ref, const gr_image *rgb, double sigma, co
     return st;
 }
 
-/* The baselines' jobs (gr_parallel_for): 0 black, 1 constant, 2 the blur baseline, then the
+/* The baselines' jobs (gr_parallel_try): 0 black, 1 constant, 2 the blur baseline, then the
  * ladder's rungs; each writes only its own slot. */
 typedef struct bl_ctx {
     const gr_image *ref, *rgb;
     const gr_metrics_options *o, *lo;
     gr_baselines *out;
-    gr_status st[GR_BASELINE_COUNT + GR_BASELINE_LADDER_N];
-    gr_error err[GR_BASELINE_COUNT + GR_BASELINE_LADDER_N];
 } bl_ctx;
 
-static void bl_job(void *arg, int i)
+static gr_status bl_job(void *arg, int i, gr_error *err)
 {
     bl_ctx *c = arg;
-    gr_error *err = &c->err[i];
     const gr_image *ref = c->ref;
     if (i == GR_BASELINE_BLUR) {
         double v;
-        c->st[i] = rung(ref, c->rgb, GR_BASELINE_BLUR_SIGMA, c->o, &c->out->m[GR_BASELINE_BLUR], &v, err);
-        return;
+        return rung(ref, c->rgb, GR_BASELINE_BLUR_SIGMA, c->o, &c->out->m[GR_BASELINE_BLUR], &v, err);
     }
     if (i >= GR_BASELINE_COUNT) { /* rung k: the verdict alone */
         const int k = i - GR_BASELINE_COUNT;
         gr_metrics *m = malloc(sizeof *m);
-        c->st[i] = m ? rung(ref, c->rgb, c->out->sigma_px[k], c->lo, m, &c->out->verdict[k], err)
-                     : gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
+        gr_status st = m ? rung(ref, c->rgb, c->out->sigma_px[k], c->lo, m, &c->out->verdict[k], err)
+                         : gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
         free(m);
-        return;
+        return st;
     }
     /* black: the image as created (zeros); constant: the truth's mean per channel (sums in double) */
     gr_image *flat = gr_image_create(ref->width, ref->height, 3, NULL);
-    if (!flat) {
-        c->st[i] = gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
-        return;
-    }
+    if (!flat) return gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
     if (i == GR_BASELINE_CONSTANT) {
         const size_t n = (size_t)ref->width * (size_t)ref->height;
         const float *px = c->rgb->pixels;
@@ -91,8 +84,9 @@ static void bl_job(void *arg, int i)
         for (size_t p = 0; p < n; p++)
             for (int ch = 0; ch < 3; ch++) flat->pixels[3 * p + (size_t)ch] = (float)(mean[ch] / (double)n);
     }
-    c->st[i] = gr_metrics_compute(ref, flat, c->o, &c->out->m[i], err);
+    gr_status st = gr_metrics_compute(ref, flat, c->o, &c->out->m[i], err);
     gr_image_destroy(flat);
+    return st;
 }
 
 gr_status gr_baselines_compute(const gr_image *ref, const gr_metrics_options *opt, gr_baselines *out,
@@ -119,31 +113,15 @@ gr_status gr_baselines_compute(const gr_image *ref, const gr_metrics_options *op
         return gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
     }
     for (int k = 0; k < GR_BASELINE_LADDER_N; k++) out->sigma_px[k] = 0.5 * pow(2.0, 0.5 * k);
-    bl_ctx *c = calloc(1, sizeof *c);
-    if (!c) {
-        gr_image_destroy(rgb);
-        gr_flip_reference_destroy(fref);
-        return gr_fail(err, GR_E_NOMEM, "baselines: out of memory");
-    }
-    *c = (bl_ctx){.ref = ref, .rgb = rgb, .o = &o, .lo = &lo, .out = out};
+    bl_ctx c = {.ref = ref, .rgb = rgb, .o = &o, .lo = &lo, .out = out};
     /* independent jobs on a few threads (common/parallel.h): the same numbers for any count */
-    gr_parallel_for(GR_BASELINE_COUNT + GR_BASELINE_LADDER_N, 0, bl_job, c);
-    gr_status st = GR_OK;
-    for (int i = 0; i < GR_BASELINE_COUNT + GR_BASELINE_LADDER_N && st == GR_OK; i++) {
-        if (c->st[i] == GR_OK) {
-            if (i >= GR_BASELINE_COUNT) { /* the rungs in order, up to the first that failed */
-                const int k = i - GR_BASELINE_COUNT;
-                /* the blurred truth gets worse with blur; where a measure wobbles, the running
-                 * maximum keeps the curve monotone so that each verdict has one equivalent blur */
-                out->envelope[k] = k == 0 || out->verdict[k] > out->envelope[k - 1] ? out->verdict[k] : out->envelope[k - 1];
-                out->n_ladder = k + 1;
-            }
-            continue;
-        }
-        st = c->st[i];
-        if (err) *err = c->err[i];
+    gr_status st = gr_parallel_try(GR_BASELINE_COUNT + GR_BASELINE_LADDER_N, 0, bl_job, &c, err);
+    for (int k = 0; k < GR_BASELINE_LADDER_N && st == GR_OK; k++) {
+        /* the blurred truth gets worse with blur; where a measure wobbles, the running maximum
+         * keeps the curve monotone so that each verdict has one equivalent blur */
+        out->envelope[k] = k == 0 || out->verdict[k] > out->envelope[k - 1] ? out->verdict[k] : out->envelope[k - 1];
+        out->n_ladder = k + 1;
     }
-    free(c);
     gr_image_destroy(rgb);
     gr_flip_reference_destroy(fref);
     return st;

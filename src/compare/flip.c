@@ -579,23 +579,20 @@ done:
 typedef struct prep_job {
     gr_flip_reference *r;
     const gr_flip_options *opt;
-    gr_status *st;
-    gr_error *err;
 } prep_job;
 
-static void prep_exposure(void *arg, int k)
+static gr_status prep_exposure(void *arg, int k, gr_error *err)
 {
     prep_job *j = arg;
     gr_flip_reference *r = j->r;
     const size_t n = (size_t)r->w * (size_t)r->h;
     flip_ws ws;
-    j->st[k] = ws_init(&ws, r->w, r->h, r->ppd, 1u, &j->err[k]);
-    if (j->st[k] != GR_OK) return;
+    gr_status st = ws_init(&ws, r->w, r->h, r->ppd, 1u, err);
+    if (st != GR_OK) return st;
     double *rgb = malloc(3 * n * sizeof(double));
     if (!rgb) {
-        j->st[k] = gr_fail(&j->err[k], GR_E_NOMEM, "FLIP: out of memory for a %d x %d image", r->w, r->h);
         ws_free(&ws);
-        return;
+        return gr_fail(err, GR_E_NOMEM, "FLIP: out of memory for a %d x %d image", r->w, r->h);
     }
     int ch[3];
     gr_metrics_pick_rgb(r->ref, ch);
@@ -608,6 +605,7 @@ static void prep_exposure(void *arg, int k)
     for (size_t p = 0; p < n; p++) half_pixel(&ws, 0, p, wh, out + 5 * p, out + 5 * p + 3);
     free(rgb);
     ws_free(&ws);
+    return GR_OK;
 }
 
 gr_status gr_flip_reference_create(const gr_image *ref, const gr_flip_options *opt, size_t max_bytes, int threads,
@@ -649,18 +647,13 @@ gr_status gr_flip_reference_create(const gr_image *ref, const gr_flip_options *o
         return GR_OK;
     }
     r->px = malloc((size_t)r->nexp * n * 5 * sizeof(double));
-    gr_status *sts = calloc((size_t)r->nexp, sizeof *sts);
-    gr_error *errs = calloc((size_t)r->nexp, sizeof *errs);
-    if (!r->px || !sts || !errs) {
+    if (!r->px) {
         const int nexp = r->nexp;
-        free(sts), free(errs), gr_flip_reference_destroy(r);
+        gr_flip_reference_destroy(r);
         return gr_fail(err, GR_E_NOMEM, "FLIP: out of memory for the reference's %d exposures", nexp);
     }
-    prep_job j = {r, opt, sts, errs};
-    gr_parallel_for(r->nexp, threads, prep_exposure, &j);
-    for (int k = 0; k < r->nexp && st == GR_OK; k++)
-        if ((st = sts[k]) != GR_OK && err) *err = errs[k];
-    free(sts), free(errs);
+    prep_job j = {r, opt};
+    st = gr_parallel_try(r->nexp, threads, prep_exposure, &j, err);
     if (st != GR_OK) {
         gr_flip_reference_destroy(r);
         return st;
