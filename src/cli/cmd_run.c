@@ -319,6 +319,7 @@ typedef struct run_state {
     char reason[GR_REPORT_MAX_TECHNIQUES][GR_ERROR_MSG_MAX];
     int n_failed;
     gr_baselines *baselines;        /* black, constant, blurred truth, the blur ladder */
+    gr_flip_reference *flip_ref;    /* the truth's half of HDR-FLIP: the baselines', then the report's */
     gr_report_input in;             /* what the report was made of (write_report) */
     gr_report_technique in_ts[GR_REPORT_MAX_TECHNIQUES]; /* the techniques that rendered, for in */
     gr_report_failure in_failed[GR_REPORT_MAX_TECHNIQUES];
@@ -591,8 +592,12 @@ static gr_status compute_metrics(const run_opts *o, run_state *rs, gr_error *err
     for (int k = 0; k < o->nt; k++)
         if (!rs->failed[k]) rs->ts[k].metrics = &rs->mets[k];
     /* the baselines, scored exactly as the techniques (and with HDR-FLIP, which the report
-     * computes for each technique from its own map) */
+     * computes for each technique from its own map); the truth's half of FLIP made once for
+     * both (compare/flip.h) */
     gr_flip_options fo = {.mode = GR_FLIP_HDR};
+    gr_status fst = gr_flip_reference_create(rs->ro.img, &fo, GR_FLIP_SHARED_PREPARE_MAX, 0, &rs->flip_ref, err);
+    if (fst != GR_OK) return fst;
+    fo.reference = rs->flip_ref;
     mopt.flip = &fo;
     if (!(rs->baselines = malloc(sizeof *rs->baselines))) return gr_fail(err, GR_E_NOMEM, "out of memory");
     return gr_baselines_compute(rs->ro.img, &mopt, rs->baselines, err);
@@ -649,7 +654,7 @@ static gr_status write_report(const run_opts *o, run_state *rs, const char *outd
     }
     gr_report_input in = {.scene = rs->scene0, .ref = ro->img, .ref_meta = &ro->meta, .n_techniques = n_ok,
                           .techniques = rs->in_ts, .n_failed = n_failed, .failed = rs->in_failed,
-                          .baselines = rs->baselines, .command_line = gr_sb_str(&rs->cmdline),
+                          .baselines = rs->baselines, .flip_ref = rs->flip_ref, .command_line = gr_sb_str(&rs->cmdline),
                           .scene_words = gr_sb_str(&rs->words), .ref_cached = ro->cached,
                           .ref_cache_path = ro->cache_on ? ro->cache_path : NULL,
                           .ref_cache_note = ro->note[0] ? ro->note : NULL, .ref_seconds = rs->t_ref,
@@ -714,6 +719,7 @@ static void run_free(const run_opts *o, run_state *rs)
     }
     free(rs->mets);
     free(rs->baselines);
+    gr_flip_reference_destroy(rs->flip_ref);
     free(rs->scene);
     gr_sb_free(&rs->cmdline);
     gr_sb_free(&rs->words);

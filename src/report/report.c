@@ -1820,9 +1820,12 @@ gr_status gr_report_write(const char *dir, const gr_report_input *in, gr_report_
     if ((st = gr_report_display(in->ref, c->exposure, &c->disp_ref, err)) != GR_OK) goto done;
     /* the techniques' HDR-FLIP maps, the report's dearest part, on a few threads, the truth's
      * half computed once (compare/flip.h: the same numbers) */
-    if (nt > 1) {
-        const gr_flip_options fo = {.mode = GR_FLIP_HDR};
-        if ((st = gr_flip_reference_create(in->ref, &fo, GR_FLIP_SHARED_PREPARE_MAX, 0, &flip_ref, err)) != GR_OK) goto done;
+    const gr_flip_options flip_fo = {.mode = GR_FLIP_HDR};
+    if (gr_flip_reference_matches(in->flip_ref, in->ref, &flip_fo)) {
+        c->flip_ref = in->flip_ref;
+    } else if (nt > 1) {
+        if ((st = gr_flip_reference_create(in->ref, &flip_fo, GR_FLIP_SHARED_PREPARE_MAX, 0, &flip_ref, err)) != GR_OK)
+            goto done;
         c->flip_ref = flip_ref;
     }
     gr_parallel_for(nt, 0, flip_job, c);

@@ -62,6 +62,9 @@ typedef struct gr_report_input {
     const gr_report_failure *failed;
     const gr_baselines *baselines;  /* scored like the techniques (compare/baseline.h); NULL: no
                                        baseline rows, no equivalent blur */
+    const gr_flip_reference *flip_ref; /* may be NULL: ref's half of HDR-FLIP (default options),
+                                       prepared by the caller (run's, shared with its baselines);
+                                       else the report prepares its own */
     /* provenance and timings; NULL strings and negative times are "unknown" */
     const char *command_line;
     int ref_cached;                 /* 1: the ground truth was read from the cache */
